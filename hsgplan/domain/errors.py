@@ -1,0 +1,18 @@
+"""Errors for bad input. Each carries one line that says what is wrong; the CLI prints it and
+exits with code 2."""
+
+
+class InvalidInputError(ValueError):
+    """Input that cannot be used: the message names the culprit and the reason."""
+
+
+class UnknownNameError(InvalidInputError):
+    """A name that is neither an object instance, a shelf, a region nor a predicate."""
+
+
+class GoalSyntaxError(InvalidInputError):
+    """Text that does not parse as literals."""
+
+
+class InfeasibleError(InvalidInputError):
+    """Literals that contradict each other or that no physical scene can satisfy."""

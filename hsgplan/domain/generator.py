@@ -1,0 +1,148 @@
+"""Seeded random goals and random initial symbolic states.
+
+The goal distribution, for n objects (2..12):
+1. Objects: n distinct types drawn uniformly when n <= 6; otherwise all six types plus n - 6
+   duplicates drawn uniformly with replacement. Instances are named as in `objects.py`.
+2. Each object, in a uniformly shuffled order, gets one literal of the paper's goal kinds, the
+   kind drawn uniformly among those still feasible for it:
+   - `On(o, shelf_a)` or `On(o, shelf_b)`: on a shelf top, while the top has room;
+   - `In(o, shelf_a)`: inside shelf A, for cans, while the interior has room;
+   - `On(o, b)`: stacked on an object b placed earlier on a shelf top, if b can carry it, is
+     still bare and the tower stays within the height limit (b uniform among such objects).
+   With `stacking=False` the stacked kind is left out (the paper does so for 2 objects).
+Every goal drawn passes `check_literals`, by construction and by a final check.
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.feasibility import check_literals
+from hsgplan.domain.goals import Goal
+from hsgplan.domain.objects import object_type, objects_for_types, sort_objects
+from hsgplan.domain.predicates import Literal, inside, on
+from hsgplan.domain.world import (
+    INTERIOR_CAPACITY,
+    MAX_OBJECTS,
+    MAX_TOWER_LEVELS,
+    OBJECT_TYPES,
+    SURFACE_CAPACITY,
+    Kind,
+    can_support,
+    fits_inside,
+)
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+MIN_OBJECTS = 2
+GOAL_SHELF_TOPS = ("shelf_a", "shelf_b")
+GOAL_INTERIOR = "shelf_a"
+
+
+def check_size(n: int) -> None:
+    if not MIN_OBJECTS <= n <= MAX_OBJECTS:
+        raise InvalidInputError(
+            f"{n} objects: a goal names between {MIN_OBJECTS} and {MAX_OBJECTS} objects"
+        )
+
+
+def random_objects(n: int, rng: random.Random) -> tuple[str, ...]:
+    """n object instances as the distribution above draws them, in canonical order."""
+    check_size(n)
+    types = list(OBJECT_TYPES)
+    if n <= len(types):
+        chosen = rng.sample(types, n)
+    else:
+        chosen = types + rng.choices(types, k=n - len(types))
+    return sort_objects(objects_for_types(chosen))
+
+
+@dataclass
+class _Room:
+    """What is left on the surfaces while a goal or a state is drawn."""
+
+    top: dict[str, int]
+    interior: dict[str, int]
+
+
+def random_goal(n: int, rng: random.Random, stacking: bool = True) -> Goal:
+    """One goal over n objects, drawn from the distribution in the module docstring."""
+    objects = list(random_objects(n, rng))
+    rng.shuffle(objects)
+    room = _Room(
+        {s: SURFACE_CAPACITY[s] for s in GOAL_SHELF_TOPS}, {GOAL_INTERIOR: INTERIOR_CAPACITY[GOAL_INTERIOR]}
+    )
+    level: dict[str, int] = {}
+    bare: list[str] = []
+    literals: list[Literal] = []
+    for o in objects:
+        t = object_type(o)
+        kinds = [s for s in GOAL_SHELF_TOPS if room.top[s] > 0]
+        if t.kind is Kind.CAN and fits_inside(t.name, GOAL_INTERIOR) and room.interior[GOAL_INTERIOR]:
+            kinds.append("inside")
+        bases = [b for b in bare if level[b] < MAX_TOWER_LEVELS] if stacking else []
+        if bases:
+            kinds.append("stack")
+        kind = rng.choice(kinds)
+        if kind == "inside":
+            literals.append(inside(o, GOAL_INTERIOR))
+            room.interior[GOAL_INTERIOR] -= 1
+            continue
+        if kind == "stack":
+            base = rng.choice(bases)
+            literals.append(on(o, base))
+            bare.remove(base)
+            level[o] = level[base] + 1
+        else:
+            literals.append(on(o, kind))
+            room.top[kind] -= 1
+            level[o] = 1
+        if can_support(t.name):
+            bare.append(o)
+    goal = Goal(frozenset(literals))
+    check_literals(goal.literals)
+    return goal
+
+
+def random_goals(n: int, count: int, seed: int, stacking: bool = True) -> list[Goal]:
+    """`count` goals over n objects; the same seed always gives the same goals."""
+    if count < 0:
+        raise InvalidInputError(f"count {count}: the number of goals cannot be negative")
+    rng = random.Random(f"goals-{n}-{seed}")
+    return [random_goal(n, rng, stacking=stacking) for _ in range(count)]
+
+
+def random_state(
+    objects: tuple[str, ...], rng: random.Random, p_elsewhere: float = 0.3
+) -> SymbolicSceneGraph:
+    """A random start: most objects on the open space, some stacked or on a shelf top.
+
+    Nothing starts held or inside a shelf, so every goal over these objects stays reachable.
+    Each object, in shuffled order, goes elsewhere than the open space with `p_elsewhere`,
+    then uniformly onto a shelf top with room or onto a bare object that can carry it.
+    """
+    order = list(objects)
+    rng.shuffle(order)
+    room = {s: SURFACE_CAPACITY[s] for s in SURFACE_CAPACITY}
+    bare: list[str] = []
+    level: dict[str, int] = {}
+    literals = []
+    for o in order:
+        options: list[str] = []
+        if rng.random() < p_elsewhere:
+            options = [s for s in GOAL_SHELF_TOPS if room[s] > 0]
+            options += [b for b in bare if level[b] < MAX_TOWER_LEVELS]
+        if not options:
+            options = ["open_space"] if room["open_space"] > 0 else [s for s in room if room[s]]
+        target = rng.choice(options)
+        literals.append(on(o, target))
+        if target in room:
+            room[target] -= 1
+            level[o] = 1
+        else:
+            bare.remove(target)
+            level[o] = level[target] + 1
+        if can_support(object_type(o).name):
+            bare.append(o)
+    return SymbolicSceneGraph.from_literals(objects, literals)

@@ -1,0 +1,159 @@
+"""Goals: sets of literals, their text syntax, and goal files.
+
+Syntax (CLI, files, tests): literals such as `On(butter, cherries)`, `In(tomato_soup, shelf_a)`,
+`Clear(popcorn)`, optionally negated with `not` or `!`, separated by `&`, `;` or new lines.
+Predicate and entity names are case-insensitive and may be CamelCase (`AlphabetSoup`).
+A goal file holds one goal per line; blank lines and lines starting with `#` are skipped.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from hsgplan.domain.errors import GoalSyntaxError, InvalidInputError, UnknownNameError
+from hsgplan.domain.feasibility import check_literals
+from hsgplan.domain.objects import kind_of, sort_objects
+from hsgplan.domain.predicates import PREDICATES, Literal, Predicate
+
+MAX_GOAL_CHARS = 10_000
+
+_LITERAL = re.compile(
+    r"^(?:(?P<neg>not\s+|!\s*))?(?P<pred>[A-Za-z_][A-Za-z0-9_]*)\s*\((?P<args>[^()]*)\)$"
+)
+_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+_PREDICATE_BY_KEY = {p.value.lower(): p for p in PREDICATES} | {"in_grasp": Predicate.IN_GRASP}
+
+
+@dataclass(frozen=True)
+class Goal:
+    """A conjunction of literals. Its problem size is the number of objects it names."""
+
+    literals: frozenset[Literal]
+
+    @property
+    def objects(self) -> tuple[str, ...]:
+        return sort_objects(o for lit in self.literals for o in lit.objects())
+
+    @property
+    def size(self) -> int:
+        return len(self.objects)
+
+    def sorted_literals(self) -> list[Literal]:
+        order = {o: i for i, o in enumerate(self.objects)}
+        return sorted(
+            self.literals,
+            key=lambda x: (order[x.subject], PREDICATES.index(x.predicate), x.args, x.positive),
+        )
+
+    def satisfied_by(self, state) -> bool:
+        """Whether every literal holds in a `SymbolicSceneGraph`."""
+        return all(state.holds(lit) for lit in self.literals)
+
+    def unsatisfied(self, state) -> list[Literal]:
+        return [lit for lit in self.sorted_literals() if not state.holds(lit)]
+
+    def __str__(self) -> str:
+        return " & ".join(str(lit) for lit in self.sorted_literals())
+
+
+def _snake(name: str) -> str:
+    """`AlphabetSoup` -> `alphabet_soup`, `shelfA` -> `shelf_a`, `Cherries_2` -> `cherries_2`."""
+    return re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name).lower()
+
+
+def parse_literal(text: str) -> Literal:
+    """One literal; raises an InvalidInputError naming it and the reason."""
+    src = text.strip()
+    m = _LITERAL.match(src)
+    if not m:
+        raise GoalSyntaxError(f"'{src}' is not a literal like On(butter, shelf_a)")
+    key = _snake(m.group("pred"))
+    pred = _PREDICATE_BY_KEY.get(key) or _PREDICATE_BY_KEY.get(key.replace("_", ""))
+    if pred is None:
+        raise UnknownNameError(
+            f"'{src}': unknown predicate '{m.group('pred')}' (known: On, In, InGrasp, Clear)"
+        )
+    raw_args = [a.strip() for a in m.group("args").split(",")]
+    if raw_args == [""]:
+        raw_args = []
+    if len(raw_args) != pred.arity:
+        raise GoalSyntaxError(
+            f"'{src}': {pred.value} takes {pred.arity} argument(s), got {len(raw_args)}"
+        )
+    args = []
+    for i, raw in enumerate(raw_args):
+        if not _NAME.match(raw):
+            raise GoalSyntaxError(f"'{src}': '{raw}' is not a name")
+        name = _snake(raw)
+        try:
+            kind = kind_of(name)
+        except UnknownNameError as e:
+            raise UnknownNameError(f"'{src}': {e}") from None
+        if kind not in pred.signature[i]:
+            allowed = " or ".join(sorted(k.value for k in pred.signature[i]))
+            raise GoalSyntaxError(
+                f"'{src}': argument {i + 1} of {pred.value} must be a {allowed}, "
+                f"'{name}' is a {kind.value}"
+            )
+        args.append(name)
+    return Literal(pred, tuple(args), positive=m.group("neg") is None)
+
+
+def split_literals(text: str) -> list[str]:
+    """The literal texts of a goal, separated by `&`, `;` or new lines."""
+    return [p.strip() for p in re.split(r"[&;\n]", text)]
+
+
+def parse_goal(text: str, validate: bool = True) -> Goal:
+    """Parse goal text; with `validate`, also refuse contradictory or impossible goals."""
+    if len(text) > MAX_GOAL_CHARS:
+        raise GoalSyntaxError(f"the goal is {len(text)} characters long; at most {MAX_GOAL_CHARS}")
+    parts = split_literals(text)
+    if all(not p for p in parts):
+        raise GoalSyntaxError("the goal is empty")
+    literals = []
+    for i, part in enumerate(parts):
+        if not part:
+            if 0 < i < len(parts) - 1:
+                raise GoalSyntaxError(f"empty literal between separators in '{text.strip()}'")
+            continue
+        literals.append(parse_literal(part))
+    goal = Goal(frozenset(literals))
+    if validate:
+        check_literals(goal.literals)
+    return goal
+
+
+def goal_of(literals: Iterable[Literal]) -> Goal:
+    """A checked goal from literals."""
+    goal = Goal(frozenset(literals))
+    check_literals(goal.literals)
+    return goal
+
+
+def write_goal_file(path: Path, goals: Iterable[Goal], header: str = "") -> None:
+    """One goal per line, after optional `#` comment lines."""
+    lines = [f"# {h}" for h in header.splitlines()] + [str(g) for g in goals]
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
+def read_goal_file(path: Path) -> list[Goal]:
+    """Every goal in a goal file; a bad line raises with its line number."""
+    p = Path(path)
+    if not p.is_file():
+        raise InvalidInputError(f"goal file '{path}' does not exist")
+    goals = []
+    for n, line in enumerate(p.read_text().splitlines(), start=1):
+        text = line.strip()
+        if not text or text.startswith("#"):
+            continue
+        try:
+            goals.append(parse_goal(text))
+        except InvalidInputError as e:
+            raise type(e)(f"{path}:{n}: {e}") from None
+    if not goals:
+        raise InvalidInputError(f"goal file '{path}' holds no goal")
+    return goals

@@ -1,0 +1,207 @@
+"""The kitchen-storage world: every size, region and fixture, in one place.
+
+Frame: origin at the robot base on the table top, z up, x away from the robot, y to the left.
+All lengths are metres. Other modules import these values; none repeats them.
+
+The derived limits at the bottom (capacities, tower height) are what the goal validator, the
+symbolic transition model and the PDDL domain all enforce, so the three agree by construction.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+
+
+class Kind(str, Enum):
+    CAN = "can"
+    BOX = "box"
+
+
+@dataclass(frozen=True)
+class ObjectType:
+    """A kind of grocery item, described in the orientation it rests in.
+
+    `size` is (extent along x, extent along y, height) when resting; for cans the first two are
+    the diameter. Boxes rest so that the gripper (max opening `GRIPPER_MAX_OPENING`) can close
+    across their narrow horizontal side: cream cheese and butter lie flat, popcorn stands upright
+    because its flat footprint (12.6 x 8.5 cm) is wider than the gripper opens.
+    """
+
+    name: str
+    kind: Kind
+    size: tuple[float, float, float]
+    color: tuple[float, float, float, float]
+
+    @property
+    def height(self) -> float:
+        return self.size[2]
+
+    @property
+    def footprint(self) -> tuple[float, float]:
+        return self.size[0], self.size[1]
+
+    @property
+    def grasp_width(self) -> float:
+        return min(self.footprint)
+
+    @property
+    def top_face_min_side(self) -> float:
+        return min(self.footprint)
+
+
+# Sizes from the HOPE/DOPE cuboids (cm in the design notes, metres here).
+OBJECT_TYPES: dict[str, ObjectType] = {
+    t.name: t
+    for t in (
+        ObjectType("cherries", Kind.CAN, (0.069, 0.069, 0.058), (0.80, 0.10, 0.15, 1.0)),
+        ObjectType("alphabet_soup", Kind.CAN, (0.071, 0.071, 0.084), (0.95, 0.75, 0.10, 1.0)),
+        ObjectType("tomato_soup", Kind.CAN, (0.070, 0.070, 0.083), (0.90, 0.35, 0.10, 1.0)),
+        ObjectType("popcorn", Kind.BOX, (0.038, 0.085, 0.126), (0.20, 0.45, 0.90, 1.0)),
+        ObjectType("cream_cheese", Kind.BOX, (0.053, 0.104, 0.024), (0.25, 0.70, 0.30, 1.0)),
+        ObjectType("butter", Kind.BOX, (0.053, 0.103, 0.024), (0.95, 0.90, 0.55, 1.0)),
+    )
+}
+
+
+@dataclass(frozen=True)
+class Rect:
+    """An axis-aligned rectangle on a horizontal plane at height `z`."""
+
+    x_min: float
+    x_max: float
+    y_min: float
+    y_max: float
+    z: float = 0.0
+
+    @property
+    def width_x(self) -> float:
+        return self.x_max - self.x_min
+
+    @property
+    def width_y(self) -> float:
+        return self.y_max - self.y_min
+
+    @property
+    def center(self) -> tuple[float, float]:
+        return (self.x_min + self.x_max) / 2, (self.y_min + self.y_max) / 2
+
+    def contains(self, x: float, y: float, margin: float = 0.0) -> bool:
+        return (
+            self.x_min - margin <= x <= self.x_max + margin
+            and self.y_min - margin <= y <= self.y_max + margin
+        )
+
+
+@dataclass(frozen=True)
+class Shelf:
+    """An open-fronted cabinet facing the robot (open at its low-x side).
+
+    `outer` is its footprint on the table; `interior` the floor of the space inside (the table
+    itself, so objects can be pushed in); `top` the flat board objects are placed on.
+    """
+
+    name: str
+    outer: Rect
+    interior: Rect
+    clearance: float
+    top: Rect
+    prepush: str
+
+
+GRIPPER_MAX_OPENING = 0.08
+TABLE = Rect(-0.30, 1.00, -0.80, 0.80, 0.0)
+
+WALL = 0.02
+SHELF_CLEARANCE = 0.12
+SHELF_TOP_Z = SHELF_CLEARANCE + WALL
+
+
+def _shelf(name: str, x_min: float, x_max: float, y_near: float, y_far: float, prepush: str):
+    y_min, y_max = min(y_near, y_far), max(y_near, y_far)
+    outer = Rect(x_min, x_max, y_min, y_max, 0.0)
+    interior = Rect(x_min, x_max - WALL, y_min + WALL, y_max - WALL, 0.0)
+    top = Rect(x_min, x_max, y_min, y_max, SHELF_TOP_Z)
+    return Shelf(name, outer, interior, SHELF_CLEARANCE, top, prepush)
+
+
+SHELVES: dict[str, Shelf] = {
+    "shelf_a": _shelf("shelf_a", 0.38, 0.60, 0.22, 0.54, "prepush_a"),
+    "shelf_b": _shelf("shelf_b", 0.38, 0.60, -0.22, -0.54, "prepush_b"),
+}
+
+REGIONS: dict[str, Rect] = {
+    "open_space": Rect(0.22, 0.70, -0.20, 0.20, 0.0),
+    "prepush_a": Rect(0.24, 0.37, 0.24, 0.52, 0.0),
+    "prepush_b": Rect(0.24, 0.37, -0.52, -0.24, 0.0),
+}
+
+# --- derived limits, shared by the validator, the transition model and the PDDL domain ---
+
+# The square each resting object is given when a surface is counted: a can plus room for the
+# fingers on both sides; the long boxes fit two to a pair of spots when turned side by side.
+# Counting spots (not areas) keeps capacities small integers that the PDDL domain can encode.
+SPOT = 0.10
+
+# A top face narrower than this does not hold another object steadily (popcorn's 3.8 cm does not).
+MIN_SUPPORT_SIDE = 0.045
+
+# Highest a tower's top may rise above the table: the hand holds the top object from above and
+# still needs room to approach and to withdraw.
+REACH_MAX_Z = 0.40
+
+MAX_OBJECTS = 12
+
+
+def capacity(rect: Rect) -> int:
+    """How many objects fit side by side on a rectangle."""
+    return max(0, math.floor(rect.width_x / SPOT + 1e-9)) * max(
+        0, math.floor(rect.width_y / SPOT + 1e-9)
+    )
+
+
+def surface_rect(name: str) -> Rect:
+    """The rectangle of a named surface: a region, or a shelf's top."""
+    if name in REGIONS:
+        return REGIONS[name]
+    return SHELVES[name].top
+
+
+SURFACES: tuple[str, ...] = tuple(REGIONS) + tuple(SHELVES)
+SURFACE_CAPACITY: dict[str, int] = {name: capacity(surface_rect(name)) for name in SURFACES}
+# Objects enter an interior only through its open front, so it is filled as one row across,
+# a can's width plus a finger's gap apart (pushes measured to land within +-9 cm of the middle).
+INTERIOR_SPOT = 0.09
+INTERIOR_CAPACITY: dict[str, int] = {
+    name: math.floor(s.interior.width_y / INTERIOR_SPOT + 1e-9) for name, s in SHELVES.items()
+}
+
+
+def max_tower_levels() -> int:
+    """How many objects one tower may hold so that any tower stays within reach on any surface.
+
+    Counted with the tallest object, so a tower that obeys it never rises past `REACH_MAX_Z`,
+    whatever it is made of and whichever surface it stands on.
+    """
+    tallest = max(t.height for t in OBJECT_TYPES.values())
+    highest_surface = max(surface_rect(n).z for n in SURFACES)
+    return max(1, math.floor((REACH_MAX_Z - highest_surface) / tallest + 1e-9))
+
+
+MAX_TOWER_LEVELS = max_tower_levels()
+
+
+def can_support(type_name: str) -> bool:
+    """Whether an object of this type may carry another one on its top face."""
+    return OBJECT_TYPES[type_name].top_face_min_side >= MIN_SUPPORT_SIDE
+
+
+def fits_inside(type_name: str, shelf: str) -> bool:
+    """Whether an object of this type, as it rests, fits into a shelf's interior."""
+    t, s = OBJECT_TYPES[type_name], SHELVES[shelf]
+    return (
+        t.height <= s.clearance
+        and max(t.footprint) <= max(s.interior.width_x, s.interior.width_y)
+        and min(t.footprint) <= min(s.interior.width_x, s.interior.width_y)
+    )
