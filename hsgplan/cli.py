@@ -6,6 +6,7 @@ import functools
 import json
 import random
 import sys
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -44,6 +45,16 @@ def refuses_bad_input(fn):
     return wrapper
 
 
+class Search(StrEnum):
+    auto = "auto"
+    optimal = "optimal"
+    fast = "fast"
+
+    @property
+    def optimal_flag(self) -> bool | None:
+        return {"auto": None, "optimal": True, "fast": False}[self.value]
+
+
 def parse_sizes(text: str) -> list[int]:
     """`2-6`, `2,4,6` or `3` as a list of sizes."""
     sizes: list[int] = []
@@ -52,7 +63,9 @@ def parse_sizes(text: str) -> list[int]:
             lo, _, hi = part.strip().partition("-")
             sizes += list(range(int(lo), int(hi or lo) + 1))
     except ValueError:
-        raise InvalidInputError(f"--sizes '{text}': expected a range like 2-6 or a list like 2,4,6") from None
+        raise InvalidInputError(
+            f"--sizes '{text}': expected a range like 2-6 or a list like 2,4,6"
+        ) from None
     from hsgplan.domain.generator import check_size
 
     if not sizes:
@@ -104,21 +117,38 @@ def _print_plan(plan, goal) -> None:
 @app.command()
 @refuses_bad_input
 def plan(
-    goal: Annotated[str, typer.Option(help="Goal literals, e.g. 'On(butter, shelf_a) & In(cherries, shelf_a)'.")],
-    objects: Annotated[str | None, typer.Option(help="Comma-separated objects in the scene (default: those the goal names).")] = None,
-    init: Annotated[str | None, typer.Option(help="Start state as On/In/InGrasp literals (default: all on open_space).")] = None,
-    optimal: Annotated[bool, typer.Option(help="Shortest plan (A* with LM-cut); slow past 8 objects.")] = False,
+    goal: Annotated[
+        str, typer.Option(help="Goal literals, e.g. 'On(butter, shelf_a) & In(cherries, shelf_a)'.")
+    ],
+    objects: Annotated[
+        str | None,
+        typer.Option(help="Comma-separated objects in the scene (default: those the goal names)."),
+    ] = None,
+    init: Annotated[
+        str | None,
+        typer.Option(help="Start state as On/In/InGrasp literals (default: all on open_space)."),
+    ] = None,
+    search: Annotated[
+        Search,
+        typer.Option(
+            help="optimal: shortest plan (A* with LM-cut, slow past 8 objects); "
+            "fast: weighted A*; auto: optimal up to 6 objects."
+        ),
+    ] = Search.auto,
     as_json: Annotated[bool, typer.Option("--json", help="Print the plan as JSON.")] = False,
 ) -> None:
     """Plan a goal with Fast Downward and show the symbolic state after each step."""
     from hsgplan.planning.fast_downward import FastDownwardPlanner
 
     g, state = _scene(goal, objects, init)
-    result = FastDownwardPlanner(optimal=optimal).plan(state, g)
+    result = FastDownwardPlanner(optimal=search.optimal_flag).plan(state, g)
     if as_json:
         steps = [
-            {"step": i, "action": None if i == 0 else str(result.actions[i - 1]),
-             "state": [str(lit) for lit in s.sorted_literals()]}
+            {
+                "step": i,
+                "action": None if i == 0 else str(result.actions[i - 1]),
+                "state": [str(lit) for lit in s.sorted_literals()],
+            }
             for i, s in enumerate(result.states)
         ]
         print(json.dumps(steps, indent=2))
@@ -132,7 +162,9 @@ def goals(
     objects: Annotated[int, typer.Option(help="Objects per goal (2-12).")],
     count: Annotated[int, typer.Option(help="How many goals.")],
     seed: Annotated[int, typer.Option(help="Random seed; the same seed gives the same goals.")] = 0,
-    out_file: Annotated[Path | None, typer.Option("--out", help="Goal file to write (default: stdout).")] = None,
+    out_file: Annotated[
+        Path | None, typer.Option("--out", help="Goal file to write (default: stdout).")
+    ] = None,
     stacking: Annotated[bool, typer.Option(help="Allow stacked goals.")] = True,
 ) -> None:
     """Write random feasible goals, one per line (the distribution is in `domain/generator.py`)."""
@@ -178,7 +210,9 @@ def bench_symbolic(
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
     goals: Annotated[int, typer.Option(help="Goals per size.")] = 20,
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
-    optimal_max_size: Annotated[int, typer.Option(help="Largest size the optimal search is timed on.")] = 8,
+    optimal_max_size: Annotated[
+        int, typer.Option(help="Largest size the optimal search is timed on.")
+    ] = 8,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
 ) -> None:
     """Fast Downward plan time per size: median over the goals, both search configurations."""
@@ -188,17 +222,22 @@ def bench_symbolic(
     total = sum(goals * (2 if n <= optimal_max_size else 1) for n in size_list)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("planning", total=total)
-        rows = run(size_list, goals, seed, optimal_max_size,
-                   on_problem=lambda: progress.advance(task))
+        rows = run(
+            size_list, goals, seed, optimal_max_size, on_problem=lambda: progress.advance(task)
+        )
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
-    table = Table(title=f"Fast Downward plan time, median over {goals} goals per size (seed {seed})")
+    table = Table(
+        title=f"Fast Downward plan time, median over {goals} goals per size (seed {seed})"
+    )
     for col in ("objects", "planner", "solved", "median s", "median plan length"):
         table.add_column(col, justify="right")
     for r in rows:
         table.add_row(
-            str(r.size), r.planner, f"{r.solved}/{r.problems}",
+            str(r.size),
+            r.planner,
+            f"{r.solved}/{r.problems}",
             "—" if r.median_seconds is None else f"{r.median_seconds:.3f}",
             "—" if r.median_plan_length is None else f"{r.median_plan_length:g}",
         )

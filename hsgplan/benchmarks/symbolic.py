@@ -46,8 +46,10 @@ def bench_symbolic(
     """
     if goals <= 0:
         raise InvalidInputError(f"--goals {goals}: need at least one goal per size")
-    planners = [FastDownwardPlanner(optimal=False, timeout_s=timeout_s),
-                FastDownwardPlanner(optimal=True, timeout_s=timeout_s)]
+    planners = [
+        FastDownwardPlanner(optimal=False, timeout_s=timeout_s),
+        FastDownwardPlanner(optimal=True, timeout_s=timeout_s),
+    ]
     rows = []
     for n in sizes:
         rng = random.Random(f"bench-symbolic-{n}-{seed}")
@@ -65,9 +67,14 @@ def bench_symbolic(
                     pass
                 if on_problem:
                     on_problem()
-            rows.append(SizeTiming(
-                n, planner.name, len(problems), len(seconds),
-                statistics.median(seconds) if seconds else None,
-                statistics.median(lengths) if lengths else None,
-            ))
+            rows.append(
+                SizeTiming(
+                    n,
+                    planner.name,
+                    len(problems),
+                    len(seconds),
+                    statistics.median(seconds) if seconds else None,
+                    statistics.median(lengths) if lengths else None,
+                )
+            )
     return rows

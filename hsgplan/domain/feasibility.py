@@ -105,7 +105,10 @@ def _check_stacks(pos: set[Literal], place: dict[str, Literal]) -> dict[str, Lit
         chain = [o]
         while (nxt := _below(place, chain[-1])) is not None:
             if nxt in chain:
-                raise InfeasibleError(f"{_q(place[o])}: the objects stack in a cycle")
+                cycle = chain[chain.index(nxt) :]
+                raise InfeasibleError(
+                    f"{_q(*(place[c] for c in cycle))}: the objects stack in a cycle"
+                )
             chain.append(nxt)
         if len(chain) > MAX_TOWER_LEVELS:
             tower = " on ".join(chain)
@@ -119,9 +122,8 @@ def _check_stacks(pos: set[Literal], place: dict[str, Literal]) -> dict[str, Lit
 
 def _below(place: dict[str, Literal], o: str) -> str | None:
     lit = place.get(o)
-    if lit is not None and lit.predicate is Predicate.ON:
-        if kind_of(lit.args[1]) is EntityKind.OBJECT:
-            return lit.args[1]
+    if lit and lit.predicate is Predicate.ON and kind_of(lit.args[1]) is EntityKind.OBJECT:
+        return lit.args[1]
     return None
 
 

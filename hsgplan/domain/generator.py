@@ -71,7 +71,8 @@ def random_goal(n: int, rng: random.Random, stacking: bool = True) -> Goal:
     objects = list(random_objects(n, rng))
     rng.shuffle(objects)
     room = _Room(
-        {s: SURFACE_CAPACITY[s] for s in GOAL_SHELF_TOPS}, {GOAL_INTERIOR: INTERIOR_CAPACITY[GOAL_INTERIOR]}
+        {s: SURFACE_CAPACITY[s] for s in GOAL_SHELF_TOPS},
+        {GOAL_INTERIOR: INTERIOR_CAPACITY[GOAL_INTERIOR]},
     )
     level: dict[str, int] = {}
     bare: list[str] = []
@@ -79,7 +80,11 @@ def random_goal(n: int, rng: random.Random, stacking: bool = True) -> Goal:
     for o in objects:
         t = object_type(o)
         kinds = [s for s in GOAL_SHELF_TOPS if room.top[s] > 0]
-        if t.kind is Kind.CAN and fits_inside(t.name, GOAL_INTERIOR) and room.interior[GOAL_INTERIOR]:
+        if (
+            t.kind is Kind.CAN
+            and fits_inside(t.name, GOAL_INTERIOR)
+            and room.interior[GOAL_INTERIOR]
+        ):
             kinds.append("inside")
         bases = [b for b in bare if level[b] < MAX_TOWER_LEVELS] if stacking else []
         if bases:

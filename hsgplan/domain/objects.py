@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable
-from enum import Enum
+from enum import StrEnum
 
 from hsgplan.domain.errors import UnknownNameError
 from hsgplan.domain.world import MAX_OBJECTS, OBJECT_TYPES, REGIONS, SHELVES, ObjectType
 
 
-class EntityKind(str, Enum):
+class EntityKind(StrEnum):
     OBJECT = "object"
     SHELF = "shelf"
     REGION = "region"
@@ -42,10 +42,11 @@ def split_instance(name: str) -> tuple[str, int]:
     m = _INSTANCE.match(name)
     if m and m.group("type") in OBJECT_TYPES and m.group("k") is not None:
         k = int(m.group("k"))
-        if k == 1 or str(k) != m.group("k"):
+        if k < 2 or str(k) != m.group("k"):
+            t = m.group("type")
             raise UnknownNameError(
-                f"unknown object '{name}' (the first {m.group('type')} is named "
-                f"'{m.group('type')}', later ones '{m.group('type')}_2', '{m.group('type')}_3', ...)"
+                f"unknown object '{name}' (the first {t} is named '{t}', "
+                f"later ones '{t}_2', '{t}_3', ...)"
             )
         if k > MAX_OBJECTS:
             raise UnknownNameError(f"unknown object '{name}' (a scene holds at most {MAX_OBJECTS})")

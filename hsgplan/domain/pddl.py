@@ -67,42 +67,85 @@ def _actions() -> list[InstantaneousAction]:
     o, s, n, m = pick_s.parameters
     for c in (ON(o, s), CLEAR(o), HANDEMPTY, COUNT(s, m), SUCC(n, m)):
         pick_s.add_precondition(c)
-    for f, v in ((ON(o, s), False), (CLEAR(o), False), (HANDEMPTY, False), (INGRASP(o), True),
-                 (COUNT(s, m), False), (COUNT(s, n), True), (LEVEL(o, N1), False)):
+    for f, v in (
+        (ON(o, s), False),
+        (CLEAR(o), False),
+        (HANDEMPTY, False),
+        (INGRASP(o), True),
+        (COUNT(s, m), False),
+        (COUNT(s, n), True),
+        (LEVEL(o, N1), False),
+    ):
         pick_s.add_effect(f, v)
 
     pick_o = InstantaneousAction("pick_from_object", o=OBJ, b=OBJ, k=NUM)
     o, b, k = pick_o.parameters
     for c in (ON(o, b), CLEAR(o), HANDEMPTY, LEVEL(o, k)):
         pick_o.add_precondition(c)
-    for f, v in ((ON(o, b), False), (CLEAR(o), False), (HANDEMPTY, False), (INGRASP(o), True),
-                 (CLEAR(b), True), (LEVEL(o, k), False)):
+    for f, v in (
+        (ON(o, b), False),
+        (CLEAR(o), False),
+        (HANDEMPTY, False),
+        (INGRASP(o), True),
+        (CLEAR(b), True),
+        (LEVEL(o, k), False),
+    ):
         pick_o.add_effect(f, v)
 
     place_s = InstantaneousAction("place_on_surface", o=OBJ, s=SURFACE, n=NUM, m=NUM)
     o, s, n, m = place_s.parameters
     for c in (INGRASP(o), COUNT(s, n), SUCC(n, m), CAP(s, m)):
         place_s.add_precondition(c)
-    for f, v in ((ON(o, s), True), (CLEAR(o), True), (HANDEMPTY, True), (INGRASP(o), False),
-                 (COUNT(s, n), False), (COUNT(s, m), True), (LEVEL(o, N1), True)):
+    for f, v in (
+        (ON(o, s), True),
+        (CLEAR(o), True),
+        (HANDEMPTY, True),
+        (INGRASP(o), False),
+        (COUNT(s, n), False),
+        (COUNT(s, m), True),
+        (LEVEL(o, N1), True),
+    ):
         place_s.add_effect(f, v)
 
     place_o = InstantaneousAction("place_on_object", o=OBJ, b=OBJ, k=NUM, k2=NUM)
     o, b, k, k2 = place_o.parameters
     for c in (INGRASP(o), CLEAR(b), CARRIER(b), LEVEL(b, k), SUCC(k, k2), MAXLEVEL(k2)):
         place_o.add_precondition(c)
-    for f, v in ((ON(o, b), True), (CLEAR(o), True), (HANDEMPTY, True), (INGRASP(o), False),
-                 (CLEAR(b), False), (LEVEL(o, k2), True)):
+    for f, v in (
+        (ON(o, b), True),
+        (CLEAR(o), True),
+        (HANDEMPTY, True),
+        (INGRASP(o), False),
+        (CLEAR(b), False),
+        (LEVEL(o, k2), True),
+    ):
         place_o.add_effect(f, v)
 
     push = InstantaneousAction("push", o=OBJ, r=REGION, s=SHELF, n=NUM, m=NUM, p=NUM, q=NUM)
     o, r, s, n, m, p, q = push.parameters
-    for c in (ON(o, r), PREPUSH(r, s), CLEAR(o), HANDEMPTY, FITS(o, s), COUNT(r, m),
-              SUCC(n, m), ICOUNT(s, p), SUCC(p, q), ICAP(s, q)):
+    for c in (
+        ON(o, r),
+        PREPUSH(r, s),
+        CLEAR(o),
+        HANDEMPTY,
+        FITS(o, s),
+        COUNT(r, m),
+        SUCC(n, m),
+        ICOUNT(s, p),
+        SUCC(p, q),
+        ICAP(s, q),
+    ):
         push.add_precondition(c)
-    for f, v in ((ON(o, r), False), (INSIDE(o, s), True), (CLEAR(o), False), (COUNT(r, m), False),
-                 (COUNT(r, n), True), (ICOUNT(s, p), False), (ICOUNT(s, q), True),
-                 (LEVEL(o, N1), False)):
+    for f, v in (
+        (ON(o, r), False),
+        (INSIDE(o, s), True),
+        (CLEAR(o), False),
+        (COUNT(r, m), False),
+        (COUNT(r, n), True),
+        (ICOUNT(s, p), False),
+        (ICOUNT(s, q), True),
+        (LEVEL(o, N1), False),
+    ):
         push.add_effect(f, v)
     return [pick_s, pick_o, place_s, place_o, push]
 
@@ -163,8 +206,12 @@ def build_problem(state: SymbolicSceneGraph, goal: Goal) -> PddlProblem:
 
 
 def _fluent(lit: Literal, ents: dict[str, Object]):
-    fluent = {Predicate.ON: ON, Predicate.IN: INSIDE, Predicate.IN_GRASP: INGRASP,
-              Predicate.CLEAR: CLEAR}[lit.predicate]
+    fluent = {
+        Predicate.ON: ON,
+        Predicate.IN: INSIDE,
+        Predicate.IN_GRASP: INGRASP,
+        Predicate.CLEAR: CLEAR,
+    }[lit.predicate]
     return fluent(*(ents[a] for a in lit.args))
 
 

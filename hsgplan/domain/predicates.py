@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
+from enum import StrEnum
 
 from hsgplan.domain.objects import EntityKind, kind_of
 
 
-class Predicate(str, Enum):
+class Predicate(StrEnum):
     """`On(o, x)`: o rests on x (a region, a shelf top or another object).
     `In(o, shelf)`: o is inside a shelf's interior.
     `InGrasp(o)`: o is held by the gripper.

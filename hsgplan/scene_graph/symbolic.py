@@ -59,7 +59,8 @@ class SymbolicSceneGraph:
         wrong = given_clear - graph.literals
         if wrong:
             raise InfeasibleError(
-                f"'{min(wrong)}' cannot hold: something rests on it, it is held, or it is in a shelf"
+                f"'{min(wrong)}' cannot hold: something rests on it, it is held, "
+                "or it is in a shelf"
             )
         return graph
 
@@ -98,7 +99,9 @@ class SymbolicSceneGraph:
         return tuple(o for o in self.objects if self.location(o) == Literal(Predicate.ON, (o, x)))
 
     def inside(self, shelf: str) -> tuple[str, ...]:
-        return tuple(o for o in self.objects if self.location(o) == Literal(Predicate.IN, (o, shelf)))
+        return tuple(
+            o for o in self.objects if self.location(o) == Literal(Predicate.IN, (o, shelf))
+        )
 
     def level(self, obj: str) -> int:
         """1 for an object on a surface, one more for each object beneath it; 0 if not stacked."""
@@ -116,7 +119,9 @@ class SymbolicSceneGraph:
 
     def sorted_literals(self) -> list[Literal]:
         order = {o: i for i, o in enumerate(self.objects)}
-        return sorted(self.literals, key=lambda x: (order[x.subject], PREDICATES.index(x.predicate)))
+        return sorted(
+            self.literals, key=lambda x: (order[x.subject], PREDICATES.index(x.predicate))
+        )
 
     def to_text(self) -> str:
         """A node-and-edge listing, one object per line with its out-edges and self edges."""

@@ -1,0 +1,92 @@
+"""Fast Downward and the transition model must agree: every plan replays step by step."""
+
+import random
+
+import pytest
+
+from hsgplan.domain.generator import random_goals, random_state
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.pddl import to_pddl_text
+from hsgplan.domain.predicates import inside, on
+from hsgplan.domain.transition import apply, why_not
+from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+
+def replay(plan, start, goal):
+    state = start
+    for action in plan.actions:
+        assert why_not(state, action) is None, f"{action} in {state}"
+        state = apply(state, action)
+    assert goal.satisfied_by(state)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5, 6])
+def test_plans_for_100_random_goals_replay_in_the_transition_model(n):
+    planner = FastDownwardPlanner()
+    rng = random.Random(f"test-fd-{n}")
+    for i, goal in enumerate(random_goals(n, 100, seed=11)):
+        # Half start with everything on the open space, half from a random arrangement.
+        start = (
+            SymbolicSceneGraph.initial(goal.objects) if i % 2 else random_state(goal.objects, rng)
+        )
+        replay(planner.plan(start, goal), start, goal)
+
+
+@pytest.mark.parametrize("n", [7, 9, 12])
+def test_generated_goals_up_to_twelve_objects_are_solved(n):
+    planner = FastDownwardPlanner(optimal=False)
+    rng = random.Random(f"test-fd-large-{n}")
+    for goal in random_goals(n, 8, seed=12):
+        start = random_state(goal.objects, rng)
+        replay(planner.plan(start, goal), start, goal)
+
+
+def test_optimal_plans_are_never_longer():
+    rng = random.Random(0)
+    for goal in random_goals(4, 6, seed=5):
+        start = random_state(goal.objects, rng)
+        best = FastDownwardPlanner(optimal=True).plan(start, goal)
+        fast = FastDownwardPlanner(optimal=False).plan(start, goal)
+        assert len(best) <= len(fast)
+
+
+def test_known_plan():
+    goal = parse_goal("On(butter, cherries) & In(tomato_soup, shelf_a)")
+    start = SymbolicSceneGraph.initial(goal.objects)
+    plan = FastDownwardPlanner(optimal=True).plan(start, goal)
+    assert len(plan) == 5  # pick, place; pick, place on prepush_a, push
+    assert [str(a) for a in plan.actions if "tomato_soup" in str(a)] == [
+        "pick(tomato_soup)",
+        "place(tomato_soup, prepush_a)",
+        "push(tomato_soup, shelf_a)",
+    ]
+
+
+def test_goal_already_true_needs_no_plan():
+    start = SymbolicSceneGraph.initial(["butter", "cherries"])
+    plan = FastDownwardPlanner().plan(start, parse_goal("On(butter, open_space)"))
+    assert len(plan) == 0 and plan.states == (start,)
+
+
+def test_unreachable_goal_is_reported():
+    # An object inside a shelf can never come out again.
+    start = SymbolicSceneGraph.from_literals(
+        ["cherries", "butter"], [inside("cherries", "shelf_a"), on("butter", "open_space")]
+    )
+    with pytest.raises(NoPlanError, match="no sequence"):
+        FastDownwardPlanner().plan(start, parse_goal("On(cherries, shelf_b)"))
+
+
+def test_pddl_text_names_the_domain_actions():
+    goal = parse_goal("On(butter, cherries)")
+    domain, problem = to_pddl_text(SymbolicSceneGraph.initial(goal.objects), goal)
+    for name in (
+        "pick_from_surface",
+        "pick_from_object",
+        "place_on_surface",
+        "place_on_object",
+        "push",
+    ):
+        assert f"(:action {name}" in domain
+    assert "(on butter cherries)" in problem
