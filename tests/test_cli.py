@@ -1,0 +1,114 @@
+"""The command line: output shapes, and bad input refused with one line and exit code 2."""
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from hsgplan.cli import app
+from hsgplan.domain.goals import parse_goal, read_goal_file
+
+runner = CliRunner()
+
+
+def run(*args):
+    return runner.invoke(app, list(args))
+
+
+def test_plan_json_lists_every_step_with_its_state():
+    r = run("plan", "--goal", "On(butter, cherries) & In(tomato_soup, shelf_a)", "--json")
+    assert r.exit_code == 0, r.output
+    steps = json.loads(r.stdout)
+    assert steps[0]["action"] is None and steps[0]["step"] == 0
+    actions = [s["action"] for s in steps[1:]]
+    assert len(actions) == 5  # the shortest plan: two steps for butter, three for the soup
+    assert {"place(butter, cherries)", "push(tomato_soup, shelf_a)"} <= set(actions)
+    final = parse_goal(" & ".join(steps[-1]["state"]), validate=False)
+    assert {str(x) for x in final.literals} >= {"On(butter, cherries)", "In(tomato_soup, shelf_a)"}
+
+
+def test_plan_from_a_given_start_with_extra_objects():
+    r = run(
+        "plan",
+        "--goal",
+        "On(butter, shelf_a)",
+        "--objects",
+        "butter,cherries",
+        "--init",
+        "On(butter, open_space) & On(cherries, butter)",
+    )
+    assert r.exit_code == 0, r.output
+    assert "pick(cherries)" in r.stdout and "goal holds: True" in r.stdout
+
+
+def test_goals_file_is_deterministic(tmp_path):
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    for path in (a, b):
+        r = run("goals", "--objects", "4", "--count", "7", "--seed", "3", "--out", str(path))
+        assert r.exit_code == 0, r.output
+    assert a.read_text() == b.read_text()
+    goals = read_goal_file(a)
+    assert len(goals) == 7 and all(g.size == 4 for g in goals)
+    r = run("goals", "--objects", "4", "--count", "7", "--seed", "3")
+    assert r.stdout == a.read_text()
+
+
+def test_demo_runs_a_plan_to_the_goal():
+    r = run("demo", "--seed", "1")
+    assert r.exit_code == 0, r.output
+    assert "goal holds: True" in r.stdout
+
+
+def test_bench_symbolic_prints_a_row_per_size_and_search():
+    r = run("bench", "symbolic", "--sizes", "2-3", "--goals", "2", "--json")
+    assert r.exit_code == 0, r.output
+    rows = json.loads(r.stdout)
+    assert [(x["size"], x["planner"]) for x in rows] == [
+        (2, "fd-wastar"),
+        (2, "fd-optimal"),
+        (3, "fd-wastar"),
+        (3, "fd-optimal"),
+    ]
+    assert all(x["solved"] == 2 and x["median_seconds"] > 0 for x in rows)
+
+
+BAD = [
+    (["plan", "--goal", "On(banana, shelf_a)"], "unknown name 'banana'"),
+    (["plan", "--goal", "On(butter, cherries) & On(cherries, butter)"], "cycle"),
+    (["plan", "--goal", "InGrasp(butter) & InGrasp(cherries)"], "one object at a time"),
+    (["plan", "--goal", "In(popcorn, shelf_a)"], "does not fit"),
+    (["plan", "--goal", ""], "empty"),
+    (["plan", "--goal", "On(butter, shelf_a)", "--objects", "cherries"], "lacks 'butter'"),
+    (["plan", "--goal", "On(butter, shelf_a)", "--objects", "butter,pear"], "unknown name 'pear'"),
+    (["plan", "--goal", "On(butter, shelf_a)", "--init", "On(butter, butter)"], "itself"),
+    (
+        ["plan", "--goal", "On(butter, shelf_a)", "--init", "On(cherries, shelf_a)"],
+        "not in the scene",
+    ),
+    (["plan", "--goal", "On(cherries, shelf_b)", "--init", "In(cherries, shelf_a)"], "no sequence"),
+    (["goals", "--objects", "4", "--count", "-3"], "negative"),
+    (["goals", "--objects", "13", "--count", "3"], "between 2 and 12"),
+    (["goals", "--objects", "0", "--count", "3"], "between 2 and 12"),
+    (["bench", "symbolic", "--sizes", "2-x"], "expected a range"),
+    (["bench", "symbolic", "--sizes", "1-3"], "between 2 and 12"),
+    (["bench", "symbolic", "--goals", "-1"], "at least one goal"),
+    (["demo", "--objects", "40"], "between 2 and 12"),
+]
+
+
+@pytest.mark.parametrize(("args", "reason"), BAD, ids=[" ".join(a)[:40] for a, _ in BAD])
+def test_bad_input_gets_one_line_and_exit_code_2(args, reason):
+    r = run(*args)
+    assert r.exit_code == 2, r.output
+    lines = [line for line in r.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:"), r.stderr
+    assert reason in lines[0]
+    assert "Traceback" not in r.output
+
+
+def test_refused_command_leaves_an_existing_file_alone(tmp_path):
+    path = tmp_path / "goals.txt"
+    path.write_text("On(butter, shelf_a)\n")
+    r = run("goals", "--objects", "4", "--count", "-1", "--out", str(path))
+    assert r.exit_code == 2
+    assert path.read_text() == "On(butter, shelf_a)\n"
