@@ -18,12 +18,12 @@ demo: $(STAMP)
 	$(BIN)/hsgplan demo
 
 test: $(STAMP)
-	$(BIN)/ruff check hsgplan tests
+	$(BIN)/ruff check hsgplan tests scripts
 	$(BIN)/python -m pytest -q -n 2 tests
 
 lint: $(STAMP)
-	$(BIN)/ruff check hsgplan tests
-	$(BIN)/ruff format --check hsgplan tests
+	$(BIN)/ruff check hsgplan tests scripts
+	$(BIN)/ruff format --check hsgplan tests scripts
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -214,6 +214,9 @@ def bench_symbolic(
         int, typer.Option(help="Largest size the optimal search is timed on.")
     ] = 8,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
 ) -> None:
     """Fast Downward plan time per size: median over the goals, both search configurations."""
     from hsgplan.benchmarks.symbolic import bench_symbolic as run
@@ -228,19 +231,35 @@ def bench_symbolic(
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
-    table = Table(
-        title=f"Fast Downward plan time, median over {goals} goals per size (seed {seed})"
-    )
-    for col in ("objects", "planner", "solved", "median s", "median plan length"):
-        table.add_column(col, justify="right")
-    for r in rows:
-        table.add_row(
+    title = f"Fast Downward plan time, median over {goals} goals per size (seed {seed})"
+    header = ("objects", "planner", "solved", "median s", "median plan length")
+    cells = [
+        (
             str(r.size),
             r.planner,
             f"{r.solved}/{r.problems}",
             "—" if r.median_seconds is None else f"{r.median_seconds:.3f}",
             "—" if r.median_plan_length is None else f"{r.median_plan_length:g}",
         )
+        for r in rows
+    ]
+    print_table(title, header, cells, markdown)
+
+
+def print_table(title: str, header: tuple[str, ...], rows: list[tuple[str, ...]], markdown: bool):
+    """A Rich table on the terminal, or a Markdown table that the README takes verbatim."""
+    if markdown:
+        print(f"{title}\n")
+        print("| " + " | ".join(header) + " |")
+        print("|" + "---:|" * len(header))
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
+        return
+    table = Table(title=title)
+    for col in header:
+        table.add_column(col, justify="right")
+    for row in rows:
+        table.add_row(*row)
     out.print(table)
 
 

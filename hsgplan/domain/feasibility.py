@@ -30,8 +30,14 @@ def _q(*lits: Literal) -> str:
     return " and ".join(f"'{lit}'" for lit in lits)
 
 
-def check_literals(literals: Iterable[Literal]) -> None:
-    """Raise InfeasibleError if no scene satisfies all the literals together."""
+def check_literals(literals: Iterable[Literal], limits: bool = True) -> None:
+    """Raise InfeasibleError if no scene satisfies all the literals together.
+
+    With `limits=False` only the structure is checked (one place per object, one object held,
+    one object per carrier, no cycles, Clear agreeing), not the world's physical limits
+    (capacities, tower height, what fits or carries): an observed scene is a fact even when
+    physics put it past a limit the planners respect.
+    """
     lits = set(literals)
     pos = {lit for lit in lits if lit.positive}
     for lit in lits:
@@ -42,9 +48,10 @@ def check_literals(literals: Iterable[Literal]) -> None:
         raise InfeasibleError(f"{len(objects)} objects named; a scene holds at most {MAX_OBJECTS}")
     place = _placements(pos)
     _check_grasp_and_clear(pos, place)
-    carried = _check_stacks(pos, place)
-    _check_capacity(pos)
-    _check_shelves(pos, carried)
+    carried = _check_stacks(pos, place, limits)
+    if limits:
+        _check_capacity(pos)
+        _check_shelves(pos, carried)
 
 
 def _placements(pos: set[Literal]) -> dict[str, Literal]:
@@ -82,7 +89,7 @@ def _check_grasp_and_clear(pos: set[Literal], place: dict[str, Literal]) -> None
                 raise InfeasibleError(f"{_q(lit, other)}: something rests on '{o}'")
 
 
-def _check_stacks(pos: set[Literal], place: dict[str, Literal]) -> dict[str, Literal]:
+def _check_stacks(pos: set[Literal], place: dict[str, Literal], limits: bool) -> dict[str, Literal]:
     """Check every object-on-object literal; return, per carrier, the literal that loads it."""
     carried: dict[str, Literal] = {}
     for lit in sorted(place.values()):
@@ -93,7 +100,7 @@ def _check_stacks(pos: set[Literal], place: dict[str, Literal]) -> dict[str, Lit
             raise InfeasibleError(f"{_q(carried[base], lit)}: an object carries at most one other")
         carried[base] = lit
         t = object_type(base)
-        if not can_support(t.name):
+        if limits and not can_support(t.name):
             raise InfeasibleError(
                 f"'{lit}': the top of {base} ({100 * t.top_face_min_side:.1f} cm wide) is too "
                 "narrow to carry anything"
@@ -110,7 +117,7 @@ def _check_stacks(pos: set[Literal], place: dict[str, Literal]) -> dict[str, Lit
                     f"{_q(*(place[c] for c in cycle))}: the objects stack in a cycle"
                 )
             chain.append(nxt)
-        if len(chain) > MAX_TOWER_LEVELS:
+        if limits and len(chain) > MAX_TOWER_LEVELS:
             tower = " on ".join(chain)
             raise InfeasibleError(
                 f"'{place[o]}': the tower {tower} is {len(chain)} objects high; towers hold at "

@@ -38,11 +38,13 @@ class SymbolicSceneGraph:
 
     @classmethod
     def from_literals(
-        cls, objects: Iterable[str], literals: Iterable[Literal]
+        cls, objects: Iterable[str], literals: Iterable[Literal], limits: bool = True
     ) -> SymbolicSceneGraph:
         """A checked state from the placement literals (On / In / InGrasp) of every object.
 
-        `Clear` literals are derived; given ones must agree with the derivation.
+        `Clear` literals are derived; given ones must agree with the derivation. With
+        `limits=False` (for observed scenes) the world's capacity, tower and fit limits are
+        not enforced, only the structure (see `check_literals`).
         """
         objs = sort_objects(objects)
         lits = set(literals)
@@ -54,7 +56,7 @@ class SymbolicSceneGraph:
                     raise InfeasibleError(f"'{lit}' names '{a}', which is not in the scene")
         placements = {lit for lit in lits if lit.predicate is not Predicate.CLEAR}
         graph = cls(objs, frozenset(placements | _derive_clear(objs, placements)))
-        graph._check()
+        graph._check(limits)
         given_clear = {lit for lit in lits if lit.predicate is Predicate.CLEAR}
         wrong = given_clear - graph.literals
         if wrong:
@@ -171,8 +173,8 @@ class SymbolicSceneGraph:
 
     # --- consistency -------------------------------------------------------------------
 
-    def _check(self) -> None:
-        check_literals(self.literals)
+    def _check(self, limits: bool) -> None:
+        check_literals(self.literals, limits)
         placed = {lit.subject for lit in self.literals if lit.predicate is not Predicate.CLEAR}
         missing = [o for o in self.objects if o not in placed]
         if missing:

@@ -108,3 +108,16 @@ def test_duplicate_instances_share_a_node_type():
     data = s.to_data()
     assert torch.equal(data.x[0], data.x[1])
     assert data.x[0, ENTITY_TYPES.index("cherries")] == 1
+
+
+def test_observed_scenes_may_break_planning_limits_but_not_structure():
+    tower = [on("butter", "cherries"), on("cherries", "tomato_soup"), on("tomato_soup", "shelf_a")]
+    objs = ["butter", "cherries", "tomato_soup"]
+    with pytest.raises(InfeasibleError, match="towers hold at most"):
+        SymbolicSceneGraph.from_literals(objs, tower)
+    observed = SymbolicSceneGraph.from_literals(objs, tower, limits=False)
+    assert observed.level("butter") == 3
+    with pytest.raises(InfeasibleError, match="one place"):
+        SymbolicSceneGraph.from_literals(
+            ["butter"], [on("butter", "shelf_a"), on("butter", "shelf_b")], limits=False
+        )

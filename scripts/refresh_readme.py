@@ -1,0 +1,49 @@
+"""Replace a README results block with what a command prints, so no table is typed by hand.
+
+Usage: python scripts/refresh_readme.py NAME -- hsgplan bench symbolic --markdown
+
+The block is the text between `<!-- BEGIN NAME -->` and `<!-- END NAME -->`; it becomes the
+command's standard output followed by a line naming the command, the date and the machine.
+"""
+
+from __future__ import annotations
+
+import datetime
+import os
+import platform
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+README = Path(__file__).resolve().parent.parent / "README.md"
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) < 3 or argv[1] != "--":
+        print(__doc__.strip().splitlines()[2], file=sys.stderr)
+        return 2
+    name, command = argv[0], argv[2:]
+    text = README.read_text()
+    pattern = re.compile(
+        rf"(<!-- BEGIN {re.escape(name)} -->\n).*?(<!-- END {re.escape(name)} -->)", re.S
+    )
+    if not pattern.search(text):
+        print(f"README.md has no block named '{name}'", file=sys.stderr)
+        return 2
+    result = subprocess.run(command, capture_output=True, text=True, check=False)
+    if result.returncode != 0:
+        print(result.stderr, file=sys.stderr)
+        return result.returncode
+    stamp = (
+        f"\n_Produced by `{shlex.join(command)}` on {datetime.date.today()} "
+        f"({platform.machine()}, {os.cpu_count()} cores)._\n"
+    )
+    block = result.stdout.strip() + "\n" + stamp
+    README.write_text(pattern.sub(lambda m: m.group(1) + block + m.group(2), text))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
