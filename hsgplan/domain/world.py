@@ -205,3 +205,13 @@ def fits_inside(type_name: str, shelf: str) -> bool:
         and max(t.footprint) <= max(s.interior.width_x, s.interior.width_y)
         and min(t.footprint) <= min(s.interior.width_x, s.interior.width_y)
     )
+
+
+# --- motion primitive parameters (the paper's discretisation) ---
+
+PLACE_BINS = 10  # x and y bins over the target region or shelf top
+PUSH_ANGLE_BINS = 21
+PUSH_DIST_BINS = 21
+# Push direction, in radians from +x (shelves open towards -x, so pushes go roughly along +x).
+PUSH_ANGLE_RANGE = (-math.pi / 4, math.pi / 4)
+PUSH_DIST_RANGE = (0.04, 0.24)

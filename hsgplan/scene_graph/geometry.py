@@ -74,6 +74,9 @@ class Pose:
         """This pose expressed in `frame`'s coordinates."""
         return Pose.from_matrix(np.linalg.inv(frame.matrix()) @ self.matrix())
 
+    def inverse(self) -> Pose:
+        return Pose.from_matrix(np.linalg.inv(self.matrix()))
+
     def compose(self, local: Pose) -> Pose:
         """A pose given in this pose's frame, expressed in the world."""
         return Pose.from_matrix(self.matrix() @ local.matrix())

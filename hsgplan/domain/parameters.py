@@ -1,0 +1,101 @@
+"""Motion-primitive parameters: the paper's discrete bins and the continuous values they mean.
+
+`place(o, target, x_bin, y_bin)`: PLACE_BINS x PLACE_BINS bin centres over the target surface,
+inset so that the object, whichever way it is turned, stays wholly on it. Stacking on an object
+takes its position from geometry instead (the bins are None).
+`push(o, angle_bin, dist_bin)`: PUSH_ANGLE_BINS directions over PUSH_ANGLE_RANGE and
+PUSH_DIST_BINS distances over PUSH_DIST_RANGE, both including their ends.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.objects import object_type
+from hsgplan.domain.world import (
+    PLACE_BINS,
+    PUSH_ANGLE_BINS,
+    PUSH_ANGLE_RANGE,
+    PUSH_DIST_BINS,
+    PUSH_DIST_RANGE,
+    SURFACES,
+    surface_rect,
+)
+
+PLACE_EDGE_GAP = 0.005
+
+
+@dataclass(frozen=True)
+class PickParams:
+    obj: str
+
+
+@dataclass(frozen=True)
+class PlaceParams:
+    obj: str
+    target: str
+    x_bin: int | None = None
+    y_bin: int | None = None
+
+
+@dataclass(frozen=True)
+class PushParams:
+    obj: str
+    angle_bin: int
+    dist_bin: int
+
+
+PrimitiveParams = PickParams | PlaceParams | PushParams
+
+
+def _check_bin(value: int, bins: int, what: str) -> None:
+    if not 0 <= value < bins:
+        raise InvalidInputError(f"{what} {value} is outside 0..{bins - 1}")
+
+
+def place_inset(obj: str) -> float:
+    """Half the object's footprint diagonal: it stays on the surface whatever its yaw."""
+    fx, fy = object_type(obj).footprint
+    return math.hypot(fx, fy) / 2 + PLACE_EDGE_GAP
+
+
+def place_xy(obj: str, target: str, x_bin: int, y_bin: int) -> tuple[float, float]:
+    """The world (x, y) of a place bin's centre on a surface."""
+    if target not in SURFACES:
+        raise InvalidInputError(f"place bins are over surfaces, not '{target}'")
+    _check_bin(x_bin, PLACE_BINS, "x_bin")
+    _check_bin(y_bin, PLACE_BINS, "y_bin")
+    r, inset = surface_rect(target), place_inset(obj)
+    x0, x1 = r.x_min + inset, r.x_max - inset
+    y0, y1 = r.y_min + inset, r.y_max - inset
+    if x1 < x0:
+        x0 = x1 = (r.x_min + r.x_max) / 2
+    if y1 < y0:
+        y0 = y1 = (r.y_min + r.y_max) / 2
+    return (
+        x0 + (x1 - x0) * (x_bin + 0.5) / PLACE_BINS,
+        y0 + (y1 - y0) * (y_bin + 0.5) / PLACE_BINS,
+    )
+
+
+def push_values(angle_bin: int, dist_bin: int) -> tuple[float, float]:
+    """(direction in radians from +x, distance in metres) of a push's bins."""
+    _check_bin(angle_bin, PUSH_ANGLE_BINS, "angle_bin")
+    _check_bin(dist_bin, PUSH_DIST_BINS, "dist_bin")
+    a0, a1 = PUSH_ANGLE_RANGE
+    d0, d1 = PUSH_DIST_RANGE
+    return (
+        a0 + (a1 - a0) * angle_bin / (PUSH_ANGLE_BINS - 1),
+        d0 + (d1 - d0) * dist_bin / (PUSH_DIST_BINS - 1),
+    )
+
+
+def nearest_push_bins(angle: float, dist: float) -> tuple[int, int]:
+    """The bins whose values are closest to a wanted direction and distance."""
+    a0, a1 = PUSH_ANGLE_RANGE
+    d0, d1 = PUSH_DIST_RANGE
+    ab = round((angle - a0) / (a1 - a0) * (PUSH_ANGLE_BINS - 1))
+    db = round((dist - d0) / (d1 - d0) * (PUSH_DIST_BINS - 1))
+    return min(max(ab, 0), PUSH_ANGLE_BINS - 1), min(max(db, 0), PUSH_DIST_BINS - 1)

@@ -1,0 +1,1 @@
+"""The simulated kitchen-storage world (PyBullet, DIRECT mode), built from parts."""

@@ -1,0 +1,126 @@
+"""Joint-space motion planning: OMPL's RRTConnect with PyBullet as the collision checker.
+
+A straight joint-space segment is tried first (most transit motions above the table are free);
+RRTConnect runs only when it collides. Simplification uses counted shortcut steps rather than a
+time budget, so that the same seed gives the same path on any machine.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from hsgplan.sim.robot import ARM, Panda
+
+ou.setLogLevel(ou.LOG_ERROR)
+
+# Checked paths keep this far from obstacles: at the edge-resolution below, thinner misses let
+# sub-millimetre contacts through (measured on shelf boards and cans).
+SAFETY_MARGIN = 0.005
+STEP = 0.02  # rad between collision checks along a joint-space segment
+RRT_TIME = 2.0
+SHORTCUT_STEPS = 60
+
+
+class CollisionChecker:
+    """Whether the arm (and the object it holds) at a configuration touches anything.
+
+    Args:
+        robot: the arm; `set_q` moves a held object along.
+        obstacles: bodies the arm and held object must keep `margin` away from.
+        self_pairs: link pairs of the arm checked against each other.
+    """
+
+    def __init__(
+        self, robot: Panda, obstacles: Iterable[int], margin: float = SAFETY_MARGIN
+    ) -> None:
+        self.robot = robot
+        self.bc = robot.bc
+        self.obstacles = tuple(obstacles)
+        self.margin = margin
+        self.self_pairs = _self_collision_pairs(robot)
+
+    def collides(self, q: np.ndarray) -> bool:
+        self.robot.set_q(q)
+        bc, arm, held = self.bc, self.robot.body, self.robot.held_body
+        for a, b in self.self_pairs:
+            if bc.getClosestPoints(arm, arm, 0.0, a, b):
+                return True
+        for body in self.obstacles:
+            if body == held:
+                continue
+            for pt in bc.getClosestPoints(arm, body, self.margin):
+                if pt[3] > 0:  # link 0 and the base stand on the table by design
+                    return True
+            if held is not None and bc.getClosestPoints(held, body, self.margin):
+                return True
+        return False
+
+    def segment_free(self, q0: np.ndarray, q1: np.ndarray) -> bool:
+        n = max(1, int(np.ceil(np.max(np.abs(q1 - q0)) / STEP)))
+        return not any(self.collides(q0 + (q1 - q0) * (i / n)) for i in range(1, n + 1))
+
+
+def _self_collision_pairs(robot: Panda) -> list[tuple[int, int]]:
+    """Non-adjacent link pairs that can meet: the hand and forearm against the upper arm."""
+    return [(a, b) for a in (6, 7, 8, 9, 10) for b in (0, 1, 2) if b < a - 1]
+
+
+class MotionPlanner:
+    """Plans collision-free joint paths for one arm."""
+
+    def __init__(self, checker: CollisionChecker, seed: int) -> None:
+        self.checker = checker
+        self.seed = seed
+        robot = checker.robot
+        self.space = ob.RealVectorStateSpace(len(ARM))
+        bounds = ob.RealVectorBounds(len(ARM))
+        for i in range(len(ARM)):
+            bounds.setLow(i, float(robot.lower[i]))
+            bounds.setHigh(i, float(robot.upper[i]))
+        self.space.setBounds(bounds)
+
+    def plan(self, q0: np.ndarray, q1: np.ndarray) -> list[np.ndarray] | None:
+        """Waypoints from q0 to q1 (both included), or None when no path is found."""
+        with self.checker.robot.preserved():
+            if self.checker.collides(q0) or self.checker.collides(q1):
+                return None
+            if self.checker.segment_free(q0, q1):
+                return [q0, q1]
+            return self._rrt(q0, q1)
+
+    def _rrt(self, q0: np.ndarray, q1: np.ndarray) -> list[np.ndarray] | None:
+        ou.RNG.setSeed(self.seed)
+        ss = og.SimpleSetup(self.space)
+        ss.setStateValidityChecker(lambda s: not self.checker.collides(_array(s)))
+        si = ss.getSpaceInformation()
+        si.setStateValidityCheckingResolution(STEP / self.space.getMaximumExtent())
+        ss.setPlanner(og.RRTConnect(si))
+        start, goal = self.space.allocState(), self.space.allocState()
+        for i in range(len(ARM)):
+            start[i], goal[i] = float(q0[i]), float(q1[i])
+        ss.setStartAndGoalStates(start, goal)
+        if not ss.solve(RRT_TIME) or not ss.haveExactSolutionPath():
+            return None
+        path = ss.getSolutionPath()
+        simplifier = og.PathSimplifier(si)
+        simplifier.reduceVertices(path, SHORTCUT_STEPS, SHORTCUT_STEPS, 0.33)
+        simplifier.ropeShortcutPath(path)
+        return [_array(path.getState(i)) for i in range(path.getStateCount())]
+
+
+def _array(state) -> np.ndarray:
+    return np.array([state[i] for i in range(len(ARM))])
+
+
+def densify(waypoints: Sequence[np.ndarray], step: float = STEP) -> list[np.ndarray]:
+    """Intermediate configurations at most `step` apart, for execution and pictures."""
+    out = [waypoints[0]]
+    for a, b in zip(waypoints, waypoints[1:], strict=False):
+        n = max(1, int(np.ceil(np.max(np.abs(b - a)) / step)))
+        out += [a + (b - a) * (i / n) for i in range(1, n + 1)]
+    return out

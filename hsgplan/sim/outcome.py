@@ -1,0 +1,70 @@
+"""What a primitive's execution came to, and the check that decides it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.symbol_mapping import AnomalyKind, map_symbols
+
+# Another object that moves further than this (horizontally) was disturbed by the primitive.
+DISTURB_TOL = 0.02
+
+
+class Status(StrEnum):
+    SUCCESS = "success"
+    INVALID = "invalid"  # the parameters cannot apply to this scene (nothing was moved)
+    NO_IK = "no_ik"  # no collision-free arm configuration for a needed pose
+    NO_PATH = "no_path"  # the motion planner found no path, or a push line left the reach
+    DROPPED = "dropped"  # the object is not in the gripper after a pick
+    KNOCKED_OVER = "knocked_over"  # some object toppled
+    OFF_TABLE = "off_table"  # some object fell off the table
+    DISTURBED = "disturbed"  # another object was moved out of place
+    EFFECT_NOT_REACHED = "effect_not_reached"  # the intended predicate does not hold
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """The result of one primitive: its status, a sentence on why, and its wall time."""
+
+    status: Status
+    detail: str
+    seconds: float
+
+    @property
+    def ok(self) -> bool:
+        return self.status is Status.SUCCESS
+
+
+def verify(scene, before: GeometricSceneGraph, obj: str, expected: Literal) -> tuple[Status, str]:
+    """Compare the scene after a primitive with its intended symbolic effect."""
+    after = scene.scene_graph()
+    mapping = map_symbols(after)
+    prior_mapping = map_symbols(before)
+    prior = prior_mapping.state
+    known = {(a.obj, a.kind) for a in prior_mapping.anomalies}
+    fresh = [a for a in mapping.anomalies if (a.obj, a.kind) not in known]
+    anomalies = sorted(fresh, key=lambda a: a.obj != obj)
+    for a in anomalies:
+        if a.kind is AnomalyKind.TOPPLED:
+            return Status.KNOCKED_OVER, f"'{a.obj}' toppled: {a.detail}"
+        if a.kind is AnomalyKind.OFF_TABLE:
+            return Status.OFF_TABLE, f"'{a.obj}' fell off the table"
+    if not mapping.state.holds(expected):
+        status = (
+            Status.DROPPED
+            if expected.predicate is Predicate.IN_GRASP
+            else (Status.EFFECT_NOT_REACHED)
+        )
+        return status, f"'{expected}' does not hold: '{mapping.state.location(obj)}' instead"
+    for o in after.objects:
+        if o == obj:
+            continue
+        moved = before.pose(o).distance(after.pose(o))
+        if moved > DISTURB_TOL or prior.location(o) != mapping.state.location(o):
+            return Status.DISTURBED, f"'{o}' moved {100 * moved:.1f} cm"
+    for a in anomalies:
+        return Status.EFFECT_NOT_REACHED, f"'{a.obj}': {a.kind.value}, {a.detail}"
+    return Status.SUCCESS, ""

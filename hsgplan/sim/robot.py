@@ -1,0 +1,196 @@
+"""The Franka Panda from `pybullet_data`: kinematics, inverse kinematics, gripper, grasp.
+
+Arm motion is kinematic (joint states are set along a collision-checked path) and contact-rich
+phases (settling, pushing) run under physics with position-controlled motors. A grasp is made
+firm by a fixed constraint between the hand and the object once the fingers have closed on it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Iterator
+
+import numpy as np
+import pybullet_data
+from pybullet_utils.bullet_client import BulletClient
+
+from hsgplan.domain.world import GRIPPER_MAX_OPENING
+from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
+
+ARM = tuple(range(7))
+FINGERS = (9, 10)
+TCP = 11  # panda_grasptarget, between the fingers
+TIP_OFFSET = 0.011  # the fingertips lie this far beyond the TCP along the hand's z axis
+REST = np.array([0.0, -0.3, 0.0, -2.2, 0.0, 2.0, math.pi / 4])
+# Measured for this robot: fewer iterations leave centimetre errors near the workspace edge.
+IK_ITERATIONS = 200
+IK_THRESHOLD = 1e-4
+IK_POS_TOL = 0.004
+IK_ANG_TOL = 0.05
+MOTOR_FORCE = 300.0
+
+
+def topdown(closing_yaw: float) -> tuple[float, float, float, float]:
+    """Hand pointing down, fingers closing along the world direction at `closing_yaw`."""
+    y = np.array([math.cos(closing_yaw), math.sin(closing_yaw), 0.0])
+    z = np.array([0.0, 0.0, -1.0])
+    return matrix_to_quat(np.column_stack([np.cross(y, z), y, z]))
+
+
+def tilted(direction_yaw: float, pitch: float) -> tuple[float, float, float, float]:
+    """Hand leaning `pitch` from vertical towards `direction_yaw`, fingers across it (pushing)."""
+    u = np.array([math.cos(direction_yaw), math.sin(direction_yaw), 0.0])
+    z = math.sin(pitch) * u + np.array([0.0, 0.0, -math.cos(pitch)])
+    y = np.array([-u[1], u[0], 0.0])
+    return matrix_to_quat(np.column_stack([np.cross(y, z), y, z]))
+
+
+class Panda:
+    """The arm in one physics client. Joint values are numpy arrays of 7 floats."""
+
+    def __init__(self, bc: BulletClient) -> None:
+        self.bc = bc
+        bc.setAdditionalSearchPath(pybullet_data.getDataPath())
+        self.body = bc.loadURDF("franka_panda/panda.urdf", useFixedBase=True)
+        info = [bc.getJointInfo(self.body, j) for j in ARM]
+        self.lower = np.array([i[8] for i in info])
+        self.upper = np.array([i[9] for i in info])
+        self.grasp_constraint: int | None = None
+        self.held_body: int | None = None
+        self.held_offset: Pose | None = None
+        self.set_q(REST)
+        self.set_fingers(GRIPPER_MAX_OPENING)
+        self.hold_position()
+
+    # --- state -----------------------------------------------------------------------
+
+    def q(self) -> np.ndarray:
+        return np.array([s[0] for s in self.bc.getJointStates(self.body, ARM)])
+
+    def set_q(self, q: np.ndarray) -> None:
+        """Set the arm's joints directly; a held object is carried along."""
+        for j, v in zip(ARM, q, strict=True):
+            self.bc.resetJointState(self.body, j, float(v))
+        if self.held_body is not None:
+            pose = self.tcp().compose(self.held_offset)
+            self.bc.resetBasePositionAndOrientation(self.held_body, pose.position, pose.orientation)
+
+    def set_fingers(self, opening: float) -> None:
+        for j in FINGERS:
+            self.bc.resetJointState(self.body, j, opening / 2)
+
+    def finger_opening(self) -> float:
+        return float(sum(s[0] for s in self.bc.getJointStates(self.body, FINGERS)))
+
+    def tcp(self) -> Pose:
+        s = self.bc.getLinkState(self.body, TCP, computeForwardKinematics=True)
+        return Pose(tuple(s[4]), tuple(s[5]))
+
+    def hold_position(self, fingers: float | None = None) -> None:
+        """Motors hold the current joints (and finger opening) while physics steps."""
+        q = self.q()
+        self.bc.setJointMotorControlArray(
+            self.body, ARM, self.bc.POSITION_CONTROL, targetPositions=q, forces=[MOTOR_FORCE] * 7
+        )
+        opening = self.finger_opening() if fingers is None else fingers
+        self.bc.setJointMotorControlArray(
+            self.body,
+            FINGERS,
+            self.bc.POSITION_CONTROL,
+            targetPositions=[opening / 2] * 2,
+            forces=[40.0] * 2,
+        )
+
+    def drive_to(self, q: np.ndarray, steps: int) -> None:
+        """Position-control the arm towards q for a number of physics steps."""
+        self.bc.setJointMotorControlArray(
+            self.body, ARM, self.bc.POSITION_CONTROL, targetPositions=q, forces=[MOTOR_FORCE] * 7
+        )
+        for _ in range(steps):
+            self.bc.stepSimulation()
+
+    @contextlib.contextmanager
+    def preserved(self) -> Iterator[None]:
+        """Collision checks and IK move the arm; this puts it (and what it holds) back after."""
+        q = self.q()
+        try:
+            yield
+        finally:
+            self.set_q(q)
+
+    # --- kinematics --------------------------------------------------------------------
+
+    def ik(
+        self,
+        target: Pose,
+        rng: np.random.Generator,
+        seeds: list[np.ndarray] | None = None,
+        restarts: int = 4,
+    ) -> np.ndarray | None:
+        """Joints that put the TCP at `target`, or None. Tries the seeds, then random restarts.
+
+        The arm is left where it was; the result is clipped to the joint limits and checked by
+        forward kinematics, since PyBullet's solver returns its best effort without a verdict.
+        """
+        saved = self.q()
+        starts = list(seeds or []) + [REST]
+        starts += [rng.uniform(self.lower, self.upper) for _ in range(restarts)]
+        found = None
+        for start in starts:
+            self._set_arm(start)
+            sol = self.bc.calculateInverseKinematics(
+                self.body,
+                TCP,
+                target.position,
+                target.orientation,
+                lowerLimits=list(self.lower) + [0.0, 0.0],
+                upperLimits=list(self.upper) + [0.04, 0.04],
+                jointRanges=list(self.upper - self.lower) + [0.04, 0.04],
+                restPoses=list(start) + [0.02, 0.02],
+                maxNumIterations=IK_ITERATIONS,
+                residualThreshold=IK_THRESHOLD,
+            )
+            q = np.clip(np.array(sol[:7]), self.lower, self.upper)
+            self._set_arm(q)
+            if self._close_to(target):
+                found = q
+                break
+        self._set_arm(saved)
+        return found
+
+    def _set_arm(self, q: np.ndarray) -> None:
+        for j, v in zip(ARM, q, strict=True):
+            self.bc.resetJointState(self.body, j, float(v))
+
+    def _close_to(self, target: Pose) -> bool:
+        now = self.tcp()
+        if now.distance(target) > IK_POS_TOL:
+            return False
+        d = abs(float(np.dot(now.orientation, target.orientation)))
+        return 2 * math.acos(min(1.0, d)) < IK_ANG_TOL
+
+    # --- grasp ---------------------------------------------------------------------------
+
+    def attach(self, body: int) -> None:
+        """Fix the object to the hand where it is now (the fingers have closed on it)."""
+        obj = Pose(*self.bc.getBasePositionAndOrientation(body))
+        self.held_offset = obj.relative_to(self.tcp())
+        self.held_body = body
+        self.grasp_constraint = self.bc.createConstraint(
+            self.body,
+            TCP,
+            body,
+            -1,
+            self.bc.JOINT_FIXED,
+            (0, 0, 0),
+            self.held_offset.position,
+            (0, 0, 0),
+            self.held_offset.orientation,
+        )
+        self.bc.changeConstraint(self.grasp_constraint, maxForce=200.0)
+
+    def detach(self) -> None:
+        if self.grasp_constraint is not None:
+            self.bc.removeConstraint(self.grasp_constraint)
+        self.grasp_constraint = self.held_body = self.held_offset = None

@@ -1,0 +1,125 @@
+"""A kitchen-storage scene built from parts: arena, robot, objects, in one physics client.
+
+The client is created here and passed to every part; nothing in the package keeps a global one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+import pybullet
+from pybullet_utils.bullet_client import BulletClient
+
+from hsgplan.domain.objects import sort_objects
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.arena import Arena, build_arena
+from hsgplan.sim.bodies import spawn_object
+from hsgplan.sim.motion import CollisionChecker, MotionPlanner
+from hsgplan.sim.robot import Panda
+
+TIME_STEP = 1.0 / 240.0
+REST_SPEED = 0.01  # m/s: below this every object counts as at rest
+MAX_SETTLE_STEPS = 480
+
+
+class Scene:
+    """The world of one episode.
+
+    Args:
+        objects: object instance names; bodies are created at `poses` (or parked off-scene
+            until `set_pose`).
+        seed: seeds inverse-kinematics restarts and motion planning.
+    """
+
+    def __init__(self, objects: Iterable[str], seed: int = 0, poses: dict[str, Pose] | None = None):
+        self.bc = BulletClient(connection_mode=pybullet.DIRECT)
+        self.bc.setGravity(0, 0, -9.81)
+        self.bc.setTimeStep(TIME_STEP)
+        self.arena: Arena = build_arena(self.bc)
+        self.robot = Panda(self.bc)
+        names = sort_objects(objects)
+        poses = poses or {}
+        self.bodies: dict[str, int] = {}
+        for i, name in enumerate(names):
+            parked = Pose.from_xyz_yaw(-0.6 - 0.15 * (i % 4), -0.4 + 0.2 * (i // 4), 0.5)
+            self.bodies[name] = spawn_object(self.bc, name, poses.get(name, parked))
+        self.rng = np.random.default_rng(seed)
+        self.seed = seed
+
+    @property
+    def objects(self) -> tuple[str, ...]:
+        return tuple(self.bodies)
+
+    def close(self) -> None:
+        self.bc.disconnect()
+
+    def __enter__(self) -> Scene:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # --- poses -----------------------------------------------------------------------------
+
+    def pose(self, name: str) -> Pose:
+        pos, orn = self.bc.getBasePositionAndOrientation(self.bodies[name])
+        return Pose(tuple(pos), tuple(orn))
+
+    def set_pose(self, name: str, pose: Pose) -> None:
+        body = self.bodies[name]
+        self.bc.resetBasePositionAndOrientation(body, pose.position, pose.orientation)
+        self.bc.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0))
+
+    def poses(self) -> dict[str, Pose]:
+        return {n: self.pose(n) for n in self.bodies}
+
+    def held(self) -> str | None:
+        for name, body in self.bodies.items():
+            if body == self.robot.held_body:
+                return name
+        return None
+
+    def scene_graph(self) -> GeometricSceneGraph:
+        """s_g from the simulator's ground truth."""
+        return GeometricSceneGraph.from_poses(self.poses(), held=self.held())
+
+    # --- physics ---------------------------------------------------------------------------
+
+    def settle(self, max_steps: int = MAX_SETTLE_STEPS, min_steps: int = 24) -> int:
+        """Step physics with the arm held still until every free object is at rest."""
+        self.robot.hold_position()
+        for step in range(1, max_steps + 1):
+            self.bc.stepSimulation()
+            if step >= min_steps and step % 12 == 0 and self.at_rest():
+                return step
+        return max_steps
+
+    def at_rest(self) -> bool:
+        for body in self.bodies.values():
+            if body == self.robot.held_body:
+                continue
+            lin, ang = self.bc.getBaseVelocity(body)
+            if np.linalg.norm(lin) > REST_SPEED or np.linalg.norm(ang) > 10 * REST_SPEED:
+                return False
+        return True
+
+    def snapshot(self) -> int:
+        return self.bc.saveState()
+
+    def restore(self, state: int) -> None:
+        self.bc.restoreState(state)
+
+    # --- planning helpers --------------------------------------------------------------------
+
+    def checker(self, ignore: Iterable[str] = (), margin: float | None = None) -> CollisionChecker:
+        """A collision checker against the arena and every object but those ignored."""
+        skip = {self.bodies[n] for n in ignore}
+        obstacles = list(self.arena.obstacles) + [b for b in self.bodies.values() if b not in skip]
+        if margin is None:
+            return CollisionChecker(self.robot, obstacles)
+        return CollisionChecker(self.robot, obstacles, margin)
+
+    def motion_planner(self, ignore: Iterable[str] = ()) -> MotionPlanner:
+        return MotionPlanner(self.checker(ignore), seed=int(self.rng.integers(2**31)))
