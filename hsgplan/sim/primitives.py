@@ -14,10 +14,16 @@ from collections.abc import Callable
 
 import numpy as np
 
-from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams, PushParams
-from hsgplan.domain.parameters import place_xy, push_values
-from hsgplan.domain.world import GRIPPER_MAX_OPENING, SHELVES, SURFACES, Kind
 from hsgplan.domain.objects import object_type
+from hsgplan.domain.parameters import (
+    PickParams,
+    PlaceParams,
+    PrimitiveParams,
+    PushParams,
+    place_xy,
+    push_values,
+)
+from hsgplan.domain.world import GRIPPER_MAX_OPENING, SHELVES, SURFACES, Kind
 from hsgplan.scene_graph.geometry import Pose, yaw_quat
 from hsgplan.sim.motion import densify
 from hsgplan.sim.outcome import Outcome, Status, verify
