@@ -9,7 +9,6 @@ PUSH_DIST_BINS distances over PUSH_DIST_RANGE, both including their ends.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from hsgplan.domain.errors import InvalidInputError
@@ -55,10 +54,11 @@ def _check_bin(value: int, bins: int, what: str) -> None:
         raise InvalidInputError(f"{what} {value} is outside 0..{bins - 1}")
 
 
-def place_inset(obj: str) -> float:
-    """Half the object's footprint diagonal: it stays on the surface whatever its yaw."""
-    fx, fy = object_type(obj).footprint
-    return math.hypot(fx, fy) / 2 + PLACE_EDGE_GAP
+def place_inset(obj: str) -> tuple[float, float]:
+    """How far a bin centre stays from a surface's x and y edges: half the object's footprint
+    as it is placed (long side along y), plus a small gap."""
+    fx, fy = sorted(object_type(obj).footprint)
+    return fx / 2 + PLACE_EDGE_GAP, fy / 2 + PLACE_EDGE_GAP
 
 
 def place_xy(obj: str, target: str, x_bin: int, y_bin: int) -> tuple[float, float]:
@@ -67,9 +67,9 @@ def place_xy(obj: str, target: str, x_bin: int, y_bin: int) -> tuple[float, floa
         raise InvalidInputError(f"place bins are over surfaces, not '{target}'")
     _check_bin(x_bin, PLACE_BINS, "x_bin")
     _check_bin(y_bin, PLACE_BINS, "y_bin")
-    r, inset = surface_rect(target), place_inset(obj)
-    x0, x1 = r.x_min + inset, r.x_max - inset
-    y0, y1 = r.y_min + inset, r.y_max - inset
+    r, (ix, iy) = surface_rect(target), place_inset(obj)
+    x0, x1 = r.x_min + ix, r.x_max - ix
+    y0, y1 = r.y_min + iy, r.y_max - iy
     if x1 < x0:
         x0 = x1 = (r.x_min + r.x_max) / 2
     if y1 < y0:

@@ -139,10 +139,12 @@ REGIONS: dict[str, Rect] = {
 
 # --- derived limits, shared by the validator, the transition model and the PDDL domain ---
 
-# The square each resting object is given when a surface is counted: a can plus room for the
-# fingers on both sides; the long boxes fit two to a pair of spots when turned side by side.
-# Counting spots (not areas) keeps capacities small integers that the PDDL domain can encode.
-SPOT = 0.10
+# The cell each resting object is given when a surface is counted: the grid of SPOT cells that
+# fits on a surface, with objects resting long side along y (`PLACE_LONG_AXIS_YAW`), leaves
+# every object at least 1.5 cm of room for the open fingers. Measured: with 10 cm cells two
+# boxes (10.4 cm) cannot lie in a 22 cm deep shelf top with that room. Counting cells (not
+# areas) keeps capacities small integers that the PDDL domain can encode.
+SPOT = 0.11
 
 # A top face narrower than this does not hold another object steadily (popcorn's 3.8 cm does not).
 MIN_SUPPORT_SIDE = 0.045
@@ -210,6 +212,9 @@ def fits_inside(type_name: str, shelf: str) -> bool:
 # --- motion primitive parameters (the paper's discretisation) ---
 
 PLACE_BINS = 10  # x and y bins over the target region or shelf top
+# Objects are placed with the long side of their footprint (local y) along world y: the shelf
+# tops are wider (y) than deep (x), and the fingers then close along x, clear of the shelf walls.
+PLACE_LONG_AXIS_YAW = 0.0
 PUSH_ANGLE_BINS = 21
 PUSH_DIST_BINS = 21
 # Push direction, in radians from +x (shelves open towards -x, so pushes go roughly along +x).

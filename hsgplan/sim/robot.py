@@ -112,11 +112,12 @@ class Panda:
 
     @contextlib.contextmanager
     def preserved(self) -> Iterator[None]:
-        """Collision checks and IK move the arm; this puts it (and what it holds) back after."""
-        q = self.q()
+        """Checks and IK move the arm and fingers; this puts them (and what is held) back after."""
+        q, opening = self.q(), self.finger_opening()
         try:
             yield
         finally:
+            self.set_fingers(opening)
             self.set_q(q)
 
     # --- kinematics --------------------------------------------------------------------

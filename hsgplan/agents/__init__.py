@@ -1,0 +1,1 @@
+"""Agents: what decides the next primitive and its parameters from an observation."""

@@ -1,0 +1,1 @@
+"""Episodes, metrics, failure taxonomy and reports."""

@@ -1,0 +1,106 @@
+"""One closed-loop episode: observe, decide, execute, until the goal holds or it cannot go on.
+
+Every episode records its seed; the same seed, goal and agent give the same record (timings
+aside).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+
+from hsgplan.agents.base import Agent
+from hsgplan.domain.goals import Goal
+from hsgplan.scene_graph.symbol_mapping import AnomalyKind
+from hsgplan.sim.env import KitchenStorageEnv, Observation, ResetOptions
+
+# Failure kinds of an episode (None when it succeeded).
+OVERSTEP = "overstep"  # the step limit came first
+NO_PLAN = "no_plan"  # the task planner found no next action
+NO_PARAMETERS = "no_parameters"  # every parameter choice for the next action had failed
+_FATAL = {AnomalyKind.TOPPLED: "knocked_over", AnomalyKind.OFF_TABLE: "off_table"}
+
+
+@dataclass(frozen=True)
+class StepRecord:
+    step: int
+    action: str
+    params: str
+    status: str
+    detail: str
+    task_seconds: float
+    motion_seconds: float
+    execution_seconds: float
+
+
+@dataclass(frozen=True)
+class EpisodeRecord:
+    seed: int
+    agent: str
+    goal: str
+    size: int
+    success: bool
+    subgoal_completion: float
+    failure: str | None
+    steps: tuple[StepRecord, ...]
+    seconds: float
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+    @staticmethod
+    def from_json(d: dict) -> EpisodeRecord:
+        return EpisodeRecord(**{**d, "steps": tuple(StepRecord(**s) for s in d["steps"])})
+
+
+def params_text(params) -> str:
+    fields = ", ".join(f"{k}={v}" for k, v in asdict(params).items() if v is not None)
+    return f"{type(params).__name__.removesuffix('Params').lower()}({fields})"
+
+
+def run_episode(
+    env: KitchenStorageEnv,
+    agent: Agent,
+    goal: Goal,
+    seed: int,
+    on_frame: Callable[[], None] | None = None,
+    on_step: Callable[[StepRecord | None, Observation], None] | None = None,
+) -> EpisodeRecord:
+    """Run one episode; `on_step` sees the start (record None) and every step after it."""
+    start = time.perf_counter()
+    obs, _ = env.reset(seed, ResetOptions(goal))
+    agent.reset(goal, seed)
+    if on_step:
+        on_step(None, obs)
+    records: list[StepRecord] = []
+    failure = None
+    while not goal.satisfied_by(obs.symbols.state):
+        fatal = [a for a in obs.symbols.anomalies if a.kind in _FATAL]
+        if fatal:
+            failure = _FATAL[fatal[0].kind]
+            break
+        if env.steps >= env.max_steps:
+            failure = OVERSTEP
+            break
+        d = agent.decide(obs.scene_graph, obs.symbols.state, goal, feasible=env.check)
+        if d.params is None:
+            failure = NO_PLAN if d.action is None else NO_PARAMETERS
+            break
+        obs, _, _, _, info = env.step(d.params, on_frame)
+        outcome = info["outcome"]
+        agent.observe(d.params, outcome)
+        record = StepRecord(
+            len(records) + 1, str(d.action), params_text(d.params), outcome.status.value,
+            outcome.detail, d.task_seconds, d.motion_seconds, outcome.seconds,
+        )
+        records.append(record)
+        if on_step:
+            on_step(record, obs)
+    state = obs.symbols.state
+    done = sum(state.holds(lit) for lit in goal.literals)
+    env.close()
+    return EpisodeRecord(
+        seed, agent.name, str(goal), goal.size, failure is None, done / len(goal.literals),
+        failure, tuple(records), time.perf_counter() - start,
+    )

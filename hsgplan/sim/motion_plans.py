@@ -1,0 +1,221 @@
+"""The planning half of each primitive: inverse kinematics, approach lines and the transit or
+transfer path, computed without moving anything.
+
+Planning is separate from execution so that a parameter choice can be checked (a dry run)
+before it is spent, and so that execution replays exactly what was checked.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from hsgplan.domain.objects import object_type
+from hsgplan.domain.parameters import (
+    PickParams,
+    PlaceParams,
+    PrimitiveParams,
+    place_xy,
+    push_values,
+)
+from hsgplan.domain.predicates import Literal, in_grasp, inside, on
+from hsgplan.domain.world import (
+    GRIPPER_MAX_OPENING,
+    PLACE_LONG_AXIS_YAW,
+    REGIONS,
+    SHELVES,
+    SURFACES,
+    Kind,
+    surface_rect,
+)
+from hsgplan.scene_graph.geometry import Pose, yaw_quat
+from hsgplan.sim.outcome import Status
+from hsgplan.sim.robot import REST, TIP_OFFSET, tilted, topdown
+from hsgplan.sim.scene import Scene
+
+APPROACH = 0.10  # m above a grasp or place pose where the straight final approach starts
+GRASP_DEPTH = 0.035  # fingertips this far below an object's top, at most
+FLOOR_GAP = 0.008  # and at least this far above what it stands on
+DROP = 0.006  # a placed object is released this far above its support
+PUSH_PITCH = math.radians(60)  # the hand leans forward to push (measured: upright hits boards)
+PUSH_TIP_Z = 0.03
+PUSH_STEP = 0.005
+PUSH_LEAD = 0.01  # the fingertip starts this far behind the object
+MAX_JOINT_JUMP = 0.3  # rad between neighbouring push waypoints: more means an IK branch flip
+
+
+@dataclass(frozen=True)
+class MotionPlan:
+    """Everything execution needs: the path to `q_above`, the straight approach to `q_at`,
+    and for a push the joints along the push line. `grip` is the finger opening to close to."""
+
+    params: PrimitiveParams
+    expected: Literal
+    path: tuple[np.ndarray, ...]
+    q_above: np.ndarray
+    q_at: np.ndarray
+    line: tuple[np.ndarray, ...] = ()
+    grip: float = 0.0
+    push_direction: tuple[float, float] = (1.0, 0.0)
+
+
+@dataclass(frozen=True)
+class PlanFailure:
+    status: Status
+    detail: str
+
+
+def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFailure:
+    """Plan a primitive from the scene as it is; the scene is left unchanged."""
+    # Checks move the arm: every query below starts from these joints, not from wherever the
+    # last check left it.
+    q0 = scene.robot.q()
+    with scene.robot.preserved():
+        if isinstance(params, PickParams):
+            return _plan_pick(scene, params, q0)
+        if isinstance(params, PlaceParams):
+            return _plan_place(scene, params, q0)
+        return _plan_push(scene, params, q0)
+
+
+def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
+    """IK for a pose and for the pose APPROACH above it, with a free straight segment between."""
+    above = Pose((target.position[0], target.position[1], target.position[2] + APPROACH),
+                 target.orientation)
+    # The rest pose first: it keeps the arm in one well-conditioned elbow-up branch, from which
+    # the straight approach and push lines stay reachable; the current joints come second.
+    q_above = scene.robot.ik(above, scene.rng, seeds=seeds)
+    if q_above is None:
+        return None
+    q_at = scene.robot.ik(target, scene.rng, seeds=[q_above])
+    if q_at is None:
+        return None
+    near = scene.checker(ignore=ignore, margin=0.001)
+    if near.collides(q_above) or not near.segment_free(q_above, q_at):
+        return None
+    return q_above, q_at
+
+
+def _path(scene: Scene, q0: np.ndarray, q_goal: np.ndarray, ignore=()):
+    path = scene.motion_planner(ignore).plan(q0, q_goal)
+    return None if path is None else tuple(path)
+
+
+def _plan_pick(scene: Scene, p: PickParams, q0: np.ndarray) -> MotionPlan | PlanFailure:
+    if p.obj not in scene.bodies:
+        return PlanFailure(Status.INVALID, f"'{p.obj}' is not in the scene")
+    if scene.robot.held_body is not None:
+        return PlanFailure(Status.INVALID, f"the gripper already holds '{scene.held()}'")
+    scene.robot.set_fingers(GRIPPER_MAX_OPENING)  # checked as executed: the hand opens first
+    t, pose = object_type(p.obj), scene.pose(p.obj)
+    top = pose.position[2] + t.height / 2
+    tip_z = max(top - GRASP_DEPTH, top - t.height + FLOOR_GAP)
+    if t.kind is Kind.BOX:
+        yaws = [pose.yaw, pose.yaw + math.pi]  # close across the box's narrow (local x) side
+    else:
+        radial = math.atan2(pose.position[1], pose.position[0]) + math.pi / 2
+        yaws = [radial + k * math.pi / 4 for k in (0, 1, -1, 2)]
+    for yaw in yaws:
+        grasp = Pose((pose.position[0], pose.position[1], tip_z + TIP_OFFSET), topdown(yaw))
+        found = _approach(scene, grasp, (p.obj,), [REST, q0])
+        if found:
+            path = _path(scene, q0, found[0])
+            if path is None:
+                return PlanFailure(Status.NO_PATH, f"no path to above '{p.obj}'")
+            return MotionPlan(p, in_grasp(p.obj), path, *found, grip=max(0.0, t.grasp_width - 0.002))
+    return PlanFailure(Status.NO_IK, f"no collision-free grasp of '{p.obj}'")
+
+
+def _plan_place(scene: Scene, p: PlaceParams, q0: np.ndarray) -> MotionPlan | PlanFailure:
+    if scene.held() != p.obj:
+        return PlanFailure(Status.INVALID, f"'{p.obj}' is not held")
+    t = object_type(p.obj)
+    if p.target in SURFACES:
+        if p.x_bin is None or p.y_bin is None:
+            return PlanFailure(Status.INVALID, f"placing on '{p.target}' needs x and y bins")
+        x, y = place_xy(p.obj, p.target, p.x_bin, p.y_bin)
+        z = surface_rect(p.target).z
+        # The convention first (long side along y), so the bins' insets hold; turned as needed.
+        turns = (0, 2, 1, -1) if t.kind is Kind.BOX else (0, 1, 2, -1, 0.5, -0.5)
+        yaws = [PLACE_LONG_AXIS_YAW + k * math.pi / 2 for k in turns]
+    elif p.target in scene.bodies and p.target != p.obj:
+        base = scene.pose(p.target)
+        x, y = base.position[:2]
+        z = base.position[2] + object_type(p.target).height / 2
+        yaws = [base.yaw + k * math.pi / 2 for k in (0, 1, -1, 2)]
+    else:
+        return PlanFailure(Status.INVALID, f"'{p.target}' is neither a surface nor another object")
+    offset = scene.robot.held_offset
+    for yaw in yaws:
+        obj_pose = Pose((x, y, z + t.height / 2 + DROP), yaw_quat(yaw))
+        found = _approach(scene, obj_pose.compose(offset.inverse()), (p.obj,), [REST, q0])
+        if found:
+            path = _path(scene, q0, found[0], ignore=(p.obj,))
+            if path is None:
+                return PlanFailure(Status.NO_PATH, f"no path to above the place pose of '{p.obj}'")
+            return MotionPlan(p, on(p.obj, p.target), path, *found)
+    return PlanFailure(Status.NO_IK, f"no collision-free way to place '{p.obj}' there")
+
+
+def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
+    if p.obj not in scene.bodies:
+        return PlanFailure(Status.INVALID, f"'{p.obj}' is not in the scene")
+    if scene.robot.held_body is not None:
+        return PlanFailure(Status.INVALID, "the gripper is holding something")
+    shelf = prepush_shelf(scene.pose(p.obj))
+    if shelf is None:
+        return PlanFailure(Status.INVALID, f"'{p.obj}' is not on a prepush region")
+    angle, dist = push_values(p.angle_bin, p.dist_bin)
+    u = np.array([math.cos(angle), math.sin(angle), 0.0])
+    pose, t = scene.pose(p.obj), object_type(p.obj)
+    orn = tilted(angle, PUSH_PITCH)
+    axis = Pose((0, 0, 0), orn).rotation[:, 2]
+    start = np.array([*pose.position[:2], min(PUSH_TIP_Z, t.height / 2)])
+    tip0 = start - (extent_along(p.obj, pose.yaw, angle) + PUSH_LEAD) * u
+    tcp = [
+        Pose(tuple(tip0 + u * s - TIP_OFFSET * axis), orn)
+        for s in np.arange(0.0, dist + 1e-9, PUSH_STEP)
+    ]
+    robot = scene.robot
+    robot.set_fingers(0.0)  # checked as executed: the hand pushes with closed fingers
+    random_seeds = [[scene.rng.uniform(robot.lower, robot.upper)] for _ in range(2)]
+    for seeds in [[REST], [q0], *random_seeds]:
+        found = _approach(scene, tcp[0], (p.obj,), seeds)
+        line = found and _line(scene, tcp[1:], found[1])
+        if line:
+            path = _path(scene, q0, found[0])
+            if path is None:
+                return PlanFailure(Status.NO_PATH, f"no path to above the push start of '{p.obj}'")
+            return MotionPlan(p, inside(p.obj, shelf), path, *found, line=tuple(line),
+                              push_direction=(float(u[0]), float(u[1])))
+    return PlanFailure(Status.NO_PATH, f"no reachable, collision-free push line for '{p.obj}'")
+
+
+def _line(scene: Scene, poses: list[Pose], q_start: np.ndarray) -> list[np.ndarray] | None:
+    """Joints along a Cartesian line, each seeded by the last; None if any is out of reach."""
+    qs, arena = [q_start], scene.checker(ignore=scene.objects, margin=0.0)
+    for target in poses:
+        q = scene.robot.ik(target, scene.rng, seeds=[qs[-1]], restarts=0)
+        if q is None or arena.collides(q) or np.max(np.abs(q - qs[-1])) > MAX_JOINT_JUMP:
+            return None
+        qs.append(q)
+    return qs[1:]
+
+
+def prepush_shelf(pose: Pose) -> str | None:
+    """The shelf whose prepush region an object stands on, if any."""
+    for name, s in SHELVES.items():
+        if REGIONS[s.prepush].contains(*pose.position[:2], margin=0.01):
+            return name
+    return None
+
+
+def extent_along(obj: str, yaw: float, angle: float) -> float:
+    """How far the object reaches from its centre in a horizontal direction."""
+    t = object_type(obj)
+    if t.kind is Kind.CAN:
+        return t.size[0] / 2
+    rel = angle - yaw
+    return abs(math.cos(rel)) * t.size[0] / 2 + abs(math.sin(rel)) * t.size[1] / 2

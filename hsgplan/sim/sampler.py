@@ -1,0 +1,118 @@
+"""Seeded random initial configurations: collision-free, at rest, and mapping back to the
+symbolic arrangement they were drawn from.
+
+The arrangement is drawn symbolically first (`domain.generator.random_state`: mostly on the open
+space, some stacked or on a shelf top, so that `Clear` matters), then each object gets a pose:
+a free spot on its surface, found by rejection sampling against the bodies already placed, or
+the centre of the object it is stacked on. After physics settles, f_m must give back the drawn
+arrangement; otherwise the draw is repeated with the next attempt's random numbers.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.generator import random_state
+from hsgplan.domain.objects import EntityKind, kind_of, object_type
+from hsgplan.domain.parameters import place_inset
+from hsgplan.domain.predicates import Predicate
+from hsgplan.domain.world import surface_rect
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.scene_graph.symbol_mapping import map_symbols
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.scene import Scene
+
+SPOT_TRIES = 300
+ATTEMPTS = 20
+# Free space kept around each object so that open fingers (8 cm across) fit beside it.
+GAP = 0.02
+STACK_JITTER = 0.005
+
+
+def sample_scene(
+    objects: tuple[str, ...], seed: int, p_elsewhere: float = 0.3
+) -> tuple[Scene, SymbolicSceneGraph]:
+    """A settled scene for the objects and the symbolic state it is in.
+
+    The same seed gives the same scene: every random number comes from `seed`.
+    """
+    rng = random.Random(f"scene-{seed}")
+    for attempt in range(ATTEMPTS):
+        state = random_state(objects, rng, p_elsewhere=p_elsewhere)
+        scene = Scene(objects, seed=seed)
+        if _place_all(scene, state, rng) and _settled_as(scene, state):
+            return scene, state
+        scene.close()
+    raise InvalidInputError(
+        f"no collision-free arrangement of {len(objects)} objects found in {ATTEMPTS} attempts "
+        f"(seed {seed})"
+    )
+
+
+def _place_all(scene: Scene, state: SymbolicSceneGraph, rng: random.Random) -> bool:
+    placed: list[str] = []
+    # Supports before what stands on them: by tower level.
+    for obj in sorted(state.objects, key=state.level):
+        below = state.location(obj).args[1]
+        if kind_of(below) is EntityKind.OBJECT:
+            pose = _stacked_pose(scene, obj, below, rng)
+        else:
+            pose = _free_spot(scene, obj, below, placed, rng)
+            if pose is None:
+                return False
+        scene.set_pose(obj, pose)
+        placed.append(obj)
+    return True
+
+
+def _stacked_pose(scene: Scene, obj: str, base: str, rng: random.Random) -> Pose:
+    b = scene.pose(base)
+    top = b.position[2] + object_type(base).height / 2
+    jitter = [rng.uniform(-STACK_JITTER, STACK_JITTER) for _ in range(2)]
+    yaw = b.yaw + rng.choice([0.0, math.pi / 2])
+    return Pose.from_xyz_yaw(
+        b.position[0] + jitter[0], b.position[1] + jitter[1],
+        top + object_type(obj).height / 2 + 0.001, yaw,
+    )
+
+
+def _free_spot(
+    scene: Scene, obj: str, surface: str, placed: list[str], rng: random.Random
+) -> Pose | None:
+    r = surface_rect(surface)
+    inset = max(place_inset(obj))  # any yaw may be drawn: keep the long half-side from edges
+    z = r.z + object_type(obj).height / 2 + 0.001
+    for _ in range(SPOT_TRIES):
+        x = rng.uniform(r.x_min + inset, r.x_max - inset)
+        y = rng.uniform(r.y_min + inset, r.y_max - inset)
+        pose = Pose.from_xyz_yaw(x, y, z, rng.uniform(-math.pi, math.pi))
+        scene.set_pose(obj, pose)
+        if not any(
+            scene.bc.getClosestPoints(scene.bodies[obj], scene.bodies[o], GAP) for o in placed
+        ) and not _touches_arena(scene, obj):
+            return pose
+    return None
+
+
+def _touches_arena(scene: Scene, obj: str) -> bool:
+    body = scene.bodies[obj]
+    return any(
+        scene.bc.getClosestPoints(body, part, 0.005)
+        for parts in scene.arena.shelves.values()
+        for part in parts
+    )
+
+
+def _settled_as(scene: Scene, state: SymbolicSceneGraph) -> bool:
+    scene.settle()
+    mapping = map_symbols(scene.scene_graph())
+    if mapping.anomalies:
+        return False
+    return all(
+        mapping.state.location(o) == state.location(o)
+        for o in state.objects
+        if state.location(o).predicate is not Predicate.CLEAR
+    )
+
