@@ -122,4 +122,4 @@ class Scene:
         return CollisionChecker(self.robot, obstacles, margin)
 
     def motion_planner(self, ignore: Iterable[str] = ()) -> MotionPlanner:
-        return MotionPlanner(self.checker(ignore), seed=int(self.rng.integers(2**31)))
+        return MotionPlanner(self.checker(ignore))

@@ -3,6 +3,7 @@ import pytest
 from hsgplan.domain.errors import InfeasibleError, InvalidInputError, UnknownNameError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file, write_goal_file
 from hsgplan.domain.predicates import Literal, Predicate, clear, in_grasp, inside, on
+from hsgplan.domain.world import SURFACE_CAPACITY
 
 
 def test_separators_and_spacing():
@@ -100,8 +101,11 @@ HOSTILE = [
         "interior holds at most 3",
     ),
     (
-        " & ".join(f"On(cherries{'' if k == 1 else f'_{k}'}, shelf_b)" for k in range(1, 8)),
-        "holds at most 6",
+        " & ".join(
+            f"On(cherries{'' if k == 1 else f'_{k}'}, shelf_b)"
+            for k in range(1, SURFACE_CAPACITY["shelf_b"] + 2)
+        ),
+        f"holds at most {SURFACE_CAPACITY['shelf_b']}",
     ),
     (
         " & ".join(f"On(butter{'' if k == 1 else f'_{k}'}, prepush_a)" for k in range(1, 4)),
