@@ -38,7 +38,10 @@ class Agent(Protocol):
         """A new episode towards `goal`."""
 
     def decide(
-        self, sg: GeometricSceneGraph, state: SymbolicSceneGraph, goal: Goal,
+        self,
+        sg: GeometricSceneGraph,
+        state: SymbolicSceneGraph,
+        goal: Goal,
         feasible: Feasibility | None = None,
     ) -> Decision:
         """The next primitive from the observation (s_g) and its symbolic reading (s_s).

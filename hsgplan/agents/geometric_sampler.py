@@ -12,10 +12,12 @@ import math
 
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.parameters import (
+    PUSH_LEAD,
     PickParams,
     PlaceParams,
     PrimitiveParams,
     PushParams,
+    extent_along,
     nearest_push_bins,
     place_xy,
 )
@@ -27,17 +29,23 @@ from hsgplan.domain.world import (
     SHELVES,
     SPOT,
     SURFACES,
+    Kind,
     Rect,
+    spot_cells,
     surface_rect,
 )
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 
-MIN_CLEARANCE = 0.015  # m between footprints (as circles) for a bin to be considered at all
+MIN_CLEARANCE = 0.015
+# The Panda hand, measured in PyBullet: about 21 cm long along the finger axis and 6 cm across,
+# its lowest part some 6 cm above the fingertips, which reach at most 3.5 cm below a top.
+HAND_HALF_LENGTH = 0.105
+HAND_HALF_WIDTH = 0.03
+HAND_DROP = 0.02  # m between footprints (as circles) for a bin to be considered at all
 # How far past the open front the pushed object's near side ends: inside, and shallow enough
 # that the leaning hand stays out of the shelf (measured: 21 cm across, it meets the side walls
 # once the fingertips go deeper than about 2 cm at the outer slots).
 PUSH_DEPTH = 0.02
-PUSH_LEAD = 0.01  # the fingertip starts this far behind the object
 
 
 def _half_extents(obj: str, yaw: float) -> tuple[float, float]:
@@ -47,12 +55,28 @@ def _half_extents(obj: str, yaw: float) -> tuple[float, float]:
     return (c * fx + s * fy) / 2, (s * fx + c * fy) / 2
 
 
-def spot_cells(rect: Rect) -> list[tuple[float, float]]:
-    """Centres of the SPOT cells a surface is counted in (its capacity), centred on it."""
-    nx, ny = int(rect.width_x // SPOT), int(rect.width_y // SPOT)
-    x0 = rect.center[0] - nx * SPOT / 2
-    y0 = rect.center[1] - ny * SPOT / 2
-    return [(x0 + SPOT * (i + 0.5), y0 + SPOT * (j + 0.5)) for i in range(nx) for j in range(ny)]
+def _hand_conflict(a, b) -> bool:
+    """Whether grasping or placing the lower of two objects would sweep the hand into the other.
+
+    Each is (x, y, half x, half y, top z, box yaw or None). The hand is long along the finger
+    axis, which for a box is fixed (across its narrow side); a can can be grasped from any side,
+    so only boxes are at risk. A neighbour matters when it rises above the lower object's top by
+    more than the fingers reach down.
+    """
+    low, high = (a, b) if a[4] <= b[4] else (b, a)
+    if low[5] is None or high[4] - low[4] < HAND_DROP:
+        return False
+    c, s = math.cos(low[5]), math.sin(low[5])
+    dx, dy = high[0] - low[0], high[1] - low[1]
+    along, across = abs(c * dx + s * dy), abs(-s * dx + c * dy)
+    reach = max(high[2], high[3])
+    return along < HAND_HALF_LENGTH + reach and across < HAND_HALF_WIDTH + reach
+
+
+def _standing(name: str, x: float, y: float, yaw: float, bottom: float):
+    t = object_type(name)
+    box_yaw = yaw if t.kind is Kind.BOX else None
+    return (x, y, *_half_extents(name, yaw), bottom + t.height, box_yaw)
 
 
 def interior_slots(shelf: str) -> list[float]:
@@ -65,22 +89,26 @@ def interior_slots(shelf: str) -> list[float]:
 def free_slots(sg: GeometricSceneGraph, shelf: str, ignore: str = "") -> list[float]:
     r = SHELVES[shelf].interior
     taken = [
-        n.pose.position[1] for n in sg.nodes
+        n.pose.position[1]
+        for n in sg.nodes
         if n.name != ignore and r.contains(*n.pose.position[:2]) and n.pose.position[2] < r.z + 0.1
     ]
     return [y for y in interior_slots(shelf) if all(abs(y - t) > 0.05 for t in taken)]
 
 
-def _on_rect(
-    sg: GeometricSceneGraph, rect: Rect, ignore: str
-) -> list[tuple[float, float, float, float]]:
-    """(x, y, half x, half y) of the objects standing on a rectangle's level within it."""
-    out = []
+def _on_rect(sg: GeometricSceneGraph, rect: Rect, ignore: str) -> tuple[list, list]:
+    """`_standing` tuples of the objects resting on a rectangle, and of all objects above it
+    (towers included, whose tops decide what the hand can sweep past)."""
+    resting, above = [], []
     for n in sg.nodes:
         x, y, _ = n.pose.position
-        if n.name != ignore and rect.contains(x, y, margin=0.05) and abs(n.bottom_z - rect.z) < 0.03:
-            out.append((x, y, *_half_extents(n.name, n.pose.yaw)))
-    return out
+        if n.name == ignore or not rect.contains(x, y, margin=0.05) or n.bottom_z < rect.z - 0.03:
+            continue
+        item = _standing(n.name, x, y, n.pose.yaw, n.bottom_z)
+        above.append(item)
+        if n.bottom_z < rect.z + 0.03:
+            resting.append(item)
+    return resting, above
 
 
 def place_candidates(
@@ -88,18 +116,20 @@ def place_candidates(
 ) -> list[PlaceParams]:
     """Place bins on a surface, best first; bins too close to other objects are left out.
 
-    Bins are ranked by how close they come to the centre of a free spot cell (so that the
-    surface's whole capacity stays usable) or, on a prepush region before a push, by how well
-    they line up with a free slot inside the shelf.
+    Bins where the hand would sweep into a taller neighbour (or a tall object would block a
+    box's later grasp) go last. Otherwise bins are ranked by how close they come to the centre
+    of a free spot cell (so that the surface's whole capacity stays usable) or, on a prepush
+    region before a push, by how well they line up with a free slot inside the shelf.
     """
     if target not in SURFACES:
         return [PlaceParams(obj, target)]
     rect = surface_rect(target)
-    others = _on_rect(sg, rect, ignore=obj)
+    others, above = _on_rect(sg, rect, ignore=obj)
     hx, hy = _half_extents(obj, PLACE_LONG_AXIS_YAW)
     free = [
-        c for c in spot_cells(rect)
-        if all(abs(c[0] - ox) > SPOT / 2 or abs(c[1] - oy) > SPOT / 2 for ox, oy, _, _ in others)
+        c
+        for c in spot_cells(rect)
+        if all(abs(c[0] - o[0]) > SPOT / 2 or abs(c[1] - o[1]) > SPOT / 2 for o in others)
     ]
     slots = []
     if next_push:
@@ -110,30 +140,33 @@ def place_candidates(
         for yb in range(PLACE_BINS):
             x, y = place_xy(obj, target, xb, yb)
             gap = min(
-                (max(abs(x - ox) - hx - ohx, abs(y - oy) - hy - ohy) for ox, oy, ohx, ohy in others),
+                (max(abs(x - o[0]) - hx - o[2], abs(y - o[1]) - hy - o[3]) for o in others),
                 default=1.0,
             )
             if gap < MIN_CLEARANCE:
                 continue
+            me = _standing(obj, x, y, PLACE_LONG_AXIS_YAW, rect.z)
+            blocked = any(_hand_conflict(me, o) for o in above)
             if slots:
                 cost = min(abs(y - s) for s in slots) + 0.3 * abs(x - rect.center[0])
             elif free:
                 cost = min(math.hypot(x - cx, y - cy) for cx, cy in free)
             else:
                 cost = -min(gap, 0.1)
-            ranked.append((cost, xb, yb))
-    return [PlaceParams(obj, target, xb, yb) for _, xb, yb in sorted(ranked)]
+            ranked.append((blocked, cost, xb, yb))
+    return [PlaceParams(obj, target, xb, yb) for _, _, xb, yb in sorted(ranked)]
 
 
 def push_candidates(sg: GeometricSceneGraph, obj: str, shelf: str) -> list[PushParams]:
     """Pushes aimed at the free interior slots, nearest slot first."""
     x, y, _ = sg.pose(obj).position
     r = SHELVES[shelf].interior
-    reach = max(_half_extents(obj, sg.pose(obj).yaw))
+    yaw = sg.pose(obj).yaw
     slots = sorted(free_slots(sg, shelf, ignore=obj), key=lambda s: abs(s - y))
     out = []
     for slot in slots:
-        tx = r.x_min + PUSH_DEPTH + reach
+        straight = math.atan2(slot - y, r.x_min - x)
+        tx = r.x_min + PUSH_DEPTH + extent_along(obj, yaw, straight)
         angle = math.atan2(slot - y, tx - x)
         dist = math.hypot(tx - x, slot - y) + PUSH_LEAD
         out.append(PushParams(obj, *nearest_push_bins(angle, dist)))
@@ -147,6 +180,8 @@ def candidates(
     if isinstance(action, Pick):
         return [PickParams(action.obj)]
     if isinstance(action, Place):
-        next_push = isinstance(following, Push) and action.target == SHELVES[following.shelf].prepush
+        next_push = (
+            isinstance(following, Push) and action.target == SHELVES[following.shelf].prepush
+        )
         return list(place_candidates(sg, action.obj, action.target, next_push))
     return list(push_candidates(sg, action.obj, action.shelf))

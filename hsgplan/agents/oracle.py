@@ -1,7 +1,10 @@
-"""The oracle: Fast Downward's next action, parameters from geometry, replanning every step.
+"""The oracle: Fast Downward's next action, parameters from geometry, closed loop.
 
-It measures the world (what a planner that knows the rules can achieve in it) and is the
-ceiling the learned agents are compared against.
+After every primitive it compares the observed symbolic state with the state its plan
+predicted: when they agree it goes on with the rest of the plan (a suffix of a shortest plan is
+a shortest plan from there, so Fast Downward would answer the same), and when they differ it
+plans again from what it sees. It measures the world (what a planner that knows the rules can
+achieve in it) and is the ceiling the learned agents are compared against.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ from hsgplan.agents.base import Decision, Feasibility
 from hsgplan.agents.geometric_sampler import candidates
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
-from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
+from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError, Plan
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.outcome import Outcome, Status
@@ -29,19 +32,26 @@ class OracleAgent:
     def __init__(self, planner: FastDownwardPlanner | None = None) -> None:
         self.planner = planner or FastDownwardPlanner()
         self.failed: set[PrimitiveParams] = set()
+        self.plan: Plan | None = None
 
     def reset(self, goal: Goal, seed: int) -> None:
         self.failed = set()
+        self.plan = None
 
     def decide(
-        self, sg: GeometricSceneGraph, state: SymbolicSceneGraph, goal: Goal,
+        self,
+        sg: GeometricSceneGraph,
+        state: SymbolicSceneGraph,
+        goal: Goal,
         feasible: Feasibility | None = None,
     ) -> Decision:
         t0 = time.perf_counter()
-        try:
-            plan = self.planner.plan(state, goal)
-        except NoPlanError as e:
-            return Decision(None, None, time.perf_counter() - t0, 0.0, f"no plan: {e}")
+        plan = self._remaining(state)
+        if plan is None:
+            try:
+                plan = self.plan = self.planner.plan(state, goal)
+            except NoPlanError as e:
+                return Decision(None, None, time.perf_counter() - t0, 0.0, f"no plan: {e}")
         t1 = time.perf_counter()
         if not plan.actions:
             return Decision(None, None, t1 - t0, 0.0, "the goal holds")
@@ -53,6 +63,13 @@ class OracleAgent:
         )
         note = "" if params else f"every parameter choice for {plan.actions[0]} failed"
         return Decision(plan.actions[0], params, t1 - t0, time.perf_counter() - t1, note)
+
+    def _remaining(self, state: SymbolicSceneGraph) -> Plan | None:
+        """The rest of the current plan, if the state is one the plan passes through."""
+        if self.plan is None or state not in self.plan.states[:-1]:
+            return None
+        i = self.plan.states.index(state)
+        return Plan(self.plan.actions[i:], self.plan.states[i:], 0.0, self.plan.planner)
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
         if outcome.status in _DO_NOT_RETRY:

@@ -4,11 +4,13 @@
 inset so that the object, whichever way it is turned, stays wholly on it. Stacking on an object
 takes its position from geometry instead (the bins are None).
 `push(o, angle_bin, dist_bin)`: PUSH_ANGLE_BINS directions over PUSH_ANGLE_RANGE and
-PUSH_DIST_BINS distances over PUSH_DIST_RANGE, both including their ends.
+PUSH_DIST_BINS distances over PUSH_DIST_RANGE, both including their ends. The distance is the
+fingertip's travel; it starts PUSH_LEAD behind the object, so the object moves PUSH_LEAD less.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from hsgplan.domain.errors import InvalidInputError
@@ -20,10 +22,12 @@ from hsgplan.domain.world import (
     PUSH_DIST_BINS,
     PUSH_DIST_RANGE,
     SURFACES,
+    Kind,
     surface_rect,
 )
 
 PLACE_EDGE_GAP = 0.005
+PUSH_LEAD = 0.01
 
 
 @dataclass(frozen=True)
@@ -90,6 +94,15 @@ def push_values(angle_bin: int, dist_bin: int) -> tuple[float, float]:
         a0 + (a1 - a0) * angle_bin / (PUSH_ANGLE_BINS - 1),
         d0 + (d1 - d0) * dist_bin / (PUSH_DIST_BINS - 1),
     )
+
+
+def extent_along(obj: str, yaw: float, angle: float) -> float:
+    """How far an object standing at `yaw` reaches from its centre towards `angle`."""
+    t = object_type(obj)
+    if t.kind is Kind.CAN:
+        return t.size[0] / 2
+    rel = angle - yaw
+    return abs(math.cos(rel)) * t.size[0] / 2 + abs(math.sin(rel)) * t.size[1] / 2
 
 
 def nearest_push_bins(angle: float, dist: float) -> tuple[int, int]:

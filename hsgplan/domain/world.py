@@ -156,11 +156,17 @@ REACH_MAX_Z = 0.40
 MAX_OBJECTS = 12
 
 
+def spot_cells(rect: Rect) -> list[tuple[float, float]]:
+    """Centres of the SPOT cells a surface is counted in (its capacity), centred on it."""
+    nx, ny = math.floor(rect.width_x / SPOT + 1e-9), math.floor(rect.width_y / SPOT + 1e-9)
+    x0 = rect.center[0] - nx * SPOT / 2
+    y0 = rect.center[1] - ny * SPOT / 2
+    return [(x0 + SPOT * (i + 0.5), y0 + SPOT * (j + 0.5)) for i in range(nx) for j in range(ny)]
+
+
 def capacity(rect: Rect) -> int:
-    """How many objects fit side by side on a rectangle."""
-    return max(0, math.floor(rect.width_x / SPOT + 1e-9)) * max(
-        0, math.floor(rect.width_y / SPOT + 1e-9)
-    )
+    """How many objects fit side by side on a rectangle: its SPOT cells."""
+    return len(spot_cells(rect))
 
 
 def surface_rect(name: str) -> Rect:
@@ -171,6 +177,7 @@ def surface_rect(name: str) -> Rect:
 
 
 SURFACES: tuple[str, ...] = tuple(REGIONS) + tuple(SHELVES)
+
 SURFACE_CAPACITY: dict[str, int] = {name: capacity(surface_rect(name)) for name in SURFACES}
 # Objects enter an interior only through its open front, so it is filled as one row across,
 # a can's width plus a finger's gap apart (pushes measured to land within +-9 cm of the middle).

@@ -91,8 +91,14 @@ def run_episode(
         outcome = info["outcome"]
         agent.observe(d.params, outcome)
         record = StepRecord(
-            len(records) + 1, str(d.action), params_text(d.params), outcome.status.value,
-            outcome.detail, d.task_seconds, d.motion_seconds, outcome.seconds,
+            len(records) + 1,
+            str(d.action),
+            params_text(d.params),
+            outcome.status.value,
+            outcome.detail,
+            d.task_seconds,
+            d.motion_seconds,
+            outcome.seconds,
         )
         records.append(record)
         if on_step:
@@ -101,6 +107,13 @@ def run_episode(
     done = sum(state.holds(lit) for lit in goal.literals)
     env.close()
     return EpisodeRecord(
-        seed, agent.name, str(goal), goal.size, failure is None, done / len(goal.literals),
-        failure, tuple(records), time.perf_counter() - start,
+        seed,
+        agent.name,
+        str(goal),
+        goal.size,
+        failure is None,
+        done / len(goal.literals),
+        failure,
+        tuple(records),
+        time.perf_counter() - start,
     )

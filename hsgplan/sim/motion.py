@@ -21,9 +21,11 @@ from hsgplan.sim.robot import ARM, Panda
 ou.setLogLevel(ou.LOG_ERROR)
 OMPL_SEED = 20210530
 
-# Checked paths keep this far from obstacles: at the edge-resolution below, thinner misses let
-# sub-millimetre contacts through (measured on shelf boards and cans).
-SAFETY_MARGIN = 0.005
+# Checked paths keep this far from obstacles, so that contacts between the checks spaced STEP
+# apart stay shallow. Transit and transfer motions are kinematic (a graze moves nothing), and
+# the approach poses at the ends of a path must pass the same margin: 5 cm measured too strict
+# there, failing grasps beside close neighbours.
+SAFETY_MARGIN = 0.002
 STEP = 0.02  # rad between collision checks along a joint-space segment
 RRT_TIME = 2.0
 SHORTCUT_STEPS = 60

@@ -14,9 +14,11 @@ import numpy as np
 
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.parameters import (
+    PUSH_LEAD,
     PickParams,
     PlaceParams,
     PrimitiveParams,
+    extent_along,
     place_xy,
     push_values,
 )
@@ -38,11 +40,11 @@ from hsgplan.sim.scene import Scene
 APPROACH = 0.10  # m above a grasp or place pose where the straight final approach starts
 GRASP_DEPTH = 0.035  # fingertips this far below an object's top, at most
 FLOOR_GAP = 0.008  # and at least this far above what it stands on
+PREGRASP_ROOM = 0.015  # the fingers open this much wider than the object before a grasp
 DROP = 0.006  # a placed object is released this far above its support
 PUSH_PITCH = math.radians(60)  # the hand leans forward to push (measured: upright hits boards)
 PUSH_TIP_Z = 0.03
 PUSH_STEP = 0.005
-PUSH_LEAD = 0.01  # the fingertip starts this far behind the object
 MAX_JOINT_JUMP = 0.3  # rad between neighbouring push waypoints: more means an IK branch flip
 
 
@@ -58,6 +60,7 @@ class MotionPlan:
     q_at: np.ndarray
     line: tuple[np.ndarray, ...] = ()
     grip: float = 0.0
+    opening: float = GRIPPER_MAX_OPENING
     push_direction: tuple[float, float] = (1.0, 0.0)
 
 
@@ -82,8 +85,9 @@ def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFa
 
 def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
     """IK for a pose and for the pose APPROACH above it, with a free straight segment between."""
-    above = Pose((target.position[0], target.position[1], target.position[2] + APPROACH),
-                 target.orientation)
+    above = Pose(
+        (target.position[0], target.position[1], target.position[2] + APPROACH), target.orientation
+    )
     # The rest pose first: it keeps the arm in one well-conditioned elbow-up branch, from which
     # the straight approach and push lines stay reachable; the current joints come second.
     q_above = scene.robot.ik(above, scene.rng, seeds=seeds)
@@ -92,7 +96,7 @@ def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
     q_at = scene.robot.ik(target, scene.rng, seeds=[q_above])
     if q_at is None:
         return None
-    near = scene.checker(ignore=ignore, margin=0.001)
+    near = scene.checker(ignore=ignore)
     if near.collides(q_above) or not near.segment_free(q_above, q_at):
         return None
     return q_above, q_at
@@ -108,8 +112,10 @@ def _plan_pick(scene: Scene, p: PickParams, q0: np.ndarray) -> MotionPlan | Plan
         return PlanFailure(Status.INVALID, f"'{p.obj}' is not in the scene")
     if scene.robot.held_body is not None:
         return PlanFailure(Status.INVALID, f"the gripper already holds '{scene.held()}'")
-    scene.robot.set_fingers(GRIPPER_MAX_OPENING)  # checked as executed: the hand opens first
     t, pose = object_type(p.obj), scene.pose(p.obj)
+    # Open only a little wider than the object: fully open fingers reach into close neighbours.
+    opening = min(GRIPPER_MAX_OPENING, t.grasp_width + PREGRASP_ROOM)
+    scene.robot.set_fingers(opening)  # checked as executed
     top = pose.position[2] + t.height / 2
     tip_z = max(top - GRASP_DEPTH, top - t.height + FLOOR_GAP)
     if t.kind is Kind.BOX:
@@ -124,7 +130,14 @@ def _plan_pick(scene: Scene, p: PickParams, q0: np.ndarray) -> MotionPlan | Plan
             path = _path(scene, q0, found[0])
             if path is None:
                 return PlanFailure(Status.NO_PATH, f"no path to above '{p.obj}'")
-            return MotionPlan(p, in_grasp(p.obj), path, *found, grip=max(0.0, t.grasp_width - 0.002))
+            return MotionPlan(
+                p,
+                in_grasp(p.obj),
+                path,
+                *found,
+                grip=max(0.0, t.grasp_width - 0.002),
+                opening=opening,
+            )
     return PlanFailure(Status.NO_IK, f"no collision-free grasp of '{p.obj}'")
 
 
@@ -188,8 +201,14 @@ def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
             path = _path(scene, q0, found[0])
             if path is None:
                 return PlanFailure(Status.NO_PATH, f"no path to above the push start of '{p.obj}'")
-            return MotionPlan(p, inside(p.obj, shelf), path, *found, line=tuple(line),
-                              push_direction=(float(u[0]), float(u[1])))
+            return MotionPlan(
+                p,
+                inside(p.obj, shelf),
+                path,
+                *found,
+                line=tuple(line),
+                push_direction=(float(u[0]), float(u[1])),
+            )
     return PlanFailure(Status.NO_PATH, f"no reachable, collision-free push line for '{p.obj}'")
 
 
@@ -210,12 +229,3 @@ def prepush_shelf(pose: Pose) -> str | None:
         if REGIONS[s.prepush].contains(*pose.position[:2], margin=0.01):
             return name
     return None
-
-
-def extent_along(obj: str, yaw: float, angle: float) -> float:
-    """How far the object reaches from its centre in a horizontal direction."""
-    t = object_type(obj)
-    if t.kind is Kind.CAN:
-        return t.size[0] / 2
-    rel = angle - yaw
-    return abs(math.cos(rel)) * t.size[0] / 2 + abs(math.sin(rel)) * t.size[1] / 2

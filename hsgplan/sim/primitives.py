@@ -12,24 +12,22 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-import numpy as np
-
 from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams
 from hsgplan.domain.world import GRIPPER_MAX_OPENING
-from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.motion import densify
-from hsgplan.sim.motion_plans import APPROACH, MotionPlan, PlanFailure, plan_primitive
+from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
 from hsgplan.sim.outcome import Outcome, verify
 from hsgplan.sim.scene import Scene
 
 PUSH_SUBSTEPS = 6  # physics steps per 5 mm of push: about 0.2 m/s
-RETREAT = 0.03
 
 Frame = Callable[[], None]
 
 
 def execute(
-    scene: Scene, params: PrimitiveParams, on_frame: Frame | None = None,
+    scene: Scene,
+    params: PrimitiveParams,
+    on_frame: Frame | None = None,
     plan: MotionPlan | None = None,
 ) -> Outcome:
     """Plan (unless a plan made for this scene is given) and run one primitive.
@@ -60,7 +58,7 @@ def _follow(scene: Scene, path, on_frame: Frame | None) -> None:
 
 def _run_pick(scene: Scene, plan: MotionPlan, on_frame) -> None:
     robot = scene.robot
-    robot.set_fingers(GRIPPER_MAX_OPENING)
+    robot.set_fingers(plan.opening)
     _follow(scene, plan.path, on_frame)
     _follow(scene, [plan.q_above, plan.q_at], on_frame)
     # The fingers close to the object's width, then a fixed constraint makes the grasp firm.
@@ -88,15 +86,8 @@ def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> None:
         robot.drive_to(q, PUSH_SUBSTEPS)
         if on_frame:
             on_frame()
-    orn = robot.tcp().orientation
-    u = np.array([*plan.push_direction, 0.0])
-    back = robot.ik(Pose(tuple(np.add(robot.tcp().position, -RETREAT * u)), orn), scene.rng,
-                    seeds=[robot.q()], restarts=0)
-    if back is not None:
-        _follow(scene, [robot.q(), back], on_frame)
+    # Back out the way it came (joints checked against the shelves while planning; the object
+    # is ahead of the fingers now), then up to where the approach began.
+    _follow(scene, [robot.q(), *reversed(plan.line), plan.q_at, plan.q_above], on_frame)
     scene.settle()
-    up = robot.ik(Pose(tuple(np.add(robot.tcp().position, (0, 0, APPROACH))), orn), scene.rng,
-                  seeds=[robot.q()], restarts=0)
-    if up is not None:
-        _follow(scene, [robot.q(), up], on_frame)
     robot.set_fingers(GRIPPER_MAX_OPENING)

@@ -23,7 +23,12 @@ class Camera:
         view = bc.computeViewMatrix(self.eye, self.target, (0, 0, 1))
         proj = bc.computeProjectionMatrixFOV(self.fov, self.width / self.height, 0.05, 4.0)
         _, _, rgba, _, _ = bc.getCameraImage(
-            self.width, self.height, view, proj, renderer=bc.ER_TINY_RENDERER,
-            lightDirection=(0.6, 0.2, 1.0), shadow=0,
+            self.width,
+            self.height,
+            view,
+            proj,
+            renderer=bc.ER_TINY_RENDERER,
+            lightDirection=(0.6, 0.2, 1.0),
+            shadow=0,
         )
         return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3]

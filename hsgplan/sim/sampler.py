@@ -16,18 +16,20 @@ import random
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.generator import random_state
 from hsgplan.domain.objects import EntityKind, kind_of, object_type
-from hsgplan.domain.parameters import place_inset
-from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import surface_rect
+from hsgplan.domain.parameters import PickParams, place_inset
+from hsgplan.domain.predicates import clear
+from hsgplan.domain.world import spot_cells, surface_rect
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
 from hsgplan.sim.scene import Scene
 
 SPOT_TRIES = 300
 ATTEMPTS = 20
-# Free space kept around each object so that open fingers (8 cm across) fit beside it.
-GAP = 0.02
+# Free space kept around each object so that the opening fingers fit beside it.
+GAP = 0.025
+JITTER = 0.015
 STACK_JITTER = 0.005
 
 
@@ -39,7 +41,7 @@ def sample_scene(
     The same seed gives the same scene: every random number comes from `seed`.
     """
     rng = random.Random(f"scene-{seed}")
-    for attempt in range(ATTEMPTS):
+    for _ in range(ATTEMPTS):
         state = random_state(objects, rng, p_elsewhere=p_elsewhere)
         scene = Scene(objects, seed=seed)
         if _place_all(scene, state, rng) and _settled_as(scene, state):
@@ -73,21 +75,31 @@ def _stacked_pose(scene: Scene, obj: str, base: str, rng: random.Random) -> Pose
     jitter = [rng.uniform(-STACK_JITTER, STACK_JITTER) for _ in range(2)]
     yaw = b.yaw + rng.choice([0.0, math.pi / 2])
     return Pose.from_xyz_yaw(
-        b.position[0] + jitter[0], b.position[1] + jitter[1],
-        top + object_type(obj).height / 2 + 0.001, yaw,
+        b.position[0] + jitter[0],
+        b.position[1] + jitter[1],
+        top + object_type(obj).height / 2 + 0.001,
+        yaw,
     )
 
 
 def _free_spot(
     scene: Scene, obj: str, surface: str, placed: list[str], rng: random.Random
 ) -> Pose | None:
+    """A random free spot cell of the surface, the object jittered and turned within it.
+
+    Cells, not arbitrary points: scattered objects would fragment a surface so that its
+    counted capacity could no longer be used.
+    """
     r = surface_rect(surface)
-    inset = max(place_inset(obj))  # any yaw may be drawn: keep the long half-side from edges
     z = r.z + object_type(obj).height / 2 + 0.001
+    cells = spot_cells(r)
     for _ in range(SPOT_TRIES):
-        x = rng.uniform(r.x_min + inset, r.x_max - inset)
-        y = rng.uniform(r.y_min + inset, r.y_max - inset)
-        pose = Pose.from_xyz_yaw(x, y, z, rng.uniform(-math.pi, math.pi))
+        cx, cy = rng.choice(cells)
+        x, y = cx + rng.uniform(-JITTER, JITTER), cy + rng.uniform(-JITTER, JITTER)
+        yaw = rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2]) + rng.uniform(-0.3, 0.3)
+        pose = Pose.from_xyz_yaw(x, y, z, yaw)
+        if not r.contains(x, y, margin=-max(place_inset(obj)) + 0.01):
+            continue
         scene.set_pose(obj, pose)
         if not any(
             scene.bc.getClosestPoints(scene.bodies[obj], scene.bodies[o], GAP) for o in placed
@@ -106,13 +118,15 @@ def _touches_arena(scene: Scene, obj: str) -> bool:
 
 
 def _settled_as(scene: Scene, state: SymbolicSceneGraph) -> bool:
+    """Settled into the drawn arrangement, with every clear object graspable (a dry run)."""
     scene.settle()
     mapping = map_symbols(scene.scene_graph())
     if mapping.anomalies:
         return False
+    if any(mapping.state.location(o) != state.location(o) for o in state.objects):
+        return False
     return all(
-        mapping.state.location(o) == state.location(o)
+        isinstance(plan_primitive(scene, PickParams(o)), MotionPlan)
         for o in state.objects
-        if state.location(o).predicate is not Predicate.CLEAR
+        if state.holds(clear(o))
     )
-

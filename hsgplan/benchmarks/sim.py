@@ -1,0 +1,63 @@
+"""Seconds per primitive (planning included) and per oracle episode: `hsgplan bench sim`.
+
+Episodes run one after another in this process (one core), on the evaluation protocol's goals.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from hsgplan.agents.oracle import OracleAgent
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.goals import parse_goal
+from hsgplan.evaluation.episode import EpisodeRecord, run_episode
+from hsgplan.evaluation.protocol import EvalConfig, episode_specs
+from hsgplan.sim.env import KitchenStorageEnv
+
+PRIMITIVES = ("pick", "place", "push")
+
+
+@dataclass(frozen=True)
+class SimTiming:
+    what: str
+    samples: int
+    median_seconds: float | None
+
+
+def bench_sim(
+    sizes: Sequence[int],
+    episodes: int,
+    seed: int,
+    on_episode: Callable[[EpisodeRecord], None] | None = None,
+) -> list[SimTiming]:
+    if episodes <= 0:
+        raise InvalidInputError(f"--episodes {episodes}: need at least one episode per size")
+    specs = episode_specs(EvalConfig("oracle", tuple(sizes), episodes, seed))
+    records = []
+    for spec in specs:
+        records.append(
+            run_episode(KitchenStorageEnv(), OracleAgent(), parse_goal(spec.goal), spec.seed)
+        )
+        if on_episode:
+            on_episode(records[-1])
+    rows = []
+    for kind in PRIMITIVES:
+        times = [
+            s.execution_seconds
+            for r in records
+            for s in r.steps
+            if s.action.startswith(kind) and s.status == "success"
+        ]
+        rows.append(
+            SimTiming(
+                f"{kind} (successful, planning included)",
+                len(times),
+                statistics.median(times) if times else None,
+            )
+        )
+    for n in sizes:
+        times = [r.seconds for r in records if r.size == n]
+        rows.append(SimTiming(f"oracle episode, {n} objects", len(times), statistics.median(times)))
+    return rows
