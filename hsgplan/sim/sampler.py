@@ -17,8 +17,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.generator import random_state
 from hsgplan.domain.objects import EntityKind, kind_of, object_type
 from hsgplan.domain.parameters import PickParams, place_inset
-from hsgplan.domain.predicates import clear
-from hsgplan.domain.world import spot_cells, surface_rect
+from hsgplan.domain.world import Kind, spot_cells, surface_rect
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -26,10 +25,11 @@ from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
 from hsgplan.sim.scene import Scene
 
 SPOT_TRIES = 300
-ATTEMPTS = 20
+ATTEMPTS = 100
 # Free space kept around each object so that the opening fingers fit beside it.
 GAP = 0.025
 JITTER = 0.015
+YAW_JITTER = 0.15
 STACK_JITTER = 0.005
 
 
@@ -41,12 +41,15 @@ def sample_scene(
     The same seed gives the same scene: every random number comes from `seed`.
     """
     rng = random.Random(f"scene-{seed}")
+    scene = Scene(objects, seed=seed)
     for _ in range(ATTEMPTS):
         state = random_state(objects, rng, p_elsewhere=p_elsewhere)
-        scene = Scene(objects, seed=seed)
+        for o in objects:
+            scene.park(o)
         if _place_all(scene, state, rng) and _settled_as(scene, state):
+            scene.robot.hold_position()
             return scene, state
-        scene.close()
+    scene.close()
     raise InvalidInputError(
         f"no collision-free arrangement of {len(objects)} objects found in {ATTEMPTS} attempts "
         f"(seed {seed})"
@@ -95,11 +98,14 @@ def _free_spot(
     cells = spot_cells(r)
     for _ in range(SPOT_TRIES):
         cx, cy = rng.choice(cells)
-        x, y = cx + rng.uniform(-JITTER, JITTER), cy + rng.uniform(-JITTER, JITTER)
-        yaw = rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2]) + rng.uniform(-0.3, 0.3)
+        # Boxes lie long side along y, as they are placed (a cell is too short for them the
+        # other way round); cans may stand any way.
+        turns = [0.0, math.pi] if object_type(obj).kind is Kind.BOX else [0.0, math.pi / 2]
+        yaw = rng.choice(turns) + rng.uniform(-YAW_JITTER, YAW_JITTER)
+        ix, iy = place_inset(obj)  # kept from the edges, as place bins are
+        x = min(max(cx + rng.uniform(-JITTER, JITTER), r.x_min + ix), r.x_max - ix)
+        y = min(max(cy + rng.uniform(-JITTER, JITTER), r.y_min + iy), r.y_max - iy)
         pose = Pose.from_xyz_yaw(x, y, z, yaw)
-        if not r.contains(x, y, margin=-max(place_inset(obj)) + 0.01):
-            continue
         scene.set_pose(obj, pose)
         if not any(
             scene.bc.getClosestPoints(scene.bodies[obj], scene.bodies[o], GAP) for o in placed
@@ -118,15 +124,23 @@ def _touches_arena(scene: Scene, obj: str) -> bool:
 
 
 def _settled_as(scene: Scene, state: SymbolicSceneGraph) -> bool:
-    """Settled into the drawn arrangement, with every clear object graspable (a dry run)."""
+    """Settled into the drawn arrangement, with every object graspable (a dry run), those under
+    another one once it is lifted off: a plan may have to unstack them."""
     scene.settle()
     mapping = map_symbols(scene.scene_graph())
     if mapping.anomalies:
         return False
     if any(mapping.state.location(o) != state.location(o) for o in state.objects):
         return False
-    return all(
-        isinstance(plan_primitive(scene, PickParams(o)), MotionPlan)
-        for o in state.objects
-        if state.holds(clear(o))
-    )
+    return all(_graspable(scene, state, o) for o in state.objects)
+
+
+def _graspable(scene: Scene, state: SymbolicSceneGraph, obj: str) -> bool:
+    above = state.resting_on(obj)
+    saved = {o: scene.pose(o) for o in above}
+    for i, o in enumerate(above):  # lifted off kinematically, put back exactly below
+        scene.set_pose(o, Pose.from_xyz_yaw(-0.8, 0.6 - 0.2 * i, 0.5))
+    ok = isinstance(plan_primitive(scene, PickParams(obj)), MotionPlan)
+    for o, pose in saved.items():
+        scene.set_pose(o, pose)
+    return ok

@@ -42,9 +42,8 @@ class Scene:
         names = sort_objects(objects)
         poses = poses or {}
         self.bodies: dict[str, int] = {}
-        for i, name in enumerate(names):
-            parked = Pose.from_xyz_yaw(-0.6 - 0.15 * (i % 4), -0.4 + 0.2 * (i // 4), 0.5)
-            self.bodies[name] = spawn_object(self.bc, name, poses.get(name, parked))
+        for name in names:
+            self.bodies[name] = spawn_object(self.bc, name, poses.get(name, self._parking(name)))
         self.rng = np.random.default_rng(seed)
         self.seed = seed
 
@@ -71,6 +70,14 @@ class Scene:
         body = self.bodies[name]
         self.bc.resetBasePositionAndOrientation(body, pose.position, pose.orientation)
         self.bc.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0))
+
+    def _parking(self, name: str) -> Pose:
+        i = len(self.bodies) if name not in self.bodies else list(self.bodies).index(name)
+        return Pose.from_xyz_yaw(-0.6 - 0.15 * (i % 4), -0.4 + 0.2 * (i // 4), 0.5)
+
+    def park(self, name: str) -> None:
+        """Move an object out of the workspace (behind the robot, in the air, held still)."""
+        self.set_pose(name, self._parking(name))
 
     def poses(self) -> dict[str, Pose]:
         return {n: self.pose(n) for n in self.bodies}
