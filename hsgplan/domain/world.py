@@ -157,11 +157,13 @@ MAX_OBJECTS = 12
 
 
 def spot_cells(rect: Rect) -> list[tuple[float, float]]:
-    """Centres of the SPOT cells a surface is counted in (its capacity), centred on it."""
+    """Centres of the cells a surface is counted in (its capacity), spread evenly over it."""
     nx, ny = math.floor(rect.width_x / SPOT + 1e-9), math.floor(rect.width_y / SPOT + 1e-9)
-    x0 = rect.center[0] - nx * SPOT / 2
-    y0 = rect.center[1] - ny * SPOT / 2
-    return [(x0 + SPOT * (i + 0.5), y0 + SPOT * (j + 0.5)) for i in range(nx) for j in range(ny)]
+    return [
+        (rect.x_min + rect.width_x * (i + 0.5) / nx, rect.y_min + rect.width_y * (j + 0.5) / ny)
+        for i in range(nx)
+        for j in range(ny)
+    ]
 
 
 def capacity(rect: Rect) -> int:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.parameters import (
     PUSH_LEAD,
@@ -75,12 +76,15 @@ def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFa
     # Checks move the arm: every query below starts from these joints, not from wherever the
     # last check left it.
     q0 = scene.robot.q()
-    with scene.robot.preserved():
-        if isinstance(params, PickParams):
-            return _plan_pick(scene, params, q0)
-        if isinstance(params, PlaceParams):
-            return _plan_place(scene, params, q0)
-        return _plan_push(scene, params, q0)
+    try:
+        with scene.robot.preserved():
+            if isinstance(params, PickParams):
+                return _plan_pick(scene, params, q0)
+            if isinstance(params, PlaceParams):
+                return _plan_place(scene, params, q0)
+            return _plan_push(scene, params, q0)
+    except InvalidInputError as e:  # bins out of range, a target that is no surface
+        return PlanFailure(Status.INVALID, str(e))
 
 
 def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):

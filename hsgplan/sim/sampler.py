@@ -24,12 +24,12 @@ from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
 from hsgplan.sim.scene import Scene
 
-SPOT_TRIES = 300
+TRIES_PER_CELL = 3
 ATTEMPTS = 100
 # Free space kept around each object so that the opening fingers fit beside it.
-GAP = 0.025
-JITTER = 0.015
-YAW_JITTER = 0.15
+GAP = 0.01  # apart; whether the fingers fit is checked by the pick dry-runs below
+JITTER = 0.01
+YAW_JITTER = 0.1
 STACK_JITTER = 0.005
 
 
@@ -91,33 +91,37 @@ def _free_spot(
     """A random free spot cell of the surface, the object jittered and turned within it.
 
     Cells, not arbitrary points: scattered objects would fragment a surface so that its
-    counted capacity could no longer be used.
+    counted capacity could no longer be used. Cells are visited in a shuffled order, each with
+    a few jittered tries and then its exact centre.
     """
     r = surface_rect(surface)
     z = r.z + object_type(obj).height / 2 + 0.001
+    ix, iy = place_inset(obj)  # kept from the edges, as place bins are
+    # Boxes lie long side along y, as they are placed (a cell is too short for them the other
+    # way round); cans may stand any way.
+    turns = [0.0, math.pi] if object_type(obj).kind is Kind.BOX else [0.0, math.pi / 2]
     cells = spot_cells(r)
-    for _ in range(SPOT_TRIES):
-        cx, cy = rng.choice(cells)
-        # Boxes lie long side along y, as they are placed (a cell is too short for them the
-        # other way round); cans may stand any way.
-        turns = [0.0, math.pi] if object_type(obj).kind is Kind.BOX else [0.0, math.pi / 2]
-        yaw = rng.choice(turns) + rng.uniform(-YAW_JITTER, YAW_JITTER)
-        ix, iy = place_inset(obj)  # kept from the edges, as place bins are
-        x = min(max(cx + rng.uniform(-JITTER, JITTER), r.x_min + ix), r.x_max - ix)
-        y = min(max(cy + rng.uniform(-JITTER, JITTER), r.y_min + iy), r.y_max - iy)
-        pose = Pose.from_xyz_yaw(x, y, z, yaw)
-        scene.set_pose(obj, pose)
-        if not any(
-            scene.bc.getClosestPoints(scene.bodies[obj], scene.bodies[o], GAP) for o in placed
-        ) and not _touches_arena(scene, obj):
-            return pose
+    rng.shuffle(cells)
+    for cx, cy in cells:
+        for k in range(TRIES_PER_CELL + 1):
+            jitter = JITTER if k < TRIES_PER_CELL else 0.0
+            yaw = rng.choice(turns) + rng.uniform(-YAW_JITTER, YAW_JITTER) * (jitter > 0)
+            x = min(max(cx + rng.uniform(-jitter, jitter), r.x_min + ix), r.x_max - ix)
+            y = min(max(cy + rng.uniform(-jitter, jitter), r.y_min + iy), r.y_max - iy)
+            pose = Pose.from_xyz_yaw(x, y, z, yaw)
+            scene.set_pose(obj, pose)
+            if not any(
+                scene.bc.getClosestPoints(scene.bodies[obj], scene.bodies[o], GAP) for o in placed
+            ) and not _touches_arena(scene, obj):
+                return pose
     return None
 
 
 def _touches_arena(scene: Scene, obj: str) -> bool:
     body = scene.bodies[obj]
     return any(
-        scene.bc.getClosestPoints(body, part, 0.005)
+        # Objects are set 1 mm above their support, so the board they stand on is no hit.
+        scene.bc.getClosestPoints(body, part, 0.0005)
         for parts in scene.arena.shelves.values()
         for part in parts
     )
