@@ -130,6 +130,10 @@ def run_evaluation(
     done = load_done(run_dir, config)
     (run_dir / CONFIG).write_text(json.dumps(asdict(config) | {"sizes": list(config.sizes)}))
     todo = [s for s in specs if s.key not in done]
+    results = run_dir / RESULTS
+    if results.exists() and results.stat().st_size and not results.read_bytes().endswith(b"\n"):
+        with open(results, "a") as log:  # an interrupted write: end its line before appending
+            log.write("\n")
     for s in specs:
         if s.key in done and on_episode:
             on_episode(done[s.key])

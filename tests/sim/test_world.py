@@ -25,8 +25,20 @@ def test_sampled_scene_is_at_rest_and_reads_back_as_drawn():
 
 @pytest.mark.parametrize("n", [2, 8, 12])
 def test_scenes_of_many_sizes_can_be_drawn(n):
-    objects = ("cherries", "cherries_2", "alphabet_soup", "tomato_soup", "popcorn", "butter",
-               "cream_cheese", "butter_2", "cherries_3", "tomato_soup_2", "popcorn_2", "butter_3")
+    objects = (
+        "cherries",
+        "cherries_2",
+        "alphabet_soup",
+        "tomato_soup",
+        "popcorn",
+        "butter",
+        "cream_cheese",
+        "butter_2",
+        "cherries_3",
+        "tomato_soup_2",
+        "popcorn_2",
+        "butter_3",
+    )
     scene, state = sample_scene(objects[:n], seed=1)
     try:
         assert len(scene.objects) == n and state.held() is None
