@@ -10,13 +10,14 @@ from pybullet_utils.bullet_client import BulletClient
 
 @dataclass(frozen=True)
 class Camera:
-    """A pinhole camera looking at the workspace from in front of and above the robot."""
+    """A pinhole camera behind and above the robot, looking over it at the workspace, so that
+    shelf A (+y) appears on the left, as the paper describes it."""
 
     width: int = 400
     height: int = 300
-    eye: tuple[float, float, float] = (1.25, 0.0, 0.85)
-    target: tuple[float, float, float] = (0.40, 0.0, 0.05)
-    fov: float = 55.0
+    eye: tuple[float, float, float] = (0.2, 0.0, 1.5)
+    target: tuple[float, float, float] = (0.5, 0.0, 0.0)
+    fov: float = 50.0
 
     def capture(self, bc: BulletClient) -> np.ndarray:
         """An RGB image, height x width x 3, uint8."""
