@@ -46,6 +46,7 @@ DROP = 0.006  # a placed object is released this far above its support
 PUSH_PITCH = math.radians(60)  # the hand leans forward to push (measured: upright hits boards)
 PUSH_TIP_Z = 0.03
 PUSH_STEP = 0.005
+IK_BRANCHES = 6  # random restarts for an approach whose first IK solutions collide
 MAX_JOINT_JUMP = 0.3  # rad between neighbouring push waypoints: more means an IK branch flip
 
 
@@ -88,22 +89,27 @@ def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFa
 
 
 def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
-    """IK for a pose and for the pose APPROACH above it, with a free straight segment between."""
+    """IK for a pose and for the pose APPROACH above it, with a free straight segment between.
+
+    The given seeds first (the rest pose keeps the arm in one well-conditioned elbow-up branch,
+    from which approach and push lines stay reachable), then random restarts: the solver
+    returns the first configuration that reaches a pose, which may put the elbow in the table.
+    """
     above = Pose(
-        (target.position[0], target.position[1], target.position[2] + APPROACH), target.orientation
+        (target.position[0], target.position[1], target.position[2] + APPROACH),
+        target.orientation,
     )
-    # The rest pose first: it keeps the arm in one well-conditioned elbow-up branch, from which
-    # the straight approach and push lines stay reachable; the current joints come second.
-    q_above = scene.robot.ik(above, scene.rng, seeds=seeds)
-    if q_above is None:
-        return None
-    q_at = scene.robot.ik(target, scene.rng, seeds=[q_above])
-    if q_at is None:
-        return None
     near = scene.checker(ignore=ignore)
-    if near.collides(q_above) or not near.segment_free(q_above, q_at):
-        return None
-    return q_above, q_at
+    robot = scene.robot
+    tries = [seeds] + [[scene.rng.uniform(robot.lower, robot.upper)] for _ in range(IK_BRANCHES)]
+    for start in tries:
+        q_above = robot.ik(above, scene.rng, seeds=start, restarts=0)
+        if q_above is None or near.collides(q_above):
+            continue
+        q_at = robot.ik(target, scene.rng, seeds=[q_above], restarts=0)
+        if q_at is not None and near.segment_free(q_above, q_at):
+            return q_above, q_at
+    return None
 
 
 def _path(scene: Scene, q0: np.ndarray, q_goal: np.ndarray, ignore=()):
