@@ -1,0 +1,34 @@
+"""The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
+
+One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval), `bench`.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+
+from hsgplan.cli import bench, symbolic, world
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="Hierarchical planning with geometric and symbolic scene graphs (kitchen storage).",
+)
+app.command()(symbolic.plan)
+app.command()(symbolic.goals)
+app.command()(world.demo)
+app.command("eval")(world.evaluate)
+app.add_typer(bench.app, name="bench")
+
+
+def main() -> None:
+    try:
+        app()
+    except BrokenPipeError:
+        sys.stderr.close()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,84 @@
+"""`hsgplan bench ...`: speed, as medians over one run."""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated
+
+import typer
+from rich.progress import Progress
+
+from hsgplan.cli.common import err, parse_sizes, print_table, refuses_bad_input
+
+app = typer.Typer(no_args_is_help=True, help="Measure speed (medians over one run).")
+
+
+@app.command("sim")
+@refuses_bad_input
+def bench_sim(
+    sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
+    episodes: Annotated[int, typer.Option(help="Oracle episodes per size.")] = 5,
+    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """Median seconds per primitive (motion planning included) and per oracle episode."""
+    from hsgplan.benchmarks.sim import bench_sim as run
+
+    size_list = parse_sizes(sizes)
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task("oracle episodes", total=len(size_list) * episodes)
+        rows = run(size_list, episodes, seed, lambda r: progress.advance(task))
+    cells = [
+        (r.what, str(r.samples), "—" if r.median_seconds is None else f"{r.median_seconds:.3f}")
+        for r in rows
+    ]
+    print_table(
+        f"Simulation speed, one core (seed {seed})",
+        ("what", "samples", "median s"),
+        cells,
+        markdown,
+    )
+
+
+@app.command("symbolic")
+@refuses_bad_input
+def bench_symbolic(
+    sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
+    goals: Annotated[int, typer.Option(help="Goals per size.")] = 20,
+    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    optimal_max_size: Annotated[
+        int, typer.Option(help="Largest size the optimal search is timed on.")
+    ] = 8,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """Fast Downward plan time per size: median over the goals, both search configurations."""
+    from hsgplan.benchmarks.symbolic import bench_symbolic as run
+
+    size_list = parse_sizes(sizes)
+    total = sum(goals * (2 if n <= optimal_max_size else 1) for n in size_list)
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task("planning", total=total)
+        rows = run(
+            size_list, goals, seed, optimal_max_size, on_problem=lambda: progress.advance(task)
+        )
+    if as_json:
+        print(json.dumps([r.to_json() for r in rows], indent=2))
+        return
+    title = f"Fast Downward plan time, median over {goals} goals per size (seed {seed})"
+    header = ("objects", "planner", "solved", "median s", "median plan length")
+    cells = [
+        (
+            str(r.size),
+            r.planner,
+            f"{r.solved}/{r.problems}",
+            "—" if r.median_seconds is None else f"{r.median_seconds:.3f}",
+            "—" if r.median_plan_length is None else f"{r.median_plan_length:g}",
+        )
+        for r in rows
+    ]
+    print_table(title, header, cells, markdown)

@@ -1,0 +1,68 @@
+"""What every command shares: consoles, the bad-input guard, argument parsing, tables."""
+
+from __future__ import annotations
+
+import functools
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from hsgplan.domain.errors import InvalidInputError
+
+out = Console()
+err = Console(stderr=True)
+
+
+def refuses_bad_input(fn):
+    """Bad input becomes one line on stderr and exit code 2, never a traceback."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        try:
+            return fn(*args, **kwargs)
+        except InvalidInputError as e:
+            err.print(f"[bold red]error:[/] {e}", highlight=False, markup=True, soft_wrap=True)
+            raise typer.Exit(2) from None
+        except KeyboardInterrupt:
+            err.print("interrupted")
+            raise typer.Exit(130) from None
+
+    return wrapper
+
+
+def parse_sizes(text: str) -> list[int]:
+    """`2-6`, `2,4,6` or `3` as a list of sizes."""
+    sizes: list[int] = []
+    try:
+        for part in text.split(","):
+            lo, _, hi = part.strip().partition("-")
+            sizes += list(range(int(lo), int(hi or lo) + 1))
+    except ValueError:
+        raise InvalidInputError(
+            f"--sizes '{text}': expected a range like 2-6 or a list like 2,4,6"
+        ) from None
+    from hsgplan.domain.generator import check_size
+
+    if not sizes:
+        raise InvalidInputError(f"--sizes '{text}' names no size")
+    for n in sizes:
+        check_size(n)
+    return sizes
+
+
+def print_table(title: str, header: tuple[str, ...], rows: list[tuple[str, ...]], markdown: bool):
+    """A Rich table on the terminal, or a Markdown table that the README takes verbatim."""
+    if markdown:
+        print(f"{title}\n")
+        print("| " + " | ".join(header) + " |")
+        print("|" + "---:|" * len(header))
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
+        return
+    table = Table(title=title)
+    for col in header:
+        table.add_column(col, justify="right")
+    for row in rows:
+        table.add_row(*row)
+    out.print(table)

@@ -1,0 +1,133 @@
+"""Commands of the symbolic level: plan, goals."""
+
+from __future__ import annotations
+
+import json
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from hsgplan.cli.common import err, out, refuses_bad_input
+from hsgplan.domain.errors import InvalidInputError
+
+
+class Search(StrEnum):
+    auto = "auto"
+    optimal = "optimal"
+    fast = "fast"
+
+    @property
+    def optimal_flag(self) -> bool | None:
+        return {"auto": None, "optimal": True, "fast": False}[self.value]
+
+
+def _scene(goal_text: str, objects: str | None, init: str | None):
+    from hsgplan.domain.goals import parse_goal
+    from hsgplan.domain.objects import kind_of, sort_objects
+    from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+    goal = parse_goal(goal_text)
+    names = list(goal.objects)
+    if objects:
+        given = [o.strip() for o in objects.split(",") if o.strip()]
+        for o in given:
+            kind_of(o)
+        missing = [o for o in goal.objects if o not in given]
+        if missing:
+            raise InvalidInputError(f"--objects lacks '{missing[0]}', which the goal names")
+        names = list(sort_objects(given))
+    if init:
+        literals = parse_goal(init, validate=False).literals
+        extra = {o for lit in literals for o in lit.objects()} - set(names)
+        if extra:
+            raise InvalidInputError(f"--init names '{sorted(extra)[0]}', which is not in the scene")
+        state = SymbolicSceneGraph.from_literals(names, literals)
+    else:
+        state = SymbolicSceneGraph.initial(names)
+    return goal, state
+
+
+def _print_plan(plan, goal) -> None:
+    out.print(f"[bold]goal[/] ({goal.size} objects): {goal}", highlight=False)
+    for i, state in enumerate(plan.states):
+        head = "start" if i == 0 else f"step {i}: [bold cyan]{plan.actions[i - 1]}[/]"
+        out.print(f"\n{head}", highlight=False)
+        out.print(state.to_text(), highlight=False, markup=False)
+    out.print(
+        f"\n{len(plan)} actions, planned by {plan.planner} in {plan.seconds:.2f} s; "
+        f"goal holds: {goal.satisfied_by(plan.states[-1])}",
+        highlight=False,
+    )
+
+
+@refuses_bad_input
+def plan(
+    goal: Annotated[
+        str, typer.Option(help="Goal literals, e.g. 'On(butter, shelf_a) & In(cherries, shelf_a)'.")
+    ],
+    objects: Annotated[
+        str | None,
+        typer.Option(help="Comma-separated objects in the scene (default: those the goal names)."),
+    ] = None,
+    init: Annotated[
+        str | None,
+        typer.Option(help="Start state as On/In/InGrasp literals (default: all on open_space)."),
+    ] = None,
+    search: Annotated[
+        Search,
+        typer.Option(
+            help="optimal: shortest plan (A* with LM-cut, slow past 8 objects); "
+            "fast: weighted A*; auto: optimal up to 6 objects."
+        ),
+    ] = Search.auto,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the plan as JSON.")] = False,
+) -> None:
+    """Plan a goal with Fast Downward and show the symbolic state after each step."""
+    from hsgplan.planning.fast_downward import FastDownwardPlanner
+
+    g, state = _scene(goal, objects, init)
+    result = FastDownwardPlanner(optimal=search.optimal_flag).plan(state, g)
+    if as_json:
+        steps = [
+            {
+                "step": i,
+                "action": None if i == 0 else str(result.actions[i - 1]),
+                "state": [str(lit) for lit in s.sorted_literals()],
+            }
+            for i, s in enumerate(result.states)
+        ]
+        print(json.dumps(steps, indent=2))
+    else:
+        _print_plan(result, g)
+
+
+@refuses_bad_input
+def goals(
+    objects: Annotated[int, typer.Option(help="Objects per goal (2-12).")],
+    count: Annotated[int, typer.Option(help="How many goals.")],
+    seed: Annotated[int, typer.Option(help="Random seed; the same seed gives the same goals.")] = 0,
+    out_file: Annotated[
+        Path | None, typer.Option("--out", help="Goal file to write (default: stdout).")
+    ] = None,
+    stacking: Annotated[bool, typer.Option(help="Allow stacked goals.")] = True,
+) -> None:
+    """Write random feasible goals, one per line (the distribution is in `domain/generator.py`)."""
+    from hsgplan.domain.generator import check_size, random_goals
+    from hsgplan.domain.goals import write_goal_file
+
+    check_size(objects)
+    drawn = random_goals(objects, count, seed, stacking=stacking)
+    header = f"hsgplan goals --objects {objects} --count {count} --seed {seed}" + (
+        "" if stacking else " --no-stacking"
+    )
+    if out_file is None:
+        print(f"# {header}")
+        for g in drawn:
+            print(g)
+        return
+    if out_file.exists() and out_file.is_dir():
+        raise InvalidInputError(f"--out '{out_file}' is a directory")
+    write_goal_file(out_file, drawn, header=header)
+    err.print(f"wrote {len(drawn)} goals to {out_file}")

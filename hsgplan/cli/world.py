@@ -1,0 +1,105 @@
+"""Commands of the simulated world: demo, eval."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.progress import Progress
+
+from hsgplan.cli.common import err, out, parse_sizes, print_table, refuses_bad_input
+from hsgplan.domain.errors import InvalidInputError
+
+
+@refuses_bad_input
+def demo(
+    agent: Annotated[str, typer.Option(help="Which agent acts.")] = "oracle",
+    goal: Annotated[
+        str | None, typer.Option(help="Goal literals (default: a random goal).")
+    ] = None,
+    objects: Annotated[int, typer.Option(help="Objects in the random goal (2-12).")] = 4,
+    seed: Annotated[int, typer.Option(help="Seed for the goal and the scene.")] = 0,
+    out_dir: Annotated[Path, typer.Option("--out", help="Folder for the pictures.")] = Path(
+        "runs/demo"
+    ),
+) -> None:
+    """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record."""
+    from hsgplan.domain.generator import check_size
+    from hsgplan.domain.goals import parse_goal
+    from hsgplan.evaluation.demo import demo_goal, run_demo
+    from hsgplan.evaluation.protocol import make_agent
+
+    make_agent(agent)
+    if goal is None:
+        check_size(objects)
+    g = parse_goal(goal) if goal else demo_goal(objects, seed)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InvalidInputError(f"--out '{out_dir}' is a file")
+    out.print(f"[bold]goal[/] ({g.size} objects, seed {seed}): {g}", highlight=False)
+    with err.status("running the episode"):
+        record = run_demo(agent, g, seed, out_dir)
+    for s in record.steps:
+        out.print(f"{s.step:>2}  {s.params:<55} {s.status}", highlight=False, markup=False)
+    verdict = "[green]success[/]" if record.success else f"[red]failed: {record.failure}[/]"
+    out.print(
+        f"{verdict} in {len(record.steps)} steps, {record.seconds:.1f} s; "
+        f"subgoal completion {record.subgoal_completion:.2f}"
+    )
+    out.print(f"wrote {out_dir}/episode.gif, {out_dir}/graphs/, {out_dir}/episode.json")
+
+
+@refuses_bad_input
+def evaluate(
+    agent: Annotated[str, typer.Option(help="Which agent acts.")] = "oracle",
+    sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-6.")] = "2-6",
+    goals: Annotated[int, typer.Option(help="Random goals per size.")] = 50,
+    seed: Annotated[int, typer.Option(help="Seed of the goals and the episodes.")] = 0,
+    goals_file: Annotated[Path | None, typer.Option(help="Goals from a file instead.")] = None,
+    workers: Annotated[int, typer.Option(help="Episodes run side by side.")] = 2,
+    run_dir: Annotated[
+        Path | None, typer.Option("--out", help="Run folder (resumed if it exists).")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """Success rate and subgoal completion per problem size, with the failure taxonomy."""
+    from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation, summarize
+
+    if workers < 1:
+        raise InvalidInputError(f"--workers {workers}: need at least one")
+    config = EvalConfig(
+        agent, tuple(parse_sizes(sizes)), goals, seed, str(goals_file) if goals_file else None
+    )
+    from hsgplan.evaluation.protocol import make_agent
+
+    make_agent(agent)
+    total = len(episode_specs(config))
+    folder = run_dir or Path("runs") / config.run_name()
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task(f"{agent} episodes", total=total)
+        records = run_evaluation(config, folder, workers, lambda r: progress.advance(task))
+    report = summarize(records) | {"agent": agent, "seed": seed, "run": str(folder)}
+    if as_json:
+        print(json.dumps(report, indent=2))
+        return
+    rows = [
+        (
+            n,
+            f"{v['success_rate']:.2f}",
+            f"{v['subgoal_completion']:.2f}",
+            str(v["episodes"]),
+            ", ".join(f"{k} {c}" for k, c in sorted(v["failures"].items())) or "—",
+        )
+        for n, v in report["by_size"].items()
+    ]
+    source = f"goals from {goals_file}" if goals_file else f"{goals} goals per size"
+    print_table(
+        f"{agent}: {source}, seed {seed}",
+        ("objects", "success", "subgoal completion", "episodes", "failures"),
+        rows,
+        markdown,
+    )
