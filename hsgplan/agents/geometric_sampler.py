@@ -145,8 +145,12 @@ def place_candidates(
             )
             if gap < MIN_CLEARANCE:
                 continue
-            me = _standing(obj, x, y, PLACE_LONG_AXIS_YAW, rect.z)
-            blocked = any(_hand_conflict(me, o) for o in above)
+            # The primitive turns a box a quarter turn when the hand would not fit the
+            # other way: blocked means blocked both ways.
+            blocked = all(
+                any(_hand_conflict(_standing(obj, x, y, yaw, rect.z), o) for o in above)
+                for yaw in (PLACE_LONG_AXIS_YAW, PLACE_LONG_AXIS_YAW + math.pi / 2)
+            )
             if slots:
                 cost = min(abs(y - s) for s in slots) + 0.3 * abs(x - rect.center[0])
             elif free:

@@ -132,7 +132,8 @@ SHELVES: dict[str, Shelf] = {
 }
 
 REGIONS: dict[str, Rect] = {
-    "open_space": Rect(0.22, 0.70, -0.20, 0.20, 0.0),
+    # Starts 26 cm out: nearer the base, top-down grasps are at the edge of the arm's reach.
+    "open_space": Rect(0.26, 0.70, -0.20, 0.20, 0.0),
     "prepush_a": Rect(0.24, 0.37, 0.24, 0.52, 0.0),
     "prepush_b": Rect(0.24, 0.37, -0.52, -0.24, 0.0),
 }
