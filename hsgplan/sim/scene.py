@@ -5,7 +5,10 @@ The client is created here and passed to every part; nothing in the package keep
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import contextlib
+import os
+import sys
+from collections.abc import Iterable, Iterator
 
 import numpy as np
 import pybullet
@@ -24,6 +27,22 @@ REST_SPEED = 0.01  # m/s: below this every object counts as at rest
 MAX_SETTLE_STEPS = 480
 
 
+@contextlib.contextmanager
+def _quiet_stdout() -> Iterator[None]:
+    """PyBullet's C code prints `argv[0]=` to the process's stdout when it connects, which
+    would corrupt a command's JSON output: stdout is pointed at /dev/null meanwhile."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(devnull)
+        os.close(saved)
+
+
 class Scene:
     """The world of one episode.
 
@@ -34,7 +53,8 @@ class Scene:
     """
 
     def __init__(self, objects: Iterable[str], seed: int = 0, poses: dict[str, Pose] | None = None):
-        self.bc = BulletClient(connection_mode=pybullet.DIRECT)
+        with _quiet_stdout():
+            self.bc = BulletClient(connection_mode=pybullet.DIRECT)
         self.bc.setGravity(0, 0, -9.81)
         self.bc.setTimeStep(TIME_STEP)
         self.arena: Arena = build_arena(self.bc)

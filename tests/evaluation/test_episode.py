@@ -95,3 +95,31 @@ def test_demo_writes_pictures_and_a_record(tmp_path):
     assert record["seed"] == 1 and record["size"] == 2
     graphs = sorted((out / "graphs").glob("step_*.png"))
     assert len(graphs) == len(record["steps"]) + 1
+
+
+def test_json_output_of_the_real_command_is_pure_json(tmp_path):
+    # PyBullet's C code prints to the process's stdout; only a real process shows it.
+    import subprocess
+    import sys
+
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "hsgplan.cli",
+            "eval",
+            "--sizes",
+            "2",
+            "--goals",
+            "1",
+            "--workers",
+            "1",
+            "--json",
+            "--out",
+            str(tmp_path / "run"),
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert json.loads(result.stdout)["by_size"]["2"]["episodes"] == 1

@@ -1,0 +1,3 @@
+from hsgplan.cli import main
+
+main()
