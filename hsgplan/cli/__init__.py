@@ -1,6 +1,7 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
-One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval), `bench`.
+One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval), `data`
+(collect), `bench`.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ import sys
 
 import typer
 
-from hsgplan.cli import bench, symbolic, world
+from hsgplan.cli import bench, data, symbolic, world
 
 app = typer.Typer(
     add_completion=False,
@@ -21,6 +22,7 @@ app.command()(symbolic.goals)
 app.command()(world.demo)
 app.command("eval")(world.evaluate)
 app.add_typer(bench.app, name="bench")
+app.add_typer(data.app, name="collect")
 
 
 def main() -> None:

@@ -1,0 +1,204 @@
+"""The paper's 18 short demonstrations, recorded in the simulated world.
+
+Tasks (fixed, so that the dataset is the same everywhere): place one object on a shelf top
+(each of the six types once, shelves alternating), stack two objects on a shelf top (nine
+pairs, each base a type that can carry), put one can into shelf A (each of the three cans).
+None of them is an evaluation task: evaluation goals name 2 to 12 objects and leave stacking out
+at 2 objects, while these name one object, or two stacked.
+
+Each demonstration is an oracle episode (Fast Downward's plan, executed in simulation); the
+symbolic scene graph is read by f_m from the simulator at every state. An episode that failed,
+had a primitive fail on the way, or whose goal held from the start is retried with the next
+seed; the seed that was kept is recorded.
+
+On disk (`FORMAT`): a folder with `meta.json` (version, command, seed) and `demos.jsonl`, one
+demonstration per line: {"task", "goal", "seed", "objects", "actions": [str],
+"states": [[literal, ...], ...]} with len(states) == len(actions) + 1; literals and actions are
+in the goal / action text syntax.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.goals import Goal, parse_goal
+from hsgplan.domain.transition import Action, parse_action
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+VERSION = 1
+FORMAT = "hsgplan-demos"
+DEMOS = "demos.jsonl"
+META = "meta.json"
+RETRIES = 5
+
+_PLACE = [
+    ("cherries", "shelf_a"),
+    ("alphabet_soup", "shelf_b"),
+    ("tomato_soup", "shelf_a"),
+    ("popcorn", "shelf_b"),
+    ("cream_cheese", "shelf_a"),
+    ("butter", "shelf_b"),
+]
+_STACK = [  # (base, top, shelf)
+    ("cherries", "butter", "shelf_a"),
+    ("alphabet_soup", "cream_cheese", "shelf_b"),
+    ("tomato_soup", "cherries", "shelf_a"),
+    ("cream_cheese", "tomato_soup", "shelf_b"),
+    ("butter", "alphabet_soup", "shelf_a"),
+    ("cherries", "popcorn", "shelf_b"),
+    ("cream_cheese", "butter", "shelf_a"),
+    ("alphabet_soup", "tomato_soup", "shelf_b"),
+    ("butter", "cherries", "shelf_a"),
+]
+_INSIDE = ["cherries", "alphabet_soup", "tomato_soup"]
+
+TASKS: tuple[tuple[str, str], ...] = (
+    tuple((f"place-{o}-{s}", f"On({o}, {s})") for o, s in _PLACE)
+    + tuple((f"stack-{t}-on-{b}-{s}", f"On({b}, {s}) & On({t}, {b})") for b, t, s in _STACK)
+    + tuple((f"inside-{o}-shelf_a", f"In({o}, shelf_a)") for o in _INSIDE)
+)
+
+
+@dataclass(frozen=True)
+class Demo:
+    """One demonstration: the goal, the seed of its scene, and its symbolic trajectory."""
+
+    task: str
+    goal: str
+    seed: int
+    objects: tuple[str, ...]
+    actions: tuple[str, ...]
+    states: tuple[tuple[str, ...], ...]
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+    def goal_literals(self) -> Goal:
+        return parse_goal(self.goal)
+
+    def symbolic_states(self) -> list[SymbolicSceneGraph]:
+        return [
+            SymbolicSceneGraph.from_literals(
+                self.objects, parse_goal(" & ".join(s), validate=False).literals, limits=False
+            )
+            for s in self.states
+        ]
+
+    def symbolic_actions(self) -> list[Action]:
+        return [parse_action(a) for a in self.actions]
+
+
+def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
+    """Run the oracle on one task; the demonstration, or None if the episode failed."""
+    from hsgplan.agents.oracle import OracleAgent
+    from hsgplan.evaluation.episode import run_episode
+    from hsgplan.sim.env import KitchenStorageEnv
+
+    goal = parse_goal(goal_text)
+    states: list[SymbolicSceneGraph] = []
+    actions: list[str] = []
+
+    def on_step(record, obs) -> None:
+        if record is not None and record.status != "success":
+            return  # a primitive that failed and changed nothing is no transition
+        if record is not None:
+            actions.append(record.action)
+        states.append(obs.symbols.state)
+
+    result = run_episode(KitchenStorageEnv(), OracleAgent(), goal, seed, on_step=on_step)
+    if not result.success or not actions or any(s.status != "success" for s in result.steps):
+        return None  # a failure, a detour, or a goal that held from the start shows nothing
+    return Demo(
+        task,
+        goal_text,
+        seed,
+        goal.objects,
+        tuple(actions),
+        tuple(tuple(str(lit) for lit in s.sorted_literals()) for s in states),
+    )
+
+
+def collect_demos(
+    out: Path, seed: int, command: str = "", on_demo: Callable[[Demo], None] | None = None
+) -> list[Demo]:
+    """Record every task not yet in `out` (appending as each finishes); all demos, in order."""
+    out.mkdir(parents=True, exist_ok=True)
+    meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
+    meta_path = out / META
+    if meta_path.exists():
+        saved = _read_json(meta_path)
+        if saved.get("seed") != seed or saved.get("version") != VERSION:
+            raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
+    else:
+        meta_path.write_text(json.dumps(meta, indent=2) + "\n")
+    done = {d.task: d for d in _read_demos(out / DEMOS, tolerate_cut=True)}
+    path = out / DEMOS
+    if path.exists() and path.stat().st_size and not path.read_bytes().endswith(b"\n"):
+        with open(path, "a") as f:  # a line cut short by an interruption: end it
+            f.write("\n")
+    for i, (task, goal) in enumerate(TASKS):
+        if task in done:
+            continue
+        for attempt in range(RETRIES):
+            demo = record_demo(task, goal, seed * 1000 + i * RETRIES + attempt)
+            if demo is not None:
+                break
+        else:
+            raise RuntimeError(f"task {task}: the oracle failed {RETRIES} times")
+        with open(path, "a") as f:
+            f.write(json.dumps(demo.to_json()) + "\n")
+        done[task] = demo
+        if on_demo:
+            on_demo(demo)
+    return [done[t] for t, _ in TASKS]
+
+
+def load_demos(folder: Path) -> list[Demo]:
+    """The demonstrations of a dataset folder, checked; bad input raises InvalidInputError."""
+    meta = _read_json(folder / META)
+    if meta.get("format") != FORMAT or meta.get("version") != VERSION:
+        raise InvalidInputError(f"'{folder}' is not a version {VERSION} demonstration dataset")
+    demos = _read_demos(folder / DEMOS, tolerate_cut=False)
+    if not demos:
+        raise InvalidInputError(f"'{folder / DEMOS}' holds no demonstration")
+    return demos
+
+
+def _read_json(path: Path) -> dict:
+    if not path.is_file():
+        raise InvalidInputError(f"'{path}' does not exist")
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError:
+        raise InvalidInputError(f"'{path}' is not valid JSON") from None
+
+
+def _read_demos(path: Path, tolerate_cut: bool) -> list[Demo]:
+    if not path.exists():
+        return []
+    demos = []
+    for n, line in enumerate(path.read_text().splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            d = json.loads(line)
+            demo = Demo(
+                d["task"],
+                d["goal"],
+                int(d["seed"]),
+                tuple(d["objects"]),
+                tuple(d["actions"]),
+                tuple(tuple(s) for s in d["states"]),
+            )
+            if len(demo.states) != len(demo.actions) + 1:
+                raise ValueError("states and actions do not match")
+        except (json.JSONDecodeError, KeyError, TypeError, ValueError) as e:
+            if tolerate_cut:
+                continue
+            raise InvalidInputError(f"{path}:{n}: not a demonstration ({e})") from None
+        demos.append(demo)
+    return demos

@@ -1,0 +1,83 @@
+"""The shipped demonstrations, their format, and collection (resume included)."""
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from hsgplan.cli import app
+from hsgplan.data import demos as demos_module
+from hsgplan.data.demos import TASKS, collect_demos, load_demos
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.transition import apply
+
+SHIPPED = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
+
+
+def test_the_paper_task_mix():
+    kinds = [t.split("-")[0] for t, _ in TASKS]
+    assert len(TASKS) == 18
+    assert (kinds.count("place"), kinds.count("stack"), kinds.count("inside")) == (6, 9, 3)
+    assert len({t for t, _ in TASKS}) == 18
+
+
+def test_shipped_demos_replay_in_the_transition_model():
+    demos = load_demos(SHIPPED)
+    assert [d.task for d in demos] == [t for t, _ in TASKS]
+    for d in demos:
+        states, actions = d.symbolic_states(), d.symbolic_actions()
+        goal = d.goal_literals()
+        assert actions, d.task
+        assert not goal.satisfied_by(states[0]) and goal.satisfied_by(states[-1])
+        for before, action, after in zip(states[:-1], actions, states[1:], strict=True):
+            assert apply(before, action) == after, (d.task, str(action))
+
+
+def test_demos_stay_out_of_the_evaluation_distribution():
+    for d in load_demos(SHIPPED):
+        goal = d.goal_literals()
+        stacked = any(lit.args[-1] in goal.objects for lit in goal.literals)
+        assert goal.size == 1 or (goal.size == 2 and stacked)
+
+
+def test_corrupted_or_missing_datasets_are_refused(tmp_path):
+    with pytest.raises(InvalidInputError, match="does not exist"):
+        load_demos(tmp_path / "nothing")
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    (bad / "meta.json").write_text((SHIPPED / "meta.json").read_text())
+    (bad / "demos.jsonl").write_text('{"task": "x", "goal"\n')
+    with pytest.raises(InvalidInputError, match="demos.jsonl:1: not a demonstration"):
+        load_demos(bad)
+    (bad / "meta.json").write_text("{not json")
+    with pytest.raises(InvalidInputError, match="not valid JSON"):
+        load_demos(bad)
+
+
+def test_collection_resumes_without_repeating(tmp_path, monkeypatch):
+    monkeypatch.setattr(demos_module, "TASKS", TASKS[:2])
+    first = collect_demos(tmp_path, seed=3)
+    log = tmp_path / "demos.jsonl"
+    lines = log.read_text().splitlines()
+    assert len(first) == 2 and len(lines) == 2
+    log.write_text(lines[0] + "\n" + lines[1][:30])  # interrupted while writing the second
+    second = collect_demos(tmp_path, seed=3)
+    assert second[0] == first[0] and second[1].task == first[1].task
+    tasks = []
+    for line in log.read_text().splitlines():
+        try:
+            tasks.append(json.loads(line)["task"])
+        except json.JSONDecodeError:
+            continue
+    assert sorted(tasks) == sorted(t for t, _ in TASKS[:2])
+    with pytest.raises(InvalidInputError, match="another seed"):
+        collect_demos(tmp_path, seed=4)
+
+
+def test_cli_refuses_a_dataset_made_with_another_seed(tmp_path):
+    (tmp_path / "meta.json").write_text(
+        json.dumps({"format": "hsgplan-demos", "version": 1, "seed": 7})
+    )
+    r = CliRunner().invoke(app, ["collect", "demos", "--seed", "0", "--out", str(tmp_path)])
+    assert r.exit_code == 2 and "another seed" in r.stderr
