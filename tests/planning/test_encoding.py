@@ -1,0 +1,73 @@
+"""The (state, goal) graph encoding on tiny hand-built scenes."""
+
+import torch
+
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.predicates import PREDICATES, Predicate, clear, in_grasp, inside, on
+from hsgplan.planning.regression.encoding import (
+    DONT_CARE,
+    EDGE_DIM,
+    FALSE,
+    NODE_DIM,
+    TRUE,
+    Slots,
+    decode,
+    encode,
+)
+from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
+
+
+def scene():
+    return SymbolicSceneGraph.from_literals(
+        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_a")]
+    )
+
+
+def test_shapes_and_one_slot_per_literal():
+    s = scene()
+    data = encode(s, parse_goal("In(cherries, shelf_a) & not Clear(butter)").literals)
+    n = 2 + len(FIXTURES)
+    assert data.x.shape == (n, NODE_DIM)
+    assert data.edge_index.shape == (2, n * n)
+    assert data.edge_attr.shape == (n * n, EDGE_DIM)
+    assert data.valid.shape == data.goal.shape == (n * n, len(PREDICATES))
+    slots = Slots(tuple(data.names))
+    for lit in (on("butter", "cherries"), inside("cherries", "shelf_a"), clear("butter")):
+        e, p = slots.slot(lit)
+        assert slots.literal(e, p) == lit
+        assert data.valid[e, p]
+        src, dst = data.edge_index[:, e].tolist()
+        assert (data.names[src], data.names[dst]) == (lit.args[0], lit.args[-1])
+
+
+def test_state_goal_and_validity_features():
+    s = scene()
+    data = encode(s, parse_goal("In(cherries, shelf_a) & not Clear(butter)").literals)
+    slots = Slots(tuple(data.names))
+    e, p = slots.slot(on("butter", "cherries"))
+    assert data.edge_attr[e, p] == 1.0  # holds in the state
+    e, p = slots.slot(inside("cherries", "shelf_a"))
+    assert data.goal[e, p] == TRUE and data.edge_attr[e, p] == 0.0
+    e, p = slots.slot(clear("butter"))
+    assert data.goal[e, p] == FALSE
+    assert (data.goal != DONT_CARE).sum() == 2
+    # no literal about a fixture's own state, no On of an object with itself, In only to shelves
+    e, p = slots.slot(on("cherries", "open_space"))
+    assert data.valid[e, PREDICATES.index(Predicate.IN)] == False  # noqa: E712
+    i = data.names.index("shelf_a")
+    assert not data.valid[i * len(data.names) : (i + 1) * len(data.names)].any()
+
+
+def test_decode_inverts_the_goal():
+    goal = parse_goal("On(butter, shelf_b) & InGrasp(cherries) & not On(butter, cherries)")
+    data = encode(scene(), goal.literals)
+    assert set(decode(data, data.goal)) == set(goal.literals)
+
+
+def test_duplicates_share_features_and_order_follows_nodes():
+    s = SymbolicSceneGraph.initial(["cherries", "cherries_2"])
+    data = encode(s, [in_grasp("cherries_2")])
+    assert torch.equal(data.x[0], data.x[1])
+    slots = Slots(tuple(data.names))
+    e, p = slots.slot(in_grasp("cherries_2"))
+    assert e == 1 * len(data.names) + 1 and data.goal[e, p] == TRUE
