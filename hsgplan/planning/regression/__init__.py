@@ -1,0 +1,1 @@
+"""The learned regression task planner: encodings, networks, the regression loop."""

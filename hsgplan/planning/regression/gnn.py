@@ -1,0 +1,159 @@
+"""Graph networks for the regression planner: per-edge predicate classifiers over scene graphs.
+
+Scene graphs are directed, with one edge per ordered object pair and a self loop per object that
+carries its unary predicates, so every predicate lives on an edge and one per-edge head predicts
+all of them. The same network serves reachability (classes=2: no / yes per predicate) and
+preimages (classes=3: don't care / true / false per predicate).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+import torch
+import torch.nn.functional as F
+from torch import Tensor, nn
+from torch_geometric.data import Data
+from torch_geometric.nn import MessagePassing
+
+
+def mlp(in_dim: int, hidden: int, out_dim: int) -> nn.Sequential:
+    """The paper's shared module: two fully connected layers with a Leaky ReLU between them."""
+    return nn.Sequential(nn.Linear(in_dim, hidden), nn.LeakyReLU(), nn.Linear(hidden, out_dim))
+
+
+class RelationalLayer(MessagePassing):
+    r"""One interaction-network step over a directed graph with edge features.
+
+    For an edge i -> j the edge update is e'_ij = MLP_e([x_i, x_j, e_ij]); each node then sums
+    its incoming updated edges, x'_i = MLP_n([x_i, \sum_j e'_ji]). Sum rather than mean because
+    counts carry meaning (how many objects hold something). Self loops are ordinary edges and are
+    neither added nor removed. Where an input and output width match, the update is residual.
+
+    Args:
+        node_dim: width of the input node features.
+        edge_dim: width of the input edge features.
+        hidden: width of the hidden layers and of both outputs.
+
+    Shapes:
+        x: [N, node_dim]; edge_index: [2, E] (row 0 source, row 1 target); edge_attr:
+        [E, edge_dim] -> (x_new [N, hidden], edge_new [E, hidden]).
+    """
+
+    def __init__(self, node_dim: int, edge_dim: int, hidden: int) -> None:
+        super().__init__(aggr="add")
+        self.node_dim_in = node_dim  # `node_dim` is taken: MessagePassing's propagation axis
+        self.edge_dim = edge_dim
+        self.hidden = hidden
+        self.edge_mlp = mlp(2 * node_dim + edge_dim, hidden, hidden)
+        self.node_mlp = mlp(node_dim + hidden, hidden, hidden)
+
+    def forward(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> tuple[Tensor, Tensor]:
+        edge_new = self.edge_updater(edge_index, x=x, edge_attr=edge_attr)
+        incoming = self.propagate(edge_index, edge_attr=edge_new, size=(x.size(0), x.size(0)))
+        x_new = self.node_mlp(torch.cat([x, incoming], dim=-1))
+        if self.node_dim_in == self.hidden:
+            x_new = x_new + x
+        if self.edge_dim == self.hidden:
+            edge_new = edge_new + edge_attr
+        return x_new, edge_new
+
+    def edge_update(self, x_i: Tensor, x_j: Tensor, edge_attr: Tensor) -> Tensor:
+        # PyG names the source x_j and the target x_i; the paper's order is [source, target].
+        return self.edge_mlp(torch.cat([x_j, x_i, edge_attr], dim=-1))
+
+    def message(self, edge_attr: Tensor) -> Tensor:
+        return edge_attr
+
+    def __repr__(self) -> str:
+        return (
+            f"{type(self).__name__}(node_dim={self.node_dim_in}, edge_dim={self.edge_dim}, "
+            f"hidden={self.hidden})"
+        )
+
+
+@dataclass(frozen=True)
+class EdgeClassifierConfig:
+    """Sizes of an `EdgeClassifier`; stored next to trained weights as JSON."""
+
+    node_dim: int
+    edge_dim: int
+    predicates: int = 4
+    classes: int = 3
+    hidden: int = 256
+    rounds: int = 3
+
+    def __post_init__(self) -> None:
+        for name in ("node_dim", "edge_dim", "predicates", "hidden"):
+            if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
+                raise ValueError(f"{name} must be a positive integer, got {getattr(self, name)!r}")
+        if not isinstance(self.classes, int) or self.classes < 2:
+            raise ValueError(f"classes must be an integer >= 2, got {self.classes!r}")
+        if not isinstance(self.rounds, int) or self.rounds < 0:
+            raise ValueError(f"rounds must be a non-negative integer, got {self.rounds!r}")
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+    @staticmethod
+    def from_json(d: dict) -> EdgeClassifierConfig:
+        known = {f.name for f in fields(EdgeClassifierConfig)}
+        unknown = sorted(set(d) - known)
+        if unknown:
+            # A typo in a saved config would otherwise silently fall back to a default size.
+            raise ValueError(f"unknown EdgeClassifierConfig keys: {', '.join(unknown)}")
+        try:
+            return EdgeClassifierConfig(**d)
+        except TypeError as e:
+            raise ValueError(f"bad EdgeClassifierConfig: {e}") from e
+
+
+class EdgeClassifier(nn.Module):
+    """Per-edge, per-predicate classification of a graph after rounds of message passing.
+
+    Node and edge features are encoded to `hidden`, passed through `rounds` relational layers
+    (separate weights per round), and each edge is classified from [x_src, x_dst, e].
+
+    Args:
+        config: the sizes, see `EdgeClassifierConfig`.
+
+    Shapes:
+        data.x: [N, node_dim]; data.edge_index: [2, E]; data.edge_attr: [E, edge_dim]
+        -> logits [E, predicates, classes]. A `Batch` works the same, edges in batch order.
+    """
+
+    def __init__(self, config: EdgeClassifierConfig) -> None:
+        super().__init__()
+        self.config = config
+        h = config.hidden
+        self.node_encoder = mlp(config.node_dim, h, h)
+        self.edge_encoder = mlp(config.edge_dim, h, h)
+        self.layers = nn.ModuleList(RelationalLayer(h, h, h) for _ in range(config.rounds))
+        self.head = mlp(3 * h, h, config.predicates * config.classes)
+
+    def forward(self, data: Data) -> Tensor:
+        edge_index = data.edge_index
+        x = self.node_encoder(data.x.float())
+        e = self.edge_encoder(data.edge_attr.float())
+        for layer in self.layers:
+            x, e = layer(x, edge_index, e)
+        logits = self.head(torch.cat([x[edge_index[0]], x[edge_index[1]], e], dim=-1))
+        return logits.view(-1, self.config.predicates, self.config.classes)
+
+
+def masked_cross_entropy(logits: Tensor, target: Tensor, mask: Tensor) -> Tensor:
+    """Mean cross entropy over the (edge, predicate) entries where `mask` is set.
+
+    Args:
+        logits: [E, P, C] raw scores.
+        target: [E, P] class indices (long); values under a cleared mask are never read.
+        mask: [E, P] bool.
+
+    Returns:
+        A scalar; 0 with a gradient path when nothing is masked in, so a batch without labels
+        adds nothing to the loss instead of producing NaN.
+    """
+    picked = logits[mask]
+    if picked.numel() == 0:
+        return logits.sum() * 0.0
+    return F.cross_entropy(picked, target[mask])
