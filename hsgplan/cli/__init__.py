@@ -1,7 +1,7 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval), `data`
-(collect), `bench`.
+(collect), `learn` (train, eval-task), `bench`.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import sys
 
 import typer
 
-from hsgplan.cli import bench, data, symbolic, world
+from hsgplan.cli import bench, data, learn, symbolic, world
 
 app = typer.Typer(
     add_completion=False,
@@ -23,6 +23,8 @@ app.command()(world.demo)
 app.command("eval")(world.evaluate)
 app.add_typer(bench.app, name="bench")
 app.add_typer(data.app, name="collect")
+app.add_typer(learn.train_app, name="train")
+app.command("eval-task")(learn.eval_task)
 
 
 def main() -> None:

@@ -1,0 +1,111 @@
+"""Commands of the learned task planner: `train task`, `eval-task`."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.progress import Progress
+
+from hsgplan.cli.common import err, out, parse_sizes, print_table, refuses_bad_input
+from hsgplan.domain.errors import InvalidInputError
+
+train_app = typer.Typer(no_args_is_help=True, help="Train the learned models (resumable).")
+CHECKPOINT = Path("checkpoints/task")
+
+
+@train_app.command("task")
+@refuses_bad_input
+def train_task(
+    config: Annotated[Path | None, typer.Option(help="Training configuration (JSON).")] = None,
+    out_dir: Annotated[Path, typer.Option("--out", help="Checkpoint folder.")] = CHECKPOINT,
+    seed: Annotated[int | None, typer.Option(help="Overrides the configuration's seed.")] = None,
+) -> None:
+    """Train f_preimage, f_reach and the forward baseline on the demonstrations."""
+    from hsgplan.planning.regression.train import TaskTrainConfig
+    from hsgplan.planning.regression.train import train_task as run
+
+    settings = {}
+    if config is not None:
+        try:
+            settings = json.loads(config.read_text())
+        except FileNotFoundError:
+            raise InvalidInputError(f"--config '{config}' does not exist") from None
+        except json.JSONDecodeError:
+            raise InvalidInputError(f"--config '{config}' is not valid JSON") from None
+    if seed is not None:
+        settings["seed"] = seed
+    cfg = TaskTrainConfig.from_json(settings)
+    with Progress(console=err, transient=True) as progress:
+        bars = {}
+
+        def on_epoch(name: str, epoch: int, loss: float) -> None:
+            if name not in bars:
+                bars[name] = progress.add_task(name, total=cfg.epochs)
+            progress.update(bars[name], completed=epoch, description=f"{name} loss {loss:.4f}")
+
+        run(cfg, out_dir, on_epoch)
+    out.print(f"trained f_preimage, f_reach and the forward baseline into {out_dir}")
+
+
+@refuses_bad_input
+def eval_task(
+    planner: Annotated[str, typer.Option(help="regression, forward or fd.")] = "regression",
+    sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
+    goals: Annotated[int, typer.Option(help="Random goals per size.")] = 500,
+    seed: Annotated[int, typer.Option(help="Seed of the goals and start states.")] = 0,
+    goals_file: Annotated[Path | None, typer.Option(help="Goals from a file instead.")] = None,
+    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = CHECKPOINT,
+    workers: Annotated[int, typer.Option(help="Episodes run side by side.")] = 2,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
+    milliseconds per decision."""
+    from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
+
+    if workers < 1:
+        raise InvalidInputError(f"--workers {workers}: need at least one")
+    size_list = parse_sizes(sizes)
+    total = goals * len(size_list) if goals_file is None else None
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task(f"{planner} episodes", total=total)
+        episodes = evaluate_task(
+            planner,
+            checkpoint,
+            size_list,
+            goals,
+            seed,
+            goals_file,
+            workers,
+            lambda e: progress.advance(task),
+        )
+    report = summarize_task(episodes) | {"planner": planner, "seed": seed}
+    if as_json:
+        print(json.dumps(report, indent=2))
+        return
+
+    def fmt(v, spec):
+        return "—" if v is None else format(v, spec)
+
+    rows = [
+        (
+            n,
+            fmt(v["success_rate"], ".3f"),
+            fmt(v["plan_length_ratio"], ".3f"),
+            fmt(v["ms_per_decision"], ".1f"),
+            str(v["episodes"]),
+            ", ".join(f"{k} {c}" for k, c in sorted(v["failures"].items())) or "—",
+        )
+        for n, v in report["by_size"].items()
+    ]
+    print_table(
+        f"{planner} in the symbolic loop, {goals} goals per size, seed {seed}",
+        ("objects", "success", "plan length / FD", "ms per decision", "episodes", "failures"),
+        rows,
+        markdown,
+    )

@@ -1,0 +1,162 @@
+"""Training examples for the task planner's networks, made from the demonstrations.
+
+f_preimage: each demonstration is regressed from its goal backwards, action by action. When the
+last action t adds literals the current subgoal g_{t+1} asks for, its preimage g_t is g_{t+1}
+without those literals, plus the literals the action consumed (true before it, false after: its
+preconditions as the demonstration shows them); an action that adds nothing g_{t+1} asks for
+leaves it as it is. The network sees a state s_tau (any state at or before t, as the planner
+sees the current state while regressing from far ahead) and g_{t+1}, and learns g_t.
+
+f_reach: the literals each demonstrated action adds are reachable in one primitive from the
+state before it; negatives are made, as the paper does, by altering those literals: here in
+every way (every subject, target and predicate), so that the network also meets, say, a push's
+target literal while the object is not yet in front of the shelf. An altered literal can still
+be reachable (placing on another surface is one primitive as well), so each is labelled by the
+symbolic transition model: reachable if one applicable action makes it true. Examples pair a
+state with the demonstrated action's literals and their alterations at once, and with each
+candidate alone, as the planner asks about whole subgoals and single literals.
+
+The forward baseline learns, from (s_t, goal), the literals action t adds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+from torch_geometric.data import Data
+
+from hsgplan.data.demos import Demo
+from hsgplan.domain.objects import EntityKind, kind_of
+from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.transition import applicable_actions, apply
+from hsgplan.planning.regression.encoding import DONT_CARE, TRUE, Slots, encode
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+
+@dataclass(frozen=True)
+class Example:
+    """An encoded (state, goal) graph, a per-slot target, and which slots are supervised."""
+
+    data: Data
+    target: torch.Tensor  # [E, P] long
+    mask: torch.Tensor  # [E, P] bool
+
+    def as_data(self) -> Data:
+        d = self.data.clone()
+        d.target, d.mask = self.target, self.mask
+        return d
+
+
+def _changes(before: SymbolicSceneGraph, after: SymbolicSceneGraph):
+    return after.literals - before.literals, before.literals - after.literals
+
+
+def regressed_subgoals(demo: Demo) -> list[frozenset[Literal]]:
+    """g_0 .. g_T: the demonstration's goal regressed through its actions (g_T is the goal)."""
+    states = demo.symbolic_states()
+    goals = [frozenset(lit for lit in demo.goal_literals().literals if lit.positive)]
+    for t in range(len(states) - 2, -1, -1):
+        added, consumed = _changes(states[t], states[t + 1])
+        g = goals[0]
+        goals.insert(0, (g - added) | consumed if g & added else g)
+    return goals
+
+
+def _target(data: Data, literals) -> tuple[torch.Tensor, torch.Tensor]:
+    slots = Slots(tuple(data.names))
+    target = torch.full_like(data.goal, DONT_CARE)
+    for lit in literals:
+        e, p = slots.slot(lit)
+        target[e, p] = TRUE
+    return target, data.valid.clone()
+
+
+def preimage_examples(demos: list[Demo]) -> list[Example]:
+    out = []
+    for demo in demos:
+        states, goals = demo.symbolic_states(), regressed_subgoals(demo)
+        for t in range(len(states) - 1):
+            if goals[t] == goals[t + 1]:
+                continue
+            for tau in range(t + 1):
+                data = encode(states[tau], goals[t + 1])
+                out.append(Example(data, *_target(data, goals[t])))
+    return out
+
+
+def _alterations(lit: Literal, state: SymbolicSceneGraph) -> set[Literal]:
+    objects = state.objects
+    out = set()
+    for o in objects:  # another subject
+        if o not in lit.args:
+            out.add(Literal(lit.predicate, (o,) + lit.args[1:]))
+    if lit.predicate.arity == 2:  # another target, and the other binary predicate
+        for x in state.nodes:
+            if x != lit.args[0]:
+                out.add(Literal(Predicate.ON, (lit.args[0], x)))
+                if kind_of(x) is EntityKind.SHELF:
+                    out.add(Literal(Predicate.IN, (lit.args[0], x)))
+    else:  # either unary predicate, of any object (grasping another while holding one, say)
+        for o in objects:
+            out |= {Literal(Predicate.IN_GRASP, (o,)), Literal(Predicate.CLEAR, (o,))}
+    out.discard(lit)
+    return out
+
+
+def _every_literal(state: SymbolicSceneGraph) -> set[Literal]:
+    out = set()
+    for o in state.objects:
+        out |= {Literal(Predicate.IN_GRASP, (o,)), Literal(Predicate.CLEAR, (o,))}
+        for x in state.nodes:
+            if x != o:
+                out.add(Literal(Predicate.ON, (o, x)))
+                if kind_of(x) is EntityKind.SHELF:
+                    out.add(Literal(Predicate.IN, (o, x)))
+    return out
+
+
+def reachable(state: SymbolicSceneGraph) -> set[Literal]:
+    """Literals false now that one applicable action makes true (labels, from the model)."""
+    made = set()
+    for action in applicable_actions(state):
+        made |= apply(state, action).literals
+    return made - state.literals
+
+
+def reach_examples(demos: list[Demo]) -> list[Example]:
+    out = []
+    for demo in demos:
+        states = demo.symbolic_states()
+        for t in range(len(states) - 1):
+            added, _ = _changes(states[t], states[t + 1])
+            candidates = set(added)
+            for lit in added:
+                candidates |= _alterations(lit, states[t])
+            candidates |= _every_literal(states[t])
+            candidates = {c for c in candidates if not states[t].holds(c)}
+            yes = reachable(states[t])
+            for goal in [candidates] + [{c} for c in sorted(candidates)]:
+                data = encode(states[t], goal)
+                slots = Slots(tuple(data.names))
+                target = torch.zeros_like(data.goal)
+                mask = torch.zeros_like(data.valid)
+                for c in goal:
+                    e, p = slots.slot(c)
+                    target[e, p] = int(c in yes)
+                    mask[e, p] = True
+                out.append(Example(data, target, mask))
+    return out
+
+
+def forward_examples(demos: list[Demo]) -> list[Example]:
+    """(s_t, goal) -> the literals action t adds: the forward baseline's next subgoal."""
+    out = []
+    for demo in demos:
+        states = demo.symbolic_states()
+        goal = [lit for lit in demo.goal_literals().literals if lit.positive]
+        for t in range(len(states) - 1):
+            added, _ = _changes(states[t], states[t + 1])
+            data = encode(states[t], goal)
+            out.append(Example(data, *_target(data, added)))
+    return out

@@ -1,0 +1,137 @@
+"""Training the task planner's networks: `hsgplan train task`.
+
+Three edge classifiers are trained on the demonstrations, with cross-entropy: f_preimage
+(don't care / true / false per slot), f_reach (no / yes per supervised slot) and the forward
+baseline (the next subgoal). A checkpoint is a folder: `train_config.json`, and one folder per
+network with `model.safetensors` and `config.json` (the network's configuration). Training saves
+its progress (`progress.pt`, loaded with weights_only) every `save_every` epochs, and a run
+started again with the same configuration continues from there.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import torch
+from safetensors.torch import load_file, save_file
+from torch_geometric.data import Batch
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.planning.regression.encoding import EDGE_DIM, NODE_DIM
+from hsgplan.planning.regression.examples import (
+    Example,
+    forward_examples,
+    preimage_examples,
+    reach_examples,
+)
+from hsgplan.planning.regression.gnn import (
+    EdgeClassifier,
+    EdgeClassifierConfig,
+    masked_cross_entropy,
+)
+
+NETWORKS = {"preimage": 3, "reach": 2, "forward": 3}
+
+
+@dataclass(frozen=True)
+class TaskTrainConfig:
+    demos: str = "data/demos/v1"
+    seed: int = 0
+    epochs: int = 150
+    lr: float = 1e-3
+    batch_size: int = 32
+    hidden: int = 256  # the paper: every layer of every module has 256 hidden units
+    rounds: int = 3
+    save_every: int = 25
+
+    @staticmethod
+    def from_json(d: dict) -> TaskTrainConfig:
+        unknown = set(d) - set(TaskTrainConfig.__dataclass_fields__)
+        if unknown:
+            raise InvalidInputError(f"unknown training setting(s): {', '.join(sorted(unknown))}")
+        return TaskTrainConfig(**d)
+
+
+def _examples(name: str, demos) -> list[Example]:
+    return {"preimage": preimage_examples, "reach": reach_examples, "forward": forward_examples}[
+        name
+    ](demos)
+
+
+def train_task(
+    config: TaskTrainConfig,
+    out: Path,
+    on_epoch: Callable[[str, int, float], None] | None = None,
+) -> None:
+    """Train (or go on training) the three networks into the checkpoint folder `out`."""
+    from hsgplan.data.demos import load_demos
+
+    if config.epochs < 1:
+        raise InvalidInputError(f"epochs {config.epochs}: need at least one")
+    demos = load_demos(Path(config.demos))
+    out.mkdir(parents=True, exist_ok=True)
+    saved = out / "train_config.json"
+    if saved.exists() and json.loads(saved.read_text()) != asdict(config):
+        raise InvalidInputError(f"'{out}' holds a checkpoint trained with another configuration")
+    saved.write_text(json.dumps(asdict(config), indent=2) + "\n")
+    for name, classes in NETWORKS.items():
+        _train_one(name, classes, _examples(name, demos), config, out / name, on_epoch)
+
+
+def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, on_epoch) -> None:
+    folder.mkdir(exist_ok=True)
+    if (folder / "model.safetensors").exists():
+        return  # finished earlier
+    torch.manual_seed(config.seed)
+    net_config = EdgeClassifierConfig(NODE_DIM, EDGE_DIM, 4, classes, config.hidden, config.rounds)
+    model = EdgeClassifier(net_config)
+    optim = torch.optim.Adam(model.parameters(), lr=config.lr)
+    start = 0
+    progress = folder / "progress.pt"
+    if progress.exists():
+        state = torch.load(progress, weights_only=True)
+        model.load_state_dict(state["model"])
+        optim.load_state_dict(state["optim"])
+        start = int(state["epoch"])
+    data = [e.as_data() for e in examples]
+    for epoch in range(start, config.epochs):
+        rng = random.Random(f"{config.seed}-{name}-{epoch}")
+        order = list(range(len(data)))
+        rng.shuffle(order)
+        total = 0.0
+        for i in range(0, len(order), config.batch_size):
+            batch = Batch.from_data_list([data[j] for j in order[i : i + config.batch_size]])
+            loss = masked_cross_entropy(model(batch), batch.target, batch.mask)
+            optim.zero_grad()
+            loss.backward()
+            optim.step()
+            total += loss.detach().item() * batch.num_graphs
+        if on_epoch:
+            on_epoch(name, epoch + 1, total / len(data))
+        if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
+            tmp = folder / "progress.tmp"
+            torch.save(
+                {"model": model.state_dict(), "optim": optim.state_dict(), "epoch": epoch + 1}, tmp
+            )
+            tmp.replace(progress)  # a crash mid-write leaves the last good progress
+    save_file(model.state_dict(), folder / "model.safetensors")
+    (folder / "config.json").write_text(json.dumps(net_config.to_json(), indent=2) + "\n")
+    progress.unlink(missing_ok=True)
+
+
+def load_network(folder: Path) -> EdgeClassifier:
+    """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
+    try:
+        config = EdgeClassifierConfig.from_json(json.loads((folder / "config.json").read_text()))
+        model = EdgeClassifier(config)
+        model.load_state_dict(load_file(folder / "model.safetensors"))
+    except FileNotFoundError:
+        raise InvalidInputError(f"no trained network in '{folder}'") from None
+    except Exception as e:  # corrupted weights or config: one line, not a traceback
+        raise InvalidInputError(f"'{folder}' is not a usable checkpoint ({e})") from None
+    model.eval()
+    return model

@@ -1,0 +1,113 @@
+"""Mechanics of the learned task planner: examples, training, checkpoints, the symbolic loop."""
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from hsgplan.cli import app
+from hsgplan.data.demos import load_demos
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.predicates import clear, in_grasp, inside, on
+from hsgplan.planning.regression.examples import (
+    reach_examples,
+    reachable,
+    regressed_subgoals,
+)
+from hsgplan.planning.regression.planner import action_for
+from hsgplan.planning.regression.train import TaskTrainConfig, load_network, train_task
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+DEMOS = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
+TINY = {"demos": str(DEMOS), "epochs": 2, "hidden": 16, "rounds": 1, "batch_size": 256}
+
+
+def test_a_stack_demonstration_regresses_base_first():
+    demo = next(d for d in load_demos(DEMOS) if d.task == "stack-butter-on-cherries-shelf_a")
+    chain = regressed_subgoals(demo)
+    assert chain[-1] == {on("cherries", "shelf_a"), on("butter", "cherries")}
+    # before the last place: butter in the hand, the base on the shelf and clear
+    assert chain[-2] == {on("cherries", "shelf_a"), in_grasp("butter"), clear("cherries")}
+
+
+def test_reach_labels_follow_the_transition_model():
+    holding = SymbolicSceneGraph.from_literals(
+        ["cherries", "butter"], [in_grasp("cherries"), on("butter", "prepush_a")]
+    )
+    yes = reachable(holding)
+    assert on("cherries", "shelf_b") in yes and on("cherries", "butter") in yes
+    assert in_grasp("butter") not in yes  # the hand is full
+    assert inside("butter", "shelf_a") not in yes  # pushing needs the hand free
+    for ex in reach_examples(load_demos(DEMOS))[:50]:
+        assert ex.mask.any() and ex.target[ex.mask].max() <= 1
+
+
+def test_action_heuristic():
+    s = SymbolicSceneGraph.from_literals(
+        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "prepush_a")]
+    )
+    assert str(action_for(clear("cherries"), s)) == "pick(butter)"
+    assert str(action_for(in_grasp("butter"), s)) == "pick(butter)"
+    assert action_for(inside("cherries", "shelf_a"), s) is None  # not clear yet
+
+
+def test_training_writes_checkpoint_folders_and_resumes(tmp_path):
+    config = TaskTrainConfig.from_json(TINY | {"save_every": 1})
+    seen = []
+
+    def stop_midway(name, epoch, loss):
+        seen.append((name, epoch))
+        if name == "reach" and epoch == 1:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        train_task(config, tmp_path, stop_midway)
+    assert (tmp_path / "preimage" / "model.safetensors").exists()
+    seen.clear()
+    train_task(config, tmp_path, lambda n, e, loss: seen.append((n, e)))
+    assert ("preimage", 1) not in seen  # finished before: not trained again
+    for name in ("preimage", "reach", "forward"):
+        net = load_network(tmp_path / name)
+        assert json.loads((tmp_path / name / "config.json").read_text())["hidden"] == 16
+        assert net.config.hidden == 16
+    with pytest.raises(InvalidInputError, match="another configuration"):
+        train_task(TaskTrainConfig.from_json(TINY | {"seed": 9}), tmp_path)
+
+
+def test_broken_checkpoints_are_refused(tmp_path):
+    with pytest.raises(InvalidInputError, match="no trained network"):
+        load_network(tmp_path)
+    (tmp_path / "config.json").write_text('{"node_dim": 3}')
+    (tmp_path / "model.safetensors").write_bytes(b"not a tensor file")
+    with pytest.raises(InvalidInputError, match="not a usable checkpoint"):
+        load_network(tmp_path)
+
+
+def test_eval_task_cli_with_fast_downward(tmp_path):
+    r = CliRunner().invoke(
+        app,
+        [
+            "eval-task",
+            "--planner",
+            "fd",
+            "--sizes",
+            "2",
+            "--goals",
+            "2",
+            "--json",
+            "--workers",
+            "1",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    entry = json.loads(r.stdout)["by_size"]["2"]
+    assert entry["success_rate"] == 1.0 and entry["plan_length_ratio"] == 1.0
+    assert entry["ms_per_decision"] > 0
+
+
+def test_eval_task_without_a_checkpoint_is_one_line(tmp_path):
+    r = CliRunner().invoke(app, ["eval-task", "--checkpoint", str(tmp_path), "--goals", "1"])
+    assert r.exit_code == 2 and "no trained network" in r.stderr
+    r = CliRunner().invoke(app, ["train", "task", "--config", str(tmp_path / "none.json")])
+    assert r.exit_code == 2 and "does not exist" in r.stderr
