@@ -111,3 +111,29 @@ def test_eval_task_without_a_checkpoint_is_one_line(tmp_path):
     assert r.exit_code == 2 and "no trained network" in r.stderr
     r = CliRunner().invoke(app, ["train", "task", "--config", str(tmp_path / "none.json")])
     assert r.exit_code == 2 and "does not exist" in r.stderr
+
+
+def test_preimage_targets_of_a_stacks_last_step():
+    from hsgplan.planning.regression.encoding import FALSE, TRUE, Slots, decode
+    from hsgplan.planning.regression.examples import preimage_examples
+
+    demo = next(d for d in load_demos(DEMOS) if d.task == "stack-butter-on-cherries-shelf_a")
+    last = [
+        e
+        for e in preimage_examples([demo])
+        if e.data.edge_attr[:, -4:].sum() == 1
+        and decode(e.data, e.data.goal) == [on("cherries", "shelf_a"), on("butter", "cherries")]
+    ]
+    ex = last[-1]
+    slots = Slots(tuple(ex.data.names))
+    assert ex.target[slots.slot(on("cherries", "shelf_a"))] == TRUE  # the base comes first
+    assert ex.target[slots.slot(in_grasp("butter"))] == TRUE
+    assert ex.target[slots.slot(clear("cherries"))] == TRUE
+    assert ex.target[slots.slot(in_grasp("cherries"))] == FALSE  # the hand holds only butter
+
+
+def test_undoing_a_literal_is_reachable_too():
+    holding = SymbolicSceneGraph.from_literals(["cherries"], [in_grasp("cherries")])
+    yes = reachable(holding)
+    assert in_grasp("cherries").negated() in yes
+    assert on("cherries", "shelf_a") in yes

@@ -21,8 +21,9 @@ from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 DONT_CARE, TRUE, FALSE = 0, 1, 2
 KINDS = tuple(EntityKind)
 NODE_DIM = len(ENTITY_TYPES) + len(KINDS)
-# state multi-hot, goal one-hot over {don't care, true, false} per predicate, valid slots
-EDGE_DIM = len(PREDICATES) + 3 * len(PREDICATES) + len(PREDICATES)
+# state multi-hot, goal one-hot over {don't care, true, false} per predicate, valid slots, and
+# the query: the one literal of the goal being regressed
+EDGE_DIM = len(PREDICATES) + 3 * len(PREDICATES) + 2 * len(PREDICATES)
 
 
 def _valid(pred: Predicate, src: str, dst: str) -> bool:
@@ -74,14 +75,17 @@ class Slots:
         return values
 
 
-def encode(state: SymbolicSceneGraph, goal: Iterable[Literal]) -> Data:
-    """The state and a goal (literals over the state's nodes) as a graph.
+def encode(
+    state: SymbolicSceneGraph, goal: Iterable[Literal], query: Iterable[Literal] = ()
+) -> Data:
+    """The state, a goal (literals over the state's nodes) and a query within it, as a graph.
 
     Shapes:
         x: [N, NODE_DIM] node type one-hot over `ENTITY_TYPES`, then kind one-hot.
         edge_index: [2, N * N] every ordered pair, self loops included.
         edge_attr: [N * N, EDGE_DIM] the state's literals (multi-hot over `PREDICATES`), the
-            goal's value per predicate (one-hot over don't care / true / false), valid slots.
+            goal's value per predicate (one-hot over don't care / true / false), valid slots,
+            the query's slots.
         valid: [N * N, P] bool, the slots a literal can occupy.
         goal: [N * N, P] long, the goal's values.
         names: list of N node names.
@@ -99,7 +103,11 @@ def encode(state: SymbolicSceneGraph, goal: Iterable[Literal]) -> Data:
     values = slots.goal_values(goal)
     valid = slots.valid_mask()
     goal_onehot = torch.nn.functional.one_hot(values, 3).float().reshape(n * n, -1)
-    edge_attr = torch.cat([holds, goal_onehot, valid.float()], dim=1)
+    asked = torch.zeros(n * n, len(PREDICATES))
+    for lit in query:
+        e, p = slots.slot(lit)
+        asked[e, p] = 1.0
+    edge_attr = torch.cat([holds, goal_onehot, valid.float(), asked], dim=1)
     edge_index = torch.tensor(slots.edges, dtype=torch.long).t().contiguous()
     return Data(
         x=x,

@@ -4,8 +4,9 @@ f_preimage: each demonstration is regressed from its goal backwards, action by a
 last action t adds literals the current subgoal g_{t+1} asks for, its preimage g_t is g_{t+1}
 without those literals, plus the literals the action consumed (true before it, false after: its
 preconditions as the demonstration shows them); an action that adds nothing g_{t+1} asks for
-leaves it as it is. The network sees a state s_tau (any state at or before t, as the planner
-sees the current state while regressing from far ahead) and g_{t+1}, and learns g_t.
+leaves it as it is. The network is asked about one achieved literal at a time (the query), sees
+a state s_tau (any state at or before t, as the planner sees the current state while regressing
+from far ahead) and g_{t+1}, and learns that literal's preimage (see `preimage_examples`).
 
 f_reach: the literals each demonstrated action adds are reachable in one primitive from the
 state before it; negatives are made, as the paper does, by altering those literals: here in
@@ -30,7 +31,7 @@ from hsgplan.data.demos import Demo
 from hsgplan.domain.objects import EntityKind, kind_of
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.transition import applicable_actions, apply
-from hsgplan.planning.regression.encoding import DONT_CARE, TRUE, Slots, encode
+from hsgplan.planning.regression.encoding import DONT_CARE, FALSE, TRUE, Slots, encode
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 
@@ -68,20 +69,33 @@ def _target(data: Data, literals) -> tuple[torch.Tensor, torch.Tensor]:
     target = torch.full_like(data.goal, DONT_CARE)
     for lit in literals:
         e, p = slots.slot(lit)
-        target[e, p] = TRUE
+        target[e, p] = TRUE if lit.positive else FALSE
     return target, data.valid.clone()
 
 
 def preimage_examples(demos: list[Demo]) -> list[Example]:
+    """One example per literal an action achieved for the regressed subgoal (the query), asked
+    from every state up to then, in the context of that subgoal. Its preimage: the literals the
+    action consumed, the task goal's literals that already held (what had to come first, as a
+    stack's base), and no other object in the hand (the previous scene graph's grasp state,
+    which the changes alone never show)."""
     out = []
     for demo in demos:
         states, goals = demo.symbolic_states(), regressed_subgoals(demo)
+        task = goals[-1]
         for t in range(len(states) - 1):
-            if goals[t] == goals[t + 1]:
-                continue
-            for tau in range(t + 1):
-                data = encode(states[tau], goals[t + 1])
-                out.append(Example(data, *_target(data, goals[t])))
+            added, consumed = _changes(states[t], states[t + 1])
+            held = states[t].held()
+            empty_hand = [
+                Literal(Predicate.IN_GRASP, (o,), positive=False)
+                for o in states[t].objects
+                if o != held
+            ]
+            for query in sorted(goals[t + 1] & added):
+                before = consumed | ((goals[t + 1] - added) & task)
+                for tau in range(t + 1):
+                    data = encode(states[tau], goals[t + 1], [query])
+                    out.append(Example(data, *_target(data, sorted(before) + empty_hand)))
     return out
 
 
@@ -117,11 +131,14 @@ def _every_literal(state: SymbolicSceneGraph) -> set[Literal]:
 
 
 def reachable(state: SymbolicSceneGraph) -> set[Literal]:
-    """Literals false now that one applicable action makes true (labels, from the model)."""
-    made = set()
+    """Literals that do not hold now and that one applicable action makes hold (labels, from
+    the model): positive ones made true, and negated ones (`not l`) made false."""
+    made, undone = set(), set()
     for action in applicable_actions(state):
-        made |= apply(state, action).literals
-    return made - state.literals
+        after = apply(state, action).literals
+        made |= after
+        undone |= state.literals - after
+    return (made - state.literals) | {lit.negated() for lit in undone}
 
 
 def reach_examples(demos: list[Demo]) -> list[Example]:
@@ -135,6 +152,9 @@ def reach_examples(demos: list[Demo]) -> list[Example]:
                 candidates |= _alterations(lit, states[t])
             candidates |= _every_literal(states[t])
             candidates = {c for c in candidates if not states[t].holds(c)}
+            # undoing, too; never both l and not l: one of them holds, and only those that do
+            # not hold are candidates
+            candidates |= {lit.negated() for lit in states[t].literals}
             yes = reachable(states[t])
             for goal in [candidates] + [{c} for c in sorted(candidates)]:
                 data = encode(states[t], goal)

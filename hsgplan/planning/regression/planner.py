@@ -1,14 +1,13 @@
 """Task planners behind one interface: the learned regression planner, the forward baseline,
 and Fast Downward. Each returns the next action for a symbolic state and a goal.
 
-The regression loop (the paper's phi): starting from the goal's unsatisfied literals, f_reach
-says which literals of the current subgoal one primitive reaches from the state, and
-f_preimage gives the subgoal's preimage. An unsatisfied literal that persists into the preimage
-must hold before the subgoal's last step, so while there are such literals only they may be
-achieved now (this keeps a stack's base ahead of what goes on it). One of the allowed, reachable
-literals is drawn uniformly (the paper's subgoal serialisation) and becomes the immediate
-subgoal g-hat; when none is, the loop regresses to the preimage and tries again. A heuristic
-then names the primitive and object that achieve g-hat.
+The regression loop (the paper's phi): f_preimage gives the preimage of one goal literal (the
+query) in the context of the goal; a goal literal whose preimage names another unsatisfied goal
+literal has to wait for it (a stack's top for its base). One of the goal literals free to go is
+drawn uniformly (the paper's subgoal serialisation) and regressed: while f_reach says one
+primitive does not reach it, it is replaced by an unsatisfied literal of its preimage (a
+reachable one when there is one), up to a depth cap. The literal reached is the immediate
+subgoal g-hat, and a heuristic names the primitive and object that achieve it.
 """
 
 from __future__ import annotations
@@ -82,35 +81,52 @@ class RegressionPlanner:
         self.rng = random.Random(seed)
         self.max_depth = max_depth
 
+    def _preimage(self, state, context, lit) -> set[Literal]:
+        data = encode(state, context, [lit])
+        return set(decode(data, self.preimage(data).argmax(-1)))
+
+    def _reachable(self, state, lit) -> bool:
+        data = encode(state, [lit])
+        return bool(self.reach(data).argmax(-1)[Slots(tuple(data.names)).slot(lit)] == 1)
+
     @torch.no_grad()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
-        subgoal = set(goal.unsatisfied(state))
-        if not subgoal:
+        unsatisfied = goal.unsatisfied(state)
+        if not unsatisfied:
             return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
-        seen: list[set[Literal]] = []
+        context = set(unsatisfied)
+        # A goal literal waits while its preimage names another unsatisfied goal literal.
+        free = [
+            lit
+            for lit in unsatisfied
+            if not (self._preimage(state, context, lit) & context) - {lit}
+        ]
+        order = list(free or unsatisfied)
+        self.rng.shuffle(order)  # the paper's uniform subgoal serialisation
+        for lit in order:
+            found = self._regress(state, context, lit)
+            if found is not None:
+                return TaskDecision(action_for(found, state), found, time.perf_counter() - start)
+        return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
+
+    def _regress(self, state, context, lit: Literal) -> Literal | None:
+        """Regress one literal until a subgoal one primitive reaches; None if there is none."""
+        path = [lit]
         for _ in range(self.max_depth):
-            data = encode(state, subgoal)
-            slots = Slots(tuple(data.names))
-            yes = self.reach(data).argmax(-1)
-            preimage = set(decode(data, self.preimage(data).argmax(-1)))
-            first = {lit for lit in subgoal if lit in preimage}
-            allowed = first or subgoal
-            doable = [
-                lit
-                for lit in sorted(allowed)
-                if yes[slots.slot(lit)] == 1 and action_for(lit, state) is not None
+            if self._reachable(state, lit) and action_for(lit, state) is not None:
+                return lit
+            options = [
+                m
+                for m in sorted(self._preimage(state, context, lit))
+                if not state.holds(m) and m not in path
             ]
-            if doable:
-                lit = self.rng.choice(doable)
-                return TaskDecision(action_for(lit, state), lit, time.perf_counter() - start)
-            seen.append(subgoal)
-            subgoal = {lit for lit in preimage if not state.holds(lit)}
-            if not subgoal or subgoal in seen:
-                return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
-        return TaskDecision(
-            None, None, time.perf_counter() - start, f"no reachable subgoal in {self.max_depth}"
-        )
+            if not options:
+                return None
+            reachable = [m for m in options if self._reachable(state, m)]
+            lit = self.rng.choice(reachable or options)
+            path.append(lit)
+        return None
 
 
 class ForwardPlanner:
