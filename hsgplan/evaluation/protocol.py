@@ -10,6 +10,7 @@ interrupted run, started again with the same command, skips what is done.
 from __future__ import annotations
 
 import json
+import multiprocessing
 import statistics
 from collections import Counter
 from collections.abc import Callable, Sequence
@@ -137,7 +138,12 @@ def run_evaluation(
     for s in specs:
         if s.key in done and on_episode:
             on_episode(done[s.key])
-    with open(run_dir / RESULTS, "a") as log, ProcessPoolExecutor(max(1, workers)) as pool:
+    # spawn, not fork: a parent that has loaded torch (a learned agent) would hang forked children
+    context = multiprocessing.get_context("spawn")
+    with (
+        open(run_dir / RESULTS, "a") as log,
+        ProcessPoolExecutor(max(1, workers), mp_context=context) as pool,
+    ):
         pending = {pool.submit(run_spec, config.agent, s) for s in todo}
         try:
             while pending:

@@ -8,6 +8,7 @@ beyond), and every decision is timed.
 
 from __future__ import annotations
 
+import multiprocessing
 import random
 import statistics
 from collections import Counter
@@ -86,6 +87,9 @@ def fd_length(goal: Goal, seed: int) -> int:
 
 
 def _work(args) -> dict:
+    import torch
+
+    torch.set_num_threads(1)  # one core per worker: the pool already fills the machine
     name, checkpoint, goal_text, seed = args
     goal = parse_goal(goal_text)
     planner = make_planner(name, Path(checkpoint), seed)
@@ -116,7 +120,11 @@ def evaluate_task(
         ]
     args = [(planner, str(checkpoint), str(g), s) for g, s in jobs]
     out = []
-    with ProcessPoolExecutor(max(1, workers)) as pool:
+    # spawn, not fork: this process has loaded torch, and a forked child of a process with live
+    # OpenMP threads hangs (measured: the workers sat idle)
+    with ProcessPoolExecutor(
+        max(1, workers), mp_context=multiprocessing.get_context("spawn")
+    ) as pool:
         for row in pool.map(_work, args, chunksize=8):
             episode = TaskEpisode(**{**row, "decision_ms": tuple(row["decision_ms"])})
             out.append(episode)

@@ -137,3 +137,26 @@ def test_undoing_a_literal_is_reachable_too():
     yes = reachable(holding)
     assert in_grasp("cherries").negated() in yes
     assert on("cherries", "shelf_a") in yes
+
+
+def test_eval_task_runs_a_trained_checkpoint_in_worker_processes(tmp_path):
+    # The pool must not fork a process that has loaded torch: forked workers hung.
+    train_task(TaskTrainConfig.from_json(TINY), tmp_path)
+    r = CliRunner().invoke(
+        app,
+        [
+            "eval-task",
+            "--checkpoint",
+            str(tmp_path),
+            "--sizes",
+            "2",
+            "--goals",
+            "2",
+            "--workers",
+            "2",
+            "--json",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    entry = json.loads(r.stdout)["by_size"]["2"]
+    assert entry["episodes"] == 2 and 0.0 <= entry["success_rate"] <= 1.0
