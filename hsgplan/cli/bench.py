@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -82,3 +83,51 @@ def bench_symbolic(
         for r in rows
     ]
     print_table(title, header, cells, markdown)
+
+
+@app.command("task")
+@refuses_bad_input
+def bench_task(
+    sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
+    goals: Annotated[int, typer.Option(help="Goals per size.")] = 20,
+    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = Path(
+        "checkpoints/task"
+    ),
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """Task-planning time: the learned regression planner against Fast Downward, one core."""
+    from hsgplan.benchmarks.task import bench_task as run
+    from hsgplan.planning.regression.train import load_network
+
+    size_list = parse_sizes(sizes)
+    load_network(checkpoint / "preimage")  # a missing checkpoint fails before any work
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task("episodes", total=goals * len(size_list))
+        rows = run(checkpoint, size_list, goals, seed, lambda: progress.advance(task))
+    if as_json:
+        print(json.dumps([r.to_json() for r in rows], indent=2))
+        return
+
+    def ms(v: float | None) -> str:
+        return "—" if v is None else f"{v:.1f}"
+
+    cells = [
+        (
+            str(r.size),
+            r.planner,
+            f"{r.solved}/{r.episodes}",
+            ms(r.median_ms_per_decision),
+            ms(r.median_ms_per_episode),
+        )
+        for r in rows
+    ]
+    print_table(
+        f"Task-planning time, median over {goals} goals per size, one core (seed {seed})",
+        ("objects", "planner", "solved", "ms per decision", "ms per episode"),
+        cells,
+        markdown,
+    )

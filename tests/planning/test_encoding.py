@@ -1,7 +1,11 @@
 """The (state, goal) graph encoding on tiny hand-built scenes."""
 
-import torch
+import random
 
+import torch
+from torch_geometric.data import Batch
+
+from hsgplan.domain.generator import random_goal, random_state
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.predicates import PREDICATES, Predicate, clear, in_grasp, inside, on
 from hsgplan.planning.regression.encoding import (
@@ -13,6 +17,7 @@ from hsgplan.planning.regression.encoding import (
     Slots,
     decode,
     encode,
+    encode_many,
 )
 from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
 
@@ -71,3 +76,26 @@ def test_duplicates_share_features_and_order_follows_nodes():
     slots = Slots(tuple(data.names))
     e, p = slots.slot(in_grasp("cherries_2"))
     assert e == 1 * len(data.names) + 1 and data.goal[e, p] == TRUE
+
+
+def test_encode_many_equals_batching_single_encodings():
+    rng = random.Random(0)
+    goal = random_goal(6, rng)
+    s = random_state(goal.objects, rng)
+    lits = sorted(goal.literals)
+    batched = Batch.from_data_list([encode(s, goal.literals, [lit]) for lit in lits])
+    many = encode_many(s, [goal.literals] * len(lits), [[lit] for lit in lits])
+    for key in ("x", "edge_index", "edge_attr", "valid", "goal", "active"):
+        assert torch.equal(getattr(batched, key), getattr(many, key)), key
+
+
+def test_active_edges_are_self_loops_and_related_pairs():
+    s = SymbolicSceneGraph.from_literals(
+        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "open_space")]
+    )
+    data = encode(s, [inside("cherries", "shelf_a")], [in_grasp("butter")])
+    slots = Slots(tuple(data.names))
+    active = {slots.literal(e, 0).args for e in data.active.nonzero().flatten().tolist()}
+    pairs = {(a, b) for a, b in active if a != b}
+    assert pairs == {("butter", "cherries"), ("cherries", "open_space"), ("cherries", "shelf_a")}
+    assert all((n, n) in active for n in data.names)

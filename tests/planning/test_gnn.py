@@ -38,17 +38,32 @@ def test_output_shapes_on_a_three_node_complete_graph_with_self_loops():
     assert x.shape == (3, 16) and e.shape == (9, 16)  # no self loops added or removed
 
 
-def test_relational_layer_sums_incoming_edges():
+def test_relational_layer_sums_incoming_and_outgoing_edges():
     layer = RelationalLayer(2, 2, 2).eval()
     x = torch.zeros(3, 2)
     edge_attr = torch.ones(2, 2)
     # Node 0 receives two edges, node 1 one, node 2 none: sums must see the difference.
-    two = layer(x, torch.tensor([[1, 2], [0, 0]]), edge_attr)[0][0]
-    one = layer(x, torch.tensor([[1], [0]]), edge_attr[:1])[0][0]
+    two = layer(x, torch.tensor([[1, 2], [0, 0]]), edge_attr)[0]
+    one = layer(x, torch.tensor([[1], [0]]), edge_attr[:1])[0]
     e = layer.edge_mlp(torch.cat([x[1], x[0], edge_attr[0]]))
-    expected = layer.node_mlp(torch.cat([x[0], 2 * e])) + x[0]
-    torch.testing.assert_close(two, expected)
-    assert not torch.allclose(two, one)
+    zero = torch.zeros_like(e)
+    torch.testing.assert_close(two[0], layer.node_mlp(torch.cat([x[0], 2 * e, zero])) + x[0])
+    # the senders see what they sent: an object learns what it rests on
+    torch.testing.assert_close(two[1], layer.node_mlp(torch.cat([x[1], zero, e])) + x[1])
+    assert not torch.allclose(two[0], one[0])
+
+
+def test_a_silenced_edge_is_read_out_but_passes_nothing_on():
+    layer = RelationalLayer(2, 2, 2).eval()
+    x, edge_attr = torch.randn(3, 2), torch.randn(2, 2)
+    edge_index = torch.tensor([[1, 2], [0, 0]])
+    with torch.no_grad():
+        x_all, e_all = layer(x, edge_index, edge_attr)
+        x_one, e_one = layer(x, edge_index, edge_attr, torch.tensor([1.0, 0.0]))
+        x_ref, _ = layer(x, edge_index[:, :1], edge_attr[:1])
+    torch.testing.assert_close(e_one, e_all)  # still updated, so still classified
+    torch.testing.assert_close(x_one, x_ref)  # as if the edge were not there
+    assert not torch.allclose(x_one[0], x_all[0])
 
 
 def test_outputs_are_equivariant_to_node_and_edge_order():

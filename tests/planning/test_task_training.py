@@ -20,7 +20,14 @@ from hsgplan.planning.regression.train import TaskTrainConfig, load_network, tra
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 DEMOS = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
-TINY = {"demos": str(DEMOS), "epochs": 2, "hidden": 16, "rounds": 1, "batch_size": 256}
+TINY = {
+    "demos": str(DEMOS),
+    "epochs": 2,
+    "hidden": 16,
+    "rounds": 1,
+    "batch_size": 256,
+    "copies": 1,
+}
 
 
 def test_a_stack_demonstration_regresses_base_first():

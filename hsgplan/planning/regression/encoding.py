@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from functools import cache, cached_property
 
 import torch
 from torch_geometric.data import Data
@@ -37,6 +38,29 @@ def _valid(pred: Predicate, src: str, dst: str) -> bool:
     return pred is Predicate.ON or kind_of(dst) is EntityKind.SHELF
 
 
+_PRED_INDEX = {p: i for i, p in enumerate(PREDICATES)}
+
+
+@cache
+def _valid_mask(nodes: tuple[str, ...]) -> torch.Tensor:
+    n = len(nodes)
+    return torch.tensor(
+        [[_valid(p, nodes[i], nodes[j]) for p in PREDICATES] for i in range(n) for j in range(n)]
+    )
+
+
+@cache
+def _layout(nodes: tuple[str, ...]) -> tuple[torch.Tensor, torch.Tensor]:
+    """Node features and the complete edge index of a node list (the same for every call)."""
+    n = len(nodes)
+    x = torch.zeros(n, NODE_DIM)
+    for i, name in enumerate(nodes):
+        x[i, ENTITY_TYPES.index(type_of(name))] = 1.0
+        x[i, len(ENTITY_TYPES) + KINDS.index(kind_of(name))] = 1.0
+    edge_index = torch.tensor(Slots(nodes).edges, dtype=torch.long).t().contiguous()
+    return x, edge_index
+
+
 @dataclass(frozen=True)
 class Slots:
     """Where each literal sits in the edge list of a graph over `nodes`."""
@@ -48,11 +72,14 @@ class Slots:
         n = len(self.nodes)
         return [(i, j) for i in range(n) for j in range(n)]
 
+    @cached_property
+    def _index(self) -> dict[str, int]:
+        return {name: i for i, name in enumerate(self.nodes)}
+
     def slot(self, lit: Literal) -> tuple[int, int]:
         """(edge index, predicate index) of a literal's atom."""
-        index = {name: i for i, name in enumerate(self.nodes)}
         src, dst = lit.args[0], lit.args[-1]
-        return index[src] * len(self.nodes) + index[dst], PREDICATES.index(lit.predicate)
+        return self._index[src] * len(self.nodes) + self._index[dst], _PRED_INDEX[lit.predicate]
 
     def literal(self, edge: int, pred: int) -> Literal:
         src, dst = divmod(edge, len(self.nodes))
@@ -62,9 +89,7 @@ class Slots:
 
     def valid_mask(self) -> torch.Tensor:
         """[E, P] bool: which slots can hold a literal at all."""
-        return torch.tensor(
-            [[_valid(p, self.nodes[i], self.nodes[j]) for p in PREDICATES] for i, j in self.edges]
-        )
+        return _valid_mask(self.nodes).clone()
 
     def goal_values(self, goal: Iterable[Literal]) -> torch.Tensor:
         """[E, P] long: DONT_CARE, TRUE or FALSE for each slot."""
@@ -88,14 +113,15 @@ def encode(
             the query's slots.
         valid: [N * N, P] bool, the slots a literal can occupy.
         goal: [N * N, P] long, the goal's values.
+        active: [N * N] bool, the edges messages travel on: self loops and the pairs a state,
+            goal or query literal relates. Other pairs are read out but pass nothing on, so
+            that objects nothing relates do not change what the network says elsewhere (scenes
+            grow from two objects in training to twelve).
         names: list of N node names.
     """
     slots = Slots(state.nodes)
     n = len(slots.nodes)
-    x = torch.zeros(n, NODE_DIM)
-    for i, name in enumerate(slots.nodes):
-        x[i, ENTITY_TYPES.index(type_of(name))] = 1.0
-        x[i, len(ENTITY_TYPES) + KINDS.index(kind_of(name))] = 1.0
+    x, edge_index = _layout(slots.nodes)
     holds = torch.zeros(n * n, len(PREDICATES))
     for lit in state.literals:
         e, p = slots.slot(lit)
@@ -108,22 +134,68 @@ def encode(
         e, p = slots.slot(lit)
         asked[e, p] = 1.0
     edge_attr = torch.cat([holds, goal_onehot, valid.float(), asked], dim=1)
-    edge_index = torch.tensor(slots.edges, dtype=torch.long).t().contiguous()
+    self_loop = edge_index[0] == edge_index[1]
+    active = self_loop | (holds.sum(1) > 0) | (values != DONT_CARE).any(1) | (asked.sum(1) > 0)
     return Data(
         x=x,
         edge_index=edge_index,
         edge_attr=edge_attr,
         valid=valid,
         goal=values,
+        active=active,
         names=list(slots.nodes),
     )
 
 
 def decode(data: Data, values: torch.Tensor) -> list[Literal]:
     """The literals a [E, P] tensor of DONT_CARE / TRUE / FALSE values states (valid slots)."""
-    slots = Slots(tuple(data.names))
+    return decode_values(data.names, values, data.valid)
+
+
+def decode_values(names, values: torch.Tensor, valid: torch.Tensor) -> list[Literal]:
+    """`decode` for one graph's [E, P] values and valid mask, over the node list `names`."""
+    slots = Slots(tuple(names))
     out = []
-    for e, p in (values != DONT_CARE).logical_and(data.valid).nonzero().tolist():
+    for e, p in (values != DONT_CARE).logical_and(valid).nonzero().tolist():
         lit = slots.literal(e, p)
         out.append(lit if values[e, p] == TRUE else lit.negated())
     return out
+
+
+def encode_many(
+    state: SymbolicSceneGraph,
+    goals: list[Iterable[Literal]],
+    queries: list[Iterable[Literal]] | None = None,
+) -> Data:
+    """Several (goal, query) graphs over one state, batched into one disjoint graph: graph k
+    owns nodes [k N, (k + 1) N) and edges [k N^2, (k + 1) N^2). Equal to batching `encode`'s
+    graphs, without building each one (the planner asks many questions per decision).
+
+    Shapes: as `encode`, with K = len(goals) graphs: x [K N, NODE_DIM], edge_index
+    [2, K N^2], edge_attr [K N^2, EDGE_DIM], valid / goal [K N^2, P], active [K N^2].
+    """
+    queries = queries if queries is not None else [()] * len(goals)
+    one = encode(state, ())
+    slots = Slots(state.nodes)
+    k, n, e = len(goals), len(slots.nodes), len(slots.nodes) ** 2
+    values = torch.stack([slots.goal_values(g) for g in goals])
+    asked = torch.zeros(k, e, len(PREDICATES))
+    for i, query in enumerate(queries):
+        for lit in query:
+            asked[(i, *slots.slot(lit))] = 1.0
+    holds = one.edge_attr[:, : len(PREDICATES)].expand(k, e, -1)
+    valid = one.valid.expand(k, e, -1)
+    goal_onehot = torch.nn.functional.one_hot(values, 3).float().reshape(k, e, -1)
+    edge_attr = torch.cat([holds, goal_onehot, valid.float(), asked], dim=2)
+    self_loop = (one.edge_index[0] == one.edge_index[1]).expand(k, e)
+    active = self_loop | (holds.sum(2) > 0) | (values != DONT_CARE).any(2) | (asked.sum(2) > 0)
+    offsets = (torch.arange(k) * n).repeat_interleave(e)
+    return Data(
+        x=one.x.repeat(k, 1),
+        edge_index=one.edge_index.repeat(1, k) + offsets,
+        edge_attr=edge_attr.reshape(k * e, -1),
+        valid=valid.reshape(k * e, -1),
+        goal=values.reshape(k * e, -1),
+        active=active.reshape(k * e),
+        names=list(slots.nodes),
+    )

@@ -22,6 +22,7 @@ The forward baseline learns, from (s_t, goal), the literals action t adds.
 
 from __future__ import annotations
 
+import random
 from dataclasses import dataclass
 
 import torch
@@ -31,6 +32,7 @@ from hsgplan.data.demos import Demo
 from hsgplan.domain.objects import EntityKind, kind_of
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.transition import applicable_actions, apply
+from hsgplan.planning.regression.augment import Trajectory, holding_one
 from hsgplan.planning.regression.encoding import DONT_CARE, FALSE, TRUE, Slots, encode
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -53,10 +55,15 @@ def _changes(before: SymbolicSceneGraph, after: SymbolicSceneGraph):
     return after.literals - before.literals, before.literals - after.literals
 
 
-def regressed_subgoals(demo: Demo) -> list[frozenset[Literal]]:
+def _trajectory(t: Trajectory | Demo) -> Trajectory:
+    return t if isinstance(t, Trajectory) else Trajectory.of(t)
+
+
+def regressed_subgoals(demo: Trajectory | Demo) -> list[frozenset[Literal]]:
     """g_0 .. g_T: the demonstration's goal regressed through its actions (g_T is the goal)."""
-    states = demo.symbolic_states()
-    goals = [frozenset(lit for lit in demo.goal_literals().literals if lit.positive)]
+    traj = _trajectory(demo)
+    states = traj.states
+    goals = [traj.goal]
     for t in range(len(states) - 2, -1, -1):
         added, consumed = _changes(states[t], states[t + 1])
         g = goals[0]
@@ -73,15 +80,18 @@ def _target(data: Data, literals) -> tuple[torch.Tensor, torch.Tensor]:
     return target, data.valid.clone()
 
 
-def preimage_examples(demos: list[Demo]) -> list[Example]:
+def preimage_examples(demos: list[Trajectory] | list[Demo], seed: int = 0) -> list[Example]:
     """One example per literal an action achieved for the regressed subgoal (the query), asked
     from every state up to then, in the context of that subgoal. Its preimage: the literals the
     action consumed, the task goal's literals that already held (what had to come first, as a
     stack's base), and no other object in the hand (the previous scene graph's grasp state,
-    which the changes alone never show)."""
+    which the changes alone never show). Added objects' goal literals are context, never
+    preimage, and half the states asked from hold an added object where the hand was free
+    (see `augment.py`)."""
+    rng = random.Random(f"preimage-{seed}")
     out = []
-    for demo in demos:
-        states, goals = demo.symbolic_states(), regressed_subgoals(demo)
+    for traj in map(_trajectory, demos):
+        states, goals = traj.states, regressed_subgoals(traj)
         task = goals[-1]
         for t in range(len(states) - 1):
             added, consumed = _changes(states[t], states[t + 1])
@@ -94,7 +104,10 @@ def preimage_examples(demos: list[Demo]) -> list[Example]:
             for query in sorted(goals[t + 1] & added):
                 before = consumed | ((goals[t + 1] - added) & task)
                 for tau in range(t + 1):
-                    data = encode(states[tau], goals[t + 1], [query])
+                    state = states[tau]
+                    if rng.random() < 0.5:
+                        state = holding_one(traj, state, rng) or state
+                    data = encode(state, goals[t + 1] | traj.extra_goal, [query])
                     out.append(Example(data, *_target(data, sorted(before) + empty_hand)))
     return out
 
@@ -141,10 +154,13 @@ def reachable(state: SymbolicSceneGraph) -> set[Literal]:
     return (made - state.literals) | {lit.negated() for lit in undone}
 
 
-def reach_examples(demos: list[Demo]) -> list[Example]:
+def reach_examples(demos: list[Trajectory] | list[Demo], seed: int = 0, singles: int = 12):
+    """Per demonstrated state: every candidate at once, and up to `singles` reachable and
+    `singles` unreachable candidates alone (sampled: a scene of twelve objects has hundreds)."""
+    rng = random.Random(f"reach-{seed}")
     out = []
-    for demo in demos:
-        states = demo.symbolic_states()
+    for traj in map(_trajectory, demos):
+        states = traj.states
         for t in range(len(states) - 1):
             added, _ = _changes(states[t], states[t + 1])
             candidates = set(added)
@@ -156,7 +172,11 @@ def reach_examples(demos: list[Demo]) -> list[Example]:
             # not hold are candidates
             candidates |= {lit.negated() for lit in states[t].literals}
             yes = reachable(states[t])
-            for goal in [candidates] + [{c} for c in sorted(candidates)]:
+            pos = sorted(c for c in candidates if c in yes)
+            neg = sorted(c for c in candidates if c not in yes)
+            chosen = rng.sample(pos, min(singles, len(pos)))
+            chosen += rng.sample(neg, min(singles, len(neg)))
+            for goal in [candidates] + [{c} for c in chosen]:
                 data = encode(states[t], goal)
                 slots = Slots(tuple(data.names))
                 target = torch.zeros_like(data.goal)
@@ -169,12 +189,12 @@ def reach_examples(demos: list[Demo]) -> list[Example]:
     return out
 
 
-def forward_examples(demos: list[Demo]) -> list[Example]:
+def forward_examples(demos: list[Trajectory] | list[Demo]) -> list[Example]:
     """(s_t, goal) -> the literals action t adds: the forward baseline's next subgoal."""
     out = []
-    for demo in demos:
-        states = demo.symbolic_states()
-        goal = [lit for lit in demo.goal_literals().literals if lit.positive]
+    for traj in map(_trajectory, demos):
+        states = traj.states
+        goal = traj.goal | traj.extra_goal
         for t in range(len(states) - 1):
             added, _ = _changes(states[t], states[t + 1])
             data = encode(states[t], goal)

@@ -26,9 +26,13 @@ class RelationalLayer(MessagePassing):
     r"""One interaction-network step over a directed graph with edge features.
 
     For an edge i -> j the edge update is e'_ij = MLP_e([x_i, x_j, e_ij]); each node then sums
-    its incoming updated edges, x'_i = MLP_n([x_i, \sum_j e'_ji]). Sum rather than mean because
-    counts carry meaning (how many objects hold something). Self loops are ordinary edges and are
-    neither added nor removed. Where an input and output width match, the update is residual.
+    the updated edges it receives and those it sends, x'_i = MLP_n([x_i, \sum_j e'_ji,
+    \sum_j e'_ij]): an object must learn both what rests on it and what it rests on (the
+    query sits on its outgoing edge). Sums rather than means because counts carry meaning (how
+    many objects a shelf holds). Self loops are ordinary edges and are neither added nor
+    removed. An optional weight per edge scales what it passes on (0 silences it, while its
+    own update is still computed and read out). Where an input and output width match, the
+    update is residual.
 
     Args:
         node_dim: width of the input node features.
@@ -37,7 +41,7 @@ class RelationalLayer(MessagePassing):
 
     Shapes:
         x: [N, node_dim]; edge_index: [2, E] (row 0 source, row 1 target); edge_attr:
-        [E, edge_dim] -> (x_new [N, hidden], edge_new [E, hidden]).
+        [E, edge_dim]; edge_weight: [E] or None -> (x_new [N, hidden], edge_new [E, hidden]).
     """
 
     def __init__(self, node_dim: int, edge_dim: int, hidden: int) -> None:
@@ -46,12 +50,17 @@ class RelationalLayer(MessagePassing):
         self.edge_dim = edge_dim
         self.hidden = hidden
         self.edge_mlp = mlp(2 * node_dim + edge_dim, hidden, hidden)
-        self.node_mlp = mlp(node_dim + hidden, hidden, hidden)
+        self.node_mlp = mlp(node_dim + 2 * hidden, hidden, hidden)
 
-    def forward(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> tuple[Tensor, Tensor]:
+    def forward(
+        self, x: Tensor, edge_index: Tensor, edge_attr: Tensor, edge_weight: Tensor | None = None
+    ) -> tuple[Tensor, Tensor]:
         edge_new = self.edge_updater(edge_index, x=x, edge_attr=edge_attr)
-        incoming = self.propagate(edge_index, edge_attr=edge_new, size=(x.size(0), x.size(0)))
-        x_new = self.node_mlp(torch.cat([x, incoming], dim=-1))
+        sent = edge_new if edge_weight is None else edge_new * edge_weight.unsqueeze(-1)
+        size = (x.size(0), x.size(0))
+        incoming = self.propagate(edge_index, edge_attr=sent, size=size)
+        outgoing = self.propagate(edge_index.flip(0), edge_attr=sent, size=size)
+        x_new = self.node_mlp(torch.cat([x, incoming, outgoing], dim=-1))
         if self.node_dim_in == self.hidden:
             x_new = x_new + x
         if self.edge_dim == self.hidden:
@@ -112,14 +121,16 @@ class EdgeClassifier(nn.Module):
     """Per-edge, per-predicate classification of a graph after rounds of message passing.
 
     Node and edge features are encoded to `hidden`, passed through `rounds` relational layers
-    (separate weights per round), and each edge is classified from [x_src, x_dst, e].
+    (separate weights per round), and each edge is classified from [x_src, x_dst, e]. If the
+    graph has an `active` edge mask, only active edges pass messages; every edge is classified.
 
     Args:
         config: the sizes, see `EdgeClassifierConfig`.
 
     Shapes:
-        data.x: [N, node_dim]; data.edge_index: [2, E]; data.edge_attr: [E, edge_dim]
-        -> logits [E, predicates, classes]. A `Batch` works the same, edges in batch order.
+        data.x: [N, node_dim]; data.edge_index: [2, E]; data.edge_attr: [E, edge_dim];
+        optional data.active: [E] bool -> logits [E, predicates, classes]. A `Batch` works
+        the same, edges in batch order.
     """
 
     def __init__(self, config: EdgeClassifierConfig) -> None:
@@ -135,8 +146,9 @@ class EdgeClassifier(nn.Module):
         edge_index = data.edge_index
         x = self.node_encoder(data.x.float())
         e = self.edge_encoder(data.edge_attr.float())
+        weight = data.active.float() if "active" in data else None
         for layer in self.layers:
-            x, e = layer(x, edge_index, e)
+            x, e = layer(x, edge_index, e, weight)
         logits = self.head(torch.cat([x[edge_index[0]], x[edge_index[1]], e], dim=-1))
         return logits.view(-1, self.config.predicates, self.config.classes)
 

@@ -23,7 +23,7 @@ import torch
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.transition import Action, Pick, Place, Push, why_not
-from hsgplan.planning.regression.encoding import TRUE, Slots, decode, encode
+from hsgplan.planning.regression.encoding import TRUE, Slots, decode_values, encode, encode_many
 from hsgplan.planning.regression.train import load_network
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -50,7 +50,6 @@ class TaskPlanner(Protocol):
 
 def action_for(lit: Literal, state: SymbolicSceneGraph) -> Action | None:
     """The primitive and object that achieve one literal, if one does from this state."""
-    held = state.held()
     if lit.positive:
         if lit.predicate is Predicate.IN_GRASP:
             options = [Pick(lit.subject)]
@@ -58,9 +57,9 @@ def action_for(lit: Literal, state: SymbolicSceneGraph) -> Action | None:
             options = [Place(*lit.args)]
         elif lit.predicate is Predicate.IN:
             options = [Push(*lit.args)]
-        else:  # Clear(x): lift what rests on x, or put x down
+        else:  # Clear(x): lift what rests on x (x in the hand is cleared by placing it
+            # where the rest of the subgoal wants it, not by dropping it anywhere)
             options = [Pick(o) for o in state.resting_on(lit.subject)]
-            options += [Place(lit.subject, BUFFER)] if held == lit.subject else []
     elif lit.predicate is Predicate.IN_GRASP:  # let go of it
         options = [Place(lit.subject, BUFFER)]
     elif lit.predicate is Predicate.ON:  # take it off
@@ -70,8 +69,23 @@ def action_for(lit: Literal, state: SymbolicSceneGraph) -> Action | None:
     return next((a for a in options if why_not(state, a) is None), None)
 
 
+@dataclass(frozen=True)
+class _Node:
+    """A literal met while regressing, the subgoal it was regressed within, and its path."""
+
+    lit: Literal
+    context: frozenset[Literal]
+    path: tuple[Literal, ...]
+
+
 class RegressionPlanner:
-    """The learned regression planner, from a checkpoint folder made by `hsgplan train task`."""
+    """The learned regression planner, from a checkpoint folder made by `hsgplan train task`.
+
+    Regression goes breadth first, one batched network call per question and level: the
+    shallowest subgoal one primitive reaches wins (uniformly among equals), so a goal literal
+    that is one step away goes before one that needs three. While regressing, the context is
+    the regressed subgoal, as in training: the literal is replaced by its preimage.
+    """
 
     name = "regression"
 
@@ -81,52 +95,82 @@ class RegressionPlanner:
         self.rng = random.Random(seed)
         self.max_depth = max_depth
 
-    def _preimage(self, state, context, lit) -> set[Literal]:
-        data = encode(state, context, [lit])
-        return set(decode(data, self.preimage(data).argmax(-1)))
+    def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
+        data = encode_many(state, [n.context for n in nodes], [[n.lit] for n in nodes])
+        values = self.preimage(data).argmax(-1).view(len(nodes), -1, data.goal.shape[1])
+        valid = data.valid.view(len(nodes), -1, data.goal.shape[1])
+        return [
+            frozenset(decode_values(data.names, v, m)) for v, m in zip(values, valid, strict=True)
+        ]
 
-    def _reachable(self, state, lit) -> bool:
-        data = encode(state, [lit])
-        return bool(self.reach(data).argmax(-1)[Slots(tuple(data.names)).slot(lit)] == 1)
+    def _reachable(self, state, lits: list[Literal]) -> list[bool]:
+        data = encode_many(state, [[lit] for lit in lits])
+        yes = self.reach(data).argmax(-1).view(len(lits), -1, data.goal.shape[1])
+        slots = Slots(tuple(data.names))
+        return [bool(yes[(i, *slots.slot(lit))] == 1) for i, lit in enumerate(lits)]
 
     @torch.no_grad()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
-        unsatisfied = goal.unsatisfied(state)
+        unsatisfied = sorted(goal.unsatisfied(state))
         if not unsatisfied:
             return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
-        context = set(unsatisfied)
-        # A goal literal waits while its preimage names another unsatisfied goal literal.
-        free = [
-            lit
-            for lit in unsatisfied
-            if not (self._preimage(state, context, lit) & context) - {lit}
-        ]
-        order = list(free or unsatisfied)
-        self.rng.shuffle(order)  # the paper's uniform subgoal serialisation
-        for lit in order:
-            found = self._regress(state, context, lit)
+        context = frozenset(goal.literals)
+        roots = [_Node(lit, context, (lit,)) for lit in unsatisfied]
+        preimages = self._preimages(state, roots)
+        # A goal literal waits while its preimage names another unsatisfied goal literal; if
+        # nothing is reached from the free ones (a dependency the network got wrong, or a
+        # goal literal stuck behind a full shelf), the waiting ones are tried as well.
+        pairs = list(zip(roots, preimages, strict=True))
+        free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
+        for frontier in (free, [x for x in pairs if x not in free]):
+            found = self._search(state, frontier)
             if found is not None:
-                return TaskDecision(action_for(found, state), found, time.perf_counter() - start)
+                node, action = found
+                return TaskDecision(action, node.lit, time.perf_counter() - start)
         return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
 
-    def _regress(self, state, context, lit: Literal) -> Literal | None:
-        """Regress one literal until a subgoal one primitive reaches; None if there is none."""
-        path = [lit]
+    def _search(self, state, frontier):
+        """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
+
+        A node is reached when f_reach says so, or when its whole preimage already holds
+        (then, by what a preimage means, one primitive achieves it)."""
         for _ in range(self.max_depth):
-            if self._reachable(state, lit) and action_for(lit, state) is not None:
-                return lit
-            options = [
-                m
-                for m in sorted(self._preimage(state, context, lit))
-                if not state.holds(m) and m not in path
-            ]
-            if not options:
+            if not frontier:
                 return None
-            reachable = [m for m in options if self._reachable(state, m)]
-            lit = self.rng.choice(reachable or options)
-            path.append(lit)
+            nodes = [n for n, _ in frontier]
+            yes = self._reachable(state, [n.lit for n in nodes])
+            if found := self._choose(state, [n for n, y in zip(nodes, yes, strict=True) if y]):
+                return found
+            frontier = self._with_preimages(state, frontier)
+            done = [n for n, pre in frontier if all(state.holds(m) for m in pre)]
+            if found := self._choose(state, done):
+                return found
+            frontier = self._children(state, frontier)
         return None
+
+    def _choose(self, state, nodes: list[_Node]):
+        hits = [(n, a) for n in nodes if (a := action_for(n.lit, state)) is not None]
+        return self.rng.choice(hits) if hits else None  # the paper's uniform serialisation
+
+    def _with_preimages(self, state, frontier):
+        missing = [n for n, pre in frontier if pre is None]
+        found = dict(zip(missing, self._preimages(state, missing), strict=True)) if missing else {}
+        return [(n, found[n] if pre is None else pre) for n, pre in frontier]
+
+    @staticmethod
+    def _children(state, frontier):
+        """The next level: each node's unsatisfied preimage literals, in the node's regressed
+        context (the node's literal replaced by its preimage)."""
+        seen, out = set(), []
+        for node, pre in frontier:
+            context = frozenset((node.context - {node.lit}) | {m for m in pre if m.positive})
+            for m in sorted(pre):
+                if state.holds(m) or m in node.path or m in seen:
+                    continue
+                seen.add(m)
+                out.append((_Node(m, context, node.path + (m,)), None))
+        return out
 
 
 class ForwardPlanner:

@@ -21,6 +21,7 @@ from safetensors.torch import load_file, save_file
 from torch_geometric.data import Batch
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.planning.regression.augment import trajectories
 from hsgplan.planning.regression.encoding import EDGE_DIM, NODE_DIM
 from hsgplan.planning.regression.examples import (
     Example,
@@ -47,6 +48,7 @@ class TaskTrainConfig:
     hidden: int = 256  # the paper: every layer of every module has 256 hidden units
     rounds: int = 3
     save_every: int = 25
+    copies: int = 20  # copies of each demonstration with added objects (`augment.py`)
 
     @staticmethod
     def from_json(d: dict) -> TaskTrainConfig:
@@ -56,10 +58,12 @@ class TaskTrainConfig:
         return TaskTrainConfig(**d)
 
 
-def _examples(name: str, demos) -> list[Example]:
-    return {"preimage": preimage_examples, "reach": reach_examples, "forward": forward_examples}[
-        name
-    ](demos)
+def _examples(name: str, trajs, seed: int) -> list[Example]:
+    if name == "reach":
+        return reach_examples(trajs, seed)
+    if name == "preimage":
+        return preimage_examples(trajs, seed)
+    return forward_examples(trajs)
 
 
 def train_task(
@@ -78,8 +82,12 @@ def train_task(
     if saved.exists() and json.loads(saved.read_text()) != asdict(config):
         raise InvalidInputError(f"'{out}' holds a checkpoint trained with another configuration")
     saved.write_text(json.dumps(asdict(config), indent=2) + "\n")
+    trajs = trajectories(demos, config.copies, config.seed)
     for name, classes in NETWORKS.items():
-        _train_one(name, classes, _examples(name, demos), config, out / name, on_epoch)
+        if (out / name / "model.safetensors").exists():
+            continue  # finished earlier
+        examples = _examples(name, trajs, config.seed)
+        _train_one(name, classes, examples, config, out / name, on_epoch)
 
 
 def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, on_epoch) -> None:

@@ -1,0 +1,169 @@
+"""Demonstrations as symbolic trajectories, and copies of them with distractor objects.
+
+The 18 demonstrations name one or two objects, while the planner meets scenes of up to twelve,
+with other objects stacked, on shelf tops or inside shelves, and goals with many literals. A
+copy of a demonstration adds objects that no action touches: each rests in the same place in
+every state (the open space, a shelf top, a prepush region, a shelf's interior, or on another
+added object), where the demonstration leaves room for it, and some get goal literals of their
+own (a shelf top, shelf A's interior, or stacked on another added object). Nothing in a copy is
+taken from evaluation goals: the added objects and their places are drawn here, from a seed.
+
+Why labels carry over: what the demonstrated action needed (its preconditions, the base of a
+stack) is the same with the added objects present, and an added object's goal literal is
+never something the demonstrated action depends on, so it stays "don't care" in every preimage;
+it does teach the network that other goal literals on the same shelf are no dependency, which
+the demonstrations alone cannot (their only two-literal goals are stacks).
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass
+
+from hsgplan.data.demos import Demo
+from hsgplan.domain.objects import objects_for_types, type_of
+from hsgplan.domain.predicates import Literal, Predicate, inside, on
+from hsgplan.domain.world import (
+    INTERIOR_CAPACITY,
+    MAX_OBJECTS,
+    MAX_TOWER_LEVELS,
+    OBJECT_TYPES,
+    SHELVES,
+    SURFACE_CAPACITY,
+    SURFACES,
+    can_support,
+    fits_inside,
+)
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+GOAL_TOPS = ("shelf_a", "shelf_b")
+GOAL_INTERIOR = "shelf_a"
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """States s_0..s_T of a demonstration, its goal, and the added objects' goal literals."""
+
+    states: tuple[SymbolicSceneGraph, ...]
+    goal: frozenset[Literal]
+    extra_goal: frozenset[Literal] = frozenset()
+    added: tuple[str, ...] = ()
+
+    @staticmethod
+    def of(demo: Demo) -> Trajectory:
+        goal = frozenset(lit for lit in demo.goal_literals().literals if lit.positive)
+        return Trajectory(tuple(demo.symbolic_states()), goal)
+
+
+def _room(states: tuple[SymbolicSceneGraph, ...]) -> tuple[dict[str, int], dict[str, int]]:
+    """Free places on each surface and in each interior, in every state at once."""
+    top = {s: SURFACE_CAPACITY[s] - max(len(x.resting_on(s)) for x in states) for s in SURFACES}
+    interior = {s: INTERIOR_CAPACITY[s] - max(len(x.inside(s)) for x in states) for s in SHELVES}
+    return top, interior
+
+
+def _places(objects: list[str], states, rng: random.Random) -> list[Literal]:
+    """Where each added object rests, unchanged through the trajectory."""
+    top, interior = _room(states)
+    level: dict[str, int] = {}
+    bare: list[str] = []
+    out = []
+    for o in objects:
+        t = type_of(o)
+        options: list[tuple[str, str]] = [("on", s) for s in SURFACES if top[s] > 0]
+        options += [("on", b) for b in bare if level[b] < MAX_TOWER_LEVELS]
+        options += [("in", s) for s in SHELVES if interior[s] > 0 and fits_inside(t, s)]
+        # the open space is where most objects wait, as in the planner's start states
+        if top["open_space"] > 0 and rng.random() < 0.4:
+            options = [("on", "open_space")]
+        kind, where = rng.choice(options)
+        if kind == "in":
+            out.append(inside(o, where))
+            interior[where] -= 1
+            continue
+        out.append(on(o, where))
+        if where in top:
+            top[where] -= 1
+            level[o] = 1
+        else:
+            bare.remove(where)
+            level[o] = level[where] + 1
+        if can_support(t):
+            bare.append(o)
+    return out
+
+
+def _extra_goals(objects: list[str], goal: frozenset[Literal], rng: random.Random):
+    """Goal literals for some added objects, within the capacities the task goal leaves."""
+    top = {s: SURFACE_CAPACITY[s] - sum(lit.args[-1] == s for lit in goal) for s in GOAL_TOPS}
+    interior = INTERIOR_CAPACITY[GOAL_INTERIOR] - sum(lit.predicate is Predicate.IN for lit in goal)
+    bare: list[str] = []
+    out = []
+    for o in objects:
+        t = type_of(o)
+        options = [on(o, s) for s in GOAL_TOPS if top[s] > 0]
+        if interior > 0 and fits_inside(t, GOAL_INTERIOR):
+            options.append(inside(o, GOAL_INTERIOR))
+        options += [on(o, b) for b in bare]
+        if not options or rng.random() < 0.3:
+            continue
+        lit = rng.choice(options)
+        out.append(lit)
+        if lit.predicate is Predicate.IN:
+            interior -= 1
+        elif lit.args[1] in top:
+            top[lit.args[1]] -= 1
+            if can_support(t):
+                bare.append(o)
+        else:
+            bare.remove(lit.args[1])  # towers have two levels: the top carries nothing
+    return frozenset(out)
+
+
+def with_distractors(traj: Trajectory, extra: int, rng: random.Random) -> Trajectory:
+    """A copy of the trajectory with `extra` added objects (fewer if the scene would overflow)."""
+    objects = traj.states[0].objects
+    extra = min(extra, MAX_OBJECTS - len(objects))
+    types = [type_of(o) for o in objects] + rng.choices(list(OBJECT_TYPES), k=extra)
+    added = list(objects_for_types(types)[len(objects) :])
+    rng.shuffle(added)
+    places = _places(added, traj.states, rng)
+    states = tuple(
+        SymbolicSceneGraph.from_literals(
+            objects + tuple(added),
+            [lit for lit in s.literals if lit.predicate is not Predicate.CLEAR] + places,
+        )
+        for s in traj.states
+    )
+    return Trajectory(states, traj.goal, _extra_goals(added, traj.goal, rng), tuple(added))
+
+
+def holding_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
+    """The state with one added object in the hand, if the hand is free and one is clear.
+
+    Only for questions about preimages, which do not depend on where untouched objects are:
+    it shows the network a held object that is neither the query's subject nor its target,
+    whose goal literal is no dependency (in the demonstrations, the object in the hand is
+    always the one the next action needs)."""
+    if state.held() is not None:
+        return None
+    free = [o for o in traj.added if state.holds(Literal(Predicate.CLEAR, (o,)))]
+    if not free:
+        return None
+    o = rng.choice(free)
+    placements = [
+        lit for lit in state.literals if lit.predicate is not Predicate.CLEAR and lit.subject != o
+    ]
+    return SymbolicSceneGraph.from_literals(
+        state.objects, placements + [Literal(Predicate.IN_GRASP, (o,))]
+    )
+
+
+def trajectories(demos: list[Demo], copies: int, seed: int) -> list[Trajectory]:
+    """Each demonstration, then `copies` copies of each with 1..10 added objects."""
+    out = [Trajectory.of(d) for d in demos]
+    rng = random.Random(f"augment-{seed}")
+    for _ in range(copies):
+        for base in out[: len(demos)]:
+            out.append(with_distractors(base, rng.randint(1, 10), rng))
+    return out
