@@ -94,6 +94,7 @@ class RegressionPlanner:
         self.reach = load_network(checkpoint / "reach")
         self.rng = random.Random(seed)
         self.max_depth = max_depth
+        self._taken: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
 
     def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
         data = encode_many(state, [n.context for n in nodes], [[n.lit] for n in nodes])
@@ -121,16 +122,22 @@ class RegressionPlanner:
         # A goal literal waits while its preimage names another unsatisfied goal literal; if
         # nothing is reached from the free ones (a dependency the network got wrong, or a
         # goal literal stuck behind a full shelf), the waiting ones are tried as well.
+        # An action already taken from this very state (with this goal) came back to it: it
+        # is avoided while any other is found, which breaks loops such as picking an object
+        # whose shelf is full and putting it back.
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
-        for frontier in (free, [x for x in pairs if x not in free]):
-            found = self._search(state, frontier)
-            if found is not None:
-                node, action = found
-                return TaskDecision(action, node.lit, time.perf_counter() - start)
+        taken = self._taken.setdefault((goal, state), set())
+        for avoid in (taken, set()):
+            for frontier in (free, [x for x in pairs if x not in free]):
+                found = self._search(state, frontier, avoid)
+                if found is not None:
+                    node, action = found
+                    taken.add(action)
+                    return TaskDecision(action, node.lit, time.perf_counter() - start)
         return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
 
-    def _search(self, state, frontier):
+    def _search(self, state, frontier, avoid):
         """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
 
         A node is reached when f_reach says so, or when its whole preimage already holds
@@ -140,17 +147,20 @@ class RegressionPlanner:
                 return None
             nodes = [n for n, _ in frontier]
             yes = self._reachable(state, [n.lit for n in nodes])
-            if found := self._choose(state, [n for n, y in zip(nodes, yes, strict=True) if y]):
+            reached = [n for n, y in zip(nodes, yes, strict=True) if y]
+            if found := self._choose(state, reached, avoid):
                 return found
             frontier = self._with_preimages(state, frontier)
             done = [n for n, pre in frontier if all(state.holds(m) for m in pre)]
-            if found := self._choose(state, done):
+            if found := self._choose(state, done, avoid):
                 return found
             frontier = self._children(state, frontier)
         return None
 
-    def _choose(self, state, nodes: list[_Node]):
-        hits = [(n, a) for n in nodes if (a := action_for(n.lit, state)) is not None]
+    def _choose(self, state, nodes: list[_Node], avoid):
+        hits = [
+            (n, a) for n in nodes if (a := action_for(n.lit, state)) is not None and a not in avoid
+        ]
         return self.rng.choice(hits) if hits else None  # the paper's uniform serialisation
 
     def _with_preimages(self, state, frontier):
