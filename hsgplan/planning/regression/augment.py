@@ -138,13 +138,51 @@ def with_distractors(traj: Trajectory, extra: int, rng: random.Random) -> Trajec
     return Trajectory(states, traj.goal, _extra_goals(added, traj.goal, rng), tuple(added))
 
 
-def holding_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
-    """The state with one added object in the hand, if the hand is free and one is clear.
+def varied(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
+    """The state as it is, with an added object in the hand, or with an added object put on
+    a demonstrated object (a third each, where possible).
 
-    Only for questions about preimages, which do not depend on where untouched objects are:
-    it shows the network a held object that is neither the query's subject nor its target,
-    whose goal literal is no dependency (in the demonstrations, the object in the hand is
-    always the one the next action needs)."""
+    Only for questions whose labels do not depend on where untouched objects are: preimages
+    (what the demonstrated action needed is the same) and reachability (labelled by the
+    transition model). They show the network what the demonstrations never do: a held
+    object that is neither the query's subject nor its target, whose goal literal is no
+    dependency and which must be put down first; and a demonstrated object that is not
+    clear (in the demonstrations, every object is free to take)."""
+    roll = rng.random()
+    if roll < 1 / 3:
+        return state
+    if roll < 2 / 3:
+        return holding_one(traj, state, rng) or state
+    return covering_one(traj, state, rng) or state
+
+
+def covering_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
+    """The state with a clear added object moved onto a clear demonstrated object that can
+    carry it, if there is such a pair."""
+    demo = [o for o in state.objects if o not in traj.added]
+    bases = [
+        b
+        for b in demo
+        if state.holds(Literal(Predicate.CLEAR, (b,)))
+        and can_support(type_of(b))
+        and state.level(b) < MAX_TOWER_LEVELS
+    ]
+    tops = [
+        o
+        for o in traj.added
+        if state.holds(Literal(Predicate.CLEAR, (o,))) and not state.resting_on(o)
+    ]
+    if not bases or not tops:
+        return None
+    b, o = rng.choice(bases), rng.choice(tops)
+    placements = [
+        lit for lit in state.literals if lit.predicate is not Predicate.CLEAR and lit.subject != o
+    ]
+    return SymbolicSceneGraph.from_literals(state.objects, placements + [on(o, b)])
+
+
+def holding_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
+    """The state with one added object in the hand, if the hand is free and one is clear."""
     if state.held() is not None:
         return None
     free = [o for o in traj.added if state.holds(Literal(Predicate.CLEAR, (o,)))]

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
-from functools import cache, cached_property
+from functools import cache, cached_property, lru_cache
 
 import torch
 from torch_geometric.data import Data
@@ -162,6 +162,11 @@ def decode_values(names, values: torch.Tensor, valid: torch.Tensor) -> list[Lite
     return out
 
 
+@lru_cache(maxsize=4)
+def _encode_state(state: SymbolicSceneGraph) -> Data:
+    return encode(state, ())
+
+
 def encode_many(
     state: SymbolicSceneGraph,
     goals: list[Iterable[Literal]],
@@ -175,14 +180,19 @@ def encode_many(
     [2, K N^2], edge_attr [K N^2, EDGE_DIM], valid / goal [K N^2, P], active [K N^2].
     """
     queries = queries if queries is not None else [()] * len(goals)
-    one = encode(state, ())
+    one = _encode_state(state)
     slots = Slots(state.nodes)
     k, n, e = len(goals), len(slots.nodes), len(slots.nodes) ** 2
-    values = torch.stack([slots.goal_values(g) for g in goals])
+    values = torch.zeros(k, e, len(PREDICATES), dtype=torch.long)
     asked = torch.zeros(k, e, len(PREDICATES))
-    for i, query in enumerate(queries):
-        for lit in query:
-            asked[(i, *slots.slot(lit))] = 1.0
+    for target, lists, is_goal in ((values, goals, True), (asked, queries, False)):
+        index, fill = [], []
+        for i, lits in enumerate(lists):
+            for lit in lits:
+                index.append((i, *slots.slot(lit)))
+                fill.append((TRUE if lit.positive else FALSE) if is_goal else 1)
+        if index:
+            target[tuple(torch.tensor(index).t())] = torch.tensor(fill, dtype=target.dtype)
     holds = one.edge_attr[:, : len(PREDICATES)].expand(k, e, -1)
     valid = one.valid.expand(k, e, -1)
     goal_onehot = torch.nn.functional.one_hot(values, 3).float().reshape(k, e, -1)

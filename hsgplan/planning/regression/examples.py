@@ -32,7 +32,7 @@ from hsgplan.data.demos import Demo
 from hsgplan.domain.objects import EntityKind, kind_of
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.transition import applicable_actions, apply
-from hsgplan.planning.regression.augment import Trajectory, holding_one
+from hsgplan.planning.regression.augment import Trajectory, varied
 from hsgplan.planning.regression.encoding import DONT_CARE, FALSE, TRUE, Slots, encode
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -86,8 +86,7 @@ def preimage_examples(demos: list[Trajectory] | list[Demo], seed: int = 0) -> li
     action consumed, the task goal's literals that already held (what had to come first, as a
     stack's base), and no other object in the hand (the previous scene graph's grasp state,
     which the changes alone never show). Added objects' goal literals are context, never
-    preimage, and half the states asked from hold an added object where the hand was free
-    (see `augment.py`)."""
+    preimage, and the states asked from are `varied` (see `augment.py`)."""
     rng = random.Random(f"preimage-{seed}")
     out = []
     for traj in map(_trajectory, demos):
@@ -104,9 +103,7 @@ def preimage_examples(demos: list[Trajectory] | list[Demo], seed: int = 0) -> li
             for query in sorted(goals[t + 1] & added):
                 before = consumed | ((goals[t + 1] - added) & task)
                 for tau in range(t + 1):
-                    state = states[tau]
-                    if rng.random() < 0.5:
-                        state = holding_one(traj, state, rng) or state
+                    state = varied(traj, states[tau], rng)
                     data = encode(state, goals[t + 1] | traj.extra_goal, [query])
                     out.append(Example(data, *_target(data, sorted(before) + empty_hand)))
     return out
@@ -160,24 +157,26 @@ def reach_examples(demos: list[Trajectory] | list[Demo], seed: int = 0, singles:
     rng = random.Random(f"reach-{seed}")
     out = []
     for traj in map(_trajectory, demos):
-        states = traj.states
-        for t in range(len(states) - 1):
-            added, _ = _changes(states[t], states[t + 1])
+        for t in range(len(traj.states) - 1):
+            state, after = traj.states[t], traj.states[t + 1]
+            if traj.added:  # the demonstrated step still shows, half the time
+                state = state if rng.random() < 0.5 else varied(traj, state, rng)
+            added, _ = _changes(state, after)
             candidates = set(added)
             for lit in added:
-                candidates |= _alterations(lit, states[t])
-            candidates |= _every_literal(states[t])
-            candidates = {c for c in candidates if not states[t].holds(c)}
+                candidates |= _alterations(lit, state)
+            candidates |= _every_literal(state)
+            candidates = {c for c in candidates if not state.holds(c)}
             # undoing, too; never both l and not l: one of them holds, and only those that do
             # not hold are candidates
-            candidates |= {lit.negated() for lit in states[t].literals}
-            yes = reachable(states[t])
+            candidates |= {lit.negated() for lit in state.literals}
+            yes = reachable(state)
             pos = sorted(c for c in candidates if c in yes)
             neg = sorted(c for c in candidates if c not in yes)
             chosen = rng.sample(pos, min(singles, len(pos)))
             chosen += rng.sample(neg, min(singles, len(neg)))
             for goal in [candidates] + [{c} for c in chosen]:
-                data = encode(states[t], goal)
+                data = encode(state, goal)
                 slots = Slots(tuple(data.names))
                 target = torch.zeros_like(data.goal)
                 mask = torch.zeros_like(data.valid)

@@ -57,10 +57,16 @@ class RelationalLayer(MessagePassing):
     ) -> tuple[Tensor, Tensor]:
         edge_new = self.edge_updater(edge_index, x=x, edge_attr=edge_attr)
         sent = edge_new if edge_weight is None else edge_new * edge_weight.unsqueeze(-1)
-        size = (x.size(0), x.size(0))
-        incoming = self.propagate(edge_index, edge_attr=sent, size=size)
-        outgoing = self.propagate(edge_index.flip(0), edge_attr=sent, size=size)
-        x_new = self.node_mlp(torch.cat([x, incoming, outgoing], dim=-1))
+        # One propagation for both directions: each edge also runs backwards, carrying its
+        # update in the second half of the channels, so a node sums [incoming, outgoing].
+        zero = torch.zeros_like(sent)
+        both = torch.cat([torch.cat([sent, zero], 1), torch.cat([zero, sent], 1)])
+        sums = self.propagate(
+            torch.cat([edge_index, edge_index.flip(0)], 1),
+            edge_attr=both,
+            size=(x.size(0), x.size(0)),
+        )
+        x_new = self.node_mlp(torch.cat([x, sums], dim=-1))
         if self.node_dim_in == self.hidden:
             x_new = x_new + x
         if self.edge_dim == self.hidden:
@@ -123,14 +129,17 @@ class EdgeClassifier(nn.Module):
     Node and edge features are encoded to `hidden`, passed through `rounds` relational layers
     (separate weights per round), and each edge is classified from [x_src, x_dst, e]. If the
     graph has an `active` edge mask, only active edges pass messages; every edge is classified.
+    An inactive edge's state depends on nothing but its own features and its two nodes, so
+    with a `readout` mask as well only active and read-out edges are computed (the planner
+    asks about a few slots of many graphs); the others get all-zero logits.
 
     Args:
         config: the sizes, see `EdgeClassifierConfig`.
 
     Shapes:
         data.x: [N, node_dim]; data.edge_index: [2, E]; data.edge_attr: [E, edge_dim];
-        optional data.active: [E] bool -> logits [E, predicates, classes]. A `Batch` works
-        the same, edges in batch order.
+        optional data.active: [E] bool; optional data.readout: [E] bool -> logits
+        [E, predicates, classes]. A `Batch` works the same, edges in batch order.
     """
 
     def __init__(self, config: EdgeClassifierConfig) -> None:
@@ -143,14 +152,23 @@ class EdgeClassifier(nn.Module):
         self.head = mlp(3 * h, h, config.predicates * config.classes)
 
     def forward(self, data: Data) -> Tensor:
-        edge_index = data.edge_index
+        edge_index, edge_attr = data.edge_index, data.edge_attr
+        active = data.active if "active" in data else None
+        keep = None
+        if active is not None and "readout" in data:
+            keep = (active | data.readout).nonzero().squeeze(1)
+            edge_index, edge_attr, active = edge_index[:, keep], edge_attr[keep], active[keep]
         x = self.node_encoder(data.x.float())
-        e = self.edge_encoder(data.edge_attr.float())
-        weight = data.active.float() if "active" in data else None
+        e = self.edge_encoder(edge_attr.float())
+        weight = active.float() if active is not None else None
         for layer in self.layers:
             x, e = layer(x, edge_index, e, weight)
         logits = self.head(torch.cat([x[edge_index[0]], x[edge_index[1]], e], dim=-1))
-        return logits.view(-1, self.config.predicates, self.config.classes)
+        logits = logits.view(-1, self.config.predicates, self.config.classes)
+        if keep is None:
+            return logits
+        full = logits.new_zeros(data.edge_index.shape[1], *logits.shape[1:])
+        return full.index_copy(0, keep, logits)
 
 
 def masked_cross_entropy(logits: Tensor, target: Tensor, mask: Tensor) -> Tensor:

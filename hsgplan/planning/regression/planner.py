@@ -76,6 +76,8 @@ class _Node:
     lit: Literal
     context: frozenset[Literal]
     path: tuple[Literal, ...]
+    # the literals this one was regressed from, with their preimages, root first
+    chain: tuple[tuple[Literal, frozenset[Literal]], ...] = ()
 
 
 class RegressionPlanner:
@@ -85,6 +87,12 @@ class RegressionPlanner:
     shallowest subgoal one primitive reaches wins (uniformly among equals), so a goal literal
     that is one step away goes before one that needs three. While regressing, the context is
     the regressed subgoal, as in training: the literal is replaced by its preimage.
+
+    After a decision the planner keeps the chain it regressed through (say In(c, shelf_a) <-
+    On(c, prepush_a) <- InGrasp(c)). At the next decision, if the next literal up the chain
+    has its whole preimage holding in the state now observed, its action is taken without
+    asking the networks again; otherwise (a primitive failed, the world moved) the chain is
+    dropped and the planner regresses from the goal.
     """
 
     name = "regression"
@@ -95,20 +103,34 @@ class RegressionPlanner:
         self.rng = random.Random(seed)
         self.max_depth = max_depth
         self._taken: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
+        self._plan: tuple[Goal, list[tuple[Literal, frozenset[Literal]]]] | None = None
 
     def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
         data = encode_many(state, [n.context for n in nodes], [[n.lit] for n in nodes])
-        values = self.preimage(data).argmax(-1).view(len(nodes), -1, data.goal.shape[1])
-        valid = data.valid.view(len(nodes), -1, data.goal.shape[1])
+        k, p = len(nodes), data.goal.shape[1]
+        # Read out the edges of the query's objects: a preimage names them (the active edges
+        # are computed anyway).
+        index = {name: i for i, name in enumerate(data.names)}
+        near = torch.zeros(k, len(data.names), dtype=torch.bool)
+        for i, n in enumerate(nodes):
+            near[i, [index[a] for a in n.lit.args]] = True
+        src, dst = data.edge_index[:, : len(data.names) ** 2]
+        data.readout = (near[:, src] | near[:, dst]).reshape(-1)
+        values = self.preimage(data).argmax(-1).masked_fill(~data.readout.unsqueeze(1), 0)
+        values, valid = values.view(k, -1, p), data.valid.view(k, -1, p)
         return [
             frozenset(decode_values(data.names, v, m)) for v, m in zip(values, valid, strict=True)
         ]
 
     def _reachable(self, state, lits: list[Literal]) -> list[bool]:
         data = encode_many(state, [[lit] for lit in lits])
-        yes = self.reach(data).argmax(-1).view(len(lits), -1, data.goal.shape[1])
         slots = Slots(tuple(data.names))
-        return [bool(yes[(i, *slots.slot(lit))] == 1) for i, lit in enumerate(lits)]
+        e = len(data.names) ** 2
+        where = [(i * e + edge, p) for i, lit in enumerate(lits) for edge, p in [slots.slot(lit)]]
+        data.readout = torch.zeros(len(lits) * e, dtype=torch.bool)
+        data.readout[[w for w, _ in where]] = True
+        yes = self.reach(data).argmax(-1)
+        return [bool(yes[w, p] == 1) for w, p in where]
 
     @torch.no_grad()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
@@ -116,6 +138,10 @@ class RegressionPlanner:
         unsatisfied = sorted(goal.unsatisfied(state))
         if not unsatisfied:
             return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
+        taken = self._taken.setdefault((goal, state), set())
+        if (step := self._follow(state, goal, taken)) is not None:
+            taken.add(step[1])
+            return TaskDecision(step[1], step[0], time.perf_counter() - start)
         context = frozenset(goal.literals)
         roots = [_Node(lit, context, (lit,)) for lit in unsatisfied]
         preimages = self._preimages(state, roots)
@@ -127,15 +153,29 @@ class RegressionPlanner:
         # whose shelf is full and putting it back.
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
-        taken = self._taken.setdefault((goal, state), set())
         for avoid in (taken, set()):
             for frontier in (free, [x for x in pairs if x not in free]):
                 found = self._search(state, frontier, avoid)
                 if found is not None:
                     node, action = found
                     taken.add(action)
+                    self._plan = (goal, list(reversed(node.chain)))
                     return TaskDecision(action, node.lit, time.perf_counter() - start)
         return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
+
+    def _follow(self, state, goal, avoid) -> tuple[Literal, Action] | None:
+        """The next step up the kept chain, if its preimage holds now."""
+        if self._plan is None or self._plan[0] != goal:
+            return None
+        chain = self._plan[1]
+        while chain and state.holds(chain[0][0]):
+            chain.pop(0)
+        if chain and all(state.holds(m) for m in chain[0][1]):
+            action = action_for(chain[0][0], state)
+            if action is not None and action not in avoid:
+                return chain[0][0], action
+        self._plan = None
+        return None
 
     def _search(self, state, frontier, avoid):
         """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
@@ -179,7 +219,8 @@ class RegressionPlanner:
                 if state.holds(m) or m in node.path or m in seen:
                     continue
                 seen.add(m)
-                out.append((_Node(m, context, node.path + (m,)), None))
+                chain = node.chain + ((node.lit, pre),)
+                out.append((_Node(m, context, node.path + (m,), chain), None))
         return out
 
 
