@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/hsgplan demo
+	$(BIN)/hsgplan demo --agent regression
 
 test: $(STAMP)
 	$(BIN)/ruff check hsgplan tests scripts

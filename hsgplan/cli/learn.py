@@ -59,19 +59,26 @@ def eval_task(
     goals_file: Annotated[Path | None, typer.Option(help="Goals from a file instead.")] = None,
     checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = CHECKPOINT,
     workers: Annotated[int, typer.Option(help="Episodes run side by side.")] = 2,
+    run: Annotated[
+        Path | None,
+        typer.Option(help="Run folder (episodes.jsonl); an interrupted run resumes from it."),
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")
     ] = False,
 ) -> None:
     """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
-    milliseconds per decision."""
+    milliseconds per decision. Episodes are kept in the run folder (by default
+    runs/eval-task-PLANNER-SIZES-gGOALS-seedSEED) as they finish."""
     from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
 
     if workers < 1:
         raise InvalidInputError(f"--workers {workers}: need at least one")
     size_list = parse_sizes(sizes)
     total = goals * len(size_list) if goals_file is None else None
+    source = goals_file.stem if goals_file else f"g{goals}"
+    run = run or Path("runs") / f"eval-task-{planner}-{sizes}-{source}-seed{seed}"
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(f"{planner} episodes", total=total)
         episodes = evaluate_task(
@@ -83,6 +90,7 @@ def eval_task(
             goals_file,
             workers,
             lambda e: progress.advance(task),
+            run,
         )
     report = summarize_task(episodes) | {"planner": planner, "seed": seed}
     if as_json:

@@ -83,7 +83,11 @@ def make_agent(name: str):
         from hsgplan.agents.oracle import OracleAgent
 
         return OracleAgent()
-    raise InvalidInputError(f"unknown agent '{name}' (known: oracle)")
+    if name == "regression":
+        from hsgplan.agents.learned_task import RegressionAgent
+
+        return RegressionAgent()
+    raise InvalidInputError(f"unknown agent '{name}' (known: oracle, regression)")
 
 
 def run_spec(agent_name: str, spec: EpisodeSpec) -> dict:

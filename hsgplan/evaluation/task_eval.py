@@ -8,6 +8,8 @@ beyond), and every decision is timed.
 
 from __future__ import annotations
 
+import contextlib
+import json
 import multiprocessing
 import random
 import statistics
@@ -25,6 +27,8 @@ from hsgplan.evaluation.protocol import episode_seed
 
 MAX_STEPS = 50
 PLANNERS = ("regression", "forward", "fd")
+RESULTS = "episodes.jsonl"
+CONFIG = "config.json"
 
 
 @dataclass(frozen=True)
@@ -105,7 +109,10 @@ def evaluate_task(
     goals_file: Path | None = None,
     workers: int = 2,
     on_episode: Callable[[TaskEpisode], None] | None = None,
+    run_dir: Path | None = None,
 ) -> list[TaskEpisode]:
+    """Every episode, `workers` at a time. With `run_dir`, finished episodes are appended to
+    its `episodes.jsonl` as they finish, and a run started again skips them."""
     make_planner(planner, checkpoint, seed)  # a bad name or checkpoint fails here, once
     if goals < 0:
         raise InvalidInputError(f"--goals {goals}: the number of goals cannot be negative")
@@ -118,19 +125,57 @@ def evaluate_task(
             for n in sizes
             for i, g in enumerate(random_goals(n, goals, seed, stacking=n > 2))
         ]
-    args = [(planner, str(checkpoint), str(g), s) for g, s in jobs]
-    out = []
+    keys = [(str(g), s) for g, s in jobs]
+    done = _load_done(run_dir, planner, checkpoint) if run_dir else {}
+    for key in keys:
+        if key in done and on_episode:
+            on_episode(done[key])
+    todo = [(planner, str(checkpoint), g, s) for g, s in keys if (g, s) not in done]
     # spawn, not fork: this process has loaded torch, and a forked child of a process with live
     # OpenMP threads hangs (measured: the workers sat idle)
-    with ProcessPoolExecutor(
-        max(1, workers), mp_context=multiprocessing.get_context("spawn")
-    ) as pool:
-        for row in pool.map(_work, args, chunksize=8):
+    with (
+        open(run_dir / RESULTS, "a") if run_dir else contextlib.nullcontext() as log,
+        ProcessPoolExecutor(
+            max(1, workers), mp_context=multiprocessing.get_context("spawn")
+        ) as pool,
+    ):
+        for row in pool.map(_work, todo, chunksize=4):
             episode = TaskEpisode(**{**row, "decision_ms": tuple(row["decision_ms"])})
-            out.append(episode)
+            done[(episode.goal, episode.seed)] = episode
+            if log:
+                log.write(json.dumps(row) + "\n")
+                log.flush()
             if on_episode:
                 on_episode(episode)
-    return out
+    return [done[k] for k in keys]
+
+
+def _load_done(run_dir: Path, planner: str, checkpoint: Path) -> dict[tuple, TaskEpisode]:
+    """Episodes a run folder already holds; refuses one made by another planner."""
+    run_dir.mkdir(parents=True, exist_ok=True)
+    config = {"planner": planner, "checkpoint": str(checkpoint)}
+    saved = run_dir / CONFIG
+    if saved.exists():
+        try:
+            if json.loads(saved.read_text()) != config:
+                raise InvalidInputError(f"'{run_dir}' holds a run of another planner")
+        except json.JSONDecodeError:
+            raise InvalidInputError(f"'{saved}' is not valid JSON") from None
+    saved.write_text(json.dumps(config) + "\n")
+    done = {}
+    results = run_dir / RESULTS
+    if results.exists():
+        text = results.read_text()
+        if text and not text.endswith("\n"):
+            results.write_text(text + "\n")  # an interrupted write: its episode runs again
+        for line in text.splitlines():
+            try:
+                row = json.loads(line)
+                e = TaskEpisode(**{**row, "decision_ms": tuple(row["decision_ms"])})
+            except (json.JSONDecodeError, TypeError):
+                continue
+            done[(e.goal, e.seed)] = e
+    return done
 
 
 def summarize_task(episodes: Sequence[TaskEpisode]) -> dict:

@@ -105,6 +105,8 @@ def test_eval_task_cli_with_fast_downward(tmp_path):
             "--json",
             "--workers",
             "1",
+            "--run",
+            str(tmp_path / "run"),
         ],
     )
     assert r.exit_code == 0, r.output
@@ -113,8 +115,27 @@ def test_eval_task_cli_with_fast_downward(tmp_path):
     assert entry["ms_per_decision"] > 0
 
 
+def test_eval_task_resumes_from_its_run_folder(tmp_path):
+    from hsgplan.evaluation.task_eval import RESULTS, evaluate_task
+
+    run = tmp_path / "run"
+    first = evaluate_task("fd", tmp_path, [2], 2, 0, workers=1, run_dir=run)
+    lines = (run / RESULTS).read_text().splitlines()
+    assert len(lines) == 2
+    (run / RESULTS).write_text(lines[0] + "\n" + lines[1][:10])  # cut short mid-write
+    again = evaluate_task("fd", tmp_path, [2], 3, 0, workers=1, run_dir=run)
+    rows = [json.loads(x) for x in (run / RESULTS).read_text().splitlines() if x.endswith("}")]
+    assert len(again) == 3 and again[0] == first[0]  # read back, not run again
+    assert (again[1].goal, again[1].steps) == (first[1].goal, first[1].steps)
+    assert len(rows) == 3 and len({(r["goal"], r["seed"]) for r in rows}) == 3
+    with pytest.raises(InvalidInputError, match="another planner"):
+        evaluate_task("fd", tmp_path / "other", [2], 1, 0, run_dir=run)
+
+
 def test_eval_task_without_a_checkpoint_is_one_line(tmp_path):
-    r = CliRunner().invoke(app, ["eval-task", "--checkpoint", str(tmp_path), "--goals", "1"])
+    r = CliRunner().invoke(
+        app, ["eval-task", "--checkpoint", str(tmp_path), "--goals", "1", "--run", str(tmp_path)]
+    )
     assert r.exit_code == 2 and "no trained network" in r.stderr
     r = CliRunner().invoke(app, ["train", "task", "--config", str(tmp_path / "none.json")])
     assert r.exit_code == 2 and "does not exist" in r.stderr
@@ -162,6 +183,8 @@ def test_eval_task_runs_a_trained_checkpoint_in_worker_processes(tmp_path):
             "--workers",
             "2",
             "--json",
+            "--run",
+            str(tmp_path / "run"),
         ],
     )
     assert r.exit_code == 0, r.output

@@ -23,7 +23,14 @@ import torch
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.transition import Action, Pick, Place, Push, why_not
-from hsgplan.planning.regression.encoding import TRUE, Slots, decode_values, encode, encode_many
+from hsgplan.planning.regression.encoding import (
+    DONT_CARE,
+    TRUE,
+    Slots,
+    decode_values,
+    encode,
+    encode_many,
+)
 from hsgplan.planning.regression.train import load_network
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -116,7 +123,8 @@ class RegressionPlanner:
             near[i, [index[a] for a in n.lit.args]] = True
         src, dst = data.edge_index[:, : len(data.names) ** 2]
         data.readout = (near[:, src] | near[:, dst]).reshape(-1)
-        values = self.preimage(data).argmax(-1).masked_fill(~data.readout.unsqueeze(1), 0)
+        computed = (data.readout | data.active).unsqueeze(1)
+        values = self.preimage(data).argmax(-1).masked_fill(~computed, DONT_CARE)
         values, valid = values.view(k, -1, p), data.valid.view(k, -1, p)
         return [
             frozenset(decode_values(data.names, v, m)) for v, m in zip(values, valid, strict=True)

@@ -49,6 +49,7 @@ class TaskTrainConfig:
     rounds: int = 3
     save_every: int = 25
     copies: int = 20  # copies of each demonstration with added objects (`augment.py`)
+    reach_singles: int = 12  # single-literal reach questions per state and label
 
     @staticmethod
     def from_json(d: dict) -> TaskTrainConfig:
@@ -58,9 +59,10 @@ class TaskTrainConfig:
         return TaskTrainConfig(**d)
 
 
-def _examples(name: str, trajs, seed: int) -> list[Example]:
+def _examples(name: str, trajs, config: TaskTrainConfig) -> list[Example]:
+    seed = config.seed
     if name == "reach":
-        return reach_examples(trajs, seed)
+        return reach_examples(trajs, seed, config.reach_singles)
     if name == "preimage":
         return preimage_examples(trajs, seed)
     return forward_examples(trajs)
@@ -86,7 +88,7 @@ def train_task(
     for name, classes in NETWORKS.items():
         if (out / name / "model.safetensors").exists():
             continue  # finished earlier
-        examples = _examples(name, trajs, config.seed)
+        examples = _examples(name, trajs, config)
         _train_one(name, classes, examples, config, out / name, on_epoch)
 
 
