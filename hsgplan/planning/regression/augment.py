@@ -139,21 +139,59 @@ def with_distractors(traj: Trajectory, extra: int, rng: random.Random) -> Trajec
 
 
 def varied(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
-    """The state as it is, with an added object in the hand, or with an added object put on
-    a demonstrated object (a third each, where possible).
+    """The state as it is, with an added object in the hand, with an added object put on a
+    demonstrated object, or with a demonstrated object moved elsewhere (a quarter each, where
+    possible).
 
-    Only for questions whose labels do not depend on where untouched objects are: preimages
-    (what the demonstrated action needed is the same) and reachability (labelled by the
-    transition model). They show the network what the demonstrations never do: a held
-    object that is neither the query's subject nor its target, whose goal literal is no
-    dependency and which must be put down first; and a demonstrated object that is not
-    clear (in the demonstrations, every object is free to take)."""
+    Only for questions whose labels do not depend on where untouched objects are, or on where
+    an object is before the step the label is about: preimages (what the demonstrated action
+    needed is the same) and reachability (labelled by the transition model). They show the
+    network what the demonstrations never do: a held object that is neither the query's
+    subject nor its target, whose goal literal is no dependency and which must be put down
+    first; a demonstrated object that is not clear; and one that starts on a shelf top or a
+    prepush region rather than the open space."""
     roll = rng.random()
-    if roll < 1 / 3:
+    if roll < 1 / 4:
         return state
-    if roll < 2 / 3:
+    if roll < 2 / 4:
         return holding_one(traj, state, rng) or state
-    return covering_one(traj, state, rng) or state
+    if roll < 3 / 4:
+        return covering_one(traj, state, rng) or state
+    return relocating_one(traj, state, rng) or state
+
+
+def _moved(state: SymbolicSceneGraph, o: str, where: Literal) -> SymbolicSceneGraph:
+    placements = [
+        lit for lit in state.literals if lit.predicate is not Predicate.CLEAR and lit.subject != o
+    ]
+    return SymbolicSceneGraph.from_literals(state.objects, placements + [where])
+
+
+def relocating_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
+    """The state with a clear demonstrated object (resting on a surface, nothing on it) moved
+    to another surface with room, or onto a clear added object that can carry it."""
+    movable = [
+        o
+        for o in state.objects
+        if o not in traj.added
+        and state.holds(Literal(Predicate.CLEAR, (o,)))
+        and state.location(o).args[-1] in SURFACES
+    ]
+    if not movable:
+        return None
+    o = rng.choice(movable)
+    here = state.location(o).args[-1]
+    options = [s for s in SURFACES if s != here and len(state.resting_on(s)) < SURFACE_CAPACITY[s]]
+    options += [
+        b
+        for b in traj.added
+        if state.holds(Literal(Predicate.CLEAR, (b,)))
+        and can_support(type_of(b))
+        and state.level(b) < MAX_TOWER_LEVELS
+    ]
+    if not options:
+        return None
+    return _moved(state, o, on(o, rng.choice(options)))
 
 
 def covering_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
@@ -175,10 +213,7 @@ def covering_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random
     if not bases or not tops:
         return None
     b, o = rng.choice(bases), rng.choice(tops)
-    placements = [
-        lit for lit in state.literals if lit.predicate is not Predicate.CLEAR and lit.subject != o
-    ]
-    return SymbolicSceneGraph.from_literals(state.objects, placements + [on(o, b)])
+    return _moved(state, o, on(o, b))
 
 
 def holding_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
@@ -189,12 +224,7 @@ def holding_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random)
     if not free:
         return None
     o = rng.choice(free)
-    placements = [
-        lit for lit in state.literals if lit.predicate is not Predicate.CLEAR and lit.subject != o
-    ]
-    return SymbolicSceneGraph.from_literals(
-        state.objects, placements + [Literal(Predicate.IN_GRASP, (o,))]
-    )
+    return _moved(state, o, Literal(Predicate.IN_GRASP, (o,)))
 
 
 def trajectories(demos: list[Demo], copies: int, seed: int) -> list[Trajectory]:

@@ -189,20 +189,25 @@ class RegressionPlanner:
         """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
 
         A node is reached when f_reach says so, or when its whole preimage already holds
-        (then, by what a preimage means, one primitive achieves it)."""
+        (then, by what a preimage means, one primitive achieves it). Where a level's
+        preimages are known, f_reach is asked about it and the next level in one call."""
+        reach: dict[Literal, bool] = {}
         for _ in range(self.max_depth):
             if not frontier:
                 return None
-            nodes = [n for n, _ in frontier]
-            yes = self._reachable(state, [n.lit for n in nodes])
-            reached = [n for n, y in zip(nodes, yes, strict=True) if y]
-            if found := self._choose(state, reached, avoid):
+            known = all(pre is not None for _, pre in frontier)
+            children = self._children(state, frontier) if known else []
+            ask = [n.lit for n, _ in frontier + children if n.lit not in reach]
+            ask = list(dict.fromkeys(ask))
+            if ask:
+                reach.update(zip(ask, self._reachable(state, ask), strict=True))
+            if found := self._choose(state, [n for n, _ in frontier if reach[n.lit]], avoid):
                 return found
             frontier = self._with_preimages(state, frontier)
             done = [n for n, pre in frontier if all(state.holds(m) for m in pre)]
             if found := self._choose(state, done, avoid):
                 return found
-            frontier = self._children(state, frontier)
+            frontier = children if known else self._children(state, frontier)
         return None
 
     def _choose(self, state, nodes: list[_Node], avoid):
