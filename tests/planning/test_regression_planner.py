@@ -19,10 +19,10 @@ from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 DEMOS = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
 SMALL = {
     "demos": str(DEMOS),
-    "epochs": 4,
+    "epochs": 10,
     "hidden": 32,
-    "rounds": 2,
-    "copies": 4,
+    "rounds": 3,
+    "copies": 3,
     "reach_singles": 4,
     "batch_size": 32,
 }

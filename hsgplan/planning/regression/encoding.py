@@ -82,10 +82,12 @@ class Slots:
         return self._index[src] * len(self.nodes) + self._index[dst], _PRED_INDEX[lit.predicate]
 
     def literal(self, edge: int, pred: int) -> Literal:
-        src, dst = divmod(edge, len(self.nodes))
-        p = PREDICATES[pred]
-        args = (self.nodes[src],) if p.arity == 1 else (self.nodes[src], self.nodes[dst])
-        return Literal(p, args)
+        return _literal(self.nodes, edge, pred)
+
+    @staticmethod
+    def of(nodes: tuple[str, ...]) -> Slots:
+        """The (shared, cached) slots of a node list."""
+        return _slots(nodes)
 
     def valid_mask(self) -> torch.Tensor:
         """[E, P] bool: which slots can hold a literal at all."""
@@ -98,6 +100,18 @@ class Slots:
             e, p = self.slot(lit)
             values[e, p] = TRUE if lit.positive else FALSE
         return values
+
+
+@cache
+def _slots(nodes: tuple[str, ...]) -> Slots:
+    return Slots(nodes)
+
+
+@lru_cache(maxsize=65536)
+def _literal(nodes: tuple[str, ...], edge: int, pred: int) -> Literal:
+    src, dst = divmod(edge, len(nodes))
+    p = PREDICATES[pred]
+    return Literal(p, (nodes[src],) if p.arity == 1 else (nodes[src], nodes[dst]))
 
 
 def encode(
@@ -181,7 +195,7 @@ def encode_many(
     """
     queries = queries if queries is not None else [()] * len(goals)
     one = _encode_state(state)
-    slots = Slots(state.nodes)
+    slots = Slots.of(state.nodes)
     k, n, e = len(goals), len(slots.nodes), len(slots.nodes) ** 2
     values = torch.zeros(k, e, len(PREDICATES), dtype=torch.long)
     asked = torch.zeros(k, e, len(PREDICATES))

@@ -27,7 +27,6 @@ from hsgplan.planning.regression.encoding import (
     DONT_CARE,
     TRUE,
     Slots,
-    decode_values,
     encode,
     encode_many,
 )
@@ -125,14 +124,18 @@ class RegressionPlanner:
         data.readout = (near[:, src] | near[:, dst]).reshape(-1)
         computed = (data.readout | data.active).unsqueeze(1)
         values = self.preimage(data).argmax(-1).masked_fill(~computed, DONT_CARE)
-        values, valid = values.view(k, -1, p), data.valid.view(k, -1, p)
-        return [
-            frozenset(decode_values(data.names, v, m)) for v, m in zip(values, valid, strict=True)
-        ]
+        values = values.view(k, -1, p)
+        said = (values != DONT_CARE) & data.valid.view(k, -1, p)
+        out: list[set[Literal]] = [set() for _ in range(k)]
+        slots = Slots.of(tuple(data.names))
+        for (i, e, q), v in zip(said.nonzero().tolist(), values[said].tolist(), strict=True):
+            lit = slots.literal(e, q)
+            out[i].add(lit if v == TRUE else lit.negated())
+        return [frozenset(x) for x in out]
 
     def _reachable(self, state, lits: list[Literal]) -> list[bool]:
         data = encode_many(state, [[lit] for lit in lits])
-        slots = Slots(tuple(data.names))
+        slots = Slots.of(tuple(data.names))
         e = len(data.names) ** 2
         where = [(i * e + edge, p) for i, lit in enumerate(lits) for edge, p in [slots.slot(lit)]]
         data.readout = torch.zeros(len(lits) * e, dtype=torch.bool)
