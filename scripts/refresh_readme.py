@@ -41,6 +41,8 @@ def main(argv: list[str]) -> int:
         f"({platform.machine()}, {os.cpu_count()} cores)._\n"
     )
     block = result.stdout.strip() + "\n" + stamp
+    # read again: the README may have changed while the command ran (another refresh, an edit)
+    text = README.read_text()
     README.write_text(pattern.sub(lambda m: m.group(1) + block + m.group(2), text))
     return 0
 

@@ -143,7 +143,7 @@ class RegressionPlanner:
         yes = self.reach(data).argmax(-1)
         return [bool(yes[w, p] == 1) for w, p in where]
 
-    @torch.no_grad()
+    @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
         unsatisfied = sorted(goal.unsatisfied(state))
@@ -248,7 +248,7 @@ class ForwardPlanner:
     def __init__(self, checkpoint: Path) -> None:
         self.net = load_network(checkpoint / "forward")
 
-    @torch.no_grad()
+    @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
         if goal.satisfied_by(state):
