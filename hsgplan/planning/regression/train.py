@@ -50,6 +50,9 @@ class TaskTrainConfig:
     save_every: int = 25
     copies: int = 20  # copies of each demonstration with added objects (`augment.py`)
     reach_singles: int = 12  # single-literal reach questions per state and label
+    # f_reach learns from the first `reach_copies` copies only (None: all of them): its
+    # examples are many per state, f_preimage's few
+    reach_copies: int | None = None
 
     @staticmethod
     def from_json(d: dict) -> TaskTrainConfig:
@@ -62,7 +65,9 @@ class TaskTrainConfig:
 def _examples(name: str, trajs, config: TaskTrainConfig) -> list[Example]:
     seed = config.seed
     if name == "reach":
-        return reach_examples(trajs, seed, config.reach_singles)
+        copies = config.copies if config.reach_copies is None else config.reach_copies
+        n = len(trajs) // (config.copies + 1)  # the demonstrations, then copy after copy
+        return reach_examples(trajs[: n * (1 + copies)], seed, config.reach_singles)
     if name == "preimage":
         return preimage_examples(trajs, seed)
     return forward_examples(trajs)
