@@ -123,3 +123,13 @@ def test_json_output_of_the_real_command_is_pure_json(tmp_path):
         check=True,
     )
     assert json.loads(result.stdout)["by_size"]["2"]["episodes"] == 1
+
+
+def test_the_shipped_task_checkpoint_closes_the_loop_in_the_simulated_world():
+    # what `make demo` runs: the learned regression planner, parameters from the sampler
+    from hsgplan.agents.learned_task import RegressionAgent
+
+    record = run_episode(KitchenStorageEnv(), RegressionAgent(), parse_goal(GOAL), seed=4)
+    assert record.success, [(s.action, s.status) for s in record.steps]
+    assert "push(tomato_soup, shelf_a)" in [s.action for s in record.steps]
+    assert record.seed == 4 and all(s.task_seconds >= 0 for s in record.steps)
