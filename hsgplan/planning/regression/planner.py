@@ -3,11 +3,12 @@ and Fast Downward. Each returns the next action for a symbolic state and a goal.
 
 The regression loop (the paper's phi): f_preimage gives the preimage of one goal literal (the
 query) in the context of the goal; a goal literal whose preimage names another unsatisfied goal
-literal has to wait for it (a stack's top for its base). One of the goal literals free to go is
-drawn uniformly (the paper's subgoal serialisation) and regressed: while f_reach says one
-primitive does not reach it, it is replaced by an unsatisfied literal of its preimage (a
-reachable one when there is one), up to a depth cap. The literal reached is the immediate
-subgoal g-hat, and a heuristic names the primitive and object that achieve it.
+literal waits for it (a stack's top for its base). From the free goal literals the planner
+regresses breadth first, replacing a literal by the unsatisfied literals of its preimage, until
+f_reach says one primitive reaches one (depth cap `MAX_DEPTH`; "regression stuck" when nothing
+is found). Among the literals reached at the shallowest level one is drawn uniformly (the
+paper's subgoal serialisation): the immediate subgoal g-hat, for which a heuristic
+(`action_for`) names the primitive and object.
 """
 
 from __future__ import annotations
