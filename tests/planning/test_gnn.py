@@ -198,3 +198,19 @@ def test_masked_graphs_stay_equivariant_to_node_order():
     net = model()
     with torch.no_grad():
         torch.testing.assert_close(net(h), net(g), rtol=1e-5, atol=1e-5)
+
+
+def test_the_scripted_network_gives_the_eager_outputs():
+    gen = torch.Generator().manual_seed(9)
+    g = complete_graph(4, 5, 4, gen)
+    g.active = torch.rand(g.num_edges, generator=gen) < 0.5
+    net = model()
+    with torch.no_grad():
+        eager = net(g)
+        g.readout = torch.zeros(g.num_edges, dtype=torch.bool)
+        g.readout[2] = True
+        eager_some = net(g)
+        net.script()
+        torch.testing.assert_close(net(g), eager_some, rtol=1e-5, atol=1e-5)
+        del g.readout
+        torch.testing.assert_close(net(g), eager, rtol=1e-5, atol=1e-5)

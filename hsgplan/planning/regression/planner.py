@@ -16,6 +16,7 @@ from __future__ import annotations
 import random
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Protocol
 
@@ -76,6 +77,14 @@ def action_for(lit: Literal, state: SymbolicSceneGraph) -> Action | None:
     return next((a for a in options if why_not(state, a) is None), None)
 
 
+@lru_cache(maxsize=4)
+def _inference_networks(checkpoint: str):
+    """f_preimage and f_reach of a checkpoint, compiled for inference; loaded once per process
+    (a planner is made per episode, and the networks keep no state)."""
+    folder = Path(checkpoint)
+    return load_network(folder / "preimage").script(), load_network(folder / "reach").script()
+
+
 @dataclass(frozen=True)
 class _Node:
     """A literal met while regressing, the subgoal it was regressed within, and its path."""
@@ -105,8 +114,7 @@ class RegressionPlanner:
     name = "regression"
 
     def __init__(self, checkpoint: Path, seed: int = 0, max_depth: int = MAX_DEPTH) -> None:
-        self.preimage = load_network(checkpoint / "preimage")
-        self.reach = load_network(checkpoint / "reach")
+        self.preimage, self.reach = _inference_networks(str(checkpoint))
         self.rng = random.Random(seed)
         self.max_depth = max_depth
         self._taken: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
