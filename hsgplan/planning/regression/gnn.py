@@ -8,6 +8,7 @@ preimages (classes=3: don't care / true / false per predicate).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import asdict, dataclass, fields
 
 import torch
@@ -159,7 +160,12 @@ class EdgeClassifier(nn.Module):
         measured about 2.5 times faster on small graphs, where Python's per-operation cost
         dominates. Training needs the eager module; load a fresh one for it."""
         self.eval()
-        self._core = [torch.jit.freeze(torch.jit.script(_Core(self).eval()))]
+        scripted = torch.jit.script(_Core(self).eval())
+        with warnings.catch_warnings():
+            # torch 2.13 points to torch.compile instead, which costs seconds to compile per
+            # graph shape, and the planner's shapes change at every call
+            warnings.simplefilter("ignore", DeprecationWarning)
+            self._core = [torch.jit.freeze(scripted)]
         return self
 
     def forward(self, data: Data) -> Tensor:
