@@ -9,6 +9,7 @@ inside the shelf's interior.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.parameters import (
@@ -35,6 +36,7 @@ from hsgplan.domain.world import (
     surface_rect,
 )
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.sim.outcome import Outcome, Status
 
 MIN_CLEARANCE = 0.015
 # The Panda hand, measured in PyBullet: about 21 cm long along the finger axis and 6 cm across,
@@ -189,3 +191,37 @@ def candidates(
         )
         return list(place_candidates(sg, action.obj, action.target, next_push))
     return list(push_candidates(sg, action.obj, action.shelf))
+
+
+# Candidates dry-run per decision before the best-ranked one is tried regardless.
+MAX_CHECKS = 30
+# Failures that say these parameters will not work here; anything else may be tried again.
+DO_NOT_RETRY = frozenset({Status.NO_IK, Status.NO_PATH, Status.EFFECT_NOT_REACHED, Status.INVALID})
+
+
+class ParameterChoice:
+    """The motion level the geometric agents share: the best-ranked candidate that passes a
+    dry run (at most `MAX_CHECKS` are checked) and has not failed for good this episode."""
+
+    def __init__(self) -> None:
+        self.failed: set[PrimitiveParams] = set()
+
+    def reset(self) -> None:
+        self.failed = set()
+
+    def choose(
+        self,
+        sg: GeometricSceneGraph,
+        action: Action,
+        following: Action | None,
+        feasible: Callable[[PrimitiveParams], bool] | None,
+    ) -> PrimitiveParams | None:
+        options = [c for c in candidates(sg, action, following) if c not in self.failed]
+        return next(
+            (c for c in options[:MAX_CHECKS] if feasible is None or feasible(c)),
+            options[0] if options else None,
+        )
+
+    def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
+        if outcome.status in DO_NOT_RETRY:
+            self.failed.add(params)

@@ -11,8 +11,7 @@ import time
 from pathlib import Path
 
 from hsgplan.agents.base import Decision, Feasibility
-from hsgplan.agents.geometric_sampler import candidates
-from hsgplan.agents.oracle import _DO_NOT_RETRY, MAX_CHECKS
+from hsgplan.agents.geometric_sampler import ParameterChoice
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.transition import Action, Place, Push
@@ -34,11 +33,11 @@ class RegressionAgent:
     def __init__(self, checkpoint: Path = TASK_CHECKPOINT) -> None:
         self.checkpoint = checkpoint
         self.planner = RegressionPlanner(checkpoint)  # a bad checkpoint fails here
-        self.failed: set[PrimitiveParams] = set()
+        self.params = ParameterChoice()
 
     def reset(self, goal: Goal, seed: int) -> None:
         self.planner = RegressionPlanner(self.checkpoint, seed=seed)
-        self.failed = set()
+        self.params.reset()
 
     def decide(
         self,
@@ -52,19 +51,12 @@ class RegressionAgent:
         t1 = time.perf_counter()
         if task.action is None:
             return Decision(None, None, t1 - t0, 0.0, task.note)
-        options = [
-            c for c in candidates(sg, task.action, _push_after(task.action)) if c not in self.failed
-        ]
-        params = next(
-            (c for c in options[:MAX_CHECKS] if feasible is None or feasible(c)),
-            options[0] if options else None,
-        )
+        params = self.params.choose(sg, task.action, _push_after(task.action), feasible)
         note = "" if params else f"every parameter choice for {task.action} failed"
         return Decision(task.action, params, t1 - t0, time.perf_counter() - t1, note)
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
-        if outcome.status in _DO_NOT_RETRY:
-            self.failed.add(params)
+        self.params.observe(params, outcome)
 
 
 def _push_after(action: Action) -> Push | None:

@@ -12,18 +12,13 @@ from __future__ import annotations
 import time
 
 from hsgplan.agents.base import Decision, Feasibility
-from hsgplan.agents.geometric_sampler import candidates
+from hsgplan.agents.geometric_sampler import ParameterChoice
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError, Plan
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.sim.outcome import Outcome, Status
-
-# Candidates dry-run per decision before the best-ranked one is tried regardless.
-MAX_CHECKS = 30
-# Failures that say these parameters will not work here; anything else may be tried again.
-_DO_NOT_RETRY = {Status.NO_IK, Status.NO_PATH, Status.EFFECT_NOT_REACHED, Status.INVALID}
+from hsgplan.sim.outcome import Outcome
 
 
 class OracleAgent:
@@ -31,11 +26,11 @@ class OracleAgent:
 
     def __init__(self, planner: FastDownwardPlanner | None = None) -> None:
         self.planner = planner or FastDownwardPlanner()
-        self.failed: set[PrimitiveParams] = set()
+        self.params = ParameterChoice()
         self.plan: Plan | None = None
 
     def reset(self, goal: Goal, seed: int) -> None:
-        self.failed = set()
+        self.params.reset()
         self.plan = None
 
     def decide(
@@ -56,11 +51,7 @@ class OracleAgent:
         if not plan.actions:
             return Decision(None, None, t1 - t0, 0.0, "the goal holds")
         following = plan.actions[1] if len(plan.actions) > 1 else None
-        options = [c for c in candidates(sg, plan.actions[0], following) if c not in self.failed]
-        params = next(
-            (c for c in options[:MAX_CHECKS] if feasible is None or feasible(c)),
-            options[0] if options else None,
-        )
+        params = self.params.choose(sg, plan.actions[0], following, feasible)
         note = "" if params else f"every parameter choice for {plan.actions[0]} failed"
         return Decision(plan.actions[0], params, t1 - t0, time.perf_counter() - t1, note)
 
@@ -72,5 +63,4 @@ class OracleAgent:
         return Plan(self.plan.actions[i:], self.plan.states[i:], 0.0, self.plan.planner)
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
-        if outcome.status in _DO_NOT_RETRY:
-            self.failed.add(params)
+        self.params.observe(params, outcome)
