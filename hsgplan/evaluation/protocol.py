@@ -22,9 +22,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.generator import random_goals
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.evaluation.episode import EpisodeRecord
-
-RESULTS = "episodes.jsonl"
-CONFIG = "config.json"
+from hsgplan.evaluation.run_folder import RESULTS, claim, logged_rows
 
 
 @dataclass(frozen=True)
@@ -103,23 +101,17 @@ def run_spec(agent_name: str, spec: EpisodeSpec) -> dict:
 
 def load_done(run_dir: Path, config: EvalConfig) -> dict[tuple, EpisodeRecord]:
     """Records already in the run folder; refuses a folder made by a different configuration."""
-    cfg_path = run_dir / CONFIG
-    if cfg_path.exists():
-        try:
-            saved = json.loads(cfg_path.read_text())
-        except json.JSONDecodeError:
-            raise InvalidInputError(f"'{cfg_path}' is not valid JSON") from None
-        if saved != asdict(config) | {"sizes": list(config.sizes)}:
-            raise InvalidInputError(f"'{run_dir}' holds a run with another configuration")
+    claim(
+        run_dir,
+        asdict(config) | {"sizes": list(config.sizes)},
+        f"'{run_dir}' holds a run with another configuration",
+    )
     done = {}
-    results = run_dir / RESULTS
-    if results.exists():
-        for line in results.read_text().splitlines():
-            try:
-                row = json.loads(line)
-                done[EpisodeSpec(**row["spec"]).key] = EpisodeRecord.from_json(row["record"])
-            except (json.JSONDecodeError, KeyError, TypeError):
-                continue  # a line cut short by an interruption: that episode runs again
+    for row in logged_rows(run_dir):
+        try:
+            done[EpisodeSpec(**row["spec"]).key] = EpisodeRecord.from_json(row["record"])
+        except (KeyError, TypeError):
+            continue  # not a row this run wrote: that episode runs again
     return done
 
 
@@ -131,14 +123,8 @@ def run_evaluation(
 ) -> list[EpisodeRecord]:
     """Run every episode not yet in `run_dir`, `workers` at a time; all records, in order."""
     specs = episode_specs(config)
-    run_dir.mkdir(parents=True, exist_ok=True)
     done = load_done(run_dir, config)
-    (run_dir / CONFIG).write_text(json.dumps(asdict(config) | {"sizes": list(config.sizes)}))
     todo = [s for s in specs if s.key not in done]
-    results = run_dir / RESULTS
-    if results.exists() and results.stat().st_size and not results.read_bytes().endswith(b"\n"):
-        with open(results, "a") as log:  # an interrupted write: end its line before appending
-            log.write("\n")
     for s in specs:
         if s.key in done and on_episode:
             on_episode(done[s.key])

@@ -24,11 +24,10 @@ from hsgplan.domain.generator import random_goals, random_state
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.domain.transition import apply, why_not
 from hsgplan.evaluation.protocol import episode_seed
+from hsgplan.evaluation.run_folder import RESULTS, claim, logged_rows
 
 MAX_STEPS = 50
 PLANNERS = ("regression", "forward", "fd")
-RESULTS = "episodes.jsonl"
-CONFIG = "config.json"
 
 
 @dataclass(frozen=True)
@@ -152,29 +151,15 @@ def evaluate_task(
 
 def _load_done(run_dir: Path, planner: str, checkpoint: Path) -> dict[tuple, TaskEpisode]:
     """Episodes a run folder already holds; refuses one made by another planner."""
-    run_dir.mkdir(parents=True, exist_ok=True)
     config = {"planner": planner, "checkpoint": str(checkpoint)}
-    saved = run_dir / CONFIG
-    if saved.exists():
-        try:
-            if json.loads(saved.read_text()) != config:
-                raise InvalidInputError(f"'{run_dir}' holds a run of another planner")
-        except json.JSONDecodeError:
-            raise InvalidInputError(f"'{saved}' is not valid JSON") from None
-    saved.write_text(json.dumps(config) + "\n")
+    claim(run_dir, config, f"'{run_dir}' holds a run of another planner")
     done = {}
-    results = run_dir / RESULTS
-    if results.exists():
-        text = results.read_text()
-        if text and not text.endswith("\n"):
-            results.write_text(text + "\n")  # an interrupted write: its episode runs again
-        for line in text.splitlines():
-            try:
-                row = json.loads(line)
-                e = TaskEpisode(**{**row, "decision_ms": tuple(row["decision_ms"])})
-            except (json.JSONDecodeError, TypeError):
-                continue
-            done[(e.goal, e.seed)] = e
+    for row in logged_rows(run_dir):
+        try:
+            e = TaskEpisode(**{**row, "decision_ms": tuple(row["decision_ms"])})
+        except (KeyError, TypeError):
+            continue
+        done[(e.goal, e.seed)] = e
     return done
 
 
