@@ -190,3 +190,14 @@ def test_eval_task_runs_a_trained_checkpoint_in_worker_processes(tmp_path):
     assert r.exit_code == 0, r.output
     entry = json.loads(r.stdout)["by_size"]["2"]
     assert entry["episodes"] == 2 and 0.0 <= entry["success_rate"] <= 1.0
+
+
+def test_bad_training_settings_are_one_line_with_exit_code_2(tmp_path):
+    for bad in ({"copies": -1}, {"epochs": 0}, {"reach_copies": 99}, {"hidden": "wide"}):
+        path = tmp_path / "config.json"
+        path.write_text(json.dumps(bad))
+        r = CliRunner().invoke(
+            app, ["train", "task", "--config", str(path), "--out", str(tmp_path)]
+        )
+        assert r.exit_code == 2, (bad, r.output)
+        assert len(r.stderr.strip().splitlines()) == 1 and next(iter(bad)) in r.stderr
