@@ -24,7 +24,6 @@ from hsgplan.domain.parameters import (
 )
 from hsgplan.domain.transition import Action, Pick, Place, Push
 from hsgplan.domain.world import (
-    INTERIOR_CAPACITY,
     PLACE_BINS,
     PLACE_LONG_AXIS_YAW,
     SHELVES,
@@ -32,6 +31,7 @@ from hsgplan.domain.world import (
     SURFACES,
     Kind,
     Rect,
+    interior_slots,
     spot_cells,
     surface_rect,
 )
@@ -79,13 +79,6 @@ def _standing(name: str, x: float, y: float, yaw: float, bottom: float):
     t = object_type(name)
     box_yaw = yaw if t.kind is Kind.BOX else None
     return (x, y, *_half_extents(name, yaw), bottom + t.height, box_yaw)
-
-
-def interior_slots(shelf: str) -> list[float]:
-    """y of each spot in a shelf's interior row, evenly spread across its width."""
-    r = SHELVES[shelf].interior
-    n = INTERIOR_CAPACITY[shelf]
-    return [r.y_min + r.width_y * (k + 0.5) / n for k in range(n)]
 
 
 def free_slots(sg: GeometricSceneGraph, shelf: str, ignore: str = "") -> list[float]:

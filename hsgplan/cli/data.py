@@ -31,3 +31,48 @@ def demos(
         progress.update(task, completed=len(TASKS))
     steps = sum(len(d.actions) for d in done)
     out.print(f"{len(done)} demonstrations, {steps} transitions, in {out_dir}")
+
+
+@app.command("place")
+@refuses_bad_input
+def place(
+    samples: Annotated[int, typer.Option(help="Successful trials to collect.")] = 14573,
+    workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
+    seed: Annotated[int, typer.Option(help="Seed of the scene and parameter stream.")] = 0,
+    ray: Annotated[
+        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
+    ] = None,
+    out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = Path("data/motion"),
+) -> None:
+    """Self-supervised place data: uniformly sampled bins tried in generated scenes."""
+    _collect("place", samples, workers, seed, ray, out_dir)
+
+
+@app.command("push")
+@refuses_bad_input
+def push(
+    samples: Annotated[int, typer.Option(help="Successful trials to collect.")] = 8000,
+    workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
+    seed: Annotated[int, typer.Option(help="Seed of the scene and parameter stream.")] = 0,
+    ray: Annotated[
+        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
+    ] = None,
+    out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = Path("data/motion"),
+) -> None:
+    """Self-supervised push data: uniformly sampled bins tried in generated scenes."""
+    _collect("push", samples, workers, seed, ray, out_dir)
+
+
+def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir: Path) -> None:
+    from hsgplan.data.motion_collect import CollectConfig, collect
+    from hsgplan.data.motion_tasks import MotionPrimitive
+
+    config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray)
+    with Progress(console=err, transient=True) as progress:
+        bar = progress.add_task(f"{primitive} samples", total=samples)
+        summary = collect(config, out_dir, lambda n: progress.update(bar, completed=n))
+    out.print(
+        f"{summary.samples} {primitive} samples from {summary.trials} trials "
+        f"({summary.samples / max(1, summary.trials):.0%} successful; {summary.chunks_run} "
+        f"chunks run now, {summary.unstaged} scenes not staged) in {summary.dataset}"
+    )

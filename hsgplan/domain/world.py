@@ -190,6 +190,13 @@ INTERIOR_CAPACITY: dict[str, int] = {
 }
 
 
+def interior_slots(shelf: str) -> list[float]:
+    """y of each spot in a shelf's interior row, evenly spread across its width."""
+    r = SHELVES[shelf].interior
+    n = INTERIOR_CAPACITY[shelf]
+    return [r.y_min + r.width_y * (k + 0.5) / n for k in range(n)]
+
+
 def max_tower_levels() -> int:
     """How many objects one tower may hold so that any tower stays within reach on any surface.
 

@@ -73,8 +73,11 @@ class Panda:
         for j, v in zip(ARM, q, strict=True):
             self.bc.resetJointState(self.body, j, float(v))
         if self.held_body is not None:
-            pose = self.tcp().compose(self.held_offset)
-            self.bc.resetBasePositionAndOrientation(self.held_body, pose.position, pose.orientation)
+            # PyBullet's own transform product: collision checks call this thousands of times.
+            s = self.bc.getLinkState(self.body, TCP, computeForwardKinematics=True)
+            off = self.held_offset
+            pos, orn = self.bc.multiplyTransforms(s[4], s[5], off.position, off.orientation)
+            self.bc.resetBasePositionAndOrientation(self.held_body, pos, orn)
 
     def set_fingers(self, opening: float) -> None:
         for j in FINGERS:

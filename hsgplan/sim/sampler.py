@@ -17,6 +17,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.generator import random_state
 from hsgplan.domain.objects import EntityKind, kind_of, object_type
 from hsgplan.domain.parameters import PickParams, place_inset
+from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import Kind, spot_cells, surface_rect
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -46,7 +47,7 @@ def sample_scene(
         state = random_state(objects, rng, p_elsewhere=p_elsewhere)
         for o in objects:
             scene.park(o)
-        if _place_all(scene, state, rng) and _settled_as(scene, state):
+        if place_all(scene, state, rng) and _settled_as(scene, state):
             scene.robot.hold_position()
             return scene, state
     scene.close()
@@ -56,15 +57,21 @@ def sample_scene(
     )
 
 
-def _place_all(scene: Scene, state: SymbolicSceneGraph, rng: random.Random) -> bool:
-    placed: list[str] = []
+def place_all(
+    scene: Scene, state: SymbolicSceneGraph, rng: random.Random, placed: list[str] | None = None
+) -> bool:
+    """Pose every object the state puts `On` something (others are left where they are),
+    clear of the objects in `placed`, which grows as objects are posed."""
+    placed = [] if placed is None else placed
     # Supports before what stands on them: by tower level.
     for obj in sorted(state.objects, key=state.level):
+        if state.location(obj).predicate is not Predicate.ON:
+            continue
         below = state.location(obj).args[1]
         if kind_of(below) is EntityKind.OBJECT:
             pose = _stacked_pose(scene, obj, below, rng)
         else:
-            pose = _free_spot(scene, obj, below, placed, rng)
+            pose = free_spot(scene, obj, below, placed, rng)
             if pose is None:
                 return False
         scene.set_pose(obj, pose)
@@ -85,7 +92,7 @@ def _stacked_pose(scene: Scene, obj: str, base: str, rng: random.Random) -> Pose
     )
 
 
-def _free_spot(
+def free_spot(
     scene: Scene, obj: str, surface: str, placed: list[str], rng: random.Random
 ) -> Pose | None:
     """A random free spot cell of the surface, the object jittered and turned within it.
@@ -112,12 +119,12 @@ def _free_spot(
             scene.set_pose(obj, pose)
             if not any(
                 scene.bc.getClosestPoints(scene.bodies[obj], scene.bodies[o], GAP) for o in placed
-            ) and not _touches_arena(scene, obj):
+            ) and not touches_arena(scene, obj):
                 return pose
     return None
 
 
-def _touches_arena(scene: Scene, obj: str) -> bool:
+def touches_arena(scene: Scene, obj: str) -> bool:
     body = scene.bodies[obj]
     return any(
         # Objects are set 1 mm above their support, so the board they stand on is no hit.

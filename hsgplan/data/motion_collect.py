@@ -1,0 +1,206 @@
+"""Self-supervised motion data collection: chunks of trials run by a local process pool or by
+Ray, saved as they finish, packed into a dataset of the first N successful trials.
+
+A work folder holds the configuration and one file per finished chunk. A run started again
+with the same folder reads which chunks are done and runs only the others, so an interruption
+loses at most the chunks that were in flight and repeats nothing that was saved. The dataset is
+the successful trials in (task, attempt) order, cut at N: it is the same whichever engine ran
+the chunks, in whatever order they finished, and however often the run was interrupted.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from collections.abc import Callable, Iterator
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hsgplan.data import motion_store as store
+from hsgplan.data.motion_tasks import MotionPrimitive
+from hsgplan.data.motion_trials import ATTEMPTS_PER_TASK, TASKS_PER_CHUNK, run_chunk
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.evaluation.run_folder import claim
+
+WORK = "work"
+
+
+@dataclass(frozen=True)
+class CollectConfig:
+    primitive: MotionPrimitive
+    samples: int
+    seed: int = 0
+    workers: int = 2
+    ray_address: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.samples < 0:
+            raise InvalidInputError(f"--samples {self.samples}: cannot be negative")
+        if self.workers < 1:
+            raise InvalidInputError(f"--workers {self.workers}: at least one is needed")
+
+
+@dataclass(frozen=True)
+class CollectSummary:
+    samples: int  # successful trials in the dataset
+    trials: int  # trials run in the chunks the dataset draws on
+    chunks_run: int  # chunks this call ran (the rest were on disk)
+    unstaged: int
+    dataset: Path
+
+
+def work_folder(out: Path, primitive: MotionPrimitive, seed: int) -> Path:
+    return out / WORK / f"{primitive.value}-seed{seed}"
+
+
+class LocalEngine:
+    """A process pool (spawned: children forked from a process with torch loaded hang)."""
+
+    def __init__(self, workers: int) -> None:
+        context = multiprocessing.get_context("spawn")
+        self.pool = ProcessPoolExecutor(workers, mp_context=context)
+
+    def submit(self, fn: Callable, *args):
+        return self.pool.submit(fn, *args)
+
+    def next_done(self, handles: set) -> tuple[object, object]:
+        done, _ = wait(handles, return_when=FIRST_COMPLETED)
+        handle = next(iter(done))
+        return handle, handle.result()
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=False, cancel_futures=True)
+
+
+class RayEngine:
+    """The same work on a Ray cluster: `address` as `ray.init` takes it ("auto", "ray://...",
+    or "local" to start a private instance on this machine)."""
+
+    def __init__(self, address: str, workers: int) -> None:
+        try:
+            import ray
+        except ImportError:
+            raise InvalidInputError(
+                "--ray needs Ray: pip install 'hsgplan[ray]' (or pip install ray)"
+            ) from None
+        self.ray = ray
+        if address == "local":
+            ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
+        else:
+            ray.init(address=address, log_to_driver=False)
+        self.remote = {}
+
+    def submit(self, fn: Callable, *args):
+        if fn not in self.remote:
+            self.remote[fn] = self.ray.remote(fn)
+        return self.remote[fn].remote(*args)
+
+    def next_done(self, handles: set) -> tuple[object, object]:
+        ready, _ = self.ray.wait(list(handles), num_returns=1)
+        return ready[0], self.ray.get(ready[0])
+
+    def close(self) -> None:
+        self.ray.shutdown()
+
+
+@contextmanager
+def engine(config: CollectConfig) -> Iterator[LocalEngine | RayEngine]:
+    runner = (
+        RayEngine(config.ray_address, config.workers)
+        if config.ray_address
+        else LocalEngine(config.workers)
+    )
+    try:
+        yield runner
+    finally:
+        runner.close()
+
+
+def _done_chunks(folder: Path) -> dict[int, int]:
+    """Successful trials in each chunk on disk; a damaged chunk file is removed (it runs again)."""
+    done = {}
+    for path in sorted(folder.glob("chunk-*.npz")):
+        try:
+            done[int(path.stem.split("-")[1])] = int(store.load(path).ok.sum())
+        except InvalidInputError:
+            path.unlink()
+    return done
+
+
+def _prefix_done(done: dict[int, int], samples: int) -> int | None:
+    """How many chunks from the first hold `samples` successes, if the ones on disk do."""
+    total, k = 0, 0
+    while total < samples:
+        if k not in done:
+            return None
+        total += done[k]
+        k += 1
+    return k
+
+
+def collect(
+    config: CollectConfig, out: Path, progress: Callable[[int], None] | None = None
+) -> CollectSummary:
+    """Run chunks until the first chunks hold `samples` successes, then write the dataset.
+
+    `progress` is told the number of successes on disk after every finished chunk.
+    """
+    folder = work_folder(out, config.primitive, config.seed)
+    claim(
+        folder,
+        {
+            "primitive": config.primitive.value,
+            "seed": config.seed,
+            "tasks_per_chunk": TASKS_PER_CHUNK,
+            "attempts_per_task": ATTEMPTS_PER_TASK,
+            "schema_version": store.SCHEMA_VERSION,
+        },
+        f"'{folder}' holds chunks made with other collection settings; use another --out",
+    )
+    done = _done_chunks(folder)
+    ran = 0
+    if progress:
+        progress(sum(done.values()))
+    if _prefix_done(done, config.samples) is None:
+        with engine(config) as runner:
+            ran = _run(runner, config, folder, done, progress)
+    return _pack(config, out, folder, done, ran)
+
+
+def _run(runner, config: CollectConfig, folder: Path, done: dict[int, int], progress) -> int:
+    in_flight: dict[object, int] = {}
+    window = 2 * config.workers
+    ran = 0
+    while _prefix_done(done, config.samples) is None:
+        per_chunk = max(1.0, sum(done.values()) / max(1, len(done)))
+        expected = sum(done.values()) + per_chunk * len(in_flight)
+        nxt = 0
+        while len(in_flight) < window and (expected < config.samples or not in_flight):
+            while nxt in done or nxt in in_flight.values():
+                nxt += 1
+            in_flight[runner.submit(run_chunk, config.primitive.value, config.seed, nxt)] = nxt
+            expected += per_chunk
+        handle, result = runner.next_done(set(in_flight))
+        del in_flight[handle]
+        store.save_chunk(folder, result)
+        done[result.chunk] = sum(t.ok for t in result.trials)
+        ran += 1
+        if progress:
+            progress(sum(done.values()))
+    return ran
+
+
+def _pack(config: CollectConfig, out: Path, folder: Path, done, ran: int) -> CollectSummary:
+    n_chunks = _prefix_done(done, config.samples) or 0
+    parts = [store.load(store.chunk_path(folder, k)) for k in range(n_chunks)]
+    unstaged = sum(store.unstaged_of(store.chunk_path(folder, k)) for k in range(n_chunks))
+    trials = store.concat(config.primitive, parts)
+    order = np.lexsort((trials.attempt, trials.task))
+    ok = order[trials.ok[order]][: config.samples]
+    dataset = out / f"{config.primitive.value}.npz"
+    store.save(dataset, trials.take(ok))
+    store.write_schema(out)
+    return CollectSummary(len(ok), len(trials), ran, unstaged, dataset)

@@ -1,0 +1,160 @@
+"""Procedurally generated situations for self-supervised motion data, as CAVIN collects it.
+
+A `MotionTask` is one situation drawn from `(primitive, seed, index)` alone, symbolically: which
+objects are in the scene, which one is to be placed (already held) or pushed, onto which surface
+or into which shelf, and where every other object rests. The physical scene is staged from it
+by `hsgplan.sim.staging`; the collector then tries uniformly sampled parameter bins in it.
+
+The draws, for `n` objects (2-6 distinct types, as in the simulated evaluation):
+- place: the held object and its target surface are uniform; `crowding` other objects (uniform
+  in 0..capacity-1, as many as there are) rest on the target, towers on them allowed, so that
+  crowded shelf tops and regions are common; the rest go anywhere else there is room.
+- push: the pushed object is a can on shelf A's prepush region (the only pushes the task
+  domain makes); `crowding` other cans (uniform in 0..interior capacity-1) are already inside
+  shelf A; the rest go anywhere there is room, the prepush region's other cell included.
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass
+from enum import StrEnum
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.objects import object_type, objects_for_types
+from hsgplan.domain.predicates import Literal, in_grasp, inside, on
+from hsgplan.domain.world import (
+    INTERIOR_CAPACITY,
+    MAX_TOWER_LEVELS,
+    OBJECT_TYPES,
+    SHELVES,
+    SURFACE_CAPACITY,
+    SURFACES,
+    Kind,
+    can_support,
+    fits_inside,
+)
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+MIN_OBJECTS, MAX_SCENE_OBJECTS = 2, len(OBJECT_TYPES)
+PUSH_SHELF = "shelf_a"
+P_STACK = 0.25  # chance that an object left to place goes on top of a bare one
+
+
+class MotionPrimitive(StrEnum):
+    PLACE = "place"
+    PUSH = "push"
+
+
+@dataclass(frozen=True)
+class MotionTask:
+    """One situation to try a primitive in.
+
+    Attributes:
+        primitive: place or push.
+        seed, index: what it was drawn from (the same pair always gives the same task).
+        obj: the object to place (held in `state`) or to push (on the prepush region).
+        target: the surface to place on, or the shelf to push into.
+        crowding: how many other objects rest on the target surface or are inside the shelf.
+        state: the symbolic arrangement the scene is staged in.
+    """
+
+    primitive: MotionPrimitive
+    seed: int
+    index: int
+    obj: str
+    target: str
+    crowding: int
+    state: SymbolicSceneGraph
+
+    @property
+    def subgoal(self) -> Literal:
+        """The literal the primitive is meant to make true (the subgoal ĝ it serves)."""
+        if self.primitive is MotionPrimitive.PLACE:
+            return on(self.obj, self.target)
+        return inside(self.obj, self.target)
+
+
+def draw_task(primitive: MotionPrimitive, seed: int, index: int) -> MotionTask:
+    """The task at `index` of the stream for `(primitive, seed)`."""
+    if index < 0:
+        raise InvalidInputError(f"task index {index} cannot be negative")
+    rng = random.Random(f"motion-{primitive.value}-{seed}-{index}")
+    if primitive is MotionPrimitive.PLACE:
+        return _draw_place(rng, seed, index)
+    return _draw_push(rng, seed, index)
+
+
+def _draw_place(rng: random.Random, seed: int, index: int) -> MotionTask:
+    objects = _objects(rng)
+    obj = rng.choice(objects)
+    target = rng.choice(SURFACES)
+    others = [o for o in objects if o != obj]
+    crowding = rng.randint(0, min(SURFACE_CAPACITY[target] - 1, len(others)))
+    rng.shuffle(others)
+    literals = [in_grasp(obj)]
+    literals += _arrange(others[:crowding], others[crowding:], target, rng, keep_off=target)
+    state = SymbolicSceneGraph.from_literals(objects, literals)
+    return MotionTask(MotionPrimitive.PLACE, seed, index, obj, target, crowding, state)
+
+
+def _draw_push(rng: random.Random, seed: int, index: int) -> MotionTask:
+    cans = [t for t, k in OBJECT_TYPES.items() if k.kind is Kind.CAN and fits_inside(t, PUSH_SHELF)]
+    obj = rng.choice(cans)
+    rest = [t for t in OBJECT_TYPES if t != obj]
+    chosen = [obj] + rng.sample(rest, rng.randint(MIN_OBJECTS, MAX_SCENE_OBJECTS) - 1)
+    objects = objects_for_types(chosen)
+    others = [o for o in objects if o != obj]
+    rng.shuffle(others)
+    fitting = [o for o in others if object_type(o).name in cans]
+    crowding = rng.randint(0, min(INTERIOR_CAPACITY[PUSH_SHELF] - 1, len(fitting)))
+    inside_now = fitting[:crowding]
+    prepush = SHELVES[PUSH_SHELF].prepush
+    literals = [on(obj, prepush)] + [inside(o, PUSH_SHELF) for o in inside_now]
+    left = [o for o in others if o not in inside_now]
+    literals += _arrange([], left, prepush, rng, taken={prepush: 1})
+    state = SymbolicSceneGraph.from_literals(objects, literals)
+    return MotionTask(MotionPrimitive.PUSH, seed, index, obj, PUSH_SHELF, crowding, state)
+
+
+def _objects(rng: random.Random) -> list[str]:
+    n = rng.randint(MIN_OBJECTS, MAX_SCENE_OBJECTS)
+    return list(objects_for_types(rng.sample(list(OBJECT_TYPES), n)))
+
+
+def _arrange(
+    on_target: list[str],
+    elsewhere: list[str],
+    target: str,
+    rng: random.Random,
+    keep_off: str | None = None,
+    taken: dict[str, int] | None = None,
+) -> list[Literal]:
+    """On-literals for objects: `on_target` on the target surface, then `elsewhere` on any
+    other surface with room or (with `P_STACK`) on a bare object, towers within their limit."""
+    room = {s: SURFACE_CAPACITY[s] - (taken or {}).get(s, 0) for s in SURFACES}
+    level: dict[str, int] = {}
+    bare: list[str] = []
+    literals = []
+
+    def put(o: str, where: str) -> None:
+        literals.append(on(o, where))
+        if where in room:
+            room[where] -= 1
+            level[o] = 1
+        else:
+            bare.remove(where)
+            level[o] = level[where] + 1
+        if can_support(object_type(o).name):
+            bare.append(o)
+
+    for o in on_target:
+        put(o, target)
+    for o in elsewhere:
+        bases = [b for b in bare if level[b] < MAX_TOWER_LEVELS]
+        if bases and rng.random() < P_STACK:
+            put(o, rng.choice(bases))
+            continue
+        surfaces = [s for s in SURFACES if room[s] > 0 and s != keep_off]
+        put(o, rng.choice(surfaces))
+    return literals

@@ -1,0 +1,127 @@
+"""Trying uniformly sampled motion parameters in staged scenes: the unit of work of the
+self-supervised collection.
+
+Work comes in chunks of `TASKS_PER_CHUNK` consecutive tasks. A chunk runs in a fresh scene
+(its own physics client), so its trials depend on `(primitive, seed, chunk)` alone, never on
+which process or machine ran it or what that process ran before. In each staged task the
+collector saves the physics state and tries `ATTEMPTS_PER_TASK` parameter choices, drawn
+uniformly over the bins, each from that same state. A trial is a training sample when the
+primitive's intended literal holds afterwards and nothing else was knocked out of place
+(`hsgplan.sim.outcome.verify`).
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass
+
+import numpy as np
+
+from hsgplan.data.motion_tasks import MotionPrimitive, MotionTask, draw_task
+from hsgplan.domain.parameters import PlaceParams, PushParams
+from hsgplan.domain.world import PLACE_BINS, PUSH_ANGLE_BINS, PUSH_DIST_BINS
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.sim.outcome import Status
+from hsgplan.sim.primitives import execute
+from hsgplan.sim.scene import Scene
+from hsgplan.sim.staging import stage
+
+TASKS_PER_CHUNK = 32
+ATTEMPTS_PER_TASK = 4
+
+BINS: dict[MotionPrimitive, tuple[int, int]] = {
+    MotionPrimitive.PLACE: (PLACE_BINS, PLACE_BINS),
+    MotionPrimitive.PUSH: (PUSH_ANGLE_BINS, PUSH_DIST_BINS),
+}
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One parameter choice tried in one staged task, and what came of it.
+
+    Attributes:
+        task, attempt: which task of the stream, which try within it.
+        crowding: the task's crowding (objects already on the target surface or in the shelf).
+        obj, target: the object placed or pushed, the surface or shelf it goes to.
+        before: the geometric scene graph the primitive started from.
+        bins: (x_bin, y_bin) for place, (angle_bin, dist_bin) for push.
+        status: the primitive's outcome; `Status.SUCCESS` makes the trial a training sample.
+    """
+
+    task: int
+    attempt: int
+    crowding: int
+    obj: str
+    target: str
+    before: GeometricSceneGraph
+    bins: tuple[int, int]
+    status: Status
+
+    @property
+    def ok(self) -> bool:
+        return self.status is Status.SUCCESS
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    primitive: MotionPrimitive
+    seed: int
+    chunk: int
+    trials: tuple[Trial, ...]
+    unstaged: int  # tasks whose scene could not be staged (no trials)
+
+
+def params_for(primitive: MotionPrimitive, obj: str, target: str, bins: tuple[int, int]):
+    """The primitive's parameters for a pair of bins."""
+    if primitive is MotionPrimitive.PLACE:
+        return PlaceParams(obj, target, *bins)
+    return PushParams(obj, *bins)
+
+
+def chunk_tasks(chunk: int) -> range:
+    return range(chunk * TASKS_PER_CHUNK, (chunk + 1) * TASKS_PER_CHUNK)
+
+
+def run_chunk(primitive: str, seed: int, chunk: int) -> ChunkResult:
+    """Stage every task of a chunk and try it; the worker entry point (pool or Ray)."""
+    kind = MotionPrimitive(primitive)
+    trials: list[Trial] = []
+    unstaged = 0
+    with Scene((), seed=seed) as scene:
+        for index in chunk_tasks(chunk):
+            got = run_task(scene, draw_task(kind, seed, index))
+            unstaged += got is None
+            trials += got or []
+    return ChunkResult(kind, seed, chunk, tuple(trials), unstaged)
+
+
+def run_task(scene: Scene, task: MotionTask) -> list[Trial] | None:
+    """Stage a task in the scene (replacing whatever objects it held) and try it; None when
+    the arrangement could not be staged."""
+    for o in scene.objects:
+        scene.remove_object(o)
+    for o in task.state.objects:
+        scene.add_object(o)
+    rng = random.Random(f"trials-{task.primitive.value}-{task.seed}-{task.index}")
+    scene.rng = np.random.default_rng(rng.getrandbits(64))
+    if not stage(scene, task.state, rng):
+        return None
+    snapshot, held = scene.snapshot(), scene.robot.held_body
+    before = scene.scene_graph()
+    trials = []
+    for attempt in range(ATTEMPTS_PER_TASK):
+        scene.restore(snapshot)
+        if held is not None:  # constraints are not part of a saved state
+            scene.robot.detach()
+            scene.robot.attach(held)
+        nx, ny = BINS[task.primitive]
+        bins = (rng.randrange(nx), rng.randrange(ny))
+        outcome = execute(scene, params_for(task.primitive, task.obj, task.target, bins))
+        trials.append(
+            Trial(
+                task.index, attempt, task.crowding, task.obj, task.target, before, bins,
+                outcome.status,
+            )
+        )
+    scene.bc.removeState(snapshot)
+    return trials
