@@ -1,7 +1,7 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval), `data`
-(collect), `learn` (train, eval-task), `bench`.
+(collect), `learn` (train task, eval-task), `motion` (train motion, eval-motion), `bench`.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import sys
 
 import typer
 
-from hsgplan.cli import bench, data, learn, symbolic, world
+from hsgplan.cli import bench, data, learn, motion, symbolic, world
 
 app = typer.Typer(
     add_completion=False,
@@ -25,6 +25,8 @@ app.add_typer(bench.app, name="bench")
 app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
 app.command("eval-task")(learn.eval_task)
+learn.train_app.command("motion")(motion.train_motion)
+app.command("eval-motion")(motion.eval_motion)
 
 
 def main() -> None:

@@ -21,7 +21,7 @@ from hsgplan.data.motion_tasks import MotionPrimitive, MotionTask, draw_task
 from hsgplan.domain.parameters import PlaceParams, PushParams
 from hsgplan.domain.world import PLACE_BINS, PUSH_ANGLE_BINS, PUSH_DIST_BINS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.sim.outcome import Status
+from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.scene import Scene
 from hsgplan.sim.staging import stage
@@ -95,9 +95,20 @@ def run_chunk(primitive: str, seed: int, chunk: int) -> ChunkResult:
     return ChunkResult(kind, seed, chunk, tuple(trials), unstaged)
 
 
-def run_task(scene: Scene, task: MotionTask) -> list[Trial] | None:
-    """Stage a task in the scene (replacing whatever objects it held) and try it; None when
-    the arrangement could not be staged."""
+@dataclass(frozen=True)
+class StagedTask:
+    """A task staged in a scene, ready to be tried from the same state again and again."""
+
+    task: MotionTask
+    snapshot: int  # the physics state, saved
+    held: int | None  # the body in the gripper (constraints are not part of a saved state)
+    before: GeometricSceneGraph
+    rng: random.Random
+
+
+def stage_task(scene: Scene, task: MotionTask) -> StagedTask | None:
+    """Stage a task in the scene (replacing whatever objects it held); None when the
+    arrangement could not be staged. `release` the result when done with it."""
     for o in scene.objects:
         scene.remove_object(o)
     for o in task.state.objects:
@@ -106,22 +117,44 @@ def run_task(scene: Scene, task: MotionTask) -> list[Trial] | None:
     scene.rng = np.random.default_rng(rng.getrandbits(64))
     if not stage(scene, task.state, rng):
         return None
-    snapshot, held = scene.snapshot(), scene.robot.held_body
-    before = scene.scene_graph()
+    return StagedTask(task, scene.snapshot(), scene.robot.held_body, scene.scene_graph(), rng)
+
+
+def try_params(scene: Scene, staged: StagedTask, params) -> Outcome:
+    """Run one primitive from the staged state."""
+    scene.restore(staged.snapshot)
+    if staged.held is not None:
+        scene.robot.detach()
+        scene.robot.attach(staged.held)
+    return execute(scene, params)
+
+
+def release(scene: Scene, staged: StagedTask) -> None:
+    scene.bc.removeState(staged.snapshot)
+
+
+def run_task(scene: Scene, task: MotionTask) -> list[Trial] | None:
+    """Stage a task and try `ATTEMPTS_PER_TASK` uniformly drawn bin pairs in it; None when
+    the arrangement could not be staged."""
+    staged = stage_task(scene, task)
+    if staged is None:
+        return None
     trials = []
+    nx, ny = BINS[task.primitive]
     for attempt in range(ATTEMPTS_PER_TASK):
-        scene.restore(snapshot)
-        if held is not None:  # constraints are not part of a saved state
-            scene.robot.detach()
-            scene.robot.attach(held)
-        nx, ny = BINS[task.primitive]
-        bins = (rng.randrange(nx), rng.randrange(ny))
-        outcome = execute(scene, params_for(task.primitive, task.obj, task.target, bins))
+        bins = (staged.rng.randrange(nx), staged.rng.randrange(ny))
+        outcome = try_params(scene, staged, params_for(task.primitive, task.obj, task.target, bins))
         trials.append(
             Trial(
-                task.index, attempt, task.crowding, task.obj, task.target, before, bins,
+                task.index,
+                attempt,
+                task.crowding,
+                task.obj,
+                task.target,
+                staged.before,
+                bins,
                 outcome.status,
             )
         )
-    scene.bc.removeState(snapshot)
+    release(scene, staged)
     return trials

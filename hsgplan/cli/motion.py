@@ -1,0 +1,106 @@
+"""Commands of the motion level: `train motion`, `eval-motion`."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.progress import Progress
+
+from hsgplan.cli.common import err, out, print_table, refuses_bad_input
+from hsgplan.domain.errors import InvalidInputError
+
+CHECKPOINTS = Path("checkpoints/motion")
+
+
+@refuses_bad_input
+def train_motion(
+    primitive: Annotated[str, typer.Option(help="place or push.")] = "place",
+    model: Annotated[str, typer.Option(help="gnn or mlp.")] = "gnn",
+    config: Annotated[Path | None, typer.Option(help="Training configuration (JSON).")] = None,
+    out_dir: Annotated[
+        Path | None,
+        typer.Option(
+            "--out", help="Checkpoint folder (default: checkpoints/motion/PRIMITIVE-MODEL)."
+        ),
+    ] = None,
+    data: Annotated[
+        Path | None, typer.Option(help="Dataset folder (overrides the config).")
+    ] = None,
+) -> None:
+    """Train a motion network on the collected successful trials (cross-entropy over bins)."""
+    from hsgplan.motion.train import MotionTrainConfig
+    from hsgplan.motion.train import train_motion as run
+
+    settings = {}
+    if config is not None:
+        try:
+            settings = json.loads(config.read_text())
+        except FileNotFoundError:
+            raise InvalidInputError(f"--config '{config}' does not exist") from None
+        except json.JSONDecodeError:
+            raise InvalidInputError(f"--config '{config}' is not valid JSON") from None
+    settings |= {"primitive": primitive, "model": model}
+    if data is not None:
+        settings["data"] = str(data)
+    cfg = MotionTrainConfig.from_json(settings)
+    folder = out_dir or CHECKPOINTS / f"{primitive}-{model}"
+    with Progress(console=err, transient=True) as progress:
+        bar = progress.add_task(f"{primitive} {model}", total=cfg.epochs)
+
+        def on_epoch(epoch: int, loss: float) -> None:
+            progress.update(
+                bar, completed=epoch, description=f"{primitive} {model} loss {loss:.3f}"
+            )
+
+        run(cfg, folder, on_epoch)
+    out.print(f"trained the {model} {primitive} network into {folder}")
+
+
+@refuses_bad_input
+def eval_motion(
+    trials: Annotated[int, typer.Option(help="Fresh scenes per primitive.")] = 200,
+    seed: Annotated[int, typer.Option(help="Seed of the evaluation scenes.")] = 0,
+    primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
+    checkpoints: Annotated[Path, typer.Option(help="Folder of motion checkpoints.")] = CHECKPOINTS,
+    workers: Annotated[int, typer.Option(help="Processes.")] = 2,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """Single-shot success of the GNN, the MLP and Random on fresh random scenes (never the
+    training scenes), per primitive and crowding level; every model sees the same scenes."""
+    from hsgplan.evaluation.motion_eval import MODELS, evaluate_motion
+
+    kinds = [p.strip() for p in primitives.split(",") if p.strip()]
+    with Progress(console=err, transient=True) as progress:
+        bar = progress.add_task("scenes", total=trials * len(kinds))
+        report = evaluate_motion(
+            kinds, trials, seed, checkpoints, workers, lambda: progress.advance(bar)
+        )
+    if as_json:
+        print(json.dumps(report, indent=2))
+        return
+    rows = []
+    for kind, by_model in report.items():
+        levels = sorted({lvl for m in MODELS for lvl in by_model[m]["by_crowding"]})
+        for lvl in ["all", *levels]:
+            cells = []
+            for m in MODELS:
+                r = by_model[m] if lvl == "all" else by_model[m]["by_crowding"].get(lvl)
+                cells.append("—" if r is None else f"{r['success_rate']:.3f}")
+            n = (
+                by_model[MODELS[0]]["trials"]
+                if lvl == "all"
+                else by_model[MODELS[0]]["by_crowding"][lvl]["trials"]
+            )
+            rows.append((kind, lvl, str(n), *cells))
+    print_table(
+        f"Single-shot motion success on fresh scenes, seed {seed}",
+        ("primitive", "crowding", "scenes", *MODELS),
+        rows,
+        markdown,
+    )

@@ -1,0 +1,146 @@
+"""Training a motion network on the collected successes: `hsgplan train motion`.
+
+Cross-entropy over the joint bin pair of each successful trial, as the paper trains. The
+checkpoint is a folder: `train_config.json`, `config.json` (the network's), `model.safetensors`;
+`progress.pt` (loaded with weights_only) holds the last finished epoch while training runs, so
+that a run started again with the same configuration continues from there.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import torch
+from safetensors.torch import load_file, save_file
+from torch_geometric.data import Batch, Data
+
+from hsgplan.data.motion_store import MotionData, load
+from hsgplan.data.motion_tasks import MotionPrimitive
+from hsgplan.data.motion_trials import BINS
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.predicates import inside, on
+from hsgplan.motion.models import MotionNetConfig, build
+from hsgplan.scene_graph.grounding import ground
+
+
+@dataclass(frozen=True)
+class MotionTrainConfig:
+    primitive: str = "place"
+    model: str = "gnn"
+    data: str = "data/motion"
+    seed: int = 0
+    epochs: int = 40
+    lr: float = 1e-3
+    batch_size: int = 64
+    hidden: int = 256  # the paper's widths
+    embed: int = 32
+    rounds: int = 2
+    save_every: int = 5
+    samples: int | None = None  # the first this many samples of the dataset (None: all)
+
+    def __post_init__(self) -> None:
+        if self.primitive not in ("place", "push"):
+            raise InvalidInputError(f"primitive '{self.primitive}': place or push")
+        for name in ("epochs", "batch_size", "save_every"):
+            if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
+                raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
+        if self.samples is not None and self.samples < 1:
+            raise InvalidInputError(f"samples {self.samples!r}: need a positive integer or null")
+        self.net_config()  # refuses a bad model name or width
+
+    def net_config(self) -> MotionNetConfig:
+        bins = BINS[MotionPrimitive(self.primitive)]
+        return MotionNetConfig(
+            self.model, self.primitive, bins, self.hidden, self.embed, self.rounds
+        )
+
+    @staticmethod
+    def from_json(d: dict) -> MotionTrainConfig:
+        unknown = set(d) - set(MotionTrainConfig.__dataclass_fields__)
+        if unknown:
+            raise InvalidInputError(f"unknown training setting(s): {', '.join(sorted(unknown))}")
+        return MotionTrainConfig(**d)
+
+
+def grounded_examples(data: MotionData) -> list[Data]:
+    """Every row grounded for its subgoal, labelled with its flattened bin pair."""
+    ny = BINS[data.primitive][1]
+    subgoal = on if data.primitive is MotionPrimitive.PLACE else inside
+    out = []
+    for i in range(len(data)):
+        g = ground(data.scene_graph(i), subgoal(data.object_name(i), data.target_name(i)))
+        g.y = torch.tensor([int(data.bins[i, 0]) * ny + int(data.bins[i, 1])])
+        out.append(g)
+    return out
+
+
+def train_motion(
+    config: MotionTrainConfig,
+    out: Path,
+    on_epoch: Callable[[int, float], None] | None = None,
+) -> None:
+    """Train (or go on training) one motion network into the checkpoint folder `out`."""
+    out.mkdir(parents=True, exist_ok=True)
+    saved = out / "train_config.json"
+    if saved.exists() and json.loads(saved.read_text()) != asdict(config):
+        raise InvalidInputError(f"'{out}' holds a checkpoint trained with another configuration")
+    saved.write_text(json.dumps(asdict(config), indent=2) + "\n")
+    if (out / "model.safetensors").exists():
+        return  # finished earlier
+    data = load(Path(config.data) / f"{config.primitive}.npz")
+    data = data.take(data.ok)
+    if config.samples is not None:
+        data = data.take(slice(0, config.samples))
+    if len(data) == 0:
+        raise InvalidInputError(f"no successful {config.primitive} samples in '{config.data}'")
+    examples = grounded_examples(data)
+    torch.manual_seed(config.seed)
+    net_config = config.net_config()
+    model = build(net_config)
+    optim = torch.optim.Adam(model.parameters(), lr=config.lr)
+    start, progress = 0, out / "progress.pt"
+    if progress.exists():
+        state = torch.load(progress, weights_only=True)
+        model.load_state_dict(state["model"])
+        optim.load_state_dict(state["optim"])
+        start = int(state["epoch"])
+    for epoch in range(start, config.epochs):
+        order = list(range(len(examples)))
+        random.Random(f"{config.seed}-{epoch}").shuffle(order)
+        total = 0.0
+        for i in range(0, len(order), config.batch_size):
+            batch = Batch.from_data_list([examples[j] for j in order[i : i + config.batch_size]])
+            loss = torch.nn.functional.cross_entropy(model(batch), batch.y)
+            optim.zero_grad()
+            loss.backward()
+            optim.step()
+            total += loss.detach().item() * batch.num_graphs
+        if on_epoch:
+            on_epoch(epoch + 1, total / len(examples))
+        if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
+            tmp = out / "progress.tmp"
+            state = {"model": model.state_dict(), "optim": optim.state_dict(), "epoch": epoch + 1}
+            torch.save(state, tmp)
+            tmp.replace(progress)  # a crash mid-write leaves the last good progress
+    save_file(model.state_dict(), out / "model.safetensors")
+    (out / "config.json").write_text(json.dumps(net_config.to_json(), indent=2) + "\n")
+    progress.unlink(missing_ok=True)
+
+
+def load_motion_net(folder: Path) -> torch.nn.Module:
+    """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
+    try:
+        config = MotionNetConfig.from_json(json.loads((folder / "config.json").read_text()))
+        model = build(config)
+        model.load_state_dict(load_file(folder / "model.safetensors"))
+    except FileNotFoundError:
+        raise InvalidInputError(f"no trained motion network in '{folder}'") from None
+    except Exception as e:  # corrupted weights or config: one line, not a traceback
+        raise InvalidInputError(f"'{folder}' is not a usable checkpoint ({e})") from None
+    model.eval()
+    model.config = config
+    return model

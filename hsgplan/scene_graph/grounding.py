@@ -1,0 +1,136 @@
+"""Grounding f_g: the geometric scene graph re-expressed around the subgoal ĝ, as tensors.
+
+For place (`On(o, surface)`) each node is described relative to the target surface, for push
+(`In(o, shelf)`) relative to the pushed object and to the shelf, as the paper does. Every node
+carries, in this order (`NODE_DIM` numbers):
+
+- object type, one-hot over `OBJECT_TYPES` (6);
+- current region, one-hot over `REGION_CLASSES` (8): the surface it ultimately stands on (a
+  tower's base decides), inside a shelf, or in the gripper;
+- whether it is the object the primitive moves (1);
+- its size as it rests (3) and its yaw as (cos 2ψ, sin 2ψ) (2): boxes look the same turned
+  half way round;
+- reference A (3): place: position minus the target surface's centre (z above the surface);
+  push: position minus the pushed object's;
+- reference B (3): place: position in the target surface's own coordinates, 0..1 across its
+  length and width where the place bins are (added: a bin's cell can then be read off
+  directly), and height above it; push: position minus the middle of the shelf's open front.
+
+Edges join every ordered pair of distinct objects (the geometric graph is fully connected);
+each carries the other object's offset (3) and horizontal distance (1). The subgoal is one
+vector `u` (`SUBGOAL_DIM`): the target entity, one-hot over `ENTITY_TYPES`, and the moved
+object's type, one-hot over `OBJECT_TYPES`. Lengths are in decimetres (`SCALE`), so that
+every feature is of order one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch
+from torch_geometric.data import Data
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.objects import ENTITY_TYPES, object_type
+from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.world import OBJECT_TYPES, REGIONS, SHELVES, SURFACES, surface_rect
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.symbol_mapping import map_symbols
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+TYPES = tuple(OBJECT_TYPES)
+REGION_CLASSES: tuple[str, ...] = (
+    *REGIONS,
+    *(f"top:{s}" for s in SHELVES),
+    *(f"in:{s}" for s in SHELVES),
+    "held",
+)
+NODE_DIM = len(TYPES) + len(REGION_CLASSES) + 1 + 3 + 2 + 3 + 3
+EDGE_DIM = 4
+SUBGOAL_DIM = len(ENTITY_TYPES) + len(TYPES)
+SCALE = 10.0  # metres to decimetres
+
+
+def _region_class(state: SymbolicSceneGraph, obj: str) -> str:
+    loc = state.location(obj)
+    while loc.predicate is Predicate.ON and loc.args[1] in state.objects:
+        loc = state.location(loc.args[1])
+    if loc.predicate is Predicate.IN_GRASP:
+        return "held"
+    if loc.predicate is Predicate.IN:
+        return f"in:{loc.args[1]}"
+    surface = loc.args[1]
+    return surface if surface in REGIONS else f"top:{surface}"
+
+
+def check_subgoal(subgoal: Literal, sg: GeometricSceneGraph) -> None:
+    """Refuse a subgoal that no motion parameters serve, in one line."""
+    obj = subgoal.args[0]
+    if obj not in sg.objects:
+        raise InvalidInputError(f"'{subgoal}' names '{obj}', which is not in the scene")
+    if subgoal.predicate is Predicate.ON and subgoal.args[1] in SURFACES:
+        return
+    if subgoal.predicate is Predicate.IN and subgoal.args[1] in SHELVES:
+        return
+    raise InvalidInputError(
+        f"'{subgoal}': motion parameters are chosen for On(o, surface) and In(o, shelf) only"
+    )
+
+
+def ground(sg: GeometricSceneGraph, subgoal: Literal) -> Data:
+    """ŝ_g for a subgoal: `Data(x [N, NODE_DIM], edge_index [2, N(N-1)], edge_attr
+    [N(N-1), EDGE_DIM], u [1, SUBGOAL_DIM], mover [N] bool)`; nodes in `sg`'s order."""
+    check_subgoal(subgoal, sg)
+    obj, target = subgoal.args
+    state = map_symbols(sg).state
+    place = subgoal.predicate is Predicate.ON
+    if place:
+        rect = surface_rect(target)
+        cx, cy = rect.center
+        ref_a = (cx, cy, rect.z)
+    else:
+        rect = SHELVES[target].interior
+        ref_a = sg.pose(obj).position
+        front = (rect.x_min, (rect.y_min + rect.y_max) / 2)
+    rows = []
+    for node in sg.nodes:
+        x, y, z = node.pose.position
+        t = object_type(node.name)
+        feat = [0.0] * NODE_DIM
+        feat[TYPES.index(t.name)] = 1.0
+        feat[len(TYPES) + REGION_CLASSES.index(_region_class(state, node.name))] = 1.0
+        k = len(TYPES) + len(REGION_CLASSES)
+        yaw = node.pose.yaw
+        size = [SCALE * s for s in t.size]
+        feat[k : k + 6] = [float(node.name == obj), *size, math.cos(2 * yaw), math.sin(2 * yaw)]
+        feat[k + 6 : k + 9] = [
+            SCALE * (x - ref_a[0]),
+            SCALE * (y - ref_a[1]),
+            SCALE * (z - ref_a[2]),
+        ]
+        if place:
+            u = (x - rect.x_min) / rect.width_x
+            v = (y - rect.y_min) / rect.width_y
+            feat[k + 9 : k + 12] = [u, v, SCALE * (z - rect.z)]
+        else:
+            feat[k + 9 : k + 12] = [SCALE * (x - front[0]), SCALE * (y - front[1]), SCALE * z]
+        rows.append(feat)
+    n = len(sg.nodes)
+    pos = torch.tensor([node.pose.position for node in sg.nodes], dtype=torch.float)
+    src, dst = torch.meshgrid(torch.arange(n), torch.arange(n), indexing="ij")
+    keep = src != dst
+    edge_index = torch.stack([src[keep], dst[keep]])
+    offset = SCALE * (pos[edge_index[1]] - pos[edge_index[0]])
+    edge_attr = torch.cat([offset, offset[:, :2].norm(dim=1, keepdim=True)], dim=1)
+    u = torch.zeros(1, SUBGOAL_DIM)
+    u[0, ENTITY_TYPES.index(target)] = 1.0
+    u[0, len(ENTITY_TYPES) + TYPES.index(object_type(obj).name)] = 1.0
+    mover = torch.tensor([node.name == obj for node in sg.nodes])
+    return Data(
+        x=torch.tensor(rows, dtype=torch.float),
+        edge_index=edge_index,
+        edge_attr=edge_attr,
+        u=u,
+        mover=mover,
+        num_nodes=n,
+    )
