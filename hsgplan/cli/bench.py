@@ -131,3 +131,45 @@ def bench_task(
         cells,
         markdown,
     )
+
+
+@app.command("collect")
+@refuses_bad_input
+def bench_collect(
+    primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
+    samples: Annotated[int, typer.Option(help="Successful samples per primitive.")] = 300,
+    workers: Annotated[int, typer.Option(help="Processes.")] = 2,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """Successful motion samples per second of the collector (wall time, start-up included)."""
+    from hsgplan.benchmarks.collect import bench_collect as run
+    from hsgplan.domain.errors import InvalidInputError
+
+    kinds = [p.strip() for p in primitives.split(",") if p.strip()]
+    for p in kinds:
+        if p not in ("place", "push"):
+            raise InvalidInputError(f"primitive '{p}': place or push")
+    rows = run(kinds, samples, workers)
+    if as_json:
+        print(json.dumps([r.to_json() for r in rows], indent=2))
+        return
+    cells = [
+        (
+            r.primitive,
+            str(r.workers),
+            str(r.samples),
+            f"{r.samples / max(1, r.trials):.0%}",
+            f"{r.seconds:.0f}",
+            f"{r.samples_per_second:.2f}",
+        )
+        for r in rows
+    ]
+    print_table(
+        "Motion data collection speed",
+        ("primitive", "workers", "samples", "trials successful", "seconds", "samples per s"),
+        cells,
+        markdown,
+    )

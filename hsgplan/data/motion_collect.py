@@ -35,12 +35,15 @@ class CollectConfig:
     seed: int = 0
     workers: int = 2
     ray_address: str | None = None
+    tasks_per_chunk: int = TASKS_PER_CHUNK  # the unit of work, and of what an interruption loses
 
     def __post_init__(self) -> None:
         if self.samples < 0:
             raise InvalidInputError(f"--samples {self.samples}: cannot be negative")
         if self.workers < 1:
             raise InvalidInputError(f"--workers {self.workers}: at least one is needed")
+        if self.tasks_per_chunk < 1:
+            raise InvalidInputError(f"tasks per chunk {self.tasks_per_chunk}: at least one")
 
 
 @dataclass(frozen=True)
@@ -154,7 +157,7 @@ def collect(
         {
             "primitive": config.primitive.value,
             "seed": config.seed,
-            "tasks_per_chunk": TASKS_PER_CHUNK,
+            "tasks_per_chunk": config.tasks_per_chunk,
             "attempts_per_task": ATTEMPTS_PER_TASK,
             "schema_version": store.SCHEMA_VERSION,
         },
@@ -181,7 +184,8 @@ def _run(runner, config: CollectConfig, folder: Path, done: dict[int, int], prog
         while len(in_flight) < window and (expected < config.samples or not in_flight):
             while nxt in done or nxt in in_flight.values():
                 nxt += 1
-            in_flight[runner.submit(run_chunk, config.primitive.value, config.seed, nxt)] = nxt
+            job = (config.primitive.value, config.seed, nxt, config.tasks_per_chunk)
+            in_flight[runner.submit(run_chunk, *job)] = nxt
             expected += per_chunk
         handle, result = runner.next_done(set(in_flight))
         del in_flight[handle]

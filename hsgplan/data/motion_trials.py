@@ -78,17 +78,15 @@ def params_for(primitive: MotionPrimitive, obj: str, target: str, bins: tuple[in
     return PushParams(obj, *bins)
 
 
-def chunk_tasks(chunk: int) -> range:
-    return range(chunk * TASKS_PER_CHUNK, (chunk + 1) * TASKS_PER_CHUNK)
-
-
-def run_chunk(primitive: str, seed: int, chunk: int) -> ChunkResult:
+def run_chunk(
+    primitive: str, seed: int, chunk: int, tasks_per_chunk: int = TASKS_PER_CHUNK
+) -> ChunkResult:
     """Stage every task of a chunk and try it; the worker entry point (pool or Ray)."""
     kind = MotionPrimitive(primitive)
     trials: list[Trial] = []
     unstaged = 0
     with Scene((), seed=seed) as scene:
-        for index in chunk_tasks(chunk):
+        for index in range(chunk * tasks_per_chunk, (chunk + 1) * tasks_per_chunk):
             got = run_task(scene, draw_task(kind, seed, index))
             unstaged += got is None
             trials += got or []
