@@ -43,9 +43,10 @@ def place(
         str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
     ] = None,
     out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = Path("data/motion"),
+    tasks_per_chunk: Annotated[int, typer.Option(help="Tasks per unit of work.")] = 32,
 ) -> None:
     """Self-supervised place data: uniformly sampled bins tried in generated scenes."""
-    _collect("place", samples, workers, seed, ray, out_dir)
+    _collect("place", samples, workers, seed, ray, out_dir, tasks_per_chunk)
 
 
 @app.command("push")
@@ -58,16 +59,17 @@ def push(
         str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
     ] = None,
     out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = Path("data/motion"),
+    tasks_per_chunk: Annotated[int, typer.Option(help="Tasks per unit of work.")] = 32,
 ) -> None:
     """Self-supervised push data: uniformly sampled bins tried in generated scenes."""
-    _collect("push", samples, workers, seed, ray, out_dir)
+    _collect("push", samples, workers, seed, ray, out_dir, tasks_per_chunk)
 
 
-def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir: Path) -> None:
+def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir: Path, chunk: int):
     from hsgplan.data.motion_collect import CollectConfig, collect
     from hsgplan.data.motion_tasks import MotionPrimitive
 
-    config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray)
+    config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray, chunk)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task(f"{primitive} samples", total=samples)
         summary = collect(config, out_dir, lambda n: progress.update(bar, completed=n))

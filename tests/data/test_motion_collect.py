@@ -1,0 +1,102 @@
+"""Self-supervised motion data: task draws, resume after a kill, and the Ray path."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from hsgplan.data import motion_store as store
+from hsgplan.data.motion_collect import CollectConfig, collect, work_folder
+from hsgplan.data.motion_tasks import MotionPrimitive, draw_task
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.predicates import Predicate
+from hsgplan.domain.world import SURFACE_CAPACITY
+
+PLACE, PUSH = MotionPrimitive.PLACE, MotionPrimitive.PUSH
+
+
+def test_tasks_are_drawn_from_their_index_alone():
+    for i in range(40):
+        assert draw_task(PLACE, 3, i) == draw_task(PLACE, 3, i)
+        place = draw_task(PLACE, 3, i)
+        assert place.state.held() == place.obj
+        assert len(place.state.resting_on(place.target)) == place.crowding
+        assert place.crowding < SURFACE_CAPACITY[place.target]
+        push = draw_task(PUSH, 3, i)
+        assert push.state.location(push.obj).args == (push.obj, "prepush_a")
+        assert len(push.state.inside("shelf_a")) == push.crowding
+        assert push.subgoal.predicate is Predicate.IN
+    assert draw_task(PLACE, 3, 0) != draw_task(PLACE, 4, 0)
+    with pytest.raises(InvalidInputError):
+        draw_task(PLACE, 0, -1)
+
+
+def _keys(data) -> list[tuple[int, int]]:
+    return list(zip(data.task.tolist(), data.attempt.tolist(), strict=True))
+
+
+def _same(a, b) -> bool:
+    return all(np.array_equal(getattr(a, f), getattr(b, f), equal_nan=True) for f in store.FIELDS)
+
+
+N, CHUNK = 10, 2  # ten samples in chunks of two tasks (eight trials)
+
+
+def test_killed_collection_resumes_to_exactly_n_samples(tmp_path):
+    cmd = [
+        sys.executable, "-m", "hsgplan.cli", "collect", "place", "--samples", str(N),
+        "--workers", "1", "--tasks-per-chunk", str(CHUNK), "--out", str(tmp_path / "a"),
+    ]  # fmt: skip
+    chunks = work_folder(tmp_path / "a", PLACE, 0)
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 240
+    while not list(chunks.glob("chunk-*.npz")) and time.time() < deadline:
+        time.sleep(0.2)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    kept = sorted(p.name for p in chunks.glob("chunk-*.npz"))
+    assert kept, "no chunk was finished before the kill"
+    mtimes = {p.name: p.stat().st_mtime_ns for p in chunks.glob("chunk-*.npz")}
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    # what was saved before the kill was not run again
+    assert all((chunks / name).stat().st_mtime_ns == mtimes[name] for name in kept)
+    resumed = store.load(tmp_path / "a" / "place.npz")
+    assert len(resumed) == N and resumed.ok.all()
+    assert len(set(_keys(resumed))) == N  # no duplicates
+    assert _keys(resumed) == sorted(_keys(resumed))
+    # the same samples as a run that was never interrupted, on two workers
+    config = CollectConfig(PLACE, N, workers=2, tasks_per_chunk=CHUNK)
+    collect(config, tmp_path / "b")
+    assert _same(resumed, store.load(tmp_path / "b" / "place.npz"))
+
+
+def test_the_ray_path_gives_the_same_samples(tmp_path):
+    import ray  # noqa: F401  (installed by the test set-up: `make test` installs .[dev,ray])
+
+    n = 4
+    config = CollectConfig(PUSH, n, workers=2, tasks_per_chunk=CHUNK, ray_address="local")
+    summary = collect(config, tmp_path / "ray")
+    local = CollectConfig(PUSH, n, workers=1, tasks_per_chunk=CHUNK)
+    collect(local, tmp_path / "pool")
+    assert summary.samples == n
+    got = store.load(tmp_path / "ray" / "push.npz")
+    assert _same(got, store.load(tmp_path / "pool" / "push.npz"))
+
+
+def test_bad_collection_settings_are_refused(tmp_path):
+    with pytest.raises(InvalidInputError, match="negative"):
+        CollectConfig(PLACE, -1)
+    with pytest.raises(InvalidInputError, match="workers"):
+        CollectConfig(PLACE, 5, workers=0)
+    collect(CollectConfig(PLACE, 0, tasks_per_chunk=CHUNK), tmp_path)
+    with pytest.raises(InvalidInputError, match="other collection settings"):
+        collect(CollectConfig(PLACE, 0, tasks_per_chunk=3), tmp_path)
+    damaged = tmp_path / "damaged.npz"
+    damaged.write_bytes(b"not a zip")
+    with pytest.raises(InvalidInputError, match="not a readable"):
+        store.load(damaged)
