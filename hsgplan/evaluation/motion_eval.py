@@ -37,6 +37,9 @@ def _generators(kind: MotionPrimitive, checkpoints: Path, seed: int, index: int)
 
 def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> list[dict]:
     """Every model once in each staged scene of tasks start..start+CHUNK-1 (a worker's job)."""
+    import torch
+
+    torch.set_num_threads(1)  # one process per core already
     kind = MotionPrimitive(primitive)
     rows = []
     with Scene((), seed=seed) as scene:

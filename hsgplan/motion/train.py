@@ -41,11 +41,14 @@ class MotionTrainConfig:
     rounds: int = 2
     save_every: int = 5
     samples: int | None = None  # the first this many samples of the dataset (None: all)
+    # The networks are small: measured on 2 busy cores, 2 threads trained ten times slower
+    # than 1 (they fight the simulation workers for the cores).
+    threads: int = 1
 
     def __post_init__(self) -> None:
         if self.primitive not in ("place", "push"):
             raise InvalidInputError(f"primitive '{self.primitive}': place or push")
-        for name in ("epochs", "batch_size", "save_every"):
+        for name in ("epochs", "batch_size", "save_every", "threads"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
         if self.samples is not None and self.samples < 1:
@@ -98,6 +101,7 @@ def train_motion(
     if len(data) == 0:
         raise InvalidInputError(f"no successful {config.primitive} samples in '{config.data}'")
     examples = grounded_examples(data)
+    torch.set_num_threads(config.threads)
     torch.manual_seed(config.seed)
     net_config = config.net_config()
     model = build(net_config)
