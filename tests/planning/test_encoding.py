@@ -17,7 +17,9 @@ from hsgplan.planning.regression.encoding import (
     Slots,
     decode,
     encode,
+    encode_computed,
     encode_many,
+    touching,
 )
 from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
 
@@ -99,3 +101,29 @@ def test_active_edges_are_self_loops_and_related_pairs():
     pairs = {(a, b) for a, b in active if a != b}
     assert pairs == {("butter", "cherries"), ("cherries", "open_space"), ("cherries", "shelf_a")}
     assert all((n, n) in active for n in data.names)
+
+
+def test_encode_computed_is_encode_many_cut_to_the_computed_edges():
+    rng = random.Random(3)
+    goal = random_goal(5, rng)
+    s = random_state(goal.objects, rng)
+    lits = sorted(goal.literals)
+    contexts = [frozenset(goal.literals)] * (len(lits) - 1) + [frozenset([clear(lits[0].subject)])]
+    readout = touching(s.nodes, [lit.args for lit in lits])
+    batch = encode_computed(s, contexts, lits, readout)
+    many = encode_many(s, contexts, [[lit] for lit in lits])
+    kept = (many.active | torch.from_numpy(readout.reshape(-1))).nonzero().squeeze(1)
+    assert torch.equal(batch.x, many.x)
+    assert torch.equal(batch.edge_index, many.edge_index[:, kept])
+    assert torch.equal(batch.edge_attr, many.edge_attr[kept])
+    assert torch.equal(batch.weight, many.active[kept].float())
+    assert (batch.valid == many.valid[kept].numpy()).all()
+    e = many.valid.shape[0] // len(lits)
+    assert (batch.graph * e + batch.edge == kept.numpy()).all()
+    assert (batch.row[kept.numpy()] == range(len(kept))).all() and (batch.row >= 0).sum() == len(
+        kept
+    )
+    # without a query or read-out edges: the active edges alone
+    batch = encode_computed(s, [frozenset([lit]) for lit in lits], [None] * len(lits))
+    many = encode_many(s, [[lit] for lit in lits])
+    assert torch.equal(batch.edge_attr, many.edge_attr[many.active])

@@ -12,6 +12,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import cache, cached_property, lru_cache
 
+import numpy as np
 import torch
 from torch_geometric.data import Data
 
@@ -222,4 +223,139 @@ def encode_many(
         goal=values.reshape(k * e, -1),
         active=active.reshape(k * e),
         names=list(slots.nodes),
+    )
+
+
+# --- the planner's batches: only the edges a network computes, built with numpy ----------------
+#
+# `encode_many` builds every edge of every graph, and the network then drops all but the active
+# and read-out ones; at planning time (many calls, a few small graphs each) building the rest was
+# most of a call's cost. `encode_computed` builds the kept edges alone, with the very values and
+# in the very order the network would have kept, so its outputs are the same numbers.
+
+_GOAL_COL = len(PREDICATES)  # edge_attr columns: holds, goal one-hot (3 per predicate), valid,
+_VALID_COL = 4 * len(PREDICATES)  # query
+_QUERY_COL = 5 * len(PREDICATES)
+
+
+@dataclass(frozen=True)
+class _Template:
+    """What every graph over one node list shares, as numpy arrays."""
+
+    x: np.ndarray  # [N, NODE_DIM] float32
+    attr: np.ndarray  # [E, EDGE_DIM] float32: no literal holds, don't care everywhere, no query
+    self_loop: np.ndarray  # [E] bool
+    src: np.ndarray  # [E] int64
+    dst: np.ndarray  # [E] int64
+    touching: np.ndarray  # [N, E] bool: the edges from or to node i
+
+
+@cache
+def _template(nodes: tuple[str, ...]) -> _Template:
+    x, edge_index = _layout(nodes)
+    n, e = len(nodes), len(nodes) ** 2
+    attr = np.zeros((e, EDGE_DIM), dtype=np.float32)
+    attr[:, _GOAL_COL:_VALID_COL:3] = 1.0  # DONT_CARE's one-hot
+    attr[:, _VALID_COL:_QUERY_COL] = _valid_mask(nodes).numpy()
+    src, dst = edge_index.numpy()
+    nodes_i = np.arange(n)[:, None]
+    touching = (src[None] == nodes_i) | (dst[None] == nodes_i)
+    return _Template(x.numpy(), attr, src == dst, src, dst, touching)
+
+
+@lru_cache(maxsize=4)
+def _state_edges(state: SymbolicSceneGraph) -> tuple[np.ndarray, np.ndarray]:
+    """[E, EDGE_DIM] features of the state with no goal and no query, and [E] active edges."""
+    t = _template(state.nodes)
+    slots = Slots.of(state.nodes)
+    attr = t.attr.copy()
+    for lit in state.literals:
+        attr[slots.slot(lit)] = 1.0
+    return attr, t.self_loop | attr[:, :_GOAL_COL].any(1)
+
+
+@lru_cache(maxsize=4096)
+def _goal_slots(nodes: tuple[str, ...], goal: frozenset[Literal]) -> np.ndarray:
+    """[L, 3] (edge, predicate, TRUE or FALSE) of a goal's literals, the last one per slot."""
+    slots = Slots.of(nodes)
+    values = {slots.slot(lit): TRUE if lit.positive else FALSE for lit in goal}
+    return np.array([(e, p, v) for (e, p), v in values.items()], dtype=np.int64).reshape(-1, 3)
+
+
+@dataclass(frozen=True)
+class Computed:
+    """K (goal, query) graphs over one state, as the network computes them: only the edges that
+    pass messages (active) or are read out, in batch order (graph k's edge e is k E + e).
+
+    Shapes: x [K N, NODE_DIM]; edge_index [2, M]; edge_attr [M, EDGE_DIM]; weight [M] (1 on
+    active edges, 0 on read-out-only ones); graph, edge [M] (which graph, which of its E edges);
+    row [K E] (the row of graph k's edge e, -1 where it is not computed).
+    """
+
+    x: torch.Tensor
+    edge_index: torch.Tensor
+    edge_attr: torch.Tensor
+    weight: torch.Tensor
+    graph: np.ndarray
+    edge: np.ndarray
+    row: np.ndarray
+    valid: np.ndarray  # [M, P] bool: the slots a literal can occupy
+
+    @property
+    def inputs(self) -> tuple[torch.Tensor, ...]:
+        """The arguments of `EdgeClassifier.computed`."""
+        return self.x, self.edge_index, self.edge_attr, self.weight
+
+
+def touching(nodes: tuple[str, ...], names: list[tuple[str, ...]]) -> np.ndarray:
+    """[K, E] bool: the edges of graph k that start or end at one of the nodes names[k]."""
+    t, index = _template(nodes), Slots.of(nodes)._index
+    out = np.zeros((len(names), len(nodes) ** 2), dtype=bool)
+    for k, group in enumerate(names):
+        for name in group:
+            out[k] |= t.touching[index[name]]
+    return out
+
+
+def encode_computed(
+    state: SymbolicSceneGraph,
+    goals: list[frozenset[Literal]],
+    queries: list[Literal | None],
+    readout: np.ndarray | None = None,
+) -> Computed:
+    """`encode_many(state, goals, [[q] for q in queries])` with the `readout` edges ([K, E]
+    bool) read out, cut to what the network computes (see `EdgeClassifier.forward`)."""
+    nodes = state.nodes
+    t, slots = _template(nodes), Slots.of(nodes)
+    base, base_active = _state_edges(state)
+    k, n, e = len(goals), len(nodes), len(nodes) ** 2
+    goal = [_goal_slots(nodes, g) for g in goals]
+    gk = np.repeat(np.arange(k), [len(g) for g in goal])
+    ge, gp, gv = np.concatenate(goal).T if goal else np.zeros((3, 0), dtype=np.int64)
+    asked = [(i, *slots.slot(q)) for i, q in enumerate(queries) if q is not None]
+    qk, qe, qp = np.array(asked, dtype=np.int64).reshape(-1, 3).T
+    active = np.repeat(base_active[None], k, 0)
+    active[gk, ge] = True
+    active[qk, qe] = True
+    active = active.reshape(-1)
+    kept = np.flatnonzero(active if readout is None else active | readout.reshape(-1))
+    row = np.full(k * e, -1, dtype=np.int64)
+    row[kept] = np.arange(len(kept))
+    graph, edge = np.divmod(kept, e)
+    attr = base[edge]
+    at = row[gk * e + ge]
+    attr[at, _GOAL_COL + 3 * gp] = 0.0
+    attr[at, _GOAL_COL + 3 * gp + gv] = 1.0
+    attr[row[qk * e + qe], _QUERY_COL + qp] = 1.0
+    offset = graph * n
+    edge_index = np.stack([t.src[edge] + offset, t.dst[edge] + offset])
+    return Computed(
+        x=torch.from_numpy(np.tile(t.x, (k, 1))),
+        edge_index=torch.from_numpy(edge_index),
+        edge_attr=torch.from_numpy(attr),
+        weight=torch.from_numpy(active[kept].astype(np.float32)),
+        graph=graph,
+        edge=edge,
+        row=row,
+        valid=attr[:, _VALID_COL:_QUERY_COL] > 0,
     )

@@ -183,6 +183,13 @@ class EdgeClassifier(nn.Module):
         full = logits.new_zeros(data.edge_index.shape[1], *logits.shape[1:])
         return full.index_copy(0, keep, logits)
 
+    def computed(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor, weight: Tensor) -> Tensor:
+        """`forward` on edges already cut to the computed ones (`encoding.encode_computed`):
+        [M, predicates, classes] logits, one row per given edge. The planner's path, which
+        skips building and cutting a `Data` per call."""
+        logits = self._core[0](x, edge_index, edge_attr, weight)
+        return logits.view(-1, self.config.predicates, self.config.classes)
+
 
 class _Core(nn.Module):
     """An `EdgeClassifier`'s computation on plain tensors (so TorchScript can compile it),

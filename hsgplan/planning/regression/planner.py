@@ -20,6 +20,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Protocol
 
+import numpy as np
 import torch
 
 from hsgplan.domain.goals import Goal
@@ -30,7 +31,8 @@ from hsgplan.planning.regression.encoding import (
     TRUE,
     Slots,
     encode,
-    encode_many,
+    encode_computed,
+    touching,
 )
 from hsgplan.planning.regression.train import load_network
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -121,36 +123,34 @@ class RegressionPlanner:
         self._plan: tuple[Goal, list[tuple[Literal, frozenset[Literal]]]] | None = None
 
     def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
-        data = encode_many(state, [n.context for n in nodes], [[n.lit] for n in nodes])
-        k, p = len(nodes), data.goal.shape[1]
         # Read out the edges of the query's objects: a preimage names them (the active edges
         # are computed anyway).
-        index = {name: i for i, name in enumerate(data.names)}
-        near = torch.zeros(k, len(data.names), dtype=torch.bool)
-        for i, n in enumerate(nodes):
-            near[i, [index[a] for a in n.lit.args]] = True
-        src, dst = data.edge_index[:, : len(data.names) ** 2]
-        data.readout = (near[:, src] | near[:, dst]).reshape(-1)
-        computed = (data.readout | data.active).unsqueeze(1)
-        values = self.preimage(data).argmax(-1).masked_fill(~computed, DONT_CARE)
-        values = values.view(k, -1, p)
-        said = (values != DONT_CARE) & data.valid.view(k, -1, p)
-        out: list[set[Literal]] = [set() for _ in range(k)]
-        slots = Slots.of(tuple(data.names))
-        for (i, e, q), v in zip(said.nonzero().tolist(), values[said].tolist(), strict=True):
+        readout = touching(state.nodes, [n.lit.args for n in nodes])
+        batch = encode_computed(state, [n.context for n in nodes], [n.lit for n in nodes], readout)
+        values = self.preimage.computed(*batch.inputs).argmax(-1).numpy()
+        rows, preds = np.nonzero((values != DONT_CARE) & batch.valid)
+        out: list[set[Literal]] = [set() for _ in nodes]
+        slots = Slots.of(state.nodes)
+        for i, e, q, v in zip(
+            batch.graph[rows].tolist(),
+            batch.edge[rows].tolist(),
+            preds.tolist(),
+            values[rows, preds].tolist(),
+            strict=True,
+        ):
             lit = slots.literal(e, q)
             out[i].add(lit if v == TRUE else lit.negated())
         return [frozenset(x) for x in out]
 
     def _reachable(self, state, lits: list[Literal]) -> list[bool]:
-        data = encode_many(state, [[lit] for lit in lits])
-        slots = Slots.of(tuple(data.names))
-        e = len(data.names) ** 2
-        where = [(i * e + edge, p) for i, lit in enumerate(lits) for edge, p in [slots.slot(lit)]]
-        data.readout = torch.zeros(len(lits) * e, dtype=torch.bool)
-        data.readout[[w for w, _ in where]] = True
-        yes = self.reach(data).argmax(-1)
-        return [bool(yes[w, p] == 1) for w, p in where]
+        # each literal's slot is on an edge its own goal makes active, so it is computed
+        batch = encode_computed(state, [frozenset((lit,)) for lit in lits], [None] * len(lits))
+        slots = Slots.of(state.nodes)
+        e = len(state.nodes) ** 2
+        where = [slots.slot(lit) for lit in lits]
+        rows = batch.row[[i * e + edge for i, (edge, _) in enumerate(where)]]
+        yes = self.reach.computed(*batch.inputs)[rows, [p for _, p in where]].argmax(-1)
+        return [bool(y == 1) for y in yes.tolist()]
 
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
