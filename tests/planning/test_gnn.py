@@ -214,3 +214,22 @@ def test_the_scripted_network_gives_the_eager_outputs():
         torch.testing.assert_close(net(g), eager_some, rtol=1e-5, atol=1e-5)
         del g.readout
         torch.testing.assert_close(net(g), eager, rtol=1e-5, atol=1e-5)
+
+
+@pytest.mark.filterwarnings("ignore:`torch.jit.freeze` is deprecated:DeprecationWarning")
+def test_the_inference_core_is_the_pyg_core_bit_for_bit():
+    # the planner's decisions must not move: the same numbers, not merely close ones
+    from hsgplan.planning.regression.gnn import _Core, _InferenceCore
+
+    gen = torch.Generator().manual_seed(10)
+    net = model(rounds=3)
+    pyg = torch.jit.freeze(torch.jit.script(_Core(net).eval()))
+    plain = torch.jit.freeze(torch.jit.script(_InferenceCore(net).eval()))
+    with torch.no_grad():
+        for n in (1, 3, 7):
+            g = complete_graph(n, 5, 4, gen)
+            keep = (torch.rand(g.num_edges, generator=gen) < 0.6).nonzero().squeeze(1)
+            weight = (torch.rand(len(keep), generator=gen) < 0.7).float()
+            args = (g.x, g.edge_index[:, keep], g.edge_attr[keep])
+            assert torch.equal(plain(*args, weight), pyg(*args, weight))
+            assert torch.equal(plain(*args, None), pyg(*args, None))
