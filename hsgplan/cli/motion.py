@@ -87,17 +87,17 @@ def eval_motion(
     rows = []
     for kind, by_model in report.items():
         levels = sorted({lvl for m in MODELS for lvl in by_model[m]["by_crowding"]})
-        for lvl in ["all", *levels]:
-            cells = []
-            for m in MODELS:
-                r = by_model[m] if lvl == "all" else by_model[m]["by_crowding"].get(lvl)
-                cells.append("—" if r is None else f"{r['success_rate']:.3f}")
-            n = (
-                by_model[MODELS[0]]["trials"]
-                if lvl == "all"
-                else by_model[MODELS[0]]["by_crowding"][lvl]["trials"]
-            )
-            rows.append((kind, lvl, str(n), *cells))
+        picks = {"all": lambda r: r} | {
+            lvl: (lambda r, lvl=lvl: r["by_crowding"].get(lvl)) for lvl in levels
+        }
+        picks["crowded shelf tops"] = lambda r: r.get("crowded_shelf_tops")
+        for label, pick in picks.items():
+            found = [pick(by_model[m]) for m in MODELS]
+            if all(r is None for r in found):
+                continue
+            cells = ["—" if r is None else f"{r['success_rate']:.3f}" for r in found]
+            n = next(r["trials"] for r in found if r is not None)
+            rows.append((kind, label, str(n), *cells))
     print_table(
         f"Single-shot motion success on fresh scenes, seed {seed}",
         ("primitive", "crowding", "scenes", *MODELS),

@@ -206,5 +206,8 @@ def _pack(config: CollectConfig, out: Path, folder: Path, done, ran: int) -> Col
     ok = order[trials.ok[order]][: config.samples]
     dataset = out / f"{config.primitive.value}.npz"
     store.save(dataset, trials.take(ok))
+    # Every trial up to the last sample, failures included: what a success classifier learns from.
+    upto = order[: int(np.flatnonzero(order == ok[-1])[0]) + 1] if len(ok) else ok
+    store.save(out / f"{config.primitive.value}_trials.npz", trials.take(upto))
     store.write_schema(out)
     return CollectSummary(len(ok), len(trials), ran, unstaged, dataset)

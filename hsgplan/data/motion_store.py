@@ -15,7 +15,8 @@ Schema (version `SCHEMA_VERSION`), written beside the data as `schema.json`:
 
 Simulated scenes hold at most one instance of each type, so a type index names an object. For
 place the object placed is the one held. A dataset file (`place.npz`, `push.npz`) holds the
-successful trials only; the collector's chunk files hold every trial plus `unstaged`.
+successful trials only; `place_trials.npz` / `push_trials.npz` every trial up to the last of
+them, failures included; the collector's chunk files hold every trial plus `unstaged`.
 About 190 bytes a row before compression.
 """
 

@@ -1,6 +1,9 @@
 """Training a motion network on the collected successes: `hsgplan train motion`.
 
-Cross-entropy over the joint bin pair of each successful trial, as the paper trains. The
+Two losses. `ce`, the paper's: cross-entropy over the joint bin pair of each successful trial,
+so the network learns which bins succeed in a scene like this one. `bce` (beyond the paper):
+every trial, failures included, teaches the logit of its own bin pair whether it succeeded, so
+the network estimates each bin's chance of success from more than twice the data. The
 checkpoint is a folder: `train_config.json`, `config.json` (the network's), `model.safetensors`;
 `progress.pt` (loaded with weights_only) holds the last finished epoch while training runs, so
 that a run started again with the same configuration continues from there.
@@ -14,6 +17,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+import numpy as np
 import torch
 from safetensors.torch import load_file, save_file
 from torch_geometric.data import Batch, Data
@@ -44,6 +48,7 @@ class MotionTrainConfig:
     # The networks are small: measured on 2 busy cores, 2 threads trained ten times slower
     # than 1 (they fight the simulation workers for the cores).
     threads: int = 1
+    loss: str = "ce"  # "ce" (successes, the paper's) or "bce" (every trial)
 
     def __post_init__(self) -> None:
         if self.primitive not in ("place", "push"):
@@ -51,6 +56,8 @@ class MotionTrainConfig:
         for name in ("epochs", "batch_size", "save_every", "threads"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
+        if self.loss not in ("ce", "bce"):
+            raise InvalidInputError(f"loss '{self.loss}': ce or bce")
         if self.samples is not None and self.samples < 1:
             raise InvalidInputError(f"samples {self.samples!r}: need a positive integer or null")
         self.net_config()  # refuses a bad model name or width
@@ -69,14 +76,39 @@ class MotionTrainConfig:
         return MotionTrainConfig(**d)
 
 
+def _training_rows(config: MotionTrainConfig) -> MotionData:
+    """The first `samples` successes, and with `bce` every trial up to the last of them."""
+    folder = Path(config.data)
+    data = load(folder / f"{config.primitive}.npz")
+    if config.samples is not None:
+        data = data.take(slice(0, config.samples))
+    if len(data) == 0:
+        raise InvalidInputError(f"no successful {config.primitive} samples in '{folder}'")
+    if config.loss == "ce":
+        return data
+    trials = load(folder / f"{config.primitive}_trials.npz")
+    last = (int(data.task[-1]), int(data.attempt[-1]))
+    keep = [(int(t), int(a)) <= last for t, a in zip(trials.task, trials.attempt, strict=True)]
+    return trials.take(np.array(keep, dtype=bool))
+
+
+def _loss(kind: str, logits: torch.Tensor, batch) -> torch.Tensor:
+    if kind == "ce":
+        return torch.nn.functional.cross_entropy(logits, batch.y)
+    picked = logits.gather(1, batch.y.view(-1, 1)).squeeze(1)
+    return torch.nn.functional.binary_cross_entropy_with_logits(picked, batch.ok.float())
+
+
 def grounded_examples(data: MotionData) -> list[Data]:
-    """Every row grounded for its subgoal, labelled with its flattened bin pair."""
+    """Every row grounded for its subgoal, labelled with its flattened bin pair and whether
+    the trial succeeded."""
     ny = BINS[data.primitive][1]
     subgoal = on if data.primitive is MotionPrimitive.PLACE else inside
     out = []
     for i in range(len(data)):
         g = ground(data.scene_graph(i), subgoal(data.object_name(i), data.target_name(i)))
         g.y = torch.tensor([int(data.bins[i, 0]) * ny + int(data.bins[i, 1])])
+        g.ok = torch.tensor([bool(data.ok[i])])
         out.append(g)
     return out
 
@@ -94,13 +126,7 @@ def train_motion(
     saved.write_text(json.dumps(asdict(config), indent=2) + "\n")
     if (out / "model.safetensors").exists():
         return  # finished earlier
-    data = load(Path(config.data) / f"{config.primitive}.npz")
-    data = data.take(data.ok)
-    if config.samples is not None:
-        data = data.take(slice(0, config.samples))
-    if len(data) == 0:
-        raise InvalidInputError(f"no successful {config.primitive} samples in '{config.data}'")
-    examples = grounded_examples(data)
+    examples = grounded_examples(_training_rows(config))
     torch.set_num_threads(config.threads)
     torch.manual_seed(config.seed)
     net_config = config.net_config()
@@ -118,7 +144,7 @@ def train_motion(
         total = 0.0
         for i in range(0, len(order), config.batch_size):
             batch = Batch.from_data_list([examples[j] for j in order[i : i + config.batch_size]])
-            loss = torch.nn.functional.cross_entropy(model(batch), batch.y)
+            loss = _loss(config.loss, model(batch), batch)
             optim.zero_grad()
             loss.backward()
             optim.step()
