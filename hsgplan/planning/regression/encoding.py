@@ -85,6 +85,11 @@ class Slots:
     def literal(self, edge: int, pred: int) -> Literal:
         return _literal(self.nodes, edge, pred)
 
+    def valued(self, edge: int, pred: int, value: int) -> Literal:
+        """The literal a TRUE or FALSE value in a slot states (shared, cached: a planner call
+        decodes many, and making a `Literal` is slow)."""
+        return _valued(self.nodes, edge, pred, value)
+
     @staticmethod
     def of(nodes: tuple[str, ...]) -> Slots:
         """The (shared, cached) slots of a node list."""
@@ -113,6 +118,12 @@ def _literal(nodes: tuple[str, ...], edge: int, pred: int) -> Literal:
     src, dst = divmod(edge, len(nodes))
     p = PREDICATES[pred]
     return Literal(p, (nodes[src],) if p.arity == 1 else (nodes[src], nodes[dst]))
+
+
+@lru_cache(maxsize=65536)
+def _valued(nodes: tuple[str, ...], edge: int, pred: int, value: int) -> Literal:
+    lit = _literal(nodes, edge, pred)
+    return lit if value == TRUE else lit.negated()
 
 
 def encode(
@@ -245,8 +256,7 @@ class _Template:
     x: np.ndarray  # [N, NODE_DIM] float32
     attr: np.ndarray  # [E, EDGE_DIM] float32: no literal holds, don't care everywhere, no query
     self_loop: np.ndarray  # [E] bool
-    src: np.ndarray  # [E] int64
-    dst: np.ndarray  # [E] int64
+    edge_index: np.ndarray  # [2, E] int64
     touching: np.ndarray  # [N, E] bool: the edges from or to node i
 
 
@@ -260,7 +270,13 @@ def _template(nodes: tuple[str, ...]) -> _Template:
     src, dst = edge_index.numpy()
     nodes_i = np.arange(n)[:, None]
     touching = (src[None] == nodes_i) | (dst[None] == nodes_i)
-    return _Template(x.numpy(), attr, src == dst, src, dst, touching)
+    return _Template(x.numpy(), attr, src == dst, edge_index.numpy(), touching)
+
+
+@lru_cache(maxsize=256)
+def _tiled_x(nodes: tuple[str, ...], k: int) -> torch.Tensor:
+    """[K N, NODE_DIM]: the node features of K graphs (read only, shared between calls)."""
+    return torch.from_numpy(np.tile(_template(nodes).x, (k, 1)))
 
 
 @lru_cache(maxsize=4)
@@ -299,7 +315,11 @@ class Computed:
     graph: np.ndarray
     edge: np.ndarray
     row: np.ndarray
-    valid: np.ndarray  # [M, P] bool: the slots a literal can occupy
+
+    @property
+    def valid(self) -> np.ndarray:
+        """[M, P] bool: the slots a literal can occupy."""
+        return self.edge_attr.numpy()[:, _VALID_COL:_QUERY_COL] > 0
 
     @property
     def inputs(self) -> tuple[torch.Tensor, ...]:
@@ -347,15 +367,12 @@ def encode_computed(
     attr[at, _GOAL_COL + 3 * gp] = 0.0
     attr[at, _GOAL_COL + 3 * gp + gv] = 1.0
     attr[row[qk * e + qe], _QUERY_COL + qp] = 1.0
-    offset = graph * n
-    edge_index = np.stack([t.src[edge] + offset, t.dst[edge] + offset])
     return Computed(
-        x=torch.from_numpy(np.tile(t.x, (k, 1))),
-        edge_index=torch.from_numpy(edge_index),
+        x=_tiled_x(nodes, k),
+        edge_index=torch.from_numpy(t.edge_index[:, edge] + graph * n),
         edge_attr=torch.from_numpy(attr),
         weight=torch.from_numpy(active[kept].astype(np.float32)),
         graph=graph,
         edge=edge,
         row=row,
-        valid=attr[:, _VALID_COL:_QUERY_COL] > 0,
     )

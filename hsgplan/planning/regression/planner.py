@@ -138,8 +138,7 @@ class RegressionPlanner:
             values[rows, preds].tolist(),
             strict=True,
         ):
-            lit = slots.literal(e, q)
-            out[i].add(lit if v == TRUE else lit.negated())
+            out[i].add(slots.valued(e, q, v))
         return [frozenset(x) for x in out]
 
     def _reachable(self, state, lits: list[Literal]) -> list[bool]:
@@ -149,8 +148,8 @@ class RegressionPlanner:
         e = len(state.nodes) ** 2
         where = [slots.slot(lit) for lit in lits]
         rows = batch.row[[i * e + edge for i, (edge, _) in enumerate(where)]]
-        yes = self.reach.computed(*batch.inputs)[rows, [p for _, p in where]].argmax(-1)
-        return [bool(y == 1) for y in yes.tolist()]
+        logits = self.reach.computed(*batch.inputs).numpy()[rows, [p for _, p in where]]
+        return (logits.argmax(-1) == 1).tolist()
 
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
