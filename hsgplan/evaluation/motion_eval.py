@@ -14,7 +14,7 @@ from pathlib import Path
 
 from hsgplan.data.motion_collect import LocalEngine
 from hsgplan.data.motion_tasks import MotionPrimitive, draw_task
-from hsgplan.data.motion_trials import release, stage_task, try_params
+from hsgplan.data.motion_trials import stage_task, try_params
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import SHELVES
 from hsgplan.sim.scene import Scene
@@ -42,27 +42,28 @@ def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> l
     torch.set_num_threads(1)  # one process per core already
     kind = MotionPrimitive(primitive)
     rows = []
-    with Scene((), seed=seed) as scene:
-        for index in range(start, start + CHUNK):
-            task = draw_task(kind, EVAL_STREAM + seed, index)
-            staged = stage_task(scene, task)
-            if staged is None:
-                continue
-            generators = _generators(kind, Path(checkpoints), seed, index)
-            for name in MODELS:
+    for index in range(start, start + CHUNK):
+        task = draw_task(kind, EVAL_STREAM + seed, index)
+        generators = _generators(kind, Path(checkpoints), seed, index)
+        for name in MODELS:
+            # A fresh scene per model: a restored physics state still carries the solver's
+            # contact caches, so one model's trial would nudge the next one's outcome.
+            with Scene((), seed=seed) as scene:
+                staged = stage_task(scene, task)
+                if staged is None:
+                    break
                 params = generators[name].ranked(staged.before, task.subgoal)[0]
                 outcome = try_params(scene, staged, params)
-                rows.append(
-                    {
-                        "task": index,
-                        "model": name,
-                        "crowding": task.crowding,
-                        "shelf_top": task.target in SHELVES and kind is MotionPrimitive.PLACE,
-                        "ok": outcome.ok,
-                        "status": outcome.status.value,
-                    }
-                )
-            release(scene, staged)
+            rows.append(
+                {
+                    "task": index,
+                    "model": name,
+                    "crowding": task.crowding,
+                    "shelf_top": task.target in SHELVES and kind is MotionPrimitive.PLACE,
+                    "ok": outcome.ok,
+                    "status": outcome.status.value,
+                }
+            )
     return rows
 
 

@@ -13,12 +13,14 @@ from dataclasses import asdict, dataclass
 import torch
 from torch import nn
 from torch_geometric.nn import global_max_pool
+from torch_geometric.utils import to_dense_batch
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.motion.layers import GroundedConv, mlp
-from hsgplan.scene_graph.grounding import EDGE_DIM, NODE_DIM, SUBGOAL_DIM, TYPES
+from hsgplan.scene_graph.grounding import EDGE_DIM, NODE_DIM, QUERY_DIM, SUBGOAL_DIM, TYPES
 
 MODELS = ("gnn", "mlp")
+HEADS = ("mlp", "bins")
 
 
 @dataclass(frozen=True)
@@ -35,10 +37,17 @@ class MotionNetConfig:
     edge_dim: int = EDGE_DIM
     subgoal_dim: int = SUBGOAL_DIM
     slots: int = len(TYPES)  # the MLP's fixed input: one node slot per object type
+    # The GNN's head: "mlp", the paper's (the embeddings, concatenated, through an MLP onto
+    # every bin), or "bins" (beyond the paper): each bin is a query that reads every node
+    # from where that bin would put the object (see `BinQueryHead`).
+    head: str = "mlp"
+    query_dim: int = QUERY_DIM
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:
             raise InvalidInputError(f"model '{self.model}': one of {', '.join(MODELS)}")
+        if self.head not in HEADS or (self.model == "mlp" and self.head != "mlp"):
+            raise InvalidInputError(f"head '{self.head}': mlp, or bins for the gnn")
         for name in ("hidden", "embed", "rounds"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
@@ -70,12 +79,17 @@ class GraphMotionNet(nn.Module):
         )
         self.graph_embed = nn.Linear(2 * c.hidden, c.embed)
         self.subgoal_embed = mlp([c.subgoal_dim, c.hidden, c.embed])
-        self.head = mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
+        if c.head == "bins":
+            self.head = BinQueryHead(c.hidden, c.embed, c.query_dim, c.embed)
+        else:
+            self.head = mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
 
     def forward(self, batch) -> torch.Tensor:
         h = batch.x
         for conv in self.convs:
             h = torch.relu(conv(h, batch.edge_index, batch.edge_attr))
+        if isinstance(self.head, BinQueryHead):
+            return self.head(h, batch, self.subgoal_embed(batch.u))
         pooled = global_max_pool(h, batch.batch)
         graph = self.graph_embed(torch.cat([h[batch.mover], pooled], dim=-1))
         return self.head(torch.cat([graph, self.subgoal_embed(batch.u)], dim=-1))
@@ -114,6 +128,43 @@ class FlatMotionNet(nn.Module):
     def forward(self, batch) -> torch.Tensor:
         graph = self.graph_embed(self.flatten(batch))
         return self.head(torch.cat([graph, self.subgoal_embed(batch.u)], dim=-1))
+
+
+class BinQueryHead(nn.Module):
+    """Scores each bin pair from every node seen from that bin: a two-layer network reads a
+    node's embedding with its offset from where the bin would put the moved object (its
+    reference-A features minus the bin's query position), the strongest reading over the
+    nodes goes with the bin's own features and the subgoal embedding through another
+    two-layer network to one logit. Clearance is local and the same everywhere, so what is
+    learnt on one surface carries over to the others.
+
+    Args:
+        hidden: node embedding width; embed: subgoal embedding width;
+        query_dim: features per bin (`grounding.QUERY_DIM`); width: the head's hidden units.
+
+    Shapes:
+        h [N, hidden], batch.query [B * bins, query_dim], subgoal [B, embed] -> [B, bins]
+    """
+
+    def __init__(self, hidden: int, embed: int, query_dim: int, width: int = 64) -> None:
+        super().__init__()
+        self.read = mlp([hidden + 3, width, width])
+        self.score = mlp([width + query_dim + embed, width, 1])
+
+    def forward(self, h: torch.Tensor, batch, subgoal: torch.Tensor) -> torch.Tensor:
+        nodes, mask = to_dense_batch(h, batch.batch)  # [B, N, hidden]
+        start = NODE_DIM - 6  # reference A: the three features after the first nine geometric
+        pos, _ = to_dense_batch(batch.x[:, start : start + 3], batch.batch)
+        b, n = mask.shape
+        query = batch.query.view(b, -1, batch.query.shape[-1])  # [B, bins, query_dim]
+        bins = query.shape[1]
+        offset = pos[:, None, :, :] - query[:, :, None, :3]  # [B, bins, N, 3]
+        seen = torch.relu(
+            self.read(torch.cat([nodes[:, None].expand(b, bins, n, -1), offset], dim=-1))
+        )
+        seen = seen.masked_fill(~mask[:, None, :, None], float("-inf")).amax(dim=2)
+        wide = subgoal[:, None, :].expand(b, bins, -1)
+        return self.score(torch.cat([seen, query, wide], dim=-1)).squeeze(-1)
 
 
 def build(config: MotionNetConfig) -> nn.Module:

@@ -49,6 +49,7 @@ class MotionTrainConfig:
     # than 1 (they fight the simulation workers for the cores).
     threads: int = 1
     loss: str = "ce"  # "ce" (successes, the paper's) or "bce" (every trial)
+    head: str = "mlp"  # the GNN's head: "mlp" (the paper's) or "bins" (`models.BinQueryHead`)
 
     def __post_init__(self) -> None:
         if self.primitive not in ("place", "push"):
@@ -65,7 +66,7 @@ class MotionTrainConfig:
     def net_config(self) -> MotionNetConfig:
         bins = BINS[MotionPrimitive(self.primitive)]
         return MotionNetConfig(
-            self.model, self.primitive, bins, self.hidden, self.embed, self.rounds
+            self.model, self.primitive, bins, self.hidden, self.embed, self.rounds, head=self.head
         )
 
     @staticmethod

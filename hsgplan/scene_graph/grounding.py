@@ -32,8 +32,18 @@ from torch_geometric.data import Data
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import ENTITY_TYPES, object_type
+from hsgplan.domain.parameters import PUSH_LEAD, place_xy, push_values
 from hsgplan.domain.predicates import Literal, Predicate
-from hsgplan.domain.world import OBJECT_TYPES, REGIONS, SHELVES, SURFACES, surface_rect
+from hsgplan.domain.world import (
+    OBJECT_TYPES,
+    PLACE_BINS,
+    PUSH_ANGLE_BINS,
+    PUSH_DIST_BINS,
+    REGIONS,
+    SHELVES,
+    SURFACES,
+    surface_rect,
+)
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -49,6 +59,7 @@ NODE_DIM = len(TYPES) + len(REGION_CLASSES) + 1 + 3 + 2 + 3 + 3
 EDGE_DIM = 4
 SUBGOAL_DIM = len(ENTITY_TYPES) + len(TYPES)
 SCALE = 10.0  # metres to decimetres
+QUERY_DIM = 5
 
 
 def _region_class(state: SymbolicSceneGraph, obj: str) -> str:
@@ -132,5 +143,46 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal) -> Data:
         edge_attr=edge_attr,
         u=u,
         mover=mover,
+        query=bin_queries(sg, subgoal),
         num_nodes=n,
     )
+
+
+def bin_queries(sg: GeometricSceneGraph, subgoal: Literal) -> torch.Tensor:
+    """Where each bin pair would put the moved object, in the frame of reference A (as the
+    nodes' reference-A features), and the bin indices scaled to 0..1: [bins, QUERY_DIM].
+
+    Place: the bin's centre on the target surface. Push: where the object would end, pushed
+    the bin's distance (less the lead) along the bin's angle. Used by the bin-query head.
+    """
+    obj, target = subgoal.args
+    rows = []
+    if subgoal.predicate is Predicate.ON:
+        cx, cy = surface_rect(target).center
+        for i in range(PLACE_BINS):
+            for j in range(PLACE_BINS):
+                x, y = place_xy(obj, target, i, j)
+                rows.append(
+                    [
+                        SCALE * (x - cx),
+                        SCALE * (y - cy),
+                        0.0,
+                        i / (PLACE_BINS - 1),
+                        j / (PLACE_BINS - 1),
+                    ]
+                )
+    else:
+        for i in range(PUSH_ANGLE_BINS):
+            for j in range(PUSH_DIST_BINS):
+                angle, dist = push_values(i, j)
+                d = SCALE * (dist - PUSH_LEAD)
+                rows.append(
+                    [
+                        d * math.cos(angle),
+                        d * math.sin(angle),
+                        0.0,
+                        i / (PUSH_ANGLE_BINS - 1),
+                        j / (PUSH_DIST_BINS - 1),
+                    ]
+                )
+    return torch.tensor(rows, dtype=torch.float)

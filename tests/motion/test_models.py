@@ -30,22 +30,25 @@ def _permuted_pair():
     return a, b
 
 
-@pytest.mark.parametrize("model", ["gnn", "mlp"])
-def test_shapes(model):
-    config = MotionNetConfig(model, "place", (10, 10), hidden=16, embed=8)
+MODELS = [("gnn", "mlp"), ("gnn", "bins"), ("mlp", "mlp")]
+
+
+@pytest.mark.parametrize("model,head", MODELS)
+def test_shapes(model, head):
+    config = MotionNetConfig(model, "place", (10, 10), hidden=16, embed=8, head=head)
     a, b = _permuted_pair()
     out = build(config)(Batch.from_data_list([a, b, a]))
     assert out.shape == (3, 100)
-    push = MotionNetConfig(model, "push", (21, 21), hidden=16, embed=8)
+    push = MotionNetConfig(model, "push", (21, 21), hidden=16, embed=8, head=head)
     sg = GeometricSceneGraph.from_poses({"cherries": Pose.from_xyz_yaw(0.3, 0.38, 0.029)})
     g = ground(sg, inside("cherries", "shelf_a"))  # a graph of one node and no edges
     assert build(push)(Batch.from_data_list([g])).shape == (1, 441)
 
 
-@pytest.mark.parametrize("model", ["gnn", "mlp"])
-def test_object_order_does_not_matter(model):
+@pytest.mark.parametrize("model,head", MODELS)
+def test_object_order_does_not_matter(model, head):
     torch.manual_seed(0)
-    net = build(MotionNetConfig(model, "place", (10, 10), hidden=32, embed=8)).eval()
+    net = build(MotionNetConfig(model, "place", (10, 10), hidden=32, embed=8, head=head)).eval()
     a, b = _permuted_pair()
     assert not torch.equal(a.x, b.x)  # really another order
     out_a = net(Batch.from_data_list([a]))
@@ -74,5 +77,7 @@ def test_the_mlp_flattens_by_type_slot():
 def test_bad_configurations_are_refused():
     with pytest.raises(InvalidInputError, match="model 'cnn'"):
         MotionNetConfig("cnn", "place", (10, 10))
+    with pytest.raises(InvalidInputError, match="head 'bins'"):
+        MotionNetConfig("mlp", "place", (10, 10), head="bins")
     with pytest.raises(InvalidInputError, match="hidden"):
         MotionNetConfig("gnn", "place", (10, 10), hidden=0)
