@@ -86,13 +86,13 @@ def eval_motion(
         return
     rows = []
     for kind, by_model in report.items():
-        levels = sorted({lvl for m in MODELS for lvl in by_model[m]["by_crowding"]})
+        levels = sorted({lvl for m in by_model.values() for lvl in m["by_crowding"]})
         picks = {"all": lambda r: r} | {
             lvl: (lambda r, lvl=lvl: r["by_crowding"].get(lvl)) for lvl in levels
         }
         picks["crowded shelf tops"] = lambda r: r.get("crowded_shelf_tops")
         for label, pick in picks.items():
-            found = [pick(by_model[m]) for m in MODELS]
+            found = [pick(by_model[m]) if m in by_model else None for m in MODELS]
             if all(r is None for r in found):
                 continue
             cells = ["—" if r is None else f"{r['success_rate']:.3f}" for r in found]

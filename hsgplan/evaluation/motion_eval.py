@@ -19,7 +19,11 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import SHELVES
 from hsgplan.sim.scene import Scene
 
-MODELS = ("gnn", "mlp", "random")
+MODELS = ("gnn", "gnn_paper", "mlp", "random")
+# The GNN with the paper's MLP head, where its checkpoint exists: shown beside ours
+# (the bin-query head) so that the difference is measured, not claimed.
+OPTIONAL = ("gnn_paper",)
+FOLDERS = {"gnn": "gnn", "gnn_paper": "gnn-paper", "mlp": "mlp"}
 EVAL_STREAM = 1_000_000  # collection streams use small seeds; evaluation never meets them
 CHUNK = 8
 CROWDED = 2  # a shelf top with this many of its 4 cells taken counts as crowded
@@ -28,11 +32,12 @@ CROWDED = 2  # a shelf top with this many of its 4 cells taken counts as crowded
 def _generators(kind: MotionPrimitive, checkpoints: Path, seed: int, index: int):
     from hsgplan.motion.generator import LearnedMotion, RandomMotion
 
-    return {
-        "gnn": LearnedMotion("gnn", {kind: checkpoints / f"{kind.value}-gnn"}),
-        "mlp": LearnedMotion("mlp", {kind: checkpoints / f"{kind.value}-mlp"}),
-        "random": RandomMotion(seed * 1_000_003 + index),
-    }
+    out = {}
+    for name, folder in FOLDERS.items():
+        path = checkpoints / f"{kind.value}-{folder}"
+        if name not in OPTIONAL or path.exists():
+            out[name] = LearnedMotion(name, {kind: path})
+    return out | {"random": RandomMotion(seed * 1_000_003 + index)}
 
 
 def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> list[dict]:
@@ -45,7 +50,7 @@ def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> l
     for index in range(start, start + CHUNK):
         task = draw_task(kind, EVAL_STREAM + seed, index)
         generators = _generators(kind, Path(checkpoints), seed, index)
-        for name in MODELS:
+        for name in generators:
             # A fresh scene per model: a restored physics state still carries the solver's
             # contact caches, so one model's trial would nudge the next one's outcome.
             with Scene((), seed=seed) as scene:
