@@ -274,9 +274,11 @@ def _template(nodes: tuple[str, ...]) -> _Template:
 
 
 @lru_cache(maxsize=256)
-def _tiled_x(nodes: tuple[str, ...], k: int) -> torch.Tensor:
-    """[K N, NODE_DIM]: the node features of K graphs (read only, shared between calls)."""
-    return torch.from_numpy(np.tile(_template(nodes).x, (k, 1)))
+def _batch(nodes: tuple[str, ...], k: int) -> tuple[torch.Tensor, np.ndarray]:
+    """[K N, NODE_DIM] node features and [2, K E] edge index of K graphs (read only, shared)."""
+    t = _template(nodes)
+    offsets = np.repeat(np.arange(k) * len(nodes), len(nodes) ** 2)
+    return torch.from_numpy(np.tile(t.x, (k, 1))), np.tile(t.edge_index, k) + offsets
 
 
 @lru_cache(maxsize=4)
@@ -327,14 +329,12 @@ class Computed:
         return self.x, self.edge_index, self.edge_attr, self.weight
 
 
-def touching(nodes: tuple[str, ...], names: list[tuple[str, ...]]) -> np.ndarray:
-    """[K, E] bool: the edges of graph k that start or end at one of the nodes names[k]."""
+def touching(nodes: tuple[str, ...], args: list[tuple[str, ...]]) -> np.ndarray:
+    """[K, E] bool: the edges of graph k that start or end at one of the nodes args[k], a
+    literal's arguments (one or two names)."""
     t, index = _template(nodes), Slots.of(nodes)._index
-    out = np.zeros((len(names), len(nodes) ** 2), dtype=bool)
-    for k, group in enumerate(names):
-        for name in group:
-            out[k] |= t.touching[index[name]]
-    return out
+    first, last = [index[a[0]] for a in args], [index[a[-1]] for a in args]
+    return t.touching[first] | t.touching[last]
 
 
 def encode_computed(
@@ -346,30 +346,35 @@ def encode_computed(
     """`encode_many(state, goals, [[q] for q in queries])` with the `readout` edges ([K, E]
     bool) read out, cut to what the network computes (see `EdgeClassifier.forward`)."""
     nodes = state.nodes
-    t, slots = _template(nodes), Slots.of(nodes)
+    slots = Slots.of(nodes)
     base, base_active = _state_edges(state)
-    k, n, e = len(goals), len(nodes), len(nodes) ** 2
+    k, e = len(goals), len(nodes) ** 2
+    x, edge_index = _batch(nodes, k)
     goal = [_goal_slots(nodes, g) for g in goals]
-    gk = np.repeat(np.arange(k), [len(g) for g in goal])
-    ge, gp, gv = np.concatenate(goal).T if goal else np.zeros((3, 0), dtype=np.int64)
-    asked = [(i, *slots.slot(q)) for i, q in enumerate(queries) if q is not None]
-    qk, qe, qp = np.array(asked, dtype=np.int64).reshape(-1, 3).T
-    active = np.repeat(base_active[None], k, 0)
-    active[gk, ge] = True
-    active[qk, qe] = True
-    active = active.reshape(-1)
+    ge, gp, gv = np.concatenate(goal).T
+    ge = ge + np.repeat(np.arange(0, k * e, e), [len(g) for g in goal])  # k E + e
+    asked = [
+        (i * e + edge, p)
+        for i, q in enumerate(queries)
+        if q is not None
+        for edge, p in [slots.slot(q)]
+    ]
+    qe, qp = np.array(asked, dtype=np.int64).reshape(-1, 2).T
+    active = np.tile(base_active, k)
+    active[ge] = True
+    active[qe] = True
     kept = np.flatnonzero(active if readout is None else active | readout.reshape(-1))
     row = np.full(k * e, -1, dtype=np.int64)
     row[kept] = np.arange(len(kept))
     graph, edge = np.divmod(kept, e)
     attr = base[edge]
-    at = row[gk * e + ge]
+    at = row[ge]
     attr[at, _GOAL_COL + 3 * gp] = 0.0
     attr[at, _GOAL_COL + 3 * gp + gv] = 1.0
-    attr[row[qk * e + qe], _QUERY_COL + qp] = 1.0
+    attr[row[qe], _QUERY_COL + qp] = 1.0
     return Computed(
-        x=_tiled_x(nodes, k),
-        edge_index=torch.from_numpy(t.edge_index[:, edge] + graph * n),
+        x=x,
+        edge_index=torch.from_numpy(edge_index[:, kept]),
         edge_attr=torch.from_numpy(attr),
         weight=torch.from_numpy(active[kept].astype(np.float32)),
         graph=graph,

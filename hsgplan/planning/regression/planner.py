@@ -87,6 +87,19 @@ def _inference_networks(checkpoint: str):
     return load_network(folder / "preimage").script(), load_network(folder / "reach").script()
 
 
+@lru_cache(maxsize=64)
+def _in_order(goal: Goal) -> list[Literal]:
+    """A goal's literals, sorted (once per goal: a decision needs them in order)."""
+    return sorted(goal.literals, key=_order)
+
+
+@lru_cache(maxsize=65536)
+def _order(lit: Literal) -> tuple:
+    """The sort key of `Literal`'s own order (predicate, args, sign), without its slow
+    generated comparisons; a planner sorts many small sets."""
+    return lit.predicate.value, lit.args, lit.positive
+
+
 @dataclass(frozen=True)
 class _Node:
     """A literal met while regressing, the subgoal it was regressed within, and its path."""
@@ -154,7 +167,7 @@ class RegressionPlanner:
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
-        unsatisfied = sorted(goal.unsatisfied(state))
+        unsatisfied = [lit for lit in _in_order(goal) if not state.holds(lit)]
         if not unsatisfied:
             return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
         taken = self._taken.setdefault((goal, state), set())
@@ -239,7 +252,7 @@ class RegressionPlanner:
         seen, out = set(), []
         for node, pre in frontier:
             context = frozenset((node.context - {node.lit}) | {m for m in pre if m.positive})
-            for m in sorted(pre):
+            for m in sorted(pre, key=_order):
                 if state.holds(m) or m in node.path or m in seen:
                     continue
                 seen.add(m)
