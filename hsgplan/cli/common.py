@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+import json
+from pathlib import Path
 
 import typer
 from rich.console import Console
@@ -29,6 +31,21 @@ def refuses_bad_input(fn):
             raise typer.Exit(130) from None
 
     return wrapper
+
+
+def read_config(path: Path | None) -> dict:
+    """The settings in a `--config` JSON file (none without a file), refused in one line."""
+    if path is None:
+        return {}
+    try:
+        settings = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise InvalidInputError(f"--config '{path}' does not exist") from None
+    except json.JSONDecodeError:
+        raise InvalidInputError(f"--config '{path}' is not valid JSON") from None
+    if not isinstance(settings, dict):
+        raise InvalidInputError(f"--config '{path}' must hold one JSON object")
+    return settings
 
 
 def parse_sizes(text: str) -> list[int]:

@@ -33,36 +33,35 @@ def demos(
     out.print(f"{len(done)} demonstrations, {steps} transitions, in {out_dir}")
 
 
-@app.command("place")
-@refuses_bad_input
-def place(
-    samples: Annotated[int, typer.Option(help="Successful trials to collect.")] = 14573,
-    workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
-    seed: Annotated[int, typer.Option(help="Seed of the scene and parameter stream.")] = 0,
-    ray: Annotated[
-        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
-    ] = None,
-    out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = Path("data/motion"),
-    tasks_per_chunk: Annotated[int, typer.Option(help="Tasks per unit of work.")] = 32,
-) -> None:
-    """Self-supervised place data: uniformly sampled bins tried in generated scenes."""
-    _collect("place", samples, workers, seed, ray, out_dir, tasks_per_chunk)
+def _collect_command(primitive: str, default_samples: int):
+    """`collect place` and `collect push`: the same options, their own default size."""
+
+    @refuses_bad_input
+    def command(
+        samples: Annotated[int, typer.Option(help="Successful trials to collect.")] = (
+            default_samples
+        ),
+        workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
+        seed: Annotated[int, typer.Option(help="Seed of the scene and parameter stream.")] = 0,
+        ray: Annotated[
+            str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
+        ] = None,
+        out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = Path(
+            "data/motion"
+        ),
+        tasks_per_chunk: Annotated[int, typer.Option(help="Tasks per unit of work.")] = 32,
+    ) -> None:
+        _collect(primitive, samples, workers, seed, ray, out_dir, tasks_per_chunk)
+
+    command.__doc__ = (
+        f"Self-supervised {primitive} data: uniformly sampled bins tried in generated scenes."
+    )
+    return command
 
 
-@app.command("push")
-@refuses_bad_input
-def push(
-    samples: Annotated[int, typer.Option(help="Successful trials to collect.")] = 8000,
-    workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
-    seed: Annotated[int, typer.Option(help="Seed of the scene and parameter stream.")] = 0,
-    ray: Annotated[
-        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
-    ] = None,
-    out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = Path("data/motion"),
-    tasks_per_chunk: Annotated[int, typer.Option(help="Tasks per unit of work.")] = 32,
-) -> None:
-    """Self-supervised push data: uniformly sampled bins tried in generated scenes."""
-    _collect("push", samples, workers, seed, ray, out_dir, tasks_per_chunk)
+# The paper's dataset sizes.
+app.command("place")(_collect_command("place", 14573))
+app.command("push")(_collect_command("push", 8000))
 
 
 def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir: Path, chunk: int):

@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import err, out, parse_sizes, print_table, refuses_bad_input
+from hsgplan.cli.common import err, out, parse_sizes, print_table, read_config, refuses_bad_input
 from hsgplan.domain.errors import InvalidInputError
 
 train_app = typer.Typer(no_args_is_help=True, help="Train the learned models (resumable).")
@@ -27,14 +27,7 @@ def train_task(
     from hsgplan.planning.regression.train import TaskTrainConfig
     from hsgplan.planning.regression.train import train_task as run
 
-    settings = {}
-    if config is not None:
-        try:
-            settings = json.loads(config.read_text())
-        except FileNotFoundError:
-            raise InvalidInputError(f"--config '{config}' does not exist") from None
-        except json.JSONDecodeError:
-            raise InvalidInputError(f"--config '{config}' is not valid JSON") from None
+    settings = read_config(config)
     if seed is not None:
         settings["seed"] = seed
     cfg = TaskTrainConfig.from_json(settings)

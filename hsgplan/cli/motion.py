@@ -9,8 +9,7 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import err, out, print_table, refuses_bad_input
-from hsgplan.domain.errors import InvalidInputError
+from hsgplan.cli.common import err, out, print_table, read_config, refuses_bad_input
 
 CHECKPOINTS = Path("checkpoints/motion")
 
@@ -34,14 +33,7 @@ def train_motion(
     from hsgplan.motion.train import MotionTrainConfig
     from hsgplan.motion.train import train_motion as run
 
-    settings = {}
-    if config is not None:
-        try:
-            settings = json.loads(config.read_text())
-        except FileNotFoundError:
-            raise InvalidInputError(f"--config '{config}' does not exist") from None
-        except json.JSONDecodeError:
-            raise InvalidInputError(f"--config '{config}' is not valid JSON") from None
+    settings = read_config(config)
     settings |= {"primitive": primitive, "model": model}
     if data is not None:
         settings["data"] = str(data)
