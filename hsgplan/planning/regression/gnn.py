@@ -222,8 +222,9 @@ class _Core(nn.Module):
 class _InferenceCore(nn.Module):
     """`_Core` without PyG's propagate, for `EdgeClassifier.script`: TorchScript runs PyG's
     argument checks and a doubled edge list at every layer, which cost a third of a planner
-    call. The same operations on the same operands in the same order (`scatter_add_` over the
-    edges, as PyG's sum), so the same numbers: a test holds it bit for bit to the PyG version."""
+    call. The same operations on the same operands, and the sums over the edges in the same
+    order (`index_add_` adds rows one edge after another, as PyG's `scatter_add_` does, and
+    measured faster), so the same numbers: a test holds it bit for bit to the PyG version."""
 
     def __init__(self, net: EdgeClassifier) -> None:
         super().__init__()
@@ -240,13 +241,12 @@ class _InferenceCore(nn.Module):
         e = self.edge_encoder(edge_attr)
         src, dst = edge_index[0], edge_index[1]
         n, h = x.size(0), e.size(1)
-        into, out = dst.unsqueeze(1).expand(-1, h), src.unsqueeze(1).expand(-1, h)
         # TorchScript's zip takes no strict=; both lists come from the same layers
         for edge_mlp, node_mlp in zip(self.edge_mlps, self.node_mlps):  # noqa: B905
             edge_new = edge_mlp(torch.cat([x.index_select(0, src), x.index_select(0, dst), e], -1))
             sent = edge_new if edge_weight is None else edge_new * edge_weight.unsqueeze(-1)
-            received = sent.new_zeros(n, h).scatter_add_(0, into, sent)
-            sent_out = sent.new_zeros(n, h).scatter_add_(0, out, sent)
+            received = sent.new_zeros(n, h).index_add_(0, dst, sent)
+            sent_out = sent.new_zeros(n, h).index_add_(0, src, sent)
             # every layer is hidden -> hidden, so both updates are residual
             x = node_mlp(torch.cat([x, received, sent_out], dim=-1)) + x
             e = edge_new + e
