@@ -115,6 +115,7 @@ def test_encode_computed_is_encode_many_cut_to_the_computed_edges():
     kept = (many.active | torch.from_numpy(readout.reshape(-1))).nonzero().squeeze(1)
     assert torch.equal(batch.x, many.x)
     assert torch.equal(batch.edge_index, many.edge_index[:, kept])
+    assert batch.edge_index.is_contiguous()  # else every index_select copies its index
     assert torch.equal(batch.edge_attr, many.edge_attr[kept])
     assert torch.equal(batch.weight, many.active[kept].float())
     assert (batch.valid == many.valid[kept].numpy()).all()

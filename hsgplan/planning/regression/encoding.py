@@ -374,7 +374,9 @@ def encode_computed(
     attr[row[qe], _QUERY_COL + qp] = 1.0
     return Computed(
         x=x,
-        edge_index=torch.from_numpy(edge_index[:, kept]),
+        # np.take, not edge_index[:, kept], whose rows numpy lays out strided: the network
+        # would copy its index rows at every index_select
+        edge_index=torch.from_numpy(np.take(edge_index, kept, axis=1)),
         edge_attr=torch.from_numpy(attr),
         weight=torch.from_numpy(active[kept].astype(np.float32)),
         graph=graph,
