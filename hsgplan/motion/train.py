@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from safetensors.torch import load_file, save_file
 from torch_geometric.data import Batch, Data
 
+from hsgplan import training
 from hsgplan.data.motion_store import MotionData, load
 from hsgplan.data.motion_tasks import MotionPrimitive
 from hsgplan.data.motion_trials import BINS
@@ -125,7 +125,7 @@ def train_motion(
     if saved.exists() and json.loads(saved.read_text()) != asdict(config):
         raise InvalidInputError(f"'{out}' holds a checkpoint trained with another configuration")
     saved.write_text(json.dumps(asdict(config), indent=2) + "\n")
-    if (out / "model.safetensors").exists():
+    if training.finished(out):
         return  # finished earlier
     examples = grounded_examples(_training_rows(config))
     torch.set_num_threads(config.threads)
@@ -133,12 +133,7 @@ def train_motion(
     net_config = config.net_config()
     model = build(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
-    start, progress = 0, out / "progress.pt"
-    if progress.exists():
-        state = torch.load(progress, weights_only=True)
-        model.load_state_dict(state["model"])
-        optim.load_state_dict(state["optim"])
-        start = int(state["epoch"])
+    start = training.resume(out, model, optim)
     for epoch in range(start, config.epochs):
         order = list(range(len(examples)))
         random.Random(f"{config.seed}-{epoch}").shuffle(order)
@@ -153,25 +148,14 @@ def train_motion(
         if on_epoch:
             on_epoch(epoch + 1, total / len(examples))
         if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
-            tmp = out / "progress.tmp"
-            state = {"model": model.state_dict(), "optim": optim.state_dict(), "epoch": epoch + 1}
-            torch.save(state, tmp)
-            tmp.replace(progress)  # a crash mid-write leaves the last good progress
-    save_file(model.state_dict(), out / "model.safetensors")
-    (out / "config.json").write_text(json.dumps(net_config.to_json(), indent=2) + "\n")
-    progress.unlink(missing_ok=True)
+            training.save_progress(out, model, optim, epoch + 1)
+    training.finish(out, model, net_config.to_json())
 
 
 def load_motion_net(folder: Path) -> torch.nn.Module:
     """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
-    try:
-        config = MotionNetConfig.from_json(json.loads((folder / "config.json").read_text()))
-        model = build(config)
-        model.load_state_dict(load_file(folder / "model.safetensors"))
-    except FileNotFoundError:
-        raise InvalidInputError(f"no trained motion network in '{folder}'") from None
-    except Exception as e:  # corrupted weights or config: one line, not a traceback
-        raise InvalidInputError(f"'{folder}' is not a usable checkpoint ({e})") from None
-    model.eval()
+    model, config = training.load_trained(
+        folder, MotionNetConfig.from_json, build, "motion network"
+    )
     model.config = config
     return model

@@ -17,9 +17,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import torch
-from safetensors.torch import load_file, save_file
 from torch_geometric.data import Batch
 
+from hsgplan import training
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.planning.regression.augment import trajectories
 from hsgplan.planning.regression.encoding import EDGE_DIM, NODE_DIM
@@ -110,19 +110,13 @@ def train_task(
 
 def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, on_epoch) -> None:
     folder.mkdir(exist_ok=True)
-    if (folder / "model.safetensors").exists():
+    if training.finished(folder):
         return  # finished earlier
     torch.manual_seed(config.seed)
     net_config = EdgeClassifierConfig(NODE_DIM, EDGE_DIM, 4, classes, config.hidden, config.rounds)
     model = EdgeClassifier(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
-    start = 0
-    progress = folder / "progress.pt"
-    if progress.exists():
-        state = torch.load(progress, weights_only=True)
-        model.load_state_dict(state["model"])
-        optim.load_state_dict(state["optim"])
-        start = int(state["epoch"])
+    start = training.resume(folder, model, optim)
     data = [e.as_data() for e in examples]
     for epoch in range(start, config.epochs):
         rng = random.Random(f"{config.seed}-{name}-{epoch}")
@@ -139,25 +133,13 @@ def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, o
         if on_epoch:
             on_epoch(name, epoch + 1, total / len(data))
         if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
-            tmp = folder / "progress.tmp"
-            torch.save(
-                {"model": model.state_dict(), "optim": optim.state_dict(), "epoch": epoch + 1}, tmp
-            )
-            tmp.replace(progress)  # a crash mid-write leaves the last good progress
-    save_file(model.state_dict(), folder / "model.safetensors")
-    (folder / "config.json").write_text(json.dumps(net_config.to_json(), indent=2) + "\n")
-    progress.unlink(missing_ok=True)
+            training.save_progress(folder, model, optim, epoch + 1)
+    training.finish(folder, model, net_config.to_json())
 
 
 def load_network(folder: Path) -> EdgeClassifier:
     """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
-    try:
-        config = EdgeClassifierConfig.from_json(json.loads((folder / "config.json").read_text()))
-        model = EdgeClassifier(config)
-        model.load_state_dict(load_file(folder / "model.safetensors"))
-    except FileNotFoundError:
-        raise InvalidInputError(f"no trained network in '{folder}'") from None
-    except Exception as e:  # corrupted weights or config: one line, not a traceback
-        raise InvalidInputError(f"'{folder}' is not a usable checkpoint ({e})") from None
-    model.eval()
+    model, _ = training.load_trained(
+        folder, EdgeClassifierConfig.from_json, EdgeClassifier, "network"
+    )
     return model
