@@ -29,15 +29,16 @@ CHUNK = 8
 CROWDED = 2  # a shelf top with this many of its 4 cells taken counts as crowded
 
 
-def _generators(kind: MotionPrimitive, checkpoints: Path, seed: int, index: int):
-    from hsgplan.motion.generator import LearnedMotion, RandomMotion
+def _learned(kind: MotionPrimitive, checkpoints: Path) -> dict:
+    """The trained models for a primitive, loaded once (optional ones where they exist)."""
+    from hsgplan.motion.generator import LearnedMotion
 
     out = {}
     for name, folder in FOLDERS.items():
         path = checkpoints / f"{kind.value}-{folder}"
         if name not in OPTIONAL or path.exists():
             out[name] = LearnedMotion(name, {kind: path})
-    return out | {"random": RandomMotion(seed * 1_000_003 + index)}
+    return out
 
 
 def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> list[dict]:
@@ -47,9 +48,13 @@ def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> l
     torch.set_num_threads(1)  # one process per core already
     kind = MotionPrimitive(primitive)
     rows = []
+    from hsgplan.motion.generator import RandomMotion
+
+    learned = _learned(kind, Path(checkpoints))
     for index in range(start, start + CHUNK):
         task = draw_task(kind, EVAL_STREAM + seed, index)
-        generators = _generators(kind, Path(checkpoints), seed, index)
+        # Random draws from its own seed per task, so chunking cannot change its choices.
+        generators = learned | {"random": RandomMotion(seed * 1_000_003 + index)}
         for name in generators:
             # A fresh scene per model: a restored physics state still carries the solver's
             # contact caches, so one model's trial would nudge the next one's outcome.
@@ -113,7 +118,7 @@ def evaluate_motion(
         if p not in ("place", "push"):
             raise InvalidInputError(f"primitive '{p}': place or push")
         kinds.append(MotionPrimitive(p))
-        _generators(MotionPrimitive(p), checkpoints, seed, 0)  # refuse missing checkpoints now
+        _learned(MotionPrimitive(p), checkpoints)  # refuse missing checkpoints before any work
     report = {}
     runner = LocalEngine(workers)
     try:
