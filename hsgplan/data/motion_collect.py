@@ -90,10 +90,16 @@ class RayEngine:
                 "--ray needs Ray: pip install 'hsgplan[ray]' (or pip install ray)"
             ) from None
         self.ray = ray
-        if address == "local":
-            ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
-        else:
-            ray.init(address=address, log_to_driver=False)
+        try:
+            if address == "local":
+                ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
+            else:
+                ray.init(address=address, log_to_driver=False)
+        except Exception as e:  # no cluster there, a bad address: one line, not a traceback
+            first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+            raise InvalidInputError(
+                f"--ray '{address}': could not start or join Ray ({first})"
+            ) from None
         self.remote = {}
 
     def submit(self, fn: Callable, *args):
