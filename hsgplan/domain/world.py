@@ -236,4 +236,7 @@ PUSH_ANGLE_BINS = 21
 PUSH_DIST_BINS = 21
 # Push direction, in radians from +x (shelves open towards -x, so pushes go roughly along +x).
 PUSH_ANGLE_RANGE = (-math.pi / 4, math.pi / 4)
-PUSH_DIST_RANGE = (0.04, 0.24)
+# Push length (the fingertips' travel). Measured over 4,466 uniform trials with 4-24 cm: under
+# 11 cm no push got a can from its prepush region into the shelf, and past 19 cm the hand always
+# met the shelf's walls or top board; the range keeps a margin on both sides.
+PUSH_DIST_RANGE = (0.08, 0.20)

@@ -9,14 +9,15 @@ steps rather than spending a time budget, for the same reason.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from hsgplan.sim.robot import ARM, Panda
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.robot import ARM, HAND, Panda
 
 ou.setLogLevel(ou.LOG_ERROR)
 OMPL_SEED = 20210530
@@ -65,6 +66,31 @@ class CollisionChecker:
                 return True
         return False
 
+    def hand_collides(self, q: np.ndarray) -> bool:
+        """Whether the hand or its fingers at q come within the margin of an obstacle."""
+        self.robot.set_q(q)
+        bc, arm = self.bc, self.robot.body
+        return any(
+            bc.getClosestPoints(arm, body, self.margin, linkIndexA=link)
+            for body in self.obstacles
+            for link in HAND
+        )
+
+    def held_collides_at(self, pose: Pose) -> bool:
+        """Whether the held object, put at `pose` (the arm left where it is), comes within the
+        margin of an obstacle. It is put back after."""
+        bc, held = self.bc, self.robot.held_body
+        pos, orn = bc.getBasePositionAndOrientation(held)
+        bc.resetBasePositionAndOrientation(held, pose.position, pose.orientation)
+        try:
+            return any(
+                bc.getClosestPoints(held, body, self.margin)
+                for body in self.obstacles
+                if body != held
+            )
+        finally:
+            bc.resetBasePositionAndOrientation(held, pos, orn)
+
     def segment_free(self, q0: np.ndarray, q1: np.ndarray) -> bool:
         n = max(1, int(np.ceil(np.max(np.abs(q1 - q0)) / STEP)))
         return not any(self.collides(q0 + (q1 - q0) * (i / n)) for i in range(1, n + 1))
@@ -88,13 +114,25 @@ class MotionPlanner:
             bounds.setHigh(i, float(robot.upper[i]))
         self.space.setBounds(bounds)
 
-    def plan(self, q0: np.ndarray, q1: np.ndarray) -> list[np.ndarray] | None:
-        """Waypoints from q0 to q1 (both included), or None when no path is found."""
-        with self.checker.robot.preserved():
-            if self.checker.collides(q0) or self.checker.collides(q1):
+    def plan(
+        self, q0: np.ndarray, q1: np.ndarray, vias: Iterable[Callable[[], list[np.ndarray]]] = ()
+    ) -> list[np.ndarray] | None:
+        """Waypoints from q0 to q1 (both included), or None when no path is found.
+
+        The straight segment first, then each of `vias` (made only when reached, as they may
+        cost inverse kinematics) as a chain of straight segments through its waypoints, then
+        RRTConnect: a few straight checks cost a fraction of a tree search.
+        """
+        checker = self.checker
+        with checker.robot.preserved():
+            if checker.collides(q0) or checker.collides(q1):
                 return None
-            if self.checker.segment_free(q0, q1):
+            if checker.segment_free(q0, q1):
                 return [q0, q1]
+            for make in vias:
+                path = [q0, *make(), q1]
+                if all(checker.segment_free(a, b) for a, b in zip(path, path[1:], strict=False)):
+                    return path
             return self._rrt(q0, q1)
 
     def _rrt(self, q0: np.ndarray, q1: np.ndarray) -> list[np.ndarray] | None:

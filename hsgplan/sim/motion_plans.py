@@ -38,6 +38,7 @@ from hsgplan.sim.outcome import Status
 from hsgplan.sim.robot import REST, TIP_OFFSET, tilted, topdown
 from hsgplan.sim.scene import Scene
 
+LIFT = 0.12  # m a hand rises before crossing, when a straight joint motion collides
 APPROACH = 0.10  # m above a grasp or place pose where the straight final approach starts
 GRASP_DEPTH = 0.035  # fingertips this far below an object's top, at most
 FLOOR_GAP = 0.008  # and at least this far above what it stands on
@@ -102,8 +103,9 @@ def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
     near = scene.checker(ignore=ignore)
     robot = scene.robot
     tries = [seeds] + [[scene.rng.uniform(robot.lower, robot.upper)] for _ in range(IK_BRANCHES)]
-    for start in tries:
-        q_above = robot.ik(above, scene.rng, seeds=start, restarts=0)
+    for i, start in enumerate(tries):
+        # A random branch falls back to nothing: the rest pose's answer is known by then.
+        q_above = robot.ik(above, scene.rng, seeds=start, restarts=0, rest_fallback=i == 0)
         if q_above is None or near.collides(q_above):
             continue
         q_at = robot.ik(target, scene.rng, seeds=[q_above], restarts=0)
@@ -113,8 +115,26 @@ def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
 
 
 def _path(scene: Scene, q0: np.ndarray, q_goal: np.ndarray, ignore=()):
-    path = scene.motion_planner(ignore).plan(q0, q_goal)
+    # Straight joint motions that collide mostly sweep the hand or the held object through a
+    # shelf's front edge on the way to or from its top: up first, across, then down is free.
+    def up_across_down() -> list[np.ndarray]:
+        return [q for q in (_lifted(scene, q0), _lifted(scene, q_goal)) if q is not None]
+
+    def across_down() -> list[np.ndarray]:
+        return [q for q in (_lifted(scene, q_goal),) if q is not None]
+
+    vias = (across_down, up_across_down, lambda: [REST])
+    path = scene.motion_planner(ignore).plan(q0, q_goal, vias)
     return None if path is None else tuple(path)
+
+
+def _lifted(scene: Scene, q: np.ndarray) -> np.ndarray | None:
+    """The joints that put the hand LIFT higher than at q, in the same orientation."""
+    robot = scene.robot
+    robot.set_q(q)
+    tcp = robot.tcp()
+    above = Pose((tcp.position[0], tcp.position[1], tcp.position[2] + LIFT), tcp.orientation)
+    return robot.ik(above, scene.rng, seeds=[q], restarts=0, rest_fallback=False)
 
 
 def _plan_pick(scene: Scene, p: PickParams, q0: np.ndarray) -> MotionPlan | PlanFailure:
@@ -171,8 +191,13 @@ def _plan_place(scene: Scene, p: PlaceParams, q0: np.ndarray) -> MotionPlan | Pl
     else:
         return PlanFailure(Status.INVALID, f"'{p.target}' is neither a surface nor another object")
     offset = scene.robot.held_offset
+    near = scene.checker(ignore=(p.obj,))
     for yaw in yaws:
         obj_pose = Pose((x, y, z + t.height / 2 + DROP), yaw_quat(yaw))
+        # An object that would touch a neighbour where it is let go needs no arm to tell: the
+        # approach ends with it there, and inverse kinematics is most of a failed place's time.
+        if near.held_collides_at(obj_pose):
+            continue
         found = _approach(scene, obj_pose.compose(offset.inverse()), (p.obj,), [REST, q0])
         if found:
             path = _path(scene, q0, found[0], ignore=(p.obj,))
@@ -204,8 +229,13 @@ def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
     robot = scene.robot
     robot.set_fingers(0.0)  # checked as executed: the hand pushes with closed fingers
     random_seeds = [[scene.rng.uniform(robot.lower, robot.upper)] for _ in range(2)]
+    end_checked = False
     for seeds in [[REST], [q0], *random_seeds]:
         found = _approach(scene, tcp[0], (p.obj,), seeds)
+        if found and not end_checked:
+            end_checked = True
+            if _hand_blocked(scene, tcp[-1], found[1]):
+                return PlanFailure(Status.NO_PATH, f"the hand would hit a shelf pushing '{p.obj}'")
         line = found and _line(scene, tcp[1:], found[1])
         if line:
             path = _path(scene, q0, found[0])
@@ -222,11 +252,20 @@ def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
     return PlanFailure(Status.NO_PATH, f"no reachable, collision-free push line for '{p.obj}'")
 
 
+def _hand_blocked(scene: Scene, end: Pose, q_start: np.ndarray) -> bool:
+    """Whether the hand at the end of a push line touches the arena. Where the hand is there
+    does not depend on the arm's joints, so such a line fails from every start: one check
+    instead of a line of inverse kinematics per start."""
+    q_end = scene.robot.ik(end, scene.rng, seeds=[q_start], restarts=0, rest_fallback=False)
+    arena = scene.checker(ignore=scene.objects, margin=0.0)
+    return q_end is not None and arena.hand_collides(q_end)
+
+
 def _line(scene: Scene, poses: list[Pose], q_start: np.ndarray) -> list[np.ndarray] | None:
     """Joints along a Cartesian line, each seeded by the last; None if any is out of reach."""
     qs, arena = [q_start], scene.checker(ignore=scene.objects, margin=0.0)
     for target in poses:
-        q = scene.robot.ik(target, scene.rng, seeds=[qs[-1]], restarts=0)
+        q = scene.robot.ik(target, scene.rng, seeds=[qs[-1]], restarts=0, rest_fallback=False)
         if q is None or arena.collides(q) or np.max(np.abs(q - qs[-1])) > MAX_JOINT_JUMP:
             return None
         qs.append(q)

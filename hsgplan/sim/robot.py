@@ -20,6 +20,7 @@ from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
 
 ARM = tuple(range(7))
 FINGERS = (9, 10)
+HAND = (8, 9, 10)  # the hand and its fingers: placed by the TCP pose alone, whatever the arm
 TCP = 11  # panda_grasptarget, between the fingers
 TIP_OFFSET = 0.011  # the fingertips lie this far beyond the TCP along the hand's z axis
 REST = np.array([0.0, -0.3, 0.0, -2.2, 0.0, 2.0, math.pi / 4])
@@ -131,14 +132,19 @@ class Panda:
         rng: np.random.Generator,
         seeds: list[np.ndarray] | None = None,
         restarts: int = 4,
+        rest_fallback: bool = True,
     ) -> np.ndarray | None:
-        """Joints that put the TCP at `target`, or None. Tries the seeds, then random restarts.
+        """Joints that put the TCP at `target`, or None. Tries the seeds, then the rest pose
+        (unless `rest_fallback` is off or it was a seed), then random restarts.
 
         The arm is left where it was; the result is clipped to the joint limits and checked by
         forward kinematics, since PyBullet's solver returns its best effort without a verdict.
         """
         saved = self.q()
-        starts = list(seeds or []) + [REST]
+        starts = list(seeds or [])
+        # The solver is deterministic: a start tried once gives the same answer again.
+        if rest_fallback and not any(np.array_equal(s, REST) for s in starts):
+            starts.append(REST)
         starts += [rng.uniform(self.lower, self.upper) for _ in range(restarts)]
         found = None
         for start in starts:
