@@ -1,10 +1,11 @@
 """Joint-space motion planning: OMPL's RRTConnect with PyBullet as the collision checker.
 
-A straight joint-space segment is tried first (most transit motions above the table are free);
-RRTConnect runs only when it collides. Every query re-seeds OMPL's seed generator with the same
-constant before its planner and simplifier draw their generators, so a query's path depends on
-its inputs alone (measured: repeated queries give identical paths); simplification counts its
-steps rather than spending a time budget, for the same reason.
+A straight joint-space segment is tried first (most transit motions above the table are free),
+then the caller's detours, and RRTConnect only when they all collide. Every query re-seeds
+OMPL's seed generator with the same constant before its planner and simplifier draw their
+generators, so a query's path depends on its inputs alone (measured: repeated queries give
+identical paths); the search spends a budget of collision checks and simplification counts its
+steps, rather than either spending seconds, for the same reason.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ OMPL_SEED = 20210530
 # there, failing grasps beside close neighbours.
 SAFETY_MARGIN = 0.002
 STEP = 0.02  # rad between collision checks along a joint-space segment
-RRT_TIME = 2.0
+RRT_CHECKS = 6000  # collision checks a tree search may spend (about 2 s)
 SHORTCUT_STEPS = 60
 
 
@@ -142,7 +143,14 @@ class MotionPlanner:
         ou.RNG.setSeed(OMPL_SEED)
         ou.setLogLevel(ou.LOG_ERROR)
         ss = og.SimpleSetup(self.space)
-        ss.setStateValidityChecker(lambda s: not self.checker.collides(_array(s)))
+        checks = 0
+
+        def valid(state) -> bool:
+            nonlocal checks
+            checks += 1
+            return not self.checker.collides(_array(state))
+
+        ss.setStateValidityChecker(valid)
         si = ss.getSpaceInformation()
         si.setStateValidityCheckingResolution(STEP / self.space.getMaximumExtent())
         ss.setPlanner(og.RRTConnect(si))
@@ -150,7 +158,10 @@ class MotionPlanner:
         for i in range(len(ARM)):
             start[i], goal[i] = float(q0[i]), float(q1[i])
         ss.setStartAndGoalStates(start, goal)
-        if not ss.solve(RRT_TIME) or not ss.haveExactSolutionPath():
+        # A budget of collision checks, not of seconds: on a busy machine a time budget would
+        # give up on searches that an idle one finishes, and results would depend on the load.
+        done = ob.PlannerTerminationCondition(lambda: checks >= RRT_CHECKS)
+        if not ss.solve(done) or not ss.haveExactSolutionPath():
             return None
         path = ss.getSolutionPath()
         simplifier = og.PathSimplifier(si)
