@@ -21,17 +21,17 @@ def replay(plan, start, goal):
     assert goal.satisfied_by(state)
 
 
-@pytest.mark.parametrize("part", [0, 1])  # two halves, so test workers share the load
+# 40 goals a size: the suite's budget (issue 2 measured 100 a size once; this keeps the check).
 @pytest.mark.parametrize("n", [2, 3, 4, 5, 6])
-def test_plans_for_100_random_goals_replay_in_the_transition_model(n, part):
+def test_plans_for_random_goals_replay_in_the_transition_model(n):
     planner = FastDownwardPlanner()
     rng = random.Random(f"test-fd-{n}")
-    goals = random_goals(n, 100, seed=11)
+    goals = random_goals(n, 40, seed=11)
     starts = [random_state(g.objects, rng) for g in goals]
-    for i in range(50 * part, 50 * (part + 1)):
+    for i, goal in enumerate(goals):
         # Half start with everything on the open space, half from a random arrangement.
-        start = SymbolicSceneGraph.initial(goals[i].objects) if i % 2 else starts[i]
-        replay(planner.plan(start, goals[i]), start, goals[i])
+        start = SymbolicSceneGraph.initial(goal.objects) if i % 2 else starts[i]
+        replay(planner.plan(start, goal), start, goal)
 
 
 @pytest.mark.parametrize("n", [7, 9, 12])
