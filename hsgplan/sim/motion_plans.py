@@ -7,6 +7,7 @@ before it is spent, and so that execution replays exactly what was checked.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -47,7 +48,7 @@ DROP = 0.006  # a placed object is released this far above its support
 PUSH_PITCH = math.radians(60)  # the hand leans forward to push (measured: upright hits boards)
 PUSH_TIP_Z = 0.03
 PUSH_STEP = 0.005
-PUSH_SLACK = 0.015
+PUSH_SLACK = 0.015  # m a push's bound must reach past a shelf's front (see _plan_push)
 IK_BRANCHES = 6  # random restarts for an approach whose first IK solutions collide
 MAX_JOINT_JUMP = 0.3  # rad between neighbouring push waypoints: more means an IK branch flip
 
@@ -118,13 +119,17 @@ def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
 def _path(scene: Scene, q0: np.ndarray, q_goal: np.ndarray, ignore=()):
     # Straight joint motions that collide mostly sweep the hand or the held object through a
     # shelf's front edge on the way to or from its top: up first, across, then down is free.
-    def up_across_down() -> list[np.ndarray]:
-        return [q for q in (_lifted(scene, q0), _lifted(scene, q_goal)) if q is not None]
+    # A lifted pose costs an IK call: the goal's is made when first needed, and only once.
+    lifted_goal = functools.cache(lambda: _lifted(scene, q_goal))
 
-    def across_down() -> list[np.ndarray]:
-        return [q for q in (_lifted(scene, q_goal),) if q is not None]
+    def found(*qs: np.ndarray | None) -> list[np.ndarray]:
+        return [q for q in qs if q is not None]
 
-    vias = (across_down, up_across_down, lambda: [REST])
+    vias = (
+        lambda: found(lifted_goal()),
+        lambda: found(_lifted(scene, q0), lifted_goal()),
+        lambda: [REST],
+    )
     path = scene.motion_planner(ignore).plan(q0, q_goal, vias)
     return None if path is None else tuple(path)
 
