@@ -15,7 +15,7 @@ import sys
 from collections import Counter
 
 from hsgplan.data.motion_tasks import MotionPrimitive, draw_task
-from hsgplan.data.motion_trials import BINS, params_for, release, stage_task, try_params
+from hsgplan.data.motion_trials import run_task
 from hsgplan.domain.parameters import PUSH_LEAD, push_values
 from hsgplan.domain.world import SHELVES
 from hsgplan.sim import motion_plans
@@ -26,24 +26,16 @@ def main(argv: list[str]) -> int:
     tasks = int(argv[0]) if argv else 120
     first = int(argv[1]) if len(argv) > 1 else 900_000
     slack, motion_plans.PUSH_SLACK = motion_plans.PUSH_SLACK, -math.inf
-    push = MotionPrimitive.PUSH
     margins: list[tuple[float, bool]] = []
     statuses: Counter[str] = Counter()
     with Scene((), seed=0) as scene:
         for index in range(first, first + tasks):
-            staged = stage_task(scene, draw_task(push, 0, index))
-            if staged is None:
-                continue
-            x = scene.pose(staged.task.obj).position[0]
-            x_min = SHELVES[staged.task.target].interior.x_min
-            for _ in range(4):
-                bins = tuple(staged.rng.randrange(n) for n in BINS[push])
-                angle, dist = push_values(*bins)
-                params = params_for(push, staged.task.obj, staged.task.target, bins)
-                out = try_params(scene, staged, params)
-                statuses[out.status.value] += 1
-                margins.append((x + (dist - PUSH_LEAD) * math.cos(angle) - x_min, out.ok))
-            release(scene, staged)
+            for trial in run_task(scene, draw_task(MotionPrimitive.PUSH, 0, index)) or []:
+                angle, dist = push_values(*trial.bins)
+                x = trial.before.pose(trial.obj).position[0]
+                x_min = SHELVES[trial.target].interior.x_min
+                margins.append((x + (dist - PUSH_LEAD) * math.cos(angle) - x_min, trial.ok))
+                statuses[trial.status.value] += 1
     ok = [m for m, success in margins if success]
     report = {
         "trials": len(margins),
