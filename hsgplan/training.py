@@ -26,10 +26,16 @@ def resume(folder: Path, model: torch.nn.Module, optim: torch.optim.Optimizer) -
     progress = folder / PROGRESS
     if not progress.exists():
         return 0
-    state = torch.load(progress, weights_only=True)
-    model.load_state_dict(state["model"])
-    optim.load_state_dict(state["optim"])
-    return int(state["epoch"])
+    try:
+        state = torch.load(progress, weights_only=True)
+        model.load_state_dict(state["model"])
+        optim.load_state_dict(state["optim"])
+        return int(state["epoch"])
+    except Exception as e:  # truncated or foreign file: one line, and nothing else is touched
+        raise InvalidInputError(
+            f"'{progress}' is not usable training progress ({type(e).__name__}); "
+            "delete it to train from the start"
+        ) from None
 
 
 def save_progress(folder: Path, model, optim, epoch: int) -> None:
