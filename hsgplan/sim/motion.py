@@ -17,89 +17,14 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from hsgplan.scene_graph.geometry import Pose
-from hsgplan.sim.robot import ARM, HAND, Panda
+from hsgplan.sim.collision import STEP, CollisionChecker
+from hsgplan.sim.robot import ARM
 
 ou.setLogLevel(ou.LOG_ERROR)
 OMPL_SEED = 20210530
 
-# Checked paths keep this far from obstacles, so that contacts between the checks spaced STEP
-# apart stay shallow. Transit and transfer motions are kinematic (a graze moves nothing), and
-# the approach poses at the ends of a path must pass the same margin: 5 cm measured too strict
-# there, failing grasps beside close neighbours.
-SAFETY_MARGIN = 0.002
-STEP = 0.02  # rad between collision checks along a joint-space segment
 RRT_CHECKS = 6000  # collision checks a tree search may spend (about 2 s)
 SHORTCUT_STEPS = 60
-
-
-class CollisionChecker:
-    """Whether the arm (and the object it holds) at a configuration touches anything.
-
-    Args:
-        robot: the arm; `set_q` moves a held object along.
-        obstacles: bodies the arm and held object must keep `margin` away from.
-        self_pairs: link pairs of the arm checked against each other.
-    """
-
-    def __init__(
-        self, robot: Panda, obstacles: Iterable[int], margin: float = SAFETY_MARGIN
-    ) -> None:
-        self.robot = robot
-        self.bc = robot.bc
-        self.obstacles = tuple(obstacles)
-        self.margin = margin
-        self.self_pairs = _self_collision_pairs(robot)
-
-    def collides(self, q: np.ndarray) -> bool:
-        self.robot.set_q(q)
-        bc, arm, held = self.bc, self.robot.body, self.robot.held_body
-        for a, b in self.self_pairs:
-            if bc.getClosestPoints(arm, arm, 0.0, a, b):
-                return True
-        for body in self.obstacles:
-            if body == held:
-                continue
-            for pt in bc.getClosestPoints(arm, body, self.margin):
-                if pt[3] > 0:  # link 0 and the base stand on the table by design
-                    return True
-            if held is not None and bc.getClosestPoints(held, body, self.margin):
-                return True
-        return False
-
-    def hand_collides(self, q: np.ndarray) -> bool:
-        """Whether the hand or its fingers at q come within the margin of an obstacle."""
-        self.robot.set_q(q)
-        bc, arm = self.bc, self.robot.body
-        return any(
-            bc.getClosestPoints(arm, body, self.margin, linkIndexA=link)
-            for body in self.obstacles
-            for link in HAND
-        )
-
-    def held_collides_at(self, pose: Pose) -> bool:
-        """Whether the held object, put at `pose` (the arm left where it is), comes within the
-        margin of an obstacle. It is put back after."""
-        bc, held = self.bc, self.robot.held_body
-        pos, orn = bc.getBasePositionAndOrientation(held)
-        bc.resetBasePositionAndOrientation(held, pose.position, pose.orientation)
-        try:
-            return any(
-                bc.getClosestPoints(held, body, self.margin)
-                for body in self.obstacles
-                if body != held
-            )
-        finally:
-            bc.resetBasePositionAndOrientation(held, pos, orn)
-
-    def segment_free(self, q0: np.ndarray, q1: np.ndarray) -> bool:
-        n = max(1, int(np.ceil(np.max(np.abs(q1 - q0)) / STEP)))
-        return not any(self.collides(q0 + (q1 - q0) * (i / n)) for i in range(1, n + 1))
-
-
-def _self_collision_pairs(robot: Panda) -> list[tuple[int, int]]:
-    """Non-adjacent link pairs that can meet: the hand and forearm against the upper arm."""
-    return [(a, b) for a in (6, 7, 8, 9, 10) for b in (0, 1, 2) if b < a - 1]
 
 
 class MotionPlanner:

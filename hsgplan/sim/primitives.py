@@ -50,6 +50,10 @@ def execute(
 
 
 def _follow(scene: Scene, path, on_frame: Frame | None) -> None:
+    # Setting joints moves nothing else and steps no physics: unwatched, only the last counts.
+    if on_frame is None:
+        scene.robot.set_q(path[-1])
+        return
     for q in densify(list(path)):
         scene.robot.set_q(q)
         if on_frame:

@@ -19,7 +19,8 @@ from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.arena import Arena, build_arena
 from hsgplan.sim.bodies import spawn_object
-from hsgplan.sim.motion import CollisionChecker, MotionPlanner
+from hsgplan.sim.collision import CollisionChecker
+from hsgplan.sim.motion import MotionPlanner
 from hsgplan.sim.robot import Panda
 
 TIME_STEP = 1.0 / 240.0

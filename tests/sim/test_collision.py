@@ -1,0 +1,97 @@
+"""The collision checker asks PyBullet about nearby pairs only: its verdicts must be those of
+asking about every pair, with and without a held object, near contact included."""
+
+import numpy as np
+import pytest
+
+from hsgplan.domain.parameters import PickParams
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.collision import SELF_PAIRS
+from hsgplan.sim.primitives import execute
+from hsgplan.sim.robot import HAND, REST, topdown
+from hsgplan.sim.scene import Scene
+
+from .test_primitives import standing
+
+
+def _every_pair(checker, q) -> bool:
+    """The verdict with no culling: every self pair, every obstacle, every link from 1."""
+    robot, bc = checker.robot, checker.bc
+    robot.set_q(q)
+    arm, held = robot.body, robot.held_body
+    if any(bc.getClosestPoints(arm, arm, 0.0, a, b) for a, b in SELF_PAIRS):
+        return True
+    for body in checker.obstacles:
+        if any(pt[3] > 0 for pt in bc.getClosestPoints(arm, body, checker.margin)):
+            return True
+        if held is not None and bc.getClosestPoints(held, body, checker.margin):
+            return True
+    return False
+
+
+def _hand_every_pair(checker, q) -> bool:
+    checker.robot.set_q(q)
+    return any(
+        checker.bc.getClosestPoints(checker.robot.body, body, checker.margin, linkIndexA=link)
+        for body in checker.obstacles
+        for link in HAND
+    )
+
+
+@pytest.fixture
+def scene():
+    s = Scene(
+        ["cherries", "tomato_soup", "butter", "popcorn"],
+        seed=0,
+        poses={
+            "cherries": standing("cherries", 0.42, 0.05),
+            "butter": standing("butter", 0.50, -0.12),
+            "tomato_soup": standing("tomato_soup", 0.305, 0.38),
+            "popcorn": standing("popcorn", 0.62, 0.10),
+        },
+    )
+    s.settle()
+    yield s
+    s.close()
+
+
+def _configurations(scene, n=300):
+    """Joints scattered around the rest pose, and joints that put the hand among the objects
+    and shelves (the hand at random points low over the table): many touch, many are within
+    centimetres, many are free."""
+    rng = np.random.default_rng(5)
+    robot = scene.robot
+    qs = [np.clip(REST + rng.normal(0, 0.6, 7), robot.lower, robot.upper) for _ in range(n // 2)]
+    while len(qs) < n:
+        xyz = rng.uniform((0.25, -0.3, 0.0), (0.75, 0.5, 0.25))
+        q = robot.ik(Pose(tuple(xyz), topdown(rng.uniform(-3, 3))), scene.rng, restarts=0)
+        if q is not None:
+            qs.append(q)
+    return qs
+
+
+def _mixed(verdicts) -> bool:
+    hits = sum(a for a, _ in verdicts)
+    return 0.15 * len(verdicts) < hits < 0.85 * len(verdicts)
+
+
+@pytest.mark.parametrize("margin", [None, 0.0])
+def test_verdicts_match_asking_every_pair(scene, margin):
+    for ignore in ((), ("cherries",)):
+        checker = scene.checker(ignore=ignore, margin=margin)
+        verdicts = [(checker.collides(q), _every_pair(checker, q)) for q in _configurations(scene)]
+        assert all(a == b for a, b in verdicts)
+        assert _mixed(verdicts)  # both kinds were seen
+        hands = [
+            (checker.hand_collides(q), _hand_every_pair(checker, q))
+            for q in _configurations(scene, 100)
+        ]
+        assert all(a == b for a, b in hands)
+
+
+def test_verdicts_match_with_a_held_object(scene):
+    assert execute(scene, PickParams("cherries")).ok
+    checker = scene.checker(ignore=("cherries",))
+    verdicts = [(checker.collides(q), _every_pair(checker, q)) for q in _configurations(scene)]
+    assert all(a == b for a, b in verdicts)
+    assert _mixed(verdicts)
