@@ -109,7 +109,7 @@ class CollisionChecker:
         return np.einsum("kmi,kmi->km", d, d) <= (reach * reach)[:, None]
 
     def collides(self, q: np.ndarray) -> bool:
-        self.robot.set_q(q)
+        self.robot.set_q_for_query(q)
         bc, arm = self.bc, self.robot.body
         links, centers = self.links, self.links.centers(self.robot)
         a, b = self._pair_rows
@@ -132,7 +132,7 @@ class CollisionChecker:
 
     def hand_collides(self, q: np.ndarray) -> bool:
         """Whether the hand or its fingers at q come within the margin of an obstacle."""
-        self.robot.set_q(q)
+        self.robot.set_q_for_query(q)
         links = self.links
         rows = [links.row[j] for j in HAND]
         near = self._near(links.centers(self.robot)[rows], links.radii[rows])

@@ -86,12 +86,14 @@ def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> None:
     robot.set_fingers(0.0)
     _follow(scene, plan.path, on_frame)
     _follow(scene, [plan.q_above, plan.q_at], on_frame)
-    for q in plan.line:
-        robot.drive_to(q, PUSH_SUBSTEPS)
-        if on_frame:
-            on_frame()
-    # Back out the way it came (joints checked against the shelves while planning; the object
-    # is ahead of the fingers now), then up to where the approach began.
-    _follow(scene, [robot.q(), *reversed(plan.line), plan.q_at, plan.q_above], on_frame)
-    scene.settle()
+    # Only the pushed object moves unless it is pushed into another, which that wakes.
+    with scene.asleep(awake=[plan.params.obj]):
+        for q in plan.line:
+            robot.drive_to(q, PUSH_SUBSTEPS)
+            if on_frame:
+                on_frame()
+        # Back out the way it came (joints checked against the shelves while planning; the
+        # object is ahead of the fingers now), then up to where the approach began.
+        _follow(scene, [robot.q(), *reversed(plan.line), plan.q_at, plan.q_above], on_frame)
+        scene.settle()
     robot.set_fingers(GRIPPER_MAX_OPENING)

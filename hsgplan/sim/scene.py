@@ -148,6 +148,25 @@ class Scene:
                 return step
         return max_steps
 
+    @contextlib.contextmanager
+    def asleep(self, awake: Iterable[str]) -> Iterator[None]:
+        """Every object but those named sleeps meanwhile: a resting object costs the solver as
+        much as a moving one (measured: 6 resting objects quadruple a physics step), and a
+        sleeping one nothing until something touches it, which wakes it. Afterwards all are
+        awake and never sleep, PyBullet's default."""
+        sleepers = [b for n, b in self.bodies.items() if n not in set(awake)]
+        for b in sleepers:
+            self.bc.changeDynamics(b, -1, activationState=self.bc.ACTIVATION_STATE_ENABLE_SLEEPING)
+            self.bc.changeDynamics(b, -1, activationState=self.bc.ACTIVATION_STATE_SLEEP)
+        try:
+            yield
+        finally:
+            for b in sleepers:
+                self.bc.changeDynamics(b, -1, activationState=self.bc.ACTIVATION_STATE_WAKE_UP)
+                self.bc.changeDynamics(
+                    b, -1, activationState=self.bc.ACTIVATION_STATE_DISABLE_SLEEPING
+                )
+
     def at_rest(self) -> bool:
         for body in self.bodies.values():
             if body == self.robot.held_body:
