@@ -84,7 +84,10 @@ class CollisionChecker:
         self.links = _bounds(robot)
         rows = self.links.row
         # Link 0 and the base stand on the table by design: links from 1 are checked.
-        self._checked = np.array([j >= 1 for j in self.links.links])
+        self._checked = [i for i, j in enumerate(self.links.links) if j >= 1]
+        # Each box grown by each checked link's reach: a centre outside it is too far.
+        reach = self.links.radii[self._checked][:, None, None] + margin
+        self._grown = np.concatenate([self._lo[None] - reach, -(self._hi[None] + reach)], axis=2)
         self._pairs = [(a, b) for a, b in SELF_PAIRS if a in rows and b in rows]
         self._pair_rows = (
             np.array([rows[a] for a, _ in self._pairs], dtype=int),
@@ -117,9 +120,11 @@ class CollisionChecker:
         for k in np.flatnonzero(np.einsum("ki,ki->k", d, d) <= self._pair_reach):
             if bc.getClosestPoints(arm, arm, 0.0, *self._pairs[k]):
                 return True
-        near = self._near(centers, links.radii) & self._checked[:, None]
+        c = centers[self._checked]
+        near = (np.concatenate([c, -c], axis=1)[:, None, :] >= self._grown).all(axis=2)
         for i, o in zip(*np.nonzero(near), strict=True):
-            if bc.getClosestPoints(arm, self.obstacles[o], self.margin, links.links[i]):
+            link = links.links[self._checked[i]]
+            if bc.getClosestPoints(arm, self.obstacles[o], self.margin, link):
                 return True
         held = self.robot.held_body
         if held is None:

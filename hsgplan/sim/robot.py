@@ -144,6 +144,7 @@ class Panda:
         seeds: list[np.ndarray] | None = None,
         restarts: int = 4,
         rest_fallback: bool = True,
+        threshold: float = IK_THRESHOLD,
     ) -> np.ndarray | None:
         """Joints that put the TCP at `target`, or None. Tries the seeds, then the rest pose
         (unless `rest_fallback` is off or it was a seed), then random restarts.
@@ -170,7 +171,7 @@ class Panda:
                 jointRanges=list(self.upper - self.lower) + [0.04, 0.04],
                 restPoses=list(start) + [0.02, 0.02],
                 maxNumIterations=IK_ITERATIONS,
-                residualThreshold=IK_THRESHOLD,
+                residualThreshold=threshold,
             )
             q = np.clip(np.array(sol[:7]), self.lower, self.upper)
             self._set_arm(q)

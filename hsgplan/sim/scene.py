@@ -20,6 +20,7 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.arena import Arena, build_arena
 from hsgplan.sim.bodies import spawn_object
 from hsgplan.sim.collision import CollisionChecker
+from hsgplan.sim.hand_ghost import HandGhost
 from hsgplan.sim.motion import MotionPlanner
 from hsgplan.sim.robot import Panda
 
@@ -79,6 +80,7 @@ class Scene:
             self.bodies[name] = spawn_object(self.bc, name, poses.get(name, self._parking(name)))
         self.rng = np.random.default_rng(seed)
         self.seed = seed
+        self._closed_hand: HandGhost | None = None
 
     @property
     def objects(self) -> tuple[str, ...]:
@@ -184,13 +186,24 @@ class Scene:
 
     # --- planning helpers --------------------------------------------------------------------
 
+    def obstacles(self, ignore: Iterable[str] = ()) -> tuple[int, ...]:
+        """The arena's bodies and every object's but those ignored."""
+        skip = {self.bodies[n] for n in ignore}
+        return self.arena.obstacles + tuple(b for b in self.bodies.values() if b not in skip)
+
     def checker(self, ignore: Iterable[str] = (), margin: float | None = None) -> CollisionChecker:
         """A collision checker against the arena and every object but those ignored."""
-        skip = {self.bodies[n] for n in ignore}
-        obstacles = list(self.arena.obstacles) + [b for b in self.bodies.values() if b not in skip]
+        obstacles = self.obstacles(ignore)
         if margin is None:
             return CollisionChecker(self.robot, obstacles)
         return CollisionChecker(self.robot, obstacles, margin)
 
     def motion_planner(self, ignore: Iterable[str] = ()) -> MotionPlanner:
         return MotionPlanner(self.checker(ignore))
+
+    def closed_hand(self) -> HandGhost:
+        """The hand with closed fingers on its own (made when first asked for: a scene that
+        never pushes never has one)."""
+        if self._closed_hand is None:
+            self._closed_hand = HandGhost(self.robot, opening=0.0)
+        return self._closed_hand

@@ -8,7 +8,7 @@ from hsgplan.domain.parameters import PickParams
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.collision import SELF_PAIRS
 from hsgplan.sim.primitives import execute
-from hsgplan.sim.robot import HAND, REST, topdown
+from hsgplan.sim.robot import HAND, REST, tilted, topdown
 from hsgplan.sim.scene import Scene
 
 from .test_primitives import standing
@@ -95,3 +95,35 @@ def test_verdicts_match_with_a_held_object(scene):
     verdicts = [(checker.collides(q), _every_pair(checker, q)) for q in _configurations(scene)]
     assert all(a == b for a, b in verdicts)
     assert _mixed(verdicts)
+
+
+def _nearest(bc, body, obstacles, link=None) -> float:
+    kw = {} if link is None else {"linkIndexA": link}
+    d = [pt[8] for o in obstacles for pt in bc.getClosestPoints(body, o, 0.2, **kw)]
+    return min(d, default=0.2)
+
+
+def test_the_ghost_hand_is_where_the_real_one_is(scene):
+    """At the pose the arm's TCP really reaches, the closed ghost hand and the arm's closed hand
+    are as far from every obstacle (to a tenth of a millimetre), and touch the same things."""
+    rng = np.random.default_rng(3)
+    robot, bc = scene.robot, scene.bc
+    hand, obstacles = scene.closed_hand(), scene.obstacles()
+    robot.set_fingers(0.0)
+    compared = touching = 0
+    while compared < 60:
+        xyz = rng.uniform((0.15, -0.3, 0.02), (0.7, 0.5, 0.2))
+        pose = Pose(tuple(xyz), tilted(rng.uniform(-0.8, 0.8), rng.uniform(0.0, 1.2)))
+        q = robot.ik(pose, scene.rng, restarts=0)
+        if q is None:
+            continue
+        robot.set_q(q)
+        tcp = robot.tcp()
+        real = min(_nearest(bc, robot.body, obstacles, link) for link in HAND)
+        bc.resetBasePositionAndOrientation(hand.body, tcp.position, tcp.orientation)
+        ghost = _nearest(bc, hand.body, obstacles)
+        assert abs(real - ghost) < 1e-4
+        assert hand.touches(tcp, obstacles, 0.0) == (real <= 0.0)
+        compared += 1
+        touching += real <= 0.0
+    assert 5 < touching < 55
