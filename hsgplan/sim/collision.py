@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from hsgplan.scene_graph.geometry import Pose
-from hsgplan.sim.robot import HAND, Panda
+from hsgplan.sim.robot import Panda
 
 # Checked paths keep this far from obstacles, so that contacts between the checks spaced STEP
 # apart stay shallow. Transit and transfer motions are kinematic (a graze moves nothing), and
@@ -133,18 +133,6 @@ class CollisionChecker:
         near = self._near(centre, np.array([self._held_radius]))[0]
         return any(
             bc.getClosestPoints(held, self.obstacles[o], self.margin) for o in np.flatnonzero(near)
-        )
-
-    def hand_collides(self, q: np.ndarray) -> bool:
-        """Whether the hand or its fingers at q come within the margin of an obstacle."""
-        self.robot.set_q_for_query(q)
-        links = self.links
-        rows = [links.row[j] for j in HAND]
-        near = self._near(links.centers(self.robot)[rows], links.radii[rows])
-        arm = self.robot.body
-        return any(
-            self.bc.getClosestPoints(arm, self.obstacles[o], self.margin, linkIndexA=HAND[i])
-            for i, o in zip(*np.nonzero(near), strict=True)
         )
 
     def held_collides_at(self, pose: Pose) -> bool:

@@ -29,15 +29,6 @@ def _every_pair(checker, q) -> bool:
     return False
 
 
-def _hand_every_pair(checker, q) -> bool:
-    checker.robot.set_q(q)
-    return any(
-        checker.bc.getClosestPoints(checker.robot.body, body, checker.margin, linkIndexA=link)
-        for body in checker.obstacles
-        for link in HAND
-    )
-
-
 @pytest.fixture
 def scene():
     s = Scene(
@@ -82,11 +73,6 @@ def test_verdicts_match_asking_every_pair(scene, margin):
         verdicts = [(checker.collides(q), _every_pair(checker, q)) for q in _configurations(scene)]
         assert all(a == b for a, b in verdicts)
         assert _mixed(verdicts)  # both kinds were seen
-        hands = [
-            (checker.hand_collides(q), _hand_every_pair(checker, q))
-            for q in _configurations(scene, 100)
-        ]
-        assert all(a == b for a, b in hands)
 
 
 def test_verdicts_match_with_a_held_object(scene):
