@@ -9,9 +9,6 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.collision import SELF_PAIRS
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.robot import HAND, REST, tilted, topdown
-from hsgplan.sim.scene import Scene
-
-from .test_primitives import standing
 
 
 def _every_pair(checker, q) -> bool:
@@ -27,23 +24,6 @@ def _every_pair(checker, q) -> bool:
         if held is not None and bc.getClosestPoints(held, body, checker.margin):
             return True
     return False
-
-
-@pytest.fixture
-def scene():
-    s = Scene(
-        ["cherries", "tomato_soup", "butter", "popcorn"],
-        seed=0,
-        poses={
-            "cherries": standing("cherries", 0.42, 0.05),
-            "butter": standing("butter", 0.50, -0.12),
-            "tomato_soup": standing("tomato_soup", 0.305, 0.38),
-            "popcorn": standing("popcorn", 0.62, 0.10),
-        },
-    )
-    s.settle()
-    yield s
-    s.close()
 
 
 def _configurations(scene, n=300):

@@ -14,7 +14,7 @@ from hsgplan.sim.primitives import execute
 from hsgplan.sim.robot import ARM
 from hsgplan.sim.scene import Scene
 
-from .test_primitives import standing
+from .conftest import standing
 
 
 @pytest.fixture

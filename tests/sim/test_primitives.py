@@ -2,35 +2,14 @@
 
 import pytest
 
-from hsgplan.domain.objects import object_type
 from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams, nearest_push_bins
 from hsgplan.domain.predicates import clear, in_grasp, inside, on
-from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.sim.outcome import Status
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.scene import Scene
 
-
-def standing(name, x, y, yaw=0.0, on_z=0.0):
-    return Pose.from_xyz_yaw(x, y, on_z + object_type(name).height / 2 + 0.001, yaw)
-
-
-@pytest.fixture
-def scene():
-    s = Scene(
-        ["cherries", "tomato_soup", "butter", "popcorn"],
-        seed=0,
-        poses={
-            "cherries": standing("cherries", 0.42, 0.05),
-            "butter": standing("butter", 0.55, -0.10),
-            "popcorn": standing("popcorn", 0.36, -0.12),
-            "tomato_soup": standing("tomato_soup", 0.305, 0.38),
-        },
-    )
-    s.settle()
-    yield s
-    s.close()
+from .conftest import standing
 
 
 def state(scene):
