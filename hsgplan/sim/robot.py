@@ -86,7 +86,9 @@ class Panda:
     def set_q_for_query(self, q: np.ndarray) -> None:
         """`set_q` for geometric queries (collision checks): one call for all seven joints,
         a fifth of the time of seven (measured). Not for inverse kinematics, whose answers it
-        perturbs in the last digits (measured: one push outcome in a thousand changed)."""
+        perturbs in the last digits (measured: one push outcome in a thousand changed). Later
+        physics differs in the last digits too (measured), so swapping one for the other in any
+        caller means collecting the motion data again."""
         self.bc.resetJointStatesMultiDof(self.body, ARM, [[float(v)] for v in q])
         if self.held_body is not None:
             self._carry_held()

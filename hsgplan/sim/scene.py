@@ -156,7 +156,8 @@ class Scene:
         much as a moving one (measured: 6 resting objects quadruple a physics step), and a
         sleeping one nothing until something touches it, which wakes it. Afterwards all are
         awake and never sleep, PyBullet's default."""
-        sleepers = [b for n, b in self.bodies.items() if n not in set(awake)]
+        keep = set(awake)
+        sleepers = [b for n, b in self.bodies.items() if n not in keep]
         for b in sleepers:
             self.bc.changeDynamics(b, -1, activationState=self.bc.ACTIVATION_STATE_ENABLE_SLEEPING)
             self.bc.changeDynamics(b, -1, activationState=self.bc.ACTIVATION_STATE_SLEEP)
