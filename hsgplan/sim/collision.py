@@ -82,19 +82,20 @@ class CollisionChecker:
         self._lo = np.array([b[0] for b in boxes]).reshape(-1, 3) - BOUND_PAD
         self._hi = np.array([b[1] for b in boxes]).reshape(-1, 3) + BOUND_PAD
         self.links = _bounds(robot)
-        rows = self.links.row
-        # Link 0 and the base stand on the table by design: links from 1 are checked.
-        self._checked = [i for i, j in enumerate(self.links.links) if j >= 1]
-        # Each box grown by each checked link's reach: a centre outside it is too far.
-        reach = self.links.radii[self._checked][:, None, None] + margin
-        self._grown = np.concatenate([self._lo[None] - reach, -(self._hi[None] + reach)], axis=2)
-        self._pairs = [(a, b) for a, b in SELF_PAIRS if a in rows and b in rows]
-        self._pair_rows = (
-            np.array([rows[a] for a, _ in self._pairs], dtype=int),
-            np.array([rows[b] for _, b in self._pairs], dtype=int),
-        )
-        reach = self.links.radii[self._pair_rows[0]] + self.links.radii[self._pair_rows[1]]
-        self._pair_reach = reach * reach
+        rows, radii = self.links.row, self.links.radii
+        # Link 0 and the base stand on the table by design: links from 1 are checked (the
+        # rows are in link order, so they are the rows from the first such link on).
+        self._first = next(i for i, j in enumerate(self.links.links) if j >= 1)
+        # Each box grown by each checked link's reach, axis first, so that a check is a few
+        # operations on small arrays (numpy's per-call cost dominates at these sizes).
+        reach = radii[self._first :][None, :, None] + margin
+        self._mid = ((self._lo + self._hi) / 2).T[:, None, :]
+        self._half = ((self._hi - self._lo) / 2).T[:, None, :] + reach
+        # Squared reach of every pair of rows, -1 for the pairs that are not checked.
+        self._pair_reach = np.full((len(radii), len(radii)), -1.0)
+        for a, b in SELF_PAIRS:
+            if a in rows and b in rows:
+                self._pair_reach[rows[a], rows[b]] = (radii[rows[a]] + radii[rows[b]]) ** 2
         self._held_radius = 0.0
         if held is not None:
             lo, hi = (np.array(v) for v in self.bc.getAABB(held))
@@ -114,18 +115,21 @@ class CollisionChecker:
     def collides(self, q: np.ndarray) -> bool:
         self.robot.set_q_for_query(q)
         bc, arm = self.bc, self.robot.body
-        links, centers = self.links, self.links.centers(self.robot)
-        a, b = self._pair_rows
-        d = centers[a] - centers[b]
-        for k in np.flatnonzero(np.einsum("ki,ki->k", d, d) <= self._pair_reach):
-            if bc.getClosestPoints(arm, arm, 0.0, *self._pairs[k]):
-                return True
-        c = centers[self._checked]
-        near = (np.concatenate([c, -c], axis=1)[:, None, :] >= self._grown).all(axis=2)
-        for i, o in zip(*np.nonzero(near), strict=True):
-            link = links.links[self._checked[i]]
-            if bc.getClosestPoints(arm, self.obstacles[o], self.margin, link):
-                return True
+        links, c = self.links.links, self.links.centers(self.robot)
+        # Pairs in SELF_PAIRS order and link-then-obstacle order: the same calls, in the same
+        # order, as asking pair by pair (PyBullet's later answers depend on its call history).
+        d = c[:, None, :] - c[None, :, :]
+        near = np.einsum("abi,abi->ab", d, d) <= self._pair_reach
+        if near.any():
+            for a, b in zip(*np.nonzero(near), strict=True):
+                if bc.getClosestPoints(arm, arm, 0.0, links[a], links[b]):
+                    return True
+        t = np.abs(c[self._first :].T[:, :, None] - self._mid) - self._half
+        near = np.maximum(np.maximum(t[0], t[1]), t[2]) <= 0.0
+        if near.any():
+            for i, o in zip(*np.nonzero(near), strict=True):
+                if bc.getClosestPoints(arm, self.obstacles[o], self.margin, links[self._first + i]):
+                    return True
         held = self.robot.held_body
         if held is None:
             return False
