@@ -164,7 +164,7 @@ def collect(
             "primitive": config.primitive.value,
             "seed": config.seed,
             "tasks_per_chunk": config.tasks_per_chunk,
-            "attempts_per_task": ATTEMPTS_PER_TASK,
+            "attempts_per_task": ATTEMPTS_PER_TASK[config.primitive],
             "schema_version": store.SCHEMA_VERSION,
         },
         f"'{folder}' holds chunks made with other collection settings; use another --out",

@@ -10,6 +10,8 @@ no visual shape.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
 from hsgplan.scene_graph.geometry import Pose
@@ -49,17 +51,21 @@ class HandGhost:
         self.body = bc.createMultiBody(0, shape, -1, PARKED, useMaximalCoordinates=True)
         bc.setCollisionFilterGroupMask(self.body, -1, 0, 0)
 
-    def touches(self, tcp: Pose, obstacles: tuple[int, ...], margin: float) -> bool:
-        """Whether the hand, with the TCP at `tcp`, comes within `margin` of an obstacle."""
+    def touches(self, tcps: Iterable[Pose], obstacles: tuple[int, ...], margin: float) -> bool:
+        """Whether the hand, with the TCP at any of `tcps` (asked in order, stopping at the
+        first touch), comes within `margin` of an obstacle."""
         bc = self.bc
-        bc.resetBasePositionAndOrientation(self.body, tcp.position, tcp.orientation)
+        boxes = np.array([bc.getAABB(b) for b in obstacles]).reshape(-1, 2, 3)
+        lo, hi = boxes[:, 0] - margin, boxes[:, 1] + margin
         try:
-            lo, hi = (np.array(v) for v in bc.getAABB(self.body))
-            for body in obstacles:
-                blo, bhi = bc.getAABB(body)
-                if np.any(lo - margin > bhi) or np.any(hi + margin < blo):
-                    continue
-                if bc.getClosestPoints(self.body, body, margin):
+            for tcp in tcps:
+                bc.resetBasePositionAndOrientation(self.body, tcp.position, tcp.orientation)
+                g_lo, g_hi = bc.getAABB(self.body)
+                near = ((lo <= g_hi) & (hi >= g_lo)).all(axis=1)
+                if any(
+                    bc.getClosestPoints(self.body, obstacles[i], margin)
+                    for i in np.flatnonzero(near)
+                ):
                     return True
             return False
         finally:

@@ -19,7 +19,7 @@ from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
 from hsgplan.sim.outcome import Outcome, verify
 from hsgplan.sim.scene import Scene
 
-PUSH_SUBSTEPS = 4  # physics steps per 5 mm of push: 0.3 m/s (measured: more successes than 0.2)
+PUSH_SUBSTEPS = 3  # physics steps per 5 mm of push: 0.4 m/s (see README "Decisions")
 
 Frame = Callable[[], None]
 

@@ -89,7 +89,31 @@ def test_the_ghost_hand_is_where_the_real_one_is(scene):
         bc.resetBasePositionAndOrientation(hand.body, tcp.position, tcp.orientation)
         ghost = _nearest(bc, hand.body, obstacles)
         assert abs(real - ghost) < 1e-4
-        assert hand.touches(tcp, obstacles, 0.0) == (real <= 0.0)
+        assert hand.touches([tcp], obstacles, 0.0) == (real <= 0.0)
         compared += 1
         touching += real <= 0.0
     assert 5 < touching < 55
+
+
+def test_the_ghost_hand_asks_every_pose_until_one_touches(scene):
+    """Several poses at once: a touch when any of them is within the margin of an obstacle
+    (asked of every obstacle, no culling), none otherwise."""
+    rng = np.random.default_rng(8)
+    bc, hand, obstacles = scene.bc, scene.closed_hand(), scene.obstacles()
+    margin = 0.01
+    verdicts = []
+    for _ in range(40):
+        poses = [
+            Pose(
+                tuple(rng.uniform((0.15, -0.3, 0.02), (0.7, 0.5, 0.2))),
+                tilted(rng.uniform(-0.8, 0.8), rng.uniform(0.0, 1.2)),
+            )
+            for _ in range(3)
+        ]
+        expected = False
+        for pose in poses:
+            bc.resetBasePositionAndOrientation(hand.body, pose.position, pose.orientation)
+            expected |= _nearest(bc, hand.body, obstacles) < margin
+        verdicts.append(expected)
+        assert hand.touches(poses, obstacles, margin) == expected
+    assert 5 < sum(verdicts) < 35
