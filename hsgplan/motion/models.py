@@ -66,8 +66,9 @@ class GraphMotionNet(nn.Module):
 
     Shapes:
         batch.x [N, node_dim], batch.edge_index [2, E], batch.edge_attr [E, edge_dim],
-        batch.u [B, subgoal_dim], batch.mover [N] bool (one per graph), batch.batch [N]
-        -> logits [B, bins[0] * bins[1]]
+        batch.u [B, subgoal_dim], batch.mover [N] bool (one per graph), batch.batch [N],
+        only [B] (optional: one flattened bin pair per graph)
+        -> logits [B, bins[0] * bins[1]], or [B, 1] for the `only` bins
     """
 
     def __init__(self, config: MotionNetConfig) -> None:
@@ -84,15 +85,15 @@ class GraphMotionNet(nn.Module):
         else:
             self.head = mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
 
-    def forward(self, batch) -> torch.Tensor:
+    def forward(self, batch, only: torch.Tensor | None = None) -> torch.Tensor:
         h = batch.x
         for conv in self.convs:
             h = torch.relu(conv(h, batch.edge_index, batch.edge_attr))
         if isinstance(self.head, BinQueryHead):
-            return self.head(h, batch, self.subgoal_embed(batch.u))
+            return self.head(h, batch, self.subgoal_embed(batch.u), only)
         pooled = global_max_pool(h, batch.batch)
         graph = self.graph_embed(torch.cat([h[batch.mover], pooled], dim=-1))
-        return self.head(torch.cat([graph, self.subgoal_embed(batch.u)], dim=-1))
+        return _pick(self.head(torch.cat([graph, self.subgoal_embed(batch.u)], dim=-1)), only)
 
 
 class FlatMotionNet(nn.Module):
@@ -100,7 +101,7 @@ class FlatMotionNet(nn.Module):
     object type and per ordered pair of types, zeros where absent), then fully connected
     layers of the same width as the GNN's.
 
-    Shapes: as `GraphMotionNet`.
+    Shapes: as `GraphMotionNet` (`only` included).
     """
 
     def __init__(self, config: MotionNetConfig) -> None:
@@ -125,9 +126,13 @@ class FlatMotionNet(nn.Module):
         edges[batch.batch[src], pair] = batch.edge_attr
         return torch.cat([nodes.flatten(1), edges.flatten(1)], dim=1)
 
-    def forward(self, batch) -> torch.Tensor:
+    def forward(self, batch, only: torch.Tensor | None = None) -> torch.Tensor:
         graph = self.graph_embed(self.flatten(batch))
-        return self.head(torch.cat([graph, self.subgoal_embed(batch.u)], dim=-1))
+        return _pick(self.head(torch.cat([graph, self.subgoal_embed(batch.u)], dim=-1)), only)
+
+
+def _pick(logits: torch.Tensor, only: torch.Tensor | None) -> torch.Tensor:
+    return logits if only is None else logits.gather(1, only.view(-1, 1))
 
 
 class BinQueryHead(nn.Module):
@@ -143,7 +148,9 @@ class BinQueryHead(nn.Module):
         query_dim: features per bin (`grounding.QUERY_DIM`); width: the head's hidden units.
 
     Shapes:
-        h [N, hidden], batch.query [B * bins, query_dim], subgoal [B, embed] -> [B, bins]
+        h [N, hidden], batch.query [B * bins, query_dim], subgoal [B, embed] -> [B, bins];
+        with `only` [B] (a bin per graph) -> [B, 1], scoring that bin alone (training on
+        single trials need not score the other bins).
     """
 
     def __init__(self, hidden: int, embed: int, query_dim: int, width: int = 64) -> None:
@@ -151,12 +158,16 @@ class BinQueryHead(nn.Module):
         self.read = mlp([hidden + 3, width, width])
         self.score = mlp([width + query_dim + embed, width, 1])
 
-    def forward(self, h: torch.Tensor, batch, subgoal: torch.Tensor) -> torch.Tensor:
+    def forward(
+        self, h: torch.Tensor, batch, subgoal: torch.Tensor, only: torch.Tensor | None = None
+    ) -> torch.Tensor:
         nodes, mask = to_dense_batch(h, batch.batch)  # [B, N, hidden]
         start = NODE_DIM - 6  # reference A: the three features after the first nine geometric
         pos, _ = to_dense_batch(batch.x[:, start : start + 3], batch.batch)
         b, n = mask.shape
         query = batch.query.view(b, -1, batch.query.shape[-1])  # [B, bins, query_dim]
+        if only is not None:
+            query = query[torch.arange(b), only.view(-1)].unsqueeze(1)  # [B, 1, query_dim]
         bins = query.shape[1]
         offset = pos[:, None, :, :] - query[:, :, None, :3]  # [B, bins, N, 3]
         seen = torch.relu(

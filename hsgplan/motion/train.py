@@ -93,10 +93,11 @@ def _training_rows(config: MotionTrainConfig) -> MotionData:
     return trials.take(np.array(keep, dtype=bool))
 
 
-def _loss(kind: str, logits: torch.Tensor, batch) -> torch.Tensor:
+def _loss(kind: str, model: torch.nn.Module, batch) -> torch.Tensor:
     if kind == "ce":
-        return torch.nn.functional.cross_entropy(logits, batch.y)
-    picked = logits.gather(1, batch.y.view(-1, 1)).squeeze(1)
+        return torch.nn.functional.cross_entropy(model(batch), batch.y)
+    # Each trial teaches its own bin pair's logit only: the others need not be scored.
+    picked = model(batch, only=batch.y).squeeze(1)
     return torch.nn.functional.binary_cross_entropy_with_logits(picked, batch.ok.float())
 
 
@@ -140,7 +141,7 @@ def train_motion(
         total = 0.0
         for i in range(0, len(order), config.batch_size):
             batch = Batch.from_data_list([examples[j] for j in order[i : i + config.batch_size]])
-            loss = _loss(config.loss, model(batch), batch)
+            loss = _loss(config.loss, model, batch)
             optim.zero_grad()
             loss.backward()
             optim.step()

@@ -18,11 +18,12 @@ runner = CliRunner()
 def checkpoints(tmp_path_factory):
     root = tmp_path_factory.mktemp("motion")
     collect(CollectConfig(MotionPrimitive.PLACE, 6, workers=1, tasks_per_chunk=2), root / "data")
-    for model, head, folder in (("gnn", "bins", "gnn"), ("mlp", "mlp", "mlp")):
+    # as shipped: the GNN learns from every trial (bce), the MLP from the successes (ce)
+    for model, head, loss in (("gnn", "bins", "bce"), ("mlp", "mlp", "ce")):
         config = MotionTrainConfig(
-            model=model, head=head, data=str(root / "data"), epochs=2, hidden=16, embed=8
+            model=model, head=head, loss=loss, data=str(root / "data"), epochs=2, hidden=16, embed=8
         )
-        train_motion(config, root / "ck" / f"place-{folder}")
+        train_motion(config, root / "ck" / f"place-{model}")
     return root / "ck"
 
 

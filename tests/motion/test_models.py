@@ -46,6 +46,20 @@ def test_shapes(model, head):
 
 
 @pytest.mark.parametrize("model,head", MODELS)
+def test_scoring_only_some_bins_gives_their_logits(model, head):
+    """`only` (one bin per graph, what the bce loss trains) gives the logits that scoring
+    every bin gives for those bins."""
+    torch.manual_seed(0)
+    net = build(MotionNetConfig(model, "place", (10, 10), hidden=16, embed=8, head=head)).eval()
+    a, b = _permuted_pair()
+    batch = Batch.from_data_list([a, b, a])
+    only = torch.tensor([3, 57, 99])
+    picked = net(batch, only=only)
+    assert picked.shape == (3, 1)
+    assert torch.allclose(picked[:, 0], net(batch)[torch.arange(3), only], atol=1e-5)
+
+
+@pytest.mark.parametrize("model,head", MODELS)
 def test_object_order_does_not_matter(model, head):
     torch.manual_seed(0)
     net = build(MotionNetConfig(model, "place", (10, 10), hidden=32, embed=8, head=head)).eval()
