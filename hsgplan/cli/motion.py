@@ -29,7 +29,7 @@ def train_motion(
         Path | None, typer.Option(help="Dataset folder (overrides the config).")
     ] = None,
 ) -> None:
-    """Train a motion network on the collected successful trials (cross-entropy over bins)."""
+    """Train a motion network (config loss: ce on the successes, bce on every trial)."""
     from hsgplan.motion.train import MotionTrainConfig
     from hsgplan.motion.train import train_motion as run
 
