@@ -27,10 +27,10 @@ from hsgplan.sim.scene import Scene
 from hsgplan.sim.staging import stage
 
 TASKS_PER_CHUNK = 32
-# Staging a scene costs about two trials. One uniformly drawn push in seven succeeds, one place
-# in three fails: eight pushes a scene still give about one sample per scene (place's four give
-# nearly three), and a push sample costs a fifth less time than with four
-# (`python scripts/push_settings.py`, README "Decisions").
+# Staging a scene costs about one push trial (a cProfile of 3 chunks: 19 ms against 23 ms).
+# One uniformly drawn push in seven succeeds, one place in three fails: eight pushes a scene
+# still give about one sample per scene (place's four give nearly three), and a push sample
+# costs a fifth less time than with four (`python scripts/push_settings.py`, README "Decisions").
 ATTEMPTS_PER_TASK: dict[MotionPrimitive, int] = {MotionPrimitive.PLACE: 4, MotionPrimitive.PUSH: 8}
 
 BINS: dict[MotionPrimitive, tuple[int, int]] = {
