@@ -1,20 +1,17 @@
-"""Checkpoint folders, shared by every trainer: `model.safetensors` and `config.json` when
-finished, `progress.pt` (model, optimiser, epoch; loaded with weights_only) while training runs.
+"""Training progress, shared by every trainer: `progress.pt` (model, optimiser, epoch; loaded
+with weights_only) while training runs. A finished network is written by `hsgplan.checkpoint`.
 """
 
 from __future__ import annotations
 
-import json
-from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import torch
-from safetensors.torch import load_file, save_file
 
+from hsgplan.checkpoint import WEIGHTS, save_trained
 from hsgplan.domain.errors import InvalidInputError
 
-WEIGHTS, CONFIG, PROGRESS = "model.safetensors", "config.json", "progress.pt"
+PROGRESS = "progress.pt"
 
 
 def finished(folder: Path) -> bool:
@@ -45,26 +42,6 @@ def save_progress(folder: Path, model, optim, epoch: int) -> None:
 
 
 def finish(folder: Path, model: torch.nn.Module, config: dict) -> None:
-    save_file(model.state_dict(), folder / WEIGHTS)
-    (folder / CONFIG).write_text(json.dumps(config, indent=2) + "\n")
+    """Write the finished network and drop the progress it no longer needs."""
+    save_trained(folder, model, config)
     (folder / PROGRESS).unlink(missing_ok=True)
-
-
-def load_trained(
-    folder: Path,
-    from_json: Callable[[dict], Any],
-    build: Callable[[Any], torch.nn.Module],
-    what: str,
-) -> tuple[torch.nn.Module, Any]:
-    """(network in eval mode, its configuration) from a finished folder; a missing or corrupted
-    one raises InvalidInputError with one line."""
-    try:
-        config = from_json(json.loads((folder / CONFIG).read_text()))
-        model = build(config)
-        model.load_state_dict(load_file(folder / WEIGHTS))
-    except FileNotFoundError:
-        raise InvalidInputError(f"no trained {what} in '{folder}'") from None
-    except Exception as e:  # corrupted weights or config: one line, not a traceback
-        raise InvalidInputError(f"'{folder}' is not a usable checkpoint ({e})") from None
-    model.eval()
-    return model, config

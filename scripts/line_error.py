@@ -15,8 +15,9 @@ import sys
 
 import numpy as np
 
-from hsgplan.data.motion_tasks import MotionPrimitive, draw_task
+from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
+from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.sim import motion_plans
 from hsgplan.sim.scene import Scene
 

@@ -14,9 +14,9 @@ import math
 import sys
 from collections import Counter
 
-from hsgplan.data.motion_tasks import MotionPrimitive, draw_task
+from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
-from hsgplan.domain.parameters import PUSH_LEAD, push_values
+from hsgplan.domain.parameters import PUSH_LEAD, MotionPrimitive, push_values
 from hsgplan.domain.world import SHELVES
 from hsgplan.sim import motion_plans
 from hsgplan.sim.scene import Scene

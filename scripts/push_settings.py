@@ -15,7 +15,8 @@ import sys
 import time
 
 from hsgplan.data import motion_trials
-from hsgplan.data.motion_tasks import MotionPrimitive, draw_task
+from hsgplan.data.motion_tasks import draw_task
+from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.sim import primitives
 from hsgplan.sim.scene import Scene
 

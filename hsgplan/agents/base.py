@@ -2,26 +2,26 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
+from hsgplan.domain.actions import Action
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
-from hsgplan.domain.transition import Action
+from hsgplan.domain.predicates import Literal
+from hsgplan.motion.generator import Feasibility
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.outcome import Outcome
-
-Feasibility = Callable[[PrimitiveParams], bool]
 
 
 @dataclass(frozen=True)
 class Decision:
     """The next primitive, or None with a reason when the agent has nothing to offer.
 
-    `task_seconds` is spent choosing the symbolic action (the task level), `motion_seconds`
-    choosing its parameters (the motion level, before execution).
+    `subgoal` is the literal the action serves (the task level's ĝ); `task_seconds` is spent
+    choosing the symbolic action (the task level), `motion_seconds` choosing its parameters
+    (the motion level, before execution).
     """
 
     action: Action | None
@@ -29,6 +29,7 @@ class Decision:
     task_seconds: float
     motion_seconds: float
     note: str = ""
+    subgoal: Literal | None = None
 
 
 class Agent(Protocol):

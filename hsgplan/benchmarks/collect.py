@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from hsgplan.data.motion_collect import CollectConfig, collect
-from hsgplan.data.motion_tasks import MotionPrimitive
+from hsgplan.domain.parameters import MotionPrimitive
 
 BENCH_SEED = 777
 

@@ -12,8 +12,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.generator import random_goals, random_state
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
+from hsgplan.symbolic.generator import random_goals, random_state
 
 
 @dataclass(frozen=True)

@@ -18,8 +18,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.generator import random_goals, random_state
 from hsgplan.evaluation.task_eval import run_task_episode
+from hsgplan.symbolic.generator import random_goals, random_state
 
 
 @dataclass(frozen=True)

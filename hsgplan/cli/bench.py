@@ -101,7 +101,7 @@ def bench_task(
 ) -> None:
     """Task-planning time: the learned regression planner against Fast Downward, one core."""
     from hsgplan.benchmarks.task import bench_task as run
-    from hsgplan.planning.regression.train import load_network
+    from hsgplan.planning.regression.gnn import load_network
 
     size_list = parse_sizes(sizes)
     load_network(checkpoint / "preimage")  # a missing checkpoint fails before any work

@@ -59,7 +59,7 @@ def parse_sizes(text: str) -> list[int]:
         raise InvalidInputError(
             f"--sizes '{text}': expected a range like 2-6 or a list like 2,4,6"
         ) from None
-    from hsgplan.domain.generator import check_size
+    from hsgplan.symbolic.generator import check_size
 
     if not sizes:
         raise InvalidInputError(f"--sizes '{text}' names no size")

@@ -22,7 +22,8 @@ def demos(
     ] = Path("data/demos/v1"),
 ) -> None:
     """Record the paper's 18 short demonstrations with the oracle in the simulated world."""
-    from hsgplan.data.demos import TASKS, collect_demos
+    from hsgplan.data.demos import TASKS
+    from hsgplan.evaluation.record_demos import collect_demos
 
     command = f"hsgplan collect demos --seed {seed} --out {out_dir}"
     with Progress(console=err, transient=True) as progress:
@@ -66,7 +67,7 @@ app.command("push")(_collect_command("push", 8000))
 
 def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir: Path, chunk: int):
     from hsgplan.data.motion_collect import CollectConfig, collect
-    from hsgplan.data.motion_tasks import MotionPrimitive
+    from hsgplan.domain.parameters import MotionPrimitive
 
     config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray, chunk)
     with Progress(console=err, transient=True) as progress:

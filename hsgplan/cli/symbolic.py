@@ -114,8 +114,8 @@ def goals(
     stacking: Annotated[bool, typer.Option(help="Allow stacked goals.")] = True,
 ) -> None:
     """Write random feasible goals, one per line (the distribution is in `domain/generator.py`)."""
-    from hsgplan.domain.generator import check_size, random_goals
     from hsgplan.domain.goals import write_goal_file
+    from hsgplan.symbolic.generator import check_size, random_goals
 
     check_size(objects)
     drawn = random_goals(objects, count, seed, stacking=stacking)

@@ -26,10 +26,10 @@ def demo(
     ),
 ) -> None:
     """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record."""
-    from hsgplan.domain.generator import check_size
     from hsgplan.domain.goals import parse_goal
     from hsgplan.evaluation.demo import demo_goal, run_demo
     from hsgplan.evaluation.protocol import make_agent
+    from hsgplan.symbolic.generator import check_size
 
     make_agent(agent)
     if goal is None:

@@ -1,4 +1,5 @@
-"""The paper's 18 short demonstrations, recorded in the simulated world.
+"""The paper's 18 short demonstrations: which tasks they are and their format on disk (the
+recorder is `hsgplan.evaluation.record_demos`).
 
 Tasks (fixed, so that the dataset is the same everywhere): place one object on a shelf top
 (each of the six types once, shelves alternating), stack two objects on a shelf top (nine
@@ -20,20 +21,19 @@ in the goal / action text syntax.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from hsgplan.domain.actions import Action, parse_action
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal
-from hsgplan.domain.transition import Action, parse_action
+from hsgplan.paths import shipped
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 VERSION = 1
 FORMAT = "hsgplan-demos"
 DEMOS = "demos.jsonl"
 META = "meta.json"
-RETRIES = 5
 
 _PLACE = [
     ("cherries", "shelf_a"),
@@ -92,83 +92,20 @@ class Demo:
         return [parse_action(a) for a in self.actions]
 
 
-def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
-    """Run the oracle on one task; the demonstration, or None if the episode failed."""
-    from hsgplan.agents.oracle import OracleAgent
-    from hsgplan.evaluation.episode import run_episode
-    from hsgplan.sim.env import KitchenStorageEnv
-
-    goal = parse_goal(goal_text)
-    states: list[SymbolicSceneGraph] = []
-    actions: list[str] = []
-
-    def on_step(record, obs) -> None:
-        if record is not None and record.status != "success":
-            return  # a primitive that failed and changed nothing is no transition
-        if record is not None:
-            actions.append(record.action)
-        states.append(obs.symbols.state)
-
-    result = run_episode(KitchenStorageEnv(), OracleAgent(), goal, seed, on_step=on_step)
-    if not result.success or not actions or any(s.status != "success" for s in result.steps):
-        return None  # a failure, a detour, or a goal that held from the start shows nothing
-    return Demo(
-        task,
-        goal_text,
-        seed,
-        goal.objects,
-        tuple(actions),
-        tuple(tuple(str(lit) for lit in s.sorted_literals()) for s in states),
-    )
-
-
-def collect_demos(
-    out: Path, seed: int, command: str = "", on_demo: Callable[[Demo], None] | None = None
-) -> list[Demo]:
-    """Record every task not yet in `out` (appending as each finishes); all demos, in order."""
-    out.mkdir(parents=True, exist_ok=True)
-    meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
-    meta_path = out / META
-    if meta_path.exists():
-        saved = _read_json(meta_path)
-        if saved.get("seed") != seed or saved.get("version") != VERSION:
-            raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
-    else:
-        meta_path.write_text(json.dumps(meta, indent=2) + "\n")
-    done = {d.task: d for d in _read_demos(out / DEMOS, tolerate_cut=True)}
-    path = out / DEMOS
-    if path.exists() and path.stat().st_size and not path.read_bytes().endswith(b"\n"):
-        with open(path, "a") as f:  # a line cut short by an interruption: end it
-            f.write("\n")
-    for i, (task, goal) in enumerate(TASKS):
-        if task in done:
-            continue
-        for attempt in range(RETRIES):
-            demo = record_demo(task, goal, seed * 1000 + i * RETRIES + attempt)
-            if demo is not None:
-                break
-        else:
-            raise RuntimeError(f"task {task}: the oracle failed {RETRIES} times")
-        with open(path, "a") as f:
-            f.write(json.dumps(demo.to_json()) + "\n")
-        done[task] = demo
-        if on_demo:
-            on_demo(demo)
-    return [done[t] for t, _ in TASKS]
-
-
 def load_demos(folder: Path) -> list[Demo]:
-    """The demonstrations of a dataset folder, checked; bad input raises InvalidInputError."""
-    meta = _read_json(folder / META)
+    """The demonstrations of a dataset folder (found as `hsgplan.paths.shipped` finds it),
+    checked; bad input raises InvalidInputError."""
+    folder = shipped(folder)
+    meta = read_json(folder / META)
     if meta.get("format") != FORMAT or meta.get("version") != VERSION:
         raise InvalidInputError(f"'{folder}' is not a version {VERSION} demonstration dataset")
-    demos = _read_demos(folder / DEMOS, tolerate_cut=False)
+    demos = read_demos(folder / DEMOS, tolerate_cut=False)
     if not demos:
         raise InvalidInputError(f"'{folder / DEMOS}' holds no demonstration")
     return demos
 
 
-def _read_json(path: Path) -> dict:
+def read_json(path: Path) -> dict:
     if not path.is_file():
         raise InvalidInputError(f"'{path}' does not exist")
     try:
@@ -177,7 +114,7 @@ def _read_json(path: Path) -> dict:
         raise InvalidInputError(f"'{path}' is not valid JSON") from None
 
 
-def _read_demos(path: Path, tolerate_cut: bool) -> list[Demo]:
+def read_demos(path: Path, tolerate_cut: bool) -> list[Demo]:
     if not path.exists():
         return []
     demos = []

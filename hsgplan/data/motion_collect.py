@@ -10,20 +10,18 @@ the chunks, in whatever order they finished, and however often the run was inter
 
 from __future__ import annotations
 
-import multiprocessing
-from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from hsgplan.data import motion_store as store
-from hsgplan.data.motion_tasks import MotionPrimitive
 from hsgplan.data.motion_trials import ATTEMPTS_PER_TASK, TASKS_PER_CHUNK, run_chunk
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.evaluation.run_folder import claim
+from hsgplan.domain.parameters import MotionPrimitive
+from hsgplan.runner.engines import engine
+from hsgplan.runner.run_folder import claim
 
 WORK = "work"
 
@@ -57,75 +55,6 @@ class CollectSummary:
 
 def work_folder(out: Path, primitive: MotionPrimitive, seed: int) -> Path:
     return out / WORK / f"{primitive.value}-seed{seed}"
-
-
-class LocalEngine:
-    """A process pool (spawned: children forked from a process with torch loaded hang)."""
-
-    def __init__(self, workers: int) -> None:
-        context = multiprocessing.get_context("spawn")
-        self.pool = ProcessPoolExecutor(workers, mp_context=context)
-
-    def submit(self, fn: Callable, *args):
-        return self.pool.submit(fn, *args)
-
-    def next_done(self, handles: set) -> tuple[object, object]:
-        done, _ = wait(handles, return_when=FIRST_COMPLETED)
-        handle = next(iter(done))
-        return handle, handle.result()
-
-    def close(self) -> None:
-        self.pool.shutdown(wait=False, cancel_futures=True)
-
-
-class RayEngine:
-    """The same work on a Ray cluster: `address` as `ray.init` takes it ("auto", "ray://...",
-    or "local" to start a private instance on this machine)."""
-
-    def __init__(self, address: str, workers: int) -> None:
-        try:
-            import ray
-        except ImportError:
-            raise InvalidInputError(
-                "--ray needs Ray: pip install 'hsgplan[ray]' (or pip install ray)"
-            ) from None
-        self.ray = ray
-        try:
-            if address == "local":
-                ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
-            else:
-                ray.init(address=address, log_to_driver=False)
-        except Exception as e:  # no cluster there, a bad address: one line, not a traceback
-            first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-            raise InvalidInputError(
-                f"--ray '{address}': could not start or join Ray ({first})"
-            ) from None
-        self.remote = {}
-
-    def submit(self, fn: Callable, *args):
-        if fn not in self.remote:
-            self.remote[fn] = self.ray.remote(fn)
-        return self.remote[fn].remote(*args)
-
-    def next_done(self, handles: set) -> tuple[object, object]:
-        ready, _ = self.ray.wait(list(handles), num_returns=1)
-        return ready[0], self.ray.get(ready[0])
-
-    def close(self) -> None:
-        self.ray.shutdown()
-
-
-@contextmanager
-def engine(config: CollectConfig) -> Iterator[LocalEngine | RayEngine]:
-    runner = (
-        RayEngine(config.ray_address, config.workers)
-        if config.ray_address
-        else LocalEngine(config.workers)
-    )
-    try:
-        yield runner
-    finally:
-        runner.close()
 
 
 def _done_chunks(folder: Path) -> dict[int, int]:
@@ -174,7 +103,7 @@ def collect(
     if progress:
         progress(sum(done.values()))
     if _prefix_done(done, config.samples) is None:
-        with engine(config) as runner:
+        with engine(config.workers, config.ray_address) as runner:
             ran = _run(runner, config, folder, done, progress)
     return _pack(config, out, folder, done, ran)
 

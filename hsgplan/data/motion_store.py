@@ -30,10 +30,10 @@ from pathlib import Path
 
 import numpy as np
 
-from hsgplan.data.motion_tasks import MotionPrimitive
 from hsgplan.data.motion_trials import ChunkResult, Trial
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import ENTITY_TYPES
+from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose

@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import random
 from dataclasses import dataclass
-from enum import StrEnum
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import object_type, objects_for_types
+from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.world import (
     INTERIOR_CAPACITY,
@@ -39,11 +39,6 @@ from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 MIN_OBJECTS, MAX_SCENE_OBJECTS = 2, len(OBJECT_TYPES)
 PUSH_SHELF = "shelf_a"
 P_STACK = 0.25  # chance that an object left to place goes on top of a bare one
-
-
-class MotionPrimitive(StrEnum):
-    PLACE = "place"
-    PUSH = "push"
 
 
 @dataclass(frozen=True)

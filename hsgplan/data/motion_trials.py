@@ -17,9 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.data.motion_tasks import MotionPrimitive, MotionTask, draw_task
-from hsgplan.domain.parameters import PlaceParams, PushParams
-from hsgplan.domain.world import PLACE_BINS, PUSH_ANGLE_BINS, PUSH_DIST_BINS
+from hsgplan.data.motion_tasks import MotionTask, draw_task
+from hsgplan.domain.parameters import BINS, MotionPrimitive, params_for
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
@@ -32,11 +31,6 @@ TASKS_PER_CHUNK = 32
 # still give about one sample per scene (place's four give nearly three), and a push sample
 # costs a fifth less time than with four (`python scripts/push_settings.py`, README "Decisions").
 ATTEMPTS_PER_TASK: dict[MotionPrimitive, int] = {MotionPrimitive.PLACE: 4, MotionPrimitive.PUSH: 8}
-
-BINS: dict[MotionPrimitive, tuple[int, int]] = {
-    MotionPrimitive.PLACE: (PLACE_BINS, PLACE_BINS),
-    MotionPrimitive.PUSH: (PUSH_ANGLE_BINS, PUSH_DIST_BINS),
-}
 
 
 @dataclass(frozen=True)
@@ -73,13 +67,6 @@ class ChunkResult:
     chunk: int
     trials: tuple[Trial, ...]
     unstaged: int  # tasks whose scene could not be staged (no trials)
-
-
-def params_for(primitive: MotionPrimitive, obj: str, target: str, bins: tuple[int, int]):
-    """The primitive's parameters for a pair of bins."""
-    if primitive is MotionPrimitive.PLACE:
-        return PlaceParams(obj, target, *bins)
-    return PushParams(obj, *bins)
 
 
 def run_chunk(

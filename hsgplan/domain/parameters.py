@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from enum import StrEnum
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import object_type
@@ -51,6 +52,29 @@ class PushParams:
 
 
 PrimitiveParams = PickParams | PlaceParams | PushParams
+
+
+class MotionPrimitive(StrEnum):
+    """The primitives whose parameters are chosen over bins (a pick has none)."""
+
+    PLACE = "place"
+    PUSH = "push"
+
+
+# The bin grid of each primitive: (x, y) for place, (angle, distance) for push.
+BINS: dict[MotionPrimitive, tuple[int, int]] = {
+    MotionPrimitive.PLACE: (PLACE_BINS, PLACE_BINS),
+    MotionPrimitive.PUSH: (PUSH_ANGLE_BINS, PUSH_DIST_BINS),
+}
+
+
+def params_for(
+    primitive: MotionPrimitive, obj: str, target: str, bins: tuple[int, int]
+) -> PlaceParams | PushParams:
+    """The primitive's parameters for a pair of bins."""
+    if primitive is MotionPrimitive.PLACE:
+        return PlaceParams(obj, target, *bins)
+    return PushParams(obj, *bins)
 
 
 def _check_bin(value: int, bins: int, what: str) -> None:

@@ -240,3 +240,9 @@ PUSH_ANGLE_RANGE = (-math.pi / 4, math.pi / 4)
 # 11 cm no push got a can from its prepush region into the shelf, and past 19 cm the hand always
 # met the shelf's walls or top board; the range keeps a margin on both sides.
 PUSH_DIST_RANGE = (0.08, 0.20)
+
+# --- episodes ---
+
+# Primitives an episode may take before it counts as an overstep (the paper's limit), in the
+# simulated world and in the symbolic loop alike.
+MAX_STEPS = 50

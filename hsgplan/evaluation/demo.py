@@ -9,12 +9,12 @@ from pathlib import Path
 
 import imageio.v3 as iio
 
-from hsgplan.domain.generator import random_goal
 from hsgplan.domain.goals import Goal
 from hsgplan.evaluation.episode import EpisodeRecord, run_episode
 from hsgplan.evaluation.protocol import make_agent
 from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.render import Camera
+from hsgplan.symbolic.generator import random_goal
 from hsgplan.viz.scene_graph_drawing import draw_symbolic
 
 FRAME_EVERY = 6  # arm waypoints between two GIF frames

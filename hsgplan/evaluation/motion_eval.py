@@ -13,9 +13,10 @@ from collections.abc import Callable
 from pathlib import Path
 
 from hsgplan.data.motion_collect import LocalEngine
-from hsgplan.data.motion_tasks import MotionPrimitive, draw_task
+from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import stage_task, try_params
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.world import SHELVES
 from hsgplan.sim.scene import Scene
 

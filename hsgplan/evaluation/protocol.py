@@ -9,20 +9,18 @@ interrupted run, started again with the same command, skips what is done.
 
 from __future__ import annotations
 
-import json
-import multiprocessing
 import statistics
 from collections import Counter
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import asdict, dataclass
+from functools import partial
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.generator import random_goals
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.run_folder import RESULTS, claim, logged_rows
+from hsgplan.runner.items import run_items
+from hsgplan.symbolic.generator import random_goals
 
 
 @dataclass(frozen=True)
@@ -47,8 +45,8 @@ class EpisodeSpec:
     seed: int
 
     @property
-    def key(self) -> tuple[int, int, str, int]:
-        return self.size, self.index, self.goal, self.seed
+    def key(self) -> str:
+        return f"{self.size}/{self.index}/{self.seed}/{self.goal}"
 
 
 def episode_specs(config: EvalConfig) -> list[EpisodeSpec]:
@@ -75,82 +73,38 @@ def episode_seed(seed: int, size: int, index: int) -> int:
     return (seed * 1_000_003 + size * 10_007 + index) % (2**31)
 
 
-def make_agent(name: str):
-    """An agent by name. Learned agents are added here as they arrive."""
-    if name == "oracle":
-        from hsgplan.agents.oracle import OracleAgent
-
-        return OracleAgent()
-    if name == "regression":
-        from hsgplan.agents.learned_task import RegressionAgent
-
-        return RegressionAgent()
-    raise InvalidInputError(f"unknown agent '{name}' (known: oracle, regression)")
-
-
 def run_spec(agent_name: str, spec: EpisodeSpec) -> dict:
-    """One episode in this process (a pool worker): its record as JSON."""
+    """One episode in this process (a worker): its record as JSON."""
+    from hsgplan.agents.registry import make_agent
     from hsgplan.evaluation.episode import run_episode
     from hsgplan.sim.env import KitchenStorageEnv
 
     record = run_episode(
         KitchenStorageEnv(), make_agent(agent_name), parse_goal(spec.goal), spec.seed
     )
-    return {"spec": asdict(spec), "record": record.to_json()}
-
-
-def load_done(run_dir: Path, config: EvalConfig) -> dict[tuple, EpisodeRecord]:
-    """Records already in the run folder; refuses a folder made by a different configuration."""
-    claim(
-        run_dir,
-        asdict(config) | {"sizes": list(config.sizes)},
-        f"'{run_dir}' holds a run with another configuration",
-    )
-    done = {}
-    for row in logged_rows(run_dir):
-        try:
-            done[EpisodeSpec(**row["spec"]).key] = EpisodeRecord.from_json(row["record"])
-        except (KeyError, TypeError):
-            continue  # not a row this run wrote: that episode runs again
-    return done
+    return record.to_json()
 
 
 def run_evaluation(
     config: EvalConfig,
-    run_dir: Path,
+    run_dir: Path | None,
     workers: int = 2,
     on_episode: Callable[[EpisodeRecord], None] | None = None,
+    ray: str | None = None,
 ) -> list[EpisodeRecord]:
     """Run every episode not yet in `run_dir`, `workers` at a time; all records, in order."""
     specs = episode_specs(config)
-    done = load_done(run_dir, config)
-    todo = [s for s in specs if s.key not in done]
-    for s in specs:
-        if s.key in done and on_episode:
-            on_episode(done[s.key])
-    # spawn, not fork: a parent that has loaded torch (a learned agent) would hang forked children
-    context = multiprocessing.get_context("spawn")
-    with (
-        open(run_dir / RESULTS, "a") as log,
-        ProcessPoolExecutor(max(1, workers), mp_context=context) as pool,
-    ):
-        pending = {pool.submit(run_spec, config.agent, s) for s in todo}
-        try:
-            while pending:
-                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                for f in finished:
-                    row = f.result()
-                    log.write(json.dumps(row) + "\n")
-                    log.flush()
-                    record = EpisodeRecord.from_json(row["record"])
-                    done[EpisodeSpec(**row["spec"]).key] = record
-                    if on_episode:
-                        on_episode(record)
-        except KeyboardInterrupt:
-            for f in pending:
-                f.cancel()
-            raise
-    return [done[s.key] for s in specs]
+    rows = run_items(
+        partial(run_spec, config.agent),
+        specs,
+        key=lambda s: s.key,
+        run_dir=run_dir,
+        config=asdict(config) | {"sizes": list(config.sizes)},
+        workers=workers,
+        ray=ray,
+        on_result=on_episode and (lambda row: on_episode(EpisodeRecord.from_json(row))),
+    )
+    return [EpisodeRecord.from_json(row) for row in rows]
 
 
 def summarize(records: Sequence[EpisodeRecord]) -> dict:

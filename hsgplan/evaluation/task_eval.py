@@ -20,11 +20,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.generator import random_goals, random_state
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
-from hsgplan.domain.transition import apply, why_not
 from hsgplan.evaluation.protocol import episode_seed
 from hsgplan.evaluation.run_folder import RESULTS, claim, logged_rows
+from hsgplan.symbolic.generator import random_goals, random_state
+from hsgplan.symbolic.transition import apply, why_not
 
 MAX_STEPS = 50
 PLANNERS = ("regression", "forward", "fd")

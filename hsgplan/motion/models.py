@@ -9,12 +9,14 @@ has `hidden` units (256 in the paper). Logits cover the bin pairs jointly (10 x 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 import torch
 from torch import nn
 from torch_geometric.nn import global_max_pool
 from torch_geometric.utils import to_dense_batch
 
+from hsgplan.checkpoint import load_trained
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.motion.layers import GroundedConv, mlp
 from hsgplan.scene_graph.grounding import EDGE_DIM, NODE_DIM, QUERY_DIM, SUBGOAL_DIM, TYPES
@@ -180,3 +182,10 @@ class BinQueryHead(nn.Module):
 
 def build(config: MotionNetConfig) -> nn.Module:
     return GraphMotionNet(config) if config.model == "gnn" else FlatMotionNet(config)
+
+
+def load_motion_net(folder: Path) -> nn.Module:
+    """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
+    model, config = load_trained(folder, MotionNetConfig.from_json, build, "motion network")
+    model.config = config
+    return model

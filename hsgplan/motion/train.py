@@ -23,11 +23,11 @@ from torch_geometric.data import Batch, Data
 
 from hsgplan import training
 from hsgplan.data.motion_store import MotionData, load
-from hsgplan.data.motion_tasks import MotionPrimitive
-from hsgplan.data.motion_trials import BINS
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.parameters import BINS, MotionPrimitive
 from hsgplan.domain.predicates import inside, on
 from hsgplan.motion.models import MotionNetConfig, build
+from hsgplan.paths import MOTION_DATA, shipped
 from hsgplan.scene_graph.grounding import ground
 
 
@@ -35,7 +35,7 @@ from hsgplan.scene_graph.grounding import ground
 class MotionTrainConfig:
     primitive: str = "place"
     model: str = "gnn"
-    data: str = "data/motion"
+    data: str = str(MOTION_DATA)
     seed: int = 0
     epochs: int = 40
     lr: float = 1e-3
@@ -79,7 +79,7 @@ class MotionTrainConfig:
 
 def _training_rows(config: MotionTrainConfig) -> MotionData:
     """The first `samples` successes, and with `bce` every trial up to the last of them."""
-    folder = Path(config.data)
+    folder = shipped(config.data)
     data = load(folder / f"{config.primitive}.npz")
     if config.samples is not None:
         data = data.take(slice(0, config.samples))
@@ -151,12 +151,3 @@ def train_motion(
         if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
             training.save_progress(out, model, optim, epoch + 1)
     training.finish(out, model, net_config.to_json())
-
-
-def load_motion_net(folder: Path) -> torch.nn.Module:
-    """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
-    model, config = training.load_trained(
-        folder, MotionNetConfig.from_json, build, "motion network"
-    )
-    model.config = config
-    return model

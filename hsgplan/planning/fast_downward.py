@@ -15,11 +15,13 @@ import unified_planning as up
 from unified_planning.engines import PlanGenerationResultStatus as Status
 from unified_planning.shortcuts import OneshotPlanner
 
+from hsgplan.domain.actions import Action, intended_literal
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.pddl import build_problem, decode
-from hsgplan.domain.transition import Action, apply
+from hsgplan.planning.base import TaskDecision
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.symbolic.pddl import build_problem, decode
+from hsgplan.symbolic.transition import apply
 
 up.shortcuts.get_environment().credits_stream = None
 
@@ -115,3 +117,46 @@ class FastDownwardPlanner:
         for a in actions:
             states.append(apply(states[-1], a))
         return Plan(actions, tuple(states), seconds, "fd-optimal" if optimal else "fd-wastar")
+
+
+class FastDownwardTaskPlanner:
+    """Fast Downward behind the task-planner interface: the next action of its plan, serving
+    the literal that action makes true.
+
+    With `follow_plan` (the default) it compares the observed state with the state its plan
+    predicted and goes on with the rest of the plan while they agree (a suffix of a shortest
+    plan is a shortest plan from there, so Fast Downward would answer the same), planning
+    again only when the world departs from it; without, it plans from every state.
+    """
+
+    name = "fd"
+
+    def __init__(self, follow_plan: bool = True, planner: FastDownwardPlanner | None = None):
+        self.planner = planner or FastDownwardPlanner()
+        self.follow_plan = follow_plan
+        self.plan: Plan | None = None
+
+    def reset(self, goal: Goal | None, seed: int) -> None:
+        self.plan = None
+
+    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
+        start = time.perf_counter()
+        plan = self._remaining(state) if self.follow_plan else None
+        if plan is None:
+            try:
+                plan = self.plan = self.planner.plan(state, goal)
+            except NoPlanError as e:
+                return TaskDecision(None, None, time.perf_counter() - start, f"no plan: {e}")
+        if not plan.actions:
+            return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
+        action = plan.actions[0]
+        following = plan.actions[1] if len(plan.actions) > 1 else None
+        seconds = time.perf_counter() - start
+        return TaskDecision(action, intended_literal(action), seconds, following=following)
+
+    def _remaining(self, state: SymbolicSceneGraph) -> Plan | None:
+        """The rest of the current plan, if the state is one the plan passes through."""
+        if self.plan is None or state not in self.plan.states[:-1]:
+            return None
+        i = self.plan.states.index(state)
+        return Plan(self.plan.actions[i:], self.plan.states[i:], 0.0, self.plan.planner)

@@ -15,6 +15,7 @@ import numpy as np
 
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
+from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
@@ -23,8 +24,6 @@ from hsgplan.sim.primitives import execute
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sampler import sample_scene
 from hsgplan.sim.scene import Scene
-
-MAX_STEPS = 50
 
 
 @dataclass(frozen=True)

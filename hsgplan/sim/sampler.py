@@ -1,7 +1,7 @@
 """Seeded random initial configurations: collision-free, at rest, and mapping back to the
 symbolic arrangement they were drawn from.
 
-The arrangement is drawn symbolically first (`domain.generator.random_state`: mostly on the open
+The arrangement is drawn symbolically first (`symbolic.generator.random_state`: mostly on the open
 space, some stacked or on a shelf top, so that `Clear` matters), then each object gets a pose:
 a free spot on its surface, found by rejection sampling against the bodies already placed, or
 the centre of the object it is stacked on. After physics settles, f_m must give back the drawn
@@ -14,7 +14,6 @@ import math
 import random
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.generator import random_state
 from hsgplan.domain.objects import EntityKind, kind_of, object_type
 from hsgplan.domain.parameters import PickParams, place_inset
 from hsgplan.domain.predicates import Predicate
@@ -24,6 +23,7 @@ from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
 from hsgplan.sim.scene import Scene
+from hsgplan.symbolic.generator import random_state
 
 TRIES_PER_CELL = 3
 ATTEMPTS = 100

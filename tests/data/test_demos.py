@@ -7,10 +7,11 @@ import pytest
 from typer.testing import CliRunner
 
 from hsgplan.cli import app
-from hsgplan.data import demos as demos_module
-from hsgplan.data.demos import TASKS, collect_demos, load_demos
+from hsgplan.data.demos import TASKS, load_demos
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.transition import apply
+from hsgplan.evaluation import record_demos
+from hsgplan.evaluation.record_demos import collect_demos
+from hsgplan.symbolic.transition import apply
 
 SHIPPED = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
 
@@ -56,7 +57,7 @@ def test_corrupted_or_missing_datasets_are_refused(tmp_path):
 
 
 def test_collection_resumes_without_repeating(tmp_path, monkeypatch):
-    monkeypatch.setattr(demos_module, "TASKS", TASKS[:2])
+    monkeypatch.setattr(record_demos, "TASKS", TASKS[:2])
     first = collect_demos(tmp_path, seed=3)
     log = tmp_path / "demos.jsonl"
     lines = log.read_text().splitlines()

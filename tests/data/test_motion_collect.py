@@ -11,8 +11,9 @@ import pytest
 
 from hsgplan.data import motion_store as store
 from hsgplan.data.motion_collect import CollectConfig, collect, work_folder
-from hsgplan.data.motion_tasks import MotionPrimitive, draw_task
+from hsgplan.data.motion_tasks import draw_task
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import SURFACE_CAPACITY
 

@@ -7,7 +7,7 @@ from typer.testing import CliRunner
 
 from hsgplan.cli import app
 from hsgplan.data.motion_collect import CollectConfig, collect
-from hsgplan.data.motion_tasks import MotionPrimitive
+from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.evaluation.motion_eval import evaluate_motion
 from hsgplan.motion.train import MotionTrainConfig, train_motion
 

@@ -5,7 +5,6 @@ from pathlib import Path
 
 from hsgplan.data.demos import load_demos
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.transition import applicable_actions, apply
 from hsgplan.planning.regression.augment import (
     Trajectory,
     covering_one,
@@ -15,6 +14,7 @@ from hsgplan.planning.regression.augment import (
     with_distractors,
 )
 from hsgplan.planning.regression.examples import regressed_subgoals
+from hsgplan.symbolic.transition import applicable_actions, apply
 
 DEMOS = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
 

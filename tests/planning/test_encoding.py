@@ -5,7 +5,6 @@ import random
 import torch
 from torch_geometric.data import Batch
 
-from hsgplan.domain.generator import random_goal, random_state
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.predicates import PREDICATES, Predicate, clear, in_grasp, inside, on
 from hsgplan.planning.regression.encoding import (
@@ -22,6 +21,7 @@ from hsgplan.planning.regression.encoding import (
     touching,
 )
 from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
+from hsgplan.symbolic.generator import random_goal, random_state
 
 
 def scene():

@@ -4,13 +4,13 @@ import random
 
 import pytest
 
-from hsgplan.domain.generator import random_goals, random_state
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.pddl import to_pddl_text
 from hsgplan.domain.predicates import inside, on
-from hsgplan.domain.transition import apply, why_not
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.symbolic.generator import random_goals, random_state
+from hsgplan.symbolic.pddl import to_pddl_text
+from hsgplan.symbolic.transition import apply, why_not
 
 
 def replay(plan, start, goal):

@@ -2,9 +2,9 @@
 
 import random
 
-from hsgplan.domain.generator import random_goal, random_state
 from hsgplan.planning.regression.encoding import Slots, touching
 from hsgplan.planning.regression.planner import _order
+from hsgplan.symbolic.generator import random_goal, random_state
 
 
 def test_the_sort_key_is_the_literals_own_order():

@@ -6,14 +6,15 @@ from pathlib import Path
 
 import torch
 
-from hsgplan.domain.generator import random_state
+from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.predicates import on
-from hsgplan.domain.transition import Pick, Place, apply
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.planning.regression.planner import RegressionPlanner
 from hsgplan.planning.regression.train import TaskTrainConfig, train_task
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.symbolic.generator import random_state
+from hsgplan.symbolic.transition import apply
 
 DEMOS = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
 SMALL = {

@@ -15,8 +15,9 @@ from hsgplan.planning.regression.examples import (
     reachable,
     regressed_subgoals,
 )
+from hsgplan.planning.regression.gnn import load_network
 from hsgplan.planning.regression.planner import action_for
-from hsgplan.planning.regression.train import TaskTrainConfig, load_network, train_task
+from hsgplan.planning.regression.train import TaskTrainConfig, train_task
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 DEMOS = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"

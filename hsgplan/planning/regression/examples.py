@@ -31,10 +31,10 @@ from torch_geometric.data import Data
 from hsgplan.data.demos import Demo
 from hsgplan.domain.objects import EntityKind, kind_of
 from hsgplan.domain.predicates import Literal, Predicate
-from hsgplan.domain.transition import applicable_actions, apply
 from hsgplan.planning.regression.augment import Trajectory, varied
 from hsgplan.planning.regression.encoding import DONT_CARE, FALSE, TRUE, Slots, encode
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.symbolic.transition import applicable_actions, apply
 
 
 @dataclass(frozen=True)

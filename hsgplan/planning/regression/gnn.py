@@ -10,12 +10,15 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import asdict, dataclass, fields
+from pathlib import Path
 
 import torch
 import torch.nn.functional as F
 from torch import Tensor, nn
 from torch_geometric.data import Data
 from torch_geometric.nn import MessagePassing
+
+from hsgplan.checkpoint import load_trained
 
 
 def mlp(in_dim: int, hidden: int, out_dim: int) -> nn.Sequential:
@@ -269,3 +272,9 @@ def masked_cross_entropy(logits: Tensor, target: Tensor, mask: Tensor) -> Tensor
     if picked.numel() == 0:
         return logits.sum() * 0.0
     return F.cross_entropy(picked, target[mask])
+
+
+def load_network(folder: Path) -> EdgeClassifier:
+    """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
+    model, _ = load_trained(folder, EdgeClassifierConfig.from_json, EdgeClassifier, "network")
+    return model

@@ -18,14 +18,14 @@ import time
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Protocol
 
 import numpy as np
 import torch
 
+from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal, Predicate
-from hsgplan.domain.transition import Action, Pick, Place, Push, why_not
+from hsgplan.planning.base import TaskDecision, push_after
 from hsgplan.planning.regression.encoding import (
     DONT_CARE,
     TRUE,
@@ -34,28 +34,16 @@ from hsgplan.planning.regression.encoding import (
     encode_computed,
     touching,
 )
-from hsgplan.planning.regression.train import load_network
+from hsgplan.planning.regression.gnn import load_network
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.symbolic.transition import why_not
 
 MAX_DEPTH = 8
 BUFFER = "open_space"
 
 
-@dataclass(frozen=True)
-class TaskDecision:
-    """The next action (None with a reason when there is none), the subgoal it serves, and the
-    time the decision took."""
-
-    action: Action | None
-    subgoal: Literal | None
-    seconds: float
-    note: str = ""
-
-
-class TaskPlanner(Protocol):
-    name: str
-
-    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision: ...
+def _decision(action: Action, subgoal: Literal, start: float) -> TaskDecision:
+    return TaskDecision(action, subgoal, time.perf_counter() - start, following=push_after(action))
 
 
 def action_for(lit: Literal, state: SymbolicSceneGraph) -> Action | None:
@@ -130,8 +118,12 @@ class RegressionPlanner:
 
     def __init__(self, checkpoint: Path, seed: int = 0, max_depth: int = MAX_DEPTH) -> None:
         self.preimage, self.reach = _inference_networks(str(checkpoint))
-        self.rng = random.Random(seed)
         self.max_depth = max_depth
+        self.reset(None, seed)
+
+    def reset(self, goal: Goal | None, seed: int) -> None:
+        """A new episode: the seed of the uniform serialisation, nothing remembered."""
+        self.rng = random.Random(seed)
         self._taken: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
         self._plan: tuple[Goal, list[tuple[Literal, frozenset[Literal]]]] | None = None
 
@@ -173,7 +165,7 @@ class RegressionPlanner:
         taken = self._taken.setdefault((goal, state), set())
         if (step := self._follow(state, goal, taken)) is not None:
             taken.add(step[1])
-            return TaskDecision(step[1], step[0], time.perf_counter() - start)
+            return _decision(step[1], step[0], start)
         context = frozenset(goal.literals)
         roots = [_Node(lit, context, (lit,)) for lit in unsatisfied]
         preimages = self._preimages(state, roots)
@@ -192,7 +184,7 @@ class RegressionPlanner:
                     node, action = found
                     taken.add(action)
                     self._plan = (goal, list(reversed(node.chain)))
-                    return TaskDecision(action, node.lit, time.perf_counter() - start)
+                    return _decision(action, node.lit, start)
         return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
 
     def _follow(self, state, goal, avoid) -> tuple[Literal, Action] | None:
@@ -269,6 +261,9 @@ class ForwardPlanner:
     def __init__(self, checkpoint: Path) -> None:
         self.net = load_network(checkpoint / "forward")
 
+    def reset(self, goal: Goal | None, seed: int) -> None:
+        """Nothing to forget: the forward planner decides from the state alone."""
+
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
@@ -280,27 +275,5 @@ class ForwardPlanner:
         for flat in probs.flatten().argsort(descending=True).tolist()[:20]:
             lit = slots.literal(*divmod(flat, probs.shape[1]))
             if not state.holds(lit) and (action := action_for(lit, state)) is not None:
-                return TaskDecision(action, lit, time.perf_counter() - start)
+                return _decision(action, lit, start)
         return TaskDecision(None, None, time.perf_counter() - start, "no applicable subgoal")
-
-
-class FastDownwardTaskPlanner:
-    """Fast Downward's plan, first action only: the search-based reference."""
-
-    name = "fd"
-
-    def __init__(self) -> None:
-        from hsgplan.planning.fast_downward import FastDownwardPlanner
-
-        self.planner = FastDownwardPlanner()
-
-    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
-        from hsgplan.planning.fast_downward import NoPlanError
-
-        start = time.perf_counter()
-        try:
-            plan = self.planner.plan(state, goal)
-        except NoPlanError as e:
-            return TaskDecision(None, None, time.perf_counter() - start, str(e))
-        action = plan.actions[0] if plan.actions else None
-        return TaskDecision(action, None, time.perf_counter() - start)

@@ -21,6 +21,7 @@ from torch_geometric.data import Batch
 
 from hsgplan import training
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.paths import DEMOS
 from hsgplan.planning.regression.augment import trajectories
 from hsgplan.planning.regression.encoding import EDGE_DIM, NODE_DIM
 from hsgplan.planning.regression.examples import (
@@ -40,7 +41,7 @@ NETWORKS = {"preimage": 3, "reach": 2, "forward": 3}
 
 @dataclass(frozen=True)
 class TaskTrainConfig:
-    demos: str = "data/demos/v1"
+    demos: str = str(DEMOS)
     seed: int = 0
     epochs: int = 8
     lr: float = 1e-3
@@ -135,11 +136,3 @@ def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, o
         if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
             training.save_progress(folder, model, optim, epoch + 1)
     training.finish(folder, model, net_config.to_json())
-
-
-def load_network(folder: Path) -> EdgeClassifier:
-    """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
-    model, _ = training.load_trained(
-        folder, EdgeClassifierConfig.from_json, EdgeClassifier, "network"
-    )
-    return model

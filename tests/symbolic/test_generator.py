@@ -5,10 +5,10 @@ import pytest
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.feasibility import check_literals
-from hsgplan.domain.generator import random_goal, random_goals, random_objects, random_state
 from hsgplan.domain.objects import split_instance
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import OBJECT_TYPES, Kind
+from hsgplan.symbolic.generator import random_goal, random_goals, random_objects, random_state
 
 
 def test_same_seed_same_goals_and_other_seed_other_goals():

@@ -7,10 +7,9 @@ shelf) come from `world.py`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import EntityKind, kind_of, object_type
+from hsgplan.domain.objects import object_type
 from hsgplan.domain.predicates import Literal, Predicate, in_grasp, inside, on
 from hsgplan.domain.world import (
     INTERIOR_CAPACITY,
@@ -22,41 +21,6 @@ from hsgplan.domain.world import (
     fits_inside,
 )
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-
-
-@dataclass(frozen=True)
-class Pick:
-    """Grasp a clear object from wherever it rests."""
-
-    obj: str
-
-    def __str__(self) -> str:
-        return f"pick({self.obj})"
-
-
-@dataclass(frozen=True)
-class Place:
-    """Put the held object on a region, a shelf top, or another object."""
-
-    obj: str
-    target: str
-
-    def __str__(self) -> str:
-        return f"place({self.obj}, {self.target})"
-
-
-@dataclass(frozen=True)
-class Push:
-    """Push an object from a shelf's prepush region into the shelf's interior."""
-
-    obj: str
-    shelf: str
-
-    def __str__(self) -> str:
-        return f"push({self.obj}, {self.shelf})"
-
-
-Action = Pick | Place | Push
 
 
 class InapplicableActionError(InvalidInputError):
@@ -146,18 +110,3 @@ def applicable_actions(state: SymbolicSceneGraph) -> list[Action]:
         candidates = [Pick(o) for o in state.objects]
         candidates += [Push(o, s) for o in state.objects for s in SHELVES]
     return [a for a in candidates if why_not(state, a) is None]
-
-
-def parse_action(text: str) -> Action:
-    """`pick(o)`, `place(o, target)` or `push(o, shelf)` back into an action."""
-    name, _, rest = text.strip().partition("(")
-    args = [a.strip() for a in rest.rstrip(") ").split(",") if a.strip()]
-    kinds = {"pick": (Pick, 1), "place": (Place, 2), "push": (Push, 2)}
-    if name.strip() not in kinds or len(args) != kinds[name.strip()][1]:
-        raise InvalidInputError(f"'{text}' is not an action (pick(o), place(o, x), push(o, shelf))")
-    for a in args:
-        kind_of(a)
-    if kind_of(args[0]) is not EntityKind.OBJECT:
-        raise InvalidInputError(f"'{text}': the first argument must be an object")
-    cls = kinds[name.strip()][0]
-    return cls(*args)

@@ -1,4 +1,5 @@
-"""Motion parameters chosen from geometry: the oracle's stand-in for the learned motion model.
+"""Motion parameters chosen from geometry: the oracle's motion generator, a hand-written stand-in
+for the learned ones.
 
 It sees only the geometric scene graph. Place bins are ranked by clearance from the objects
 already on the target surface (and, on a prepush region, by how well they line up with a free
@@ -9,8 +10,8 @@ inside the shelf's interior.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
+from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.parameters import (
     PUSH_LEAD,
@@ -22,7 +23,6 @@ from hsgplan.domain.parameters import (
     nearest_push_bins,
     place_xy,
 )
-from hsgplan.domain.transition import Action, Pick, Place, Push
 from hsgplan.domain.world import (
     PLACE_BINS,
     PLACE_LONG_AXIS_YAW,
@@ -35,8 +35,8 @@ from hsgplan.domain.world import (
     spot_cells,
     surface_rect,
 )
+from hsgplan.motion.generator import Feasibility, SingleShotMemory
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.sim.outcome import Outcome, Status
 
 MIN_CLEARANCE = 0.015
 # The Panda hand, measured in PyBullet: about 21 cm long along the finger axis and 6 cm across,
@@ -188,33 +188,23 @@ def candidates(
 
 # Candidates dry-run per decision before the best-ranked one is tried regardless.
 MAX_CHECKS = 30
-# Failures that say these parameters will not work here; anything else may be tried again.
-DO_NOT_RETRY = frozenset({Status.NO_IK, Status.NO_PATH, Status.EFFECT_NOT_REACHED, Status.INVALID})
 
 
-class ParameterChoice:
-    """The motion level the geometric agents share: the best-ranked candidate that passes a
-    dry run (at most `MAX_CHECKS` are checked) and has not failed for good this episode."""
+class GeometricSampler(SingleShotMemory):
+    """The best-ranked candidate that passes a dry run (at most `MAX_CHECKS` are checked) and
+    has not failed for good this episode; without a dry run, the best-ranked one."""
 
-    def __init__(self) -> None:
-        self.failed: set[PrimitiveParams] = set()
+    name = "sampler"
 
-    def reset(self) -> None:
-        self.failed = set()
-
-    def choose(
+    def propose(
         self,
         sg: GeometricSceneGraph,
         action: Action,
-        following: Action | None,
-        feasible: Callable[[PrimitiveParams], bool] | None,
+        following: Action | None = None,
+        feasible: Feasibility | None = None,
     ) -> PrimitiveParams | None:
         options = [c for c in candidates(sg, action, following) if c not in self.failed]
         return next(
             (c for c in options[:MAX_CHECKS] if feasible is None or feasible(c)),
             options[0] if options else None,
         )
-
-    def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
-        if outcome.status in DO_NOT_RETRY:
-            self.failed.add(params)

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 from unified_planning.model import Fluent, InstantaneousAction, Object, Problem
 from unified_planning.shortcuts import BoolType, Not, UserType
 
+from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.predicates import Literal, Predicate
-from hsgplan.domain.transition import Action, Pick, Place, Push
 from hsgplan.domain.world import (
     INTERIOR_CAPACITY,
     MAX_TOWER_LEVELS,

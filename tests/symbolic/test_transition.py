@@ -1,17 +1,9 @@
 import pytest
 
+from hsgplan.domain.actions import Pick, Place, Push, parse_action
 from hsgplan.domain.predicates import clear, in_grasp, inside, on
-from hsgplan.domain.transition import (
-    InapplicableActionError,
-    Pick,
-    Place,
-    Push,
-    applicable_actions,
-    apply,
-    parse_action,
-    why_not,
-)
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph as G
+from hsgplan.symbolic.transition import InapplicableActionError, applicable_actions, apply, why_not
 
 
 def state(*literals, objects=None):

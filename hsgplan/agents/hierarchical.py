@@ -1,0 +1,53 @@
+"""The one agent class: a task planner and a motion generator, composed as the paper composes
+them. The task planner reads the symbolic scene graph s_s and names the next action and the
+subgoal it serves; the motion generator reads the geometric scene graph s_g and chooses the
+action's parameters."""
+
+from __future__ import annotations
+
+import time
+
+from hsgplan.agents.base import Decision
+from hsgplan.domain.goals import Goal
+from hsgplan.domain.parameters import PrimitiveParams
+from hsgplan.motion.generator import Feasibility, MotionGenerator
+from hsgplan.planning.base import TaskPlanner
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.outcome import Outcome
+
+
+class HierarchicalAgent:
+    """Args:
+    name: what episodes record as the agent.
+    planner: the task level (`hsgplan.planning.base.TaskPlanner`).
+    motion: the motion level (`hsgplan.motion.generator.MotionGenerator`).
+    """
+
+    def __init__(self, name: str, planner: TaskPlanner, motion: MotionGenerator) -> None:
+        self.name = name
+        self.planner = planner
+        self.motion = motion
+
+    def reset(self, goal: Goal, seed: int) -> None:
+        self.planner.reset(goal, seed)
+        self.motion.reset(seed)
+
+    def decide(
+        self,
+        sg: GeometricSceneGraph,
+        state: SymbolicSceneGraph,
+        goal: Goal,
+        feasible: Feasibility | None = None,
+    ) -> Decision:
+        task = self.planner.next_action(state, goal)
+        if task.action is None:
+            return Decision(None, None, task.seconds, 0.0, task.note)
+        start = time.perf_counter()
+        params = self.motion.propose(sg, task.action, task.following, feasible)
+        note = "" if params else f"every parameter choice for {task.action} failed"
+        seconds = time.perf_counter() - start
+        return Decision(task.action, params, task.seconds, seconds, note, task.subgoal)
+
+    def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
+        self.motion.observe(params, outcome)

@@ -1,0 +1,114 @@
+"""Agents, task planners and motion generators by name, as the CLI offers them.
+
+An agent is a task planner and a motion generator (`HierarchicalAgent`). The registered agents
+are named pairs; any other pair is asked for as `PLANNER+MOTION` (`regression+gnn`). Shipped
+checkpoints are found as `hsgplan.paths` finds them, wherever the command runs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+from hsgplan.agents.hierarchical import HierarchicalAgent
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.motion.generator import MotionGenerator
+from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
+from hsgplan.planning.base import TaskPlanner
+
+
+def _regression(checkpoint: Path) -> TaskPlanner:
+    from hsgplan.planning.regression.planner import RegressionPlanner
+
+    return RegressionPlanner(checkpoint)
+
+
+def _forward(checkpoint: Path) -> TaskPlanner:
+    from hsgplan.planning.regression.planner import ForwardPlanner
+
+    return ForwardPlanner(checkpoint)
+
+
+def _fast_downward(checkpoint: Path) -> TaskPlanner:
+    from hsgplan.planning.fast_downward import FastDownwardTaskPlanner
+
+    return FastDownwardTaskPlanner()
+
+
+# name -> factory of a task planner from the learned planner's checkpoint folder
+TASK_PLANNERS: dict[str, Callable[[Path], TaskPlanner]] = {
+    "regression": _regression,
+    "forward": _forward,
+    "fd": _fast_downward,
+}
+
+
+def _sampler(checkpoints: Path) -> MotionGenerator:
+    from hsgplan.motion.sampler import GeometricSampler
+
+    return GeometricSampler()
+
+
+def _learned(model: str) -> Callable[[Path], MotionGenerator]:
+    def make(checkpoints: Path) -> MotionGenerator:
+        from hsgplan.domain.parameters import MotionPrimitive
+        from hsgplan.motion.generator import LearnedMotion
+
+        folders = {kind: checkpoints / f"{kind.value}-{model}" for kind in MotionPrimitive}
+        return LearnedMotion(model, folders)
+
+    return make
+
+
+def _random(checkpoints: Path) -> MotionGenerator:
+    from hsgplan.motion.generator import RandomMotion
+
+    return RandomMotion()
+
+
+# name -> factory of a motion generator from the folder of motion checkpoints
+MOTION_GENERATORS: dict[str, Callable[[Path], MotionGenerator]] = {
+    "sampler": _sampler,
+    "gnn": _learned("gnn"),
+    "mlp": _learned("mlp"),
+    "random": _random,
+}
+
+# name -> (task planner, motion generator)
+AGENTS: dict[str, tuple[str, str]] = {
+    "oracle": ("fd", "sampler"),  # the rules and geometry: the ceiling the learned agents meet
+    "regression": ("regression", "sampler"),  # the learned task level alone
+    "paper": ("regression", "gnn"),  # the paper's system: both levels learned
+}
+
+
+def _known(what: str, name: str, names) -> None:
+    if name not in names:
+        raise InvalidInputError(f"unknown {what} '{name}' (known: {', '.join(names)})")
+
+
+def make_planner(name: str, checkpoint: Path = TASK_CHECKPOINT) -> TaskPlanner:
+    _known("task planner", name, TASK_PLANNERS)
+    return TASK_PLANNERS[name](checkpoint)
+
+
+def make_motion(name: str, checkpoints: Path = MOTION_CHECKPOINTS) -> MotionGenerator:
+    _known("motion generator", name, MOTION_GENERATORS)
+    return MOTION_GENERATORS[name](checkpoints)
+
+
+def agent_parts(name: str) -> tuple[str, str]:
+    """(task planner, motion generator) of a registered agent or of `PLANNER+MOTION`."""
+    if "+" in name:
+        planner, _, motion = name.partition("+")
+        _known("task planner", planner, TASK_PLANNERS)
+        _known("motion generator", motion, MOTION_GENERATORS)
+        return planner, motion
+    _known("agent", name, list(AGENTS) + ["PLANNER+MOTION"])
+    return AGENTS[name]
+
+
+def make_agent(name: str) -> HierarchicalAgent:
+    """An agent by name; an unknown name or a missing checkpoint is refused in one line."""
+    planner, motion = agent_parts(name)
+    return HierarchicalAgent(name, make_planner(planner), make_motion(motion))

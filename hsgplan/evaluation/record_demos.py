@@ -1,0 +1,80 @@
+"""Recording the demonstrations: oracle episodes in the simulated world, one per task of
+`hsgplan.data.demos.TASKS`, appended to the dataset folder as each finishes (an interrupted
+recording, started again, records only the tasks that are missing)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+
+from hsgplan.agents.oracle import OracleAgent
+from hsgplan.data.demos import DEMOS, FORMAT, META, TASKS, VERSION, Demo, read_demos, read_json
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.goals import parse_goal
+from hsgplan.evaluation.episode import run_episode
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.env import KitchenStorageEnv
+
+RETRIES = 5
+
+
+def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
+    """Run the oracle on one task; the demonstration, or None if the episode failed."""
+    goal = parse_goal(goal_text)
+    states: list[SymbolicSceneGraph] = []
+    actions: list[str] = []
+
+    def on_step(record, obs) -> None:
+        if record is not None and record.status != "success":
+            return  # a primitive that failed and changed nothing is no transition
+        if record is not None:
+            actions.append(record.action)
+        states.append(obs.symbols.state)
+
+    result = run_episode(KitchenStorageEnv(), OracleAgent(), goal, seed, on_step=on_step)
+    if not result.success or not actions or any(s.status != "success" for s in result.steps):
+        return None  # a failure, a detour, or a goal that held from the start shows nothing
+    return Demo(
+        task,
+        goal_text,
+        seed,
+        goal.objects,
+        tuple(actions),
+        tuple(tuple(str(lit) for lit in s.sorted_literals()) for s in states),
+    )
+
+
+def collect_demos(
+    out: Path, seed: int, command: str = "", on_demo: Callable[[Demo], None] | None = None
+) -> list[Demo]:
+    """Record every task not yet in `out` (appending as each finishes); all demos, in order."""
+    out.mkdir(parents=True, exist_ok=True)
+    meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
+    meta_path = out / META
+    if meta_path.exists():
+        saved = read_json(meta_path)
+        if saved.get("seed") != seed or saved.get("version") != VERSION:
+            raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
+    else:
+        meta_path.write_text(json.dumps(meta, indent=2) + "\n")
+    done = {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
+    path = out / DEMOS
+    if path.exists() and path.stat().st_size and not path.read_bytes().endswith(b"\n"):
+        with open(path, "a") as f:  # a line cut short by an interruption: end it
+            f.write("\n")
+    for i, (task, goal) in enumerate(TASKS):
+        if task in done:
+            continue
+        for attempt in range(RETRIES):
+            demo = record_demo(task, goal, seed * 1000 + i * RETRIES + attempt)
+            if demo is not None:
+                break
+        else:
+            raise RuntimeError(f"task {task}: the oracle failed {RETRIES} times")
+        with open(path, "a") as f:
+            f.write(json.dumps(demo.to_json()) + "\n")
+        done[task] = demo
+        if on_demo:
+            on_demo(demo)
+    return [done[t] for t, _ in TASKS]

@@ -1,0 +1,44 @@
+"""Where the shipped checkpoints and datasets are, wherever a command runs.
+
+The shipped files live in the repository beside the package (`checkpoints/`, `data/`). Their
+home is, in this order: the folder named by the environment variable `HSGPLAN_HOME`; the
+folder above the installed package when it holds `checkpoints/` (a checkout, or an editable
+install); the current folder. A relative path a user gives (`--checkpoint`, a training
+configuration's `demos`) is read from the current folder when it exists there, and otherwise
+from the home, so `checkpoints/task` means the shipped planner from any folder.
+
+Run folders (`runs/...`) are not shipped: they are made where the user runs the command, or
+wherever `--out` says.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+HOME_VARIABLE = "HSGPLAN_HOME"
+CHECKPOINTS = Path("checkpoints")
+DATA = Path("data")
+TASK_CHECKPOINT = CHECKPOINTS / "task"
+MOTION_CHECKPOINTS = CHECKPOINTS / "motion"
+DEMOS = DATA / "demos" / "v1"
+MOTION_DATA = DATA / "motion"
+RUNS = Path("runs")
+
+
+def home() -> Path:
+    """The folder that holds `checkpoints/` and `data/`."""
+    if value := os.environ.get(HOME_VARIABLE):
+        return Path(value).expanduser()
+    beside_package = Path(__file__).resolve().parent.parent
+    if (beside_package / CHECKPOINTS).is_dir():
+        return beside_package
+    return Path.cwd()
+
+
+def shipped(path: Path | str) -> Path:
+    """A path as the user meant it: as given when absolute or present here, else in `home()`."""
+    path = Path(path).expanduser()
+    if path.is_absolute() or path.exists():
+        return path
+    return home() / path

@@ -1,0 +1,51 @@
+"""What every task planner offers the agent: the next action for a symbolic state and a goal,
+with the subgoal it serves.
+
+Task planners are the learned regression planner and the forward baseline
+(`planning/regression/planner.py`) and Fast Downward (`planning/fast_downward.py`); the
+registry (`hsgplan.agents.registry`) names them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+from hsgplan.domain.actions import Action, Place, Push
+from hsgplan.domain.goals import Goal
+from hsgplan.domain.predicates import Literal
+from hsgplan.domain.world import SHELVES
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+
+@dataclass(frozen=True)
+class TaskDecision:
+    """The next action (None with a reason when there is none), the subgoal it serves, the time
+    the decision took, and the action the planner expects to take after it where it knows one
+    (the motion level uses it: a place that a push follows puts the object where the push can
+    start)."""
+
+    action: Action | None
+    subgoal: Literal | None
+    seconds: float
+    note: str = ""
+    following: Action | None = None
+
+
+class TaskPlanner(Protocol):
+    name: str
+
+    def reset(self, goal: Goal, seed: int) -> None:
+        """A new episode towards `goal`, seeded."""
+
+    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision: ...
+
+
+def push_after(action: Action) -> Push | None:
+    """The paper's heuristic from subgoal to primitive, one step on: an object placed on a
+    shelf's prepush region is there to be pushed into that shelf."""
+    if isinstance(action, Place):
+        return next(
+            (Push(action.obj, s) for s in SHELVES if SHELVES[s].prepush == action.target), None
+        )
+    return None
