@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint clean
+.PHONY: demo test test-fast lint clean
 
 # torch is installed first and alone so that nothing resolves it to a CUDA build.
 $(STAMP): pyproject.toml
@@ -17,13 +17,19 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/hsgplan demo --agent regression
 
-test: $(STAMP)
-	$(BIN)/ruff check hsgplan tests scripts
+# The whole suite, in a random order (pytest-randomly), on both cores; what CI runs.
+test: lint
 	$(BIN)/python -m pytest -q -n 2 tests
 
+# Everything but the tests marked slow: under two minutes, for the edit-test loop.
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -q -n 2 -m "not slow" tests
+
+# Style, and the layer contracts in pyproject.toml ([tool.importlinter]).
 lint: $(STAMP)
 	$(BIN)/ruff check hsgplan tests scripts
 	$(BIN)/ruff format --check hsgplan tests scripts
+	$(BIN)/lint-imports
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -87,13 +87,17 @@ BAD = [
     (["bench", "symbolic", "--sizes", "1-3"], "between 2 and 12"),
     (["bench", "symbolic", "--goals", "-1"], "at least one goal"),
     (["demo", "--objects", "40"], "between 2 and 12"),
-    (["demo", "--agent", "wizard"], "unknown agent 'wizard'"),
+    (["demo", "--agent", "wizard"], "'wizard' is not one of 'oracle'"),
     (["demo", "--goal", "On(butter, butter)"], "itself"),
     (["eval", "--sizes", "2", "--goals", "-1"], "cannot be negative"),
     (["eval", "--sizes", "2", "--workers", "0"], "at least one"),
-    (["eval", "--agent", "wizard"], "unknown agent 'wizard'"),
+    (["eval", "--motion", "wizard"], "'wizard' is not one of 'sampler'"),
     (["eval", "--goals-file", "/nonexistent/goals.txt"], "does not exist"),
     (["bench", "sim", "--episodes", "0"], "at least one episode"),
+    (["plan", "--goal", "On(cherries, shelf_a) &"], "ends with '&'"),
+    (["eval", "--goals", "many"], "valid integer"),
+    (["eval-task", "--planner", "wizard"], "'wizard' is not one of 'regression'"),
+    (["eval-motion", "--workers", "0"], "at least one"),
 ]
 
 

@@ -9,12 +9,15 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from hsgplan.agents.hierarchical import HierarchicalAgent
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.motion.generator import MotionGenerator
 from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
-from hsgplan.planning.base import TaskPlanner
+
+if TYPE_CHECKING:  # the names are read by the CLI's --help, which should not load torch
+    from hsgplan.agents.hierarchical import HierarchicalAgent
+    from hsgplan.motion.generator import MotionGenerator
+    from hsgplan.planning.base import TaskPlanner
 
 
 def _regression(checkpoint: Path) -> TaskPlanner:
@@ -97,6 +100,16 @@ def make_motion(name: str, checkpoints: Path = MOTION_CHECKPOINTS) -> MotionGene
     return MOTION_GENERATORS[name](checkpoints)
 
 
+def agent_name(agent: str, planner: str | None = None, motion: str | None = None) -> str:
+    """The agent a command asks for: a registered one, with its planner or its motion
+    generator replaced where `planner` or `motion` is given."""
+    if planner is None and motion is None:
+        agent_parts(agent)
+        return agent
+    default_planner, default_motion = agent_parts(agent)
+    return f"{planner or default_planner}+{motion or default_motion}"
+
+
 def agent_parts(name: str) -> tuple[str, str]:
     """(task planner, motion generator) of a registered agent or of `PLANNER+MOTION`."""
     if "+" in name:
@@ -110,5 +123,7 @@ def agent_parts(name: str) -> tuple[str, str]:
 
 def make_agent(name: str) -> HierarchicalAgent:
     """An agent by name; an unknown name or a missing checkpoint is refused in one line."""
+    from hsgplan.agents.hierarchical import HierarchicalAgent
+
     planner, motion = agent_parts(name)
     return HierarchicalAgent(name, make_planner(planner), make_motion(motion))

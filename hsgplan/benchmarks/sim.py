@@ -9,7 +9,7 @@ import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from hsgplan.agents.oracle import OracleAgent
+from hsgplan.agents.registry import make_agent
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.episode import EpisodeRecord, run_episode
@@ -38,7 +38,7 @@ def bench_sim(
     records = []
     for spec in specs:
         records.append(
-            run_episode(KitchenStorageEnv(), OracleAgent(), parse_goal(spec.goal), spec.seed)
+            run_episode(KitchenStorageEnv(), make_agent("oracle"), parse_goal(spec.goal), spec.seed)
         )
         if on_episode:
             on_episode(records[-1])

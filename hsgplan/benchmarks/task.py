@@ -59,14 +59,14 @@ def bench_task(
     """Time the three planners on `goals` problems per size."""
     import torch
 
-    from hsgplan.planning.fast_downward import NoPlanError
-    from hsgplan.planning.regression.planner import FastDownwardTaskPlanner, RegressionPlanner
+    from hsgplan.planning.fast_downward import FastDownwardTaskPlanner, NoPlanError
+    from hsgplan.planning.regression.planner import RegressionPlanner
 
     if goals <= 0:
         raise InvalidInputError(f"--goals {goals}: need at least one goal per size")
     torch.set_num_threads(1)
     learned = RegressionPlanner(checkpoint, seed=seed)
-    closed_loop = FastDownwardTaskPlanner()
+    closed_loop = FastDownwardTaskPlanner(follow_plan=False)
     rows = []
     for n in sizes:
         problems = random_goals(n, goals, seed, stacking=n > 2)

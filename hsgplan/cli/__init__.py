@@ -11,8 +11,10 @@ import sys
 import typer
 
 from hsgplan.cli import bench, data, learn, motion, symbolic, world
+from hsgplan.cli.common import OneLineErrors
 
 app = typer.Typer(
+    cls=OneLineErrors,
     add_completion=False,
     no_args_is_help=True,
     help="Hierarchical planning with geometric and symbolic scene graphs (kitchen storage).",

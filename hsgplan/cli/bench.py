@@ -10,6 +10,7 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import err, parse_sizes, print_table, refuses_bad_input
+from hsgplan.paths import TASK_CHECKPOINT
 
 app = typer.Typer(no_args_is_help=True, help="Measure speed (medians over one run).")
 
@@ -91,9 +92,7 @@ def bench_task(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
     goals: Annotated[int, typer.Option(help="Goals per size.")] = 20,
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
-    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = Path(
-        "checkpoints/task"
-    ),
+    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = TASK_CHECKPOINT,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")

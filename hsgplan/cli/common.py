@@ -4,16 +4,43 @@ from __future__ import annotations
 
 import functools
 import json
+import sys
+from enum import StrEnum
 from pathlib import Path
 
 import typer
 from rich.console import Console
 from rich.table import Table
+from typer.core import TyperGroup
 
+from hsgplan.agents.registry import AGENTS, MOTION_GENERATORS, TASK_PLANNERS
 from hsgplan.domain.errors import InvalidInputError
 
 out = Console()
 err = Console(stderr=True)
+
+
+class OneLineErrors(TyperGroup):
+    """The top-level group: a usage error (an unknown choice, a malformed number) is one line on
+    stderr and exit code 2, like every other refusal, instead of click's framed box."""
+
+    def main(self, *args, standalone_mode: bool = True, **kwargs):
+        try:
+            code = super().main(*args, standalone_mode=False, **kwargs)
+        except typer.TyperException as e:  # click's exceptions, as typer ships them
+            if type(e).__name__ == "NoArgsIsHelpError":
+                e.show()
+            else:
+                message = " ".join(e.format_message().split())
+                err.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+            code = e.exit_code
+        except typer.Abort:
+            err.print("aborted")
+            code = 1
+        code = code if isinstance(code, int) else 0
+        if standalone_mode:
+            sys.exit(code)
+        return code
 
 
 def refuses_bad_input(fn):
@@ -31,6 +58,17 @@ def refuses_bad_input(fn):
             raise typer.Exit(130) from None
 
     return wrapper
+
+
+def choice(what: str, names) -> type[StrEnum]:
+    """Names offered as choices, listed by `--help` and checked by the parser (its `.value` is
+    the name)."""
+    return StrEnum(what, {name: name for name in names})
+
+
+AgentName = choice("AgentName", AGENTS)
+PlannerName = choice("PlannerName", TASK_PLANNERS)
+MotionName = choice("MotionName", MOTION_GENERATORS)
 
 
 def read_config(path: Path | None) -> dict:

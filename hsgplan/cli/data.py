@@ -9,6 +9,7 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import err, out, refuses_bad_input
+from hsgplan.paths import DEMOS, MOTION_DATA
 
 app = typer.Typer(no_args_is_help=True, help="Collect datasets (resumable).")
 
@@ -19,7 +20,7 @@ def demos(
     seed: Annotated[int, typer.Option(help="Seed of the demonstration scenes.")] = 0,
     out_dir: Annotated[
         Path, typer.Option("--out", help="Dataset folder (resumed if it exists).")
-    ] = Path("data/demos/v1"),
+    ] = DEMOS,
 ) -> None:
     """Record the paper's 18 short demonstrations with the oracle in the simulated world."""
     from hsgplan.data.demos import TASKS
@@ -47,9 +48,7 @@ def _collect_command(primitive: str, default_samples: int):
         ray: Annotated[
             str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
         ] = None,
-        out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = Path(
-            "data/motion"
-        ),
+        out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = MOTION_DATA,
         tasks_per_chunk: Annotated[int, typer.Option(help="Tasks per unit of work.")] = 32,
     ) -> None:
         _collect(primitive, samples, workers, seed, ray, out_dir, tasks_per_chunk)

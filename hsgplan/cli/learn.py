@@ -9,18 +9,27 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import err, out, parse_sizes, print_table, read_config, refuses_bad_input
+from hsgplan.cli.common import (
+    PlannerName,
+    err,
+    out,
+    parse_sizes,
+    print_table,
+    read_config,
+    refuses_bad_input,
+)
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.paths import RUNS, TASK_CHECKPOINT
 
 train_app = typer.Typer(no_args_is_help=True, help="Train the learned models (resumable).")
-CHECKPOINT = Path("checkpoints/task")
+REGRESSION = PlannerName("regression")
 
 
 @train_app.command("task")
 @refuses_bad_input
 def train_task(
     config: Annotated[Path | None, typer.Option(help="Training configuration (JSON).")] = None,
-    out_dir: Annotated[Path, typer.Option("--out", help="Checkpoint folder.")] = CHECKPOINT,
+    out_dir: Annotated[Path, typer.Option("--out", help="Checkpoint folder.")] = TASK_CHECKPOINT,
     seed: Annotated[int | None, typer.Option(help="Overrides the configuration's seed.")] = None,
 ) -> None:
     """Train f_preimage, f_reach and the forward baseline on the demonstrations."""
@@ -45,16 +54,16 @@ def train_task(
 
 @refuses_bad_input
 def eval_task(
-    planner: Annotated[str, typer.Option(help="regression, forward or fd.")] = "regression",
+    planner: Annotated[PlannerName, typer.Option(help="Task planner.")] = REGRESSION,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
     goals: Annotated[int, typer.Option(help="Random goals per size.")] = 500,
     seed: Annotated[int, typer.Option(help="Seed of the goals and start states.")] = 0,
     goals_file: Annotated[Path | None, typer.Option(help="Goals from a file instead.")] = None,
-    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = CHECKPOINT,
+    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = TASK_CHECKPOINT,
     workers: Annotated[int, typer.Option(help="Episodes run side by side.")] = 2,
-    run: Annotated[
+    run_dir: Annotated[
         Path | None,
-        typer.Option(help="Run folder (episodes.jsonl); an interrupted run resumes from it."),
+        typer.Option("--out", help="Run folder (resumed if it exists; default runs/NAME)."),
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
@@ -68,10 +77,11 @@ def eval_task(
 
     if workers < 1:
         raise InvalidInputError(f"--workers {workers}: need at least one")
+    planner = planner.value
     size_list = parse_sizes(sizes)
     total = goals * len(size_list) if goals_file is None else None
     source = goals_file.stem if goals_file else f"g{goals}"
-    run = run or Path("runs") / f"eval-task-{planner}-{sizes}-{source}-seed{seed}"
+    run_dir = run_dir or RUNS / f"eval-task-{planner}-{sizes}-{source}-seed{seed}"
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(f"{planner} episodes", total=total)
         episodes = evaluate_task(
@@ -83,7 +93,7 @@ def eval_task(
             goals_file,
             workers,
             lambda e: progress.advance(task),
-            run,
+            run_dir,
         )
     report = summarize_task(episodes) | {"planner": planner, "seed": seed}
     if as_json:

@@ -10,8 +10,7 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import err, out, print_table, read_config, refuses_bad_input
-
-CHECKPOINTS = Path("checkpoints/motion")
+from hsgplan.paths import MOTION_CHECKPOINTS
 
 
 @refuses_bad_input
@@ -38,7 +37,7 @@ def train_motion(
     if data is not None:
         settings["data"] = str(data)
     cfg = MotionTrainConfig.from_json(settings)
-    folder = out_dir or CHECKPOINTS / f"{primitive}-{model}"
+    folder = out_dir or MOTION_CHECKPOINTS / f"{primitive}-{model}"
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task(f"{primitive} {model}", total=cfg.epochs)
 
@@ -56,8 +55,14 @@ def eval_motion(
     trials: Annotated[int, typer.Option(help="Fresh scenes per primitive.")] = 200,
     seed: Annotated[int, typer.Option(help="Seed of the evaluation scenes.")] = 0,
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
-    checkpoints: Annotated[Path, typer.Option(help="Folder of motion checkpoints.")] = CHECKPOINTS,
+    checkpoints: Annotated[
+        Path, typer.Option(help="Folder of motion checkpoints.")
+    ] = MOTION_CHECKPOINTS,
     workers: Annotated[int, typer.Option(help="Processes.")] = 2,
+    run_dir: Annotated[
+        Path | None,
+        typer.Option("--out", help="Run folder (resumed if it exists); none: nothing is kept."),
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")
@@ -71,7 +76,7 @@ def eval_motion(
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("scenes", total=trials * len(kinds))
         report = evaluate_motion(
-            kinds, trials, seed, checkpoints, workers, lambda: progress.advance(bar)
+            kinds, trials, seed, checkpoints, workers, lambda: progress.advance(bar), run_dir
         )
     if as_json:
         print(json.dumps(report, indent=2))

@@ -9,29 +9,54 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import err, out, parse_sizes, print_table, refuses_bad_input
+from hsgplan.agents.registry import AGENTS, agent_name
+from hsgplan.cli.common import (
+    AgentName,
+    MotionName,
+    PlannerName,
+    err,
+    out,
+    parse_sizes,
+    print_table,
+    refuses_bad_input,
+)
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.paths import RUNS
+
+AGENT_HELP = "A registered agent: " + "; ".join(
+    f"{name} ({planner} + {motion})" for name, (planner, motion) in AGENTS.items()
+)
+ORACLE = AgentName("oracle")
+AgentOption = Annotated[AgentName, typer.Option(help=AGENT_HELP)]
+PlannerOption = Annotated[
+    PlannerName | None, typer.Option(help="Task planner in place of the agent's.")
+]
+MotionOption = Annotated[
+    MotionName | None, typer.Option(help="Motion generator in place of the agent's.")
+]
 
 
 @refuses_bad_input
 def demo(
-    agent: Annotated[str, typer.Option(help="Which agent acts.")] = "oracle",
+    agent: AgentOption = ORACLE,
+    planner: PlannerOption = None,
+    motion: MotionOption = None,
     goal: Annotated[
         str | None, typer.Option(help="Goal literals (default: a random goal).")
     ] = None,
     objects: Annotated[int, typer.Option(help="Objects in the random goal (2-12).")] = 4,
     seed: Annotated[int, typer.Option(help="Seed for the goal and the scene.")] = 0,
-    out_dir: Annotated[Path, typer.Option("--out", help="Folder for the pictures.")] = Path(
-        "runs/demo"
-    ),
+    out_dir: Annotated[Path, typer.Option("--out", help="Folder for the pictures.")] = RUNS
+    / "demo",
 ) -> None:
     """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record."""
+    from hsgplan.agents.registry import make_agent
     from hsgplan.domain.goals import parse_goal
     from hsgplan.evaluation.demo import demo_goal, run_demo
-    from hsgplan.evaluation.protocol import make_agent
     from hsgplan.symbolic.generator import check_size
 
-    make_agent(agent)
+    agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
+    make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
     if goal is None:
         check_size(objects)
     g = parse_goal(goal) if goal else demo_goal(objects, seed)
@@ -52,14 +77,20 @@ def demo(
 
 @refuses_bad_input
 def evaluate(
-    agent: Annotated[str, typer.Option(help="Which agent acts.")] = "oracle",
+    agent: AgentOption = ORACLE,
+    planner: PlannerOption = None,
+    motion: MotionOption = None,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-6.")] = "2-6",
     goals: Annotated[int, typer.Option(help="Random goals per size.")] = 50,
     seed: Annotated[int, typer.Option(help="Seed of the goals and the episodes.")] = 0,
     goals_file: Annotated[Path | None, typer.Option(help="Goals from a file instead.")] = None,
     workers: Annotated[int, typer.Option(help="Episodes run side by side.")] = 2,
     run_dir: Annotated[
-        Path | None, typer.Option("--out", help="Run folder (resumed if it exists).")
+        Path | None,
+        typer.Option("--out", help="Run folder (resumed if it exists; default runs/NAME)."),
+    ] = None,
+    ray: Annotated[
+        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
@@ -67,21 +98,21 @@ def evaluate(
     ] = False,
 ) -> None:
     """Success rate and subgoal completion per problem size, with the failure taxonomy."""
+    from hsgplan.agents.registry import make_agent
     from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation, summarize
 
     if workers < 1:
         raise InvalidInputError(f"--workers {workers}: need at least one")
+    agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
     config = EvalConfig(
         agent, tuple(parse_sizes(sizes)), goals, seed, str(goals_file) if goals_file else None
     )
-    from hsgplan.evaluation.protocol import make_agent
-
-    make_agent(agent)
+    make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
     total = len(episode_specs(config))
-    folder = run_dir or Path("runs") / config.run_name()
+    folder = run_dir or RUNS / config.run_name()
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(f"{agent} episodes", total=total)
-        records = run_evaluation(config, folder, workers, lambda r: progress.advance(task))
+        records = run_evaluation(config, folder, workers, lambda r: progress.advance(task), ray)
     report = summarize(records) | {"agent": agent, "seed": seed, "run": str(folder)}
     if as_json:
         print(json.dumps(report, indent=2))

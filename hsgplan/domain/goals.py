@@ -103,25 +103,34 @@ def parse_literal(text: str) -> Literal:
 
 
 def split_literals(text: str) -> list[str]:
-    """The literal texts of a goal, separated by `&`, `;` or new lines."""
-    return [p.strip() for p in re.split(r"[&;\n]", text)]
+    """The literal texts of a goal, separated by `&`, `;` or new lines.
+
+    Blank lines are skipped, but an `&` or `;` must stand between two literals: one at the
+    start or the end of the goal, or two in a row, is refused (`GoalSyntaxError`).
+    """
+    literals = []
+    parts = re.split(r"([&;])", text)
+    for i in range(0, len(parts), 2):
+        lines = [line.strip() for line in parts[i].split("\n") if line.strip()]
+        if not lines and len(parts) > 1:
+            before = parts[i - 1] if i > 0 else None
+            after = parts[i + 1] if i + 1 < len(parts) else None
+            if before is None:
+                raise GoalSyntaxError(f"the goal starts with '{after}', not with a literal")
+            if after is None:
+                raise GoalSyntaxError(f"the goal ends with '{before}', not with a literal")
+            raise GoalSyntaxError(f"no literal between '{before}' and '{after}'")
+        literals += lines
+    return literals
 
 
 def parse_goal(text: str, validate: bool = True) -> Goal:
     """Parse goal text; with `validate`, also refuse contradictory or impossible goals."""
     if len(text) > MAX_GOAL_CHARS:
         raise GoalSyntaxError(f"the goal is {len(text)} characters long; at most {MAX_GOAL_CHARS}")
-    parts = split_literals(text)
-    if all(not p for p in parts):
+    if not re.sub(r"[&;\s]", "", text):
         raise GoalSyntaxError("the goal is empty")
-    literals = []
-    for i, part in enumerate(parts):
-        if not part:
-            if 0 < i < len(parts) - 1:
-                raise GoalSyntaxError(f"empty literal between separators in '{text.strip()}'")
-            continue
-        literals.append(parse_literal(part))
-    goal = Goal(frozenset(literals))
+    goal = Goal(frozenset(parse_literal(part) for part in split_literals(text)))
     if validate:
         check_literals(goal.literals)
     return goal

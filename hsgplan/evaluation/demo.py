@@ -9,9 +9,9 @@ from pathlib import Path
 
 import imageio.v3 as iio
 
+from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import Goal
 from hsgplan.evaluation.episode import EpisodeRecord, run_episode
-from hsgplan.evaluation.protocol import make_agent
 from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.render import Camera
 from hsgplan.symbolic.generator import random_goal

@@ -12,19 +12,17 @@ from dataclasses import asdict, dataclass
 
 from hsgplan.agents.base import Agent
 from hsgplan.domain.goals import Goal
+from hsgplan.evaluation.failures import Failure
 from hsgplan.scene_graph.symbol_mapping import AnomalyKind
 from hsgplan.sim.env import KitchenStorageEnv, Observation, ResetOptions
 
-# Failure kinds of an episode (None when it succeeded).
-OVERSTEP = "overstep"  # the step limit came first
-NO_PLAN = "no_plan"  # the task planner found no next action
-NO_PARAMETERS = "no_parameters"  # every parameter choice for the next action had failed
-_FATAL = {AnomalyKind.TOPPLED: "knocked_over", AnomalyKind.OFF_TABLE: "off_table"}
+_FATAL = {AnomalyKind.TOPPLED: Failure.KNOCKED_OVER, AnomalyKind.OFF_TABLE: Failure.OFF_TABLE}
 
 
 @dataclass(frozen=True)
 class StepRecord:
     step: int
+    subgoal: str
     action: str
     params: str
     status: str
@@ -81,17 +79,18 @@ def run_episode(
             failure = _FATAL[fatal[0].kind]
             break
         if env.steps >= env.max_steps:
-            failure = OVERSTEP
+            failure = Failure.OVERSTEP
             break
         d = agent.decide(obs.scene_graph, obs.symbols.state, goal, feasible=env.check)
         if d.params is None:
-            failure = NO_PLAN if d.action is None else NO_PARAMETERS
+            failure = Failure.NO_SUBGOAL if d.action is None else Failure.NO_PARAMETERS
             break
         obs, _, _, _, info = env.step(d.params, on_frame)
         outcome = info["outcome"]
         agent.observe(d.params, outcome)
         record = StepRecord(
             len(records) + 1,
+            str(d.subgoal or ""),
             str(d.action),
             params_text(d.params),
             outcome.status.value,
@@ -113,7 +112,7 @@ def run_episode(
         goal.size,
         failure is None,
         done / len(goal.literals),
-        failure,
+        None if failure is None else str(failure),
         tuple(records),
         time.perf_counter() - start,
     )

@@ -10,14 +10,16 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
-from hsgplan.data.motion_collect import LocalEngine
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import stage_task, try_params
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.world import SHELVES
+from hsgplan.paths import shipped
+from hsgplan.runner.items import run_items
 from hsgplan.sim.scene import Scene
 
 MODELS = ("gnn", "gnn_paper", "mlp", "mlp_bce", "random")
@@ -36,6 +38,7 @@ def _learned(kind: MotionPrimitive, checkpoints: Path) -> dict:
     from hsgplan.motion.generator import LearnedMotion
 
     out = {}
+    checkpoints = shipped(checkpoints)
     for name, folder in FOLDERS.items():
         path = checkpoints / f"{kind.value}-{folder}"
         if name not in OPTIONAL or path.exists():
@@ -101,6 +104,24 @@ def summarize(rows: list[dict]) -> dict:
     return out
 
 
+@dataclass(frozen=True)
+class MotionChunk:
+    """CHUNK consecutive evaluation scenes of one primitive: a unit of `eval-motion` work."""
+
+    primitive: str
+    seed: int
+    start: int
+    checkpoints: str
+
+    @property
+    def key(self) -> str:
+        return f"{self.primitive}/{self.start}"
+
+
+def run_motion_chunk(chunk: MotionChunk) -> list[dict]:
+    return run_eval_chunk(chunk.primitive, chunk.seed, chunk.start, chunk.checkpoints)
+
+
 def evaluate_motion(
     primitives: list[str],
     trials: int,
@@ -108,37 +129,52 @@ def evaluate_motion(
     checkpoints: Path,
     workers: int,
     progress: Callable[[], None] | None = None,
+    run_dir: Path | None = None,
 ) -> dict:
     """`{primitive: {model: {"success_rate", "trials", "by_crowding", ...}}}` over the first
-    `trials` tasks of the evaluation stream (scenes that could not be staged are skipped)."""
+    `trials` tasks of the evaluation stream (scenes that could not be staged are skipped).
+    With `run_dir`, finished chunks are kept there and a run started again skips them."""
     if trials < 1:
         raise InvalidInputError(f"--trials {trials}: need at least one")
-    if workers < 1:
-        raise InvalidInputError(f"--workers {workers}: need at least one")
     kinds = []
     for p in primitives:
         if p not in ("place", "push"):
             raise InvalidInputError(f"primitive '{p}': place or push")
         kinds.append(MotionPrimitive(p))
         _learned(MotionPrimitive(p), checkpoints)  # refuse missing checkpoints before any work
+    chunks = [
+        MotionChunk(kind.value, seed, start, str(checkpoints))
+        for kind in kinds
+        for start in range(0, trials, CHUNK)
+    ]
+
+    def on_chunk(rows: list[dict]) -> None:
+        if progress:
+            for _ in range(len({r["task"] for r in rows if r["task"] < trials})):
+                progress()
+
+    results = run_items(
+        run_motion_chunk,
+        chunks,
+        key=lambda c: c.key,
+        run_dir=run_dir,
+        config={
+            "primitives": [k.value for k in kinds],
+            "seed": seed,
+            "checkpoints": str(checkpoints),
+        },
+        workers=workers,
+        on_result=on_chunk,
+    )
     report = {}
-    runner = LocalEngine(workers)
-    try:
-        for kind in kinds:
-            pending = {
-                runner.submit(run_eval_chunk, kind.value, seed, start, str(checkpoints))
-                for start in range(0, trials, CHUNK)
-            }
-            rows: list[dict] = []
-            while pending:
-                handle, got = runner.next_done(pending)
-                pending.discard(handle)
-                rows += [r for r in got if r["task"] < trials]
-                if progress:
-                    for _ in range(len({r["task"] for r in got if r["task"] < trials})):
-                        progress()
-            rows.sort(key=lambda r: (r["task"], MODELS.index(r["model"])))
-            report[kind.value] = summarize(rows)
-    finally:
-        runner.close()
+    for kind in kinds:
+        rows = [
+            r
+            for chunk, got in zip(chunks, results, strict=True)
+            if chunk.primitive == kind.value
+            for r in got
+            if r["task"] < trials
+        ]
+        rows.sort(key=lambda r: (r["task"], MODELS.index(r["model"])))
+        report[kind.value] = summarize(rows)
     return report

@@ -8,7 +8,7 @@ import json
 from collections.abc import Callable
 from pathlib import Path
 
-from hsgplan.agents.oracle import OracleAgent
+from hsgplan.agents.registry import make_agent
 from hsgplan.data.demos import DEMOS, FORMAT, META, TASKS, VERSION, Demo, read_demos, read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
@@ -32,7 +32,7 @@ def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
             actions.append(record.action)
         states.append(obs.symbols.state)
 
-    result = run_episode(KitchenStorageEnv(), OracleAgent(), goal, seed, on_step=on_step)
+    result = run_episode(KitchenStorageEnv(), make_agent("oracle"), goal, seed, on_step=on_step)
     if not result.success or not actions or any(s.status != "success" for s in result.steps):
         return None  # a failure, a detour, or a goal that held from the start shows nothing
     return Demo(

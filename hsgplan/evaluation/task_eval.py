@@ -8,26 +8,22 @@ beyond), and every decision is timed.
 
 from __future__ import annotations
 
-import contextlib
-import json
-import multiprocessing
 import random
 import statistics
 from collections import Counter
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from hsgplan.agents.registry import make_planner
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
+from hsgplan.domain.world import MAX_STEPS
+from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.protocol import episode_seed
-from hsgplan.evaluation.run_folder import RESULTS, claim, logged_rows
+from hsgplan.runner.items import run_items
 from hsgplan.symbolic.generator import random_goals, random_state
 from hsgplan.symbolic.transition import apply, why_not
-
-MAX_STEPS = 50
-PLANNERS = ("regression", "forward", "fd")
 
 
 @dataclass(frozen=True)
@@ -43,40 +39,25 @@ class TaskEpisode:
     decision_ms: tuple[float, ...]
 
 
-def make_planner(name: str, checkpoint: Path, seed: int):
-    from hsgplan.planning.regression.planner import (
-        FastDownwardTaskPlanner,
-        ForwardPlanner,
-        RegressionPlanner,
-    )
-
-    if name == "regression":
-        return RegressionPlanner(checkpoint, seed=seed)
-    if name == "forward":
-        return ForwardPlanner(checkpoint)
-    if name == "fd":
-        return FastDownwardTaskPlanner()
-    raise InvalidInputError(f"unknown planner '{name}' (known: {', '.join(PLANNERS)})")
-
-
 def run_task_episode(planner, goal: Goal, seed: int, fd_length: int) -> TaskEpisode:
     state = random_state(goal.objects, random.Random(f"task-{seed}"))
     times, failure, steps = [], None, 0
     while not goal.satisfied_by(state):
         if steps >= MAX_STEPS:
-            failure = "overstep"
+            failure = Failure.OVERSTEP
             break
         decision = planner.next_action(state, goal)
         times.append(1000 * decision.seconds)
         if decision.action is None:
-            failure = "no_subgoal"
+            failure = Failure.NO_SUBGOAL
             break
         if why_not(state, decision.action) is not None:
-            failure = "inapplicable"
+            failure = Failure.INAPPLICABLE
             break
         state = apply(state, decision.action)
         steps += 1
     done = sum(state.holds(lit) for lit in goal.literals) / len(goal.literals)
+    failure = None if failure is None else str(failure)
     return TaskEpisode(
         goal.size, seed, str(goal), failure is None, failure, steps, fd_length, done, tuple(times)
     )
@@ -89,14 +70,29 @@ def fd_length(goal: Goal, seed: int) -> int:
     return len(FastDownwardPlanner().plan(state, goal))
 
 
-def _work(args) -> dict:
+@dataclass(frozen=True)
+class TaskJob:
+    """One episode of an `eval-task` run: which planner, from which checkpoint, on which goal."""
+
+    planner: str
+    checkpoint: str
+    goal: str
+    seed: int
+
+    @property
+    def key(self) -> str:
+        return f"{self.seed}/{self.goal}"
+
+
+def run_task_job(job: TaskJob) -> dict:
+    """One episode in this process (a worker): the episode as JSON."""
     import torch
 
     torch.set_num_threads(1)  # one core per worker: the pool already fills the machine
-    name, checkpoint, goal_text, seed = args
-    goal = parse_goal(goal_text)
-    planner = make_planner(name, Path(checkpoint), seed)
-    return asdict(run_task_episode(planner, goal, seed, fd_length(goal, seed)))
+    goal = parse_goal(job.goal)
+    planner = make_planner(job.planner, Path(job.checkpoint))
+    planner.reset(goal, job.seed)
+    return asdict(run_task_episode(planner, goal, job.seed, fd_length(goal, job.seed)))
 
 
 def evaluate_task(
@@ -112,7 +108,7 @@ def evaluate_task(
 ) -> list[TaskEpisode]:
     """Every episode, `workers` at a time. With `run_dir`, finished episodes are appended to
     its `episodes.jsonl` as they finish, and a run started again skips them."""
-    make_planner(planner, checkpoint, seed)  # a bad name or checkpoint fails here, once
+    make_planner(planner, checkpoint)  # a bad name or checkpoint fails here, once
     if goals < 0:
         raise InvalidInputError(f"--goals {goals}: the number of goals cannot be negative")
     if goals_file:
@@ -124,43 +120,20 @@ def evaluate_task(
             for n in sizes
             for i, g in enumerate(random_goals(n, goals, seed, stacking=n > 2))
         ]
-    keys = [(str(g), s) for g, s in jobs]
-    done = _load_done(run_dir, planner, checkpoint) if run_dir else {}
-    for key in keys:
-        if key in done and on_episode:
-            on_episode(done[key])
-    todo = [(planner, str(checkpoint), g, s) for g, s in keys if (g, s) not in done]
-    # spawn, not fork: this process has loaded torch, and a forked child of a process with live
-    # OpenMP threads hangs (measured: the workers sat idle)
-    with (
-        open(run_dir / RESULTS, "a") if run_dir else contextlib.nullcontext() as log,
-        ProcessPoolExecutor(
-            max(1, workers), mp_context=multiprocessing.get_context("spawn")
-        ) as pool,
-    ):
-        for row in pool.map(_work, todo, chunksize=4):
-            episode = TaskEpisode(**{**row, "decision_ms": tuple(row["decision_ms"])})
-            done[(episode.goal, episode.seed)] = episode
-            if log:
-                log.write(json.dumps(row) + "\n")
-                log.flush()
-            if on_episode:
-                on_episode(episode)
-    return [done[k] for k in keys]
+    rows = run_items(
+        run_task_job,
+        [TaskJob(planner, str(checkpoint), str(g), s) for g, s in jobs],
+        key=lambda job: job.key,
+        run_dir=run_dir,
+        config={"planner": planner, "checkpoint": str(checkpoint)},
+        workers=workers,
+        on_result=on_episode and (lambda row: on_episode(_episode(row))),
+    )
+    return [_episode(row) for row in rows]
 
 
-def _load_done(run_dir: Path, planner: str, checkpoint: Path) -> dict[tuple, TaskEpisode]:
-    """Episodes a run folder already holds; refuses one made by another planner."""
-    config = {"planner": planner, "checkpoint": str(checkpoint)}
-    claim(run_dir, config, f"'{run_dir}' holds a run of another planner")
-    done = {}
-    for row in logged_rows(run_dir):
-        try:
-            e = TaskEpisode(**{**row, "decision_ms": tuple(row["decision_ms"])})
-        except (KeyError, TypeError):
-            continue
-        done[(e.goal, e.seed)] = e
-    return done
+def _episode(row: dict) -> TaskEpisode:
+    return TaskEpisode(**{**row, "decision_ms": tuple(row["decision_ms"])})
 
 
 def summarize_task(episodes: Sequence[TaskEpisode]) -> dict:

@@ -47,6 +47,7 @@ def _same(a, b) -> bool:
 N, CHUNK = 10, 2  # ten samples in chunks of two tasks (eight trials)
 
 
+@pytest.mark.slow
 def test_killed_collection_resumes_to_exactly_n_samples(tmp_path):
     cmd = [
         sys.executable, "-m", "hsgplan.cli", "collect", "place", "--samples", str(N),
@@ -76,6 +77,7 @@ def test_killed_collection_resumes_to_exactly_n_samples(tmp_path):
     assert _same(resumed, store.load(tmp_path / "b" / "place.npz"))
 
 
+@pytest.mark.slow
 def test_the_ray_path_gives_the_same_samples(tmp_path):
     import ray  # noqa: F401  (installed by the test set-up: `make test` installs .[dev,ray])
 

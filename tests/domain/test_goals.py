@@ -49,7 +49,10 @@ HOSTILE = [
     # syntax
     ("", "empty"),
     ("   \n ; & ", "empty"),
-    ("On(butter, cherries) && Clear(butter)", "empty literal"),
+    ("On(butter, cherries) && Clear(butter)", "no literal between '&' and '&'"),
+    ("On(cherries, shelf_a) &", "ends with '&'"),
+    ("On(cherries, shelf_a) ;\n", "ends with ';'"),
+    ("& On(cherries, shelf_a)", "starts with '&'"),
     ("On butter cherries", "not a literal"),
     ("On(butter, cherries", "not a literal"),
     ("On(butter, cherries))", "not a literal"),

@@ -22,6 +22,7 @@ def replay(plan, start, goal):
 
 
 # 40 goals a size: the suite's budget (issue 2 measured 100 a size once; this keeps the check).
+@pytest.mark.slow
 @pytest.mark.parametrize("n", [2, 3, 4, 5, 6])
 def test_plans_for_random_goals_replay_in_the_transition_model(n):
     planner = FastDownwardPlanner()
@@ -34,6 +35,7 @@ def test_plans_for_random_goals_replay_in_the_transition_model(n):
         replay(planner.plan(start, goal), start, goal)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n", [7, 9, 12])
 def test_generated_goals_up_to_twelve_objects_are_solved(n):
     planner = FastDownwardPlanner(optimal=False)
@@ -43,6 +45,7 @@ def test_generated_goals_up_to_twelve_objects_are_solved(n):
         replay(planner.plan(start, goal), start, goal)
 
 
+@pytest.mark.slow
 def test_optimal_plans_are_never_longer():
     rng = random.Random(0)
     for goal in random_goals(4, 6, seed=5):

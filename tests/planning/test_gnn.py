@@ -1,4 +1,4 @@
-"""The per-edge graph classifier: shapes, symmetry, batching, the loss, and that it can learn."""
+"""The per-edge graph classifier: shapes, symmetry, batching, the loss, learning mechanics."""
 
 import pytest
 import torch
@@ -127,49 +127,35 @@ def test_masked_cross_entropy_of_an_empty_mask_is_zero_with_a_gradient():
     assert torch.equal(logits.grad, torch.zeros_like(logits))
 
 
-def toy_graph(gen: torch.Generator) -> Data:
-    """Predicate 0 of edge s -> t: edge bit 0 set AND a node other than s has node bit 0.
-
-    The second half needs information from elsewhere in the graph, so only message passing can
-    learn it. Predicate 1 is local (edge bit 1) and is masked out on self loops.
-    """
-    n = int(torch.randint(2, 6, (1,), generator=gen))
-    pairs = [(i, j) for i in range(n) for j in range(n)]
-    edge_index = torch.tensor(pairs, dtype=torch.long).t().contiguous()
-    x = (torch.rand(n, 3, generator=gen) < 0.25).float()
-    bits = (torch.rand(len(pairs), 2, generator=gen) < 0.5).float()
-    self_loop = (edge_index[0] == edge_index[1]).float().unsqueeze(1)
-    has_bit = x[:, 0].bool()
-    elsewhere = torch.tensor([bool((has_bit.sum() - has_bit[s].long()) > 0) for s, _ in pairs])
-    y = torch.stack([bits[:, 0].bool() & elsewhere, bits[:, 1].bool()], dim=1).long()
-    mask = torch.ones_like(y, dtype=torch.bool)
-    mask[:, 1] = ~self_loop.squeeze(1).bool()
-    return Data(x=x, edge_index=edge_index, edge_attr=torch.cat([bits, self_loop], 1), y=y, m=mask)
+def test_what_an_edge_is_told_reaches_it_only_through_message_passing():
+    # The control that decides whether a rule such as "s -> t holds when a third node has a
+    # property" is learnable at all: with no rounds an edge's output reads only its own
+    # endpoints, with rounds it reads a node elsewhere in the graph.
+    g = complete_graph(3, 5, 4, torch.Generator().manual_seed(5))
+    third = g.clone()
+    third.x = g.x.clone()
+    third.x[2] += 1.0  # change node 2 only
+    edge = 1  # the edge 0 -> 1
+    for rounds, reads_node_2 in ((0, False), (1, True), (3, True)):
+        net = model(rounds=rounds)
+        changed = not torch.allclose(net(g)[edge], net(third)[edge], atol=1e-6)
+        assert changed == reads_node_2, rounds
 
 
-def train(rounds: int, batch: Batch, steps: int = 300) -> torch.Tensor:
-    """Fit a small model full-batch; returns which (edge, predicate) entries it gets right."""
-    torch.manual_seed(5)
-    config = EdgeClassifierConfig(3, 3, predicates=2, classes=2, hidden=32, rounds=rounds)
-    net = EdgeClassifier(config)
-    opt = torch.optim.Adam(net.parameters(), lr=3e-3)
-    for _ in range(steps):
-        opt.zero_grad()
-        masked_cross_entropy(net(batch), batch.y, batch.m).backward()
-        opt.step()
+def test_one_optimiser_step_lowers_the_loss_on_a_fixed_batch():
+    # Mechanics of learning (gradients reach every weight, the loss falls), not its quality.
+    gen = torch.Generator().manual_seed(3)
+    batch = Batch.from_data_list([complete_graph(3, 5, 4, gen) for _ in range(4)])
+    target = torch.randint(0, 3, (batch.edge_index.shape[1], 4), generator=gen)
+    mask = torch.ones_like(target, dtype=torch.bool)
+    net = model().train()
+    opt = torch.optim.SGD(net.parameters(), lr=1e-2)
+    before = masked_cross_entropy(net(batch), target, mask)
+    before.backward()
+    assert all(p.grad is not None and p.grad.abs().sum() > 0 for p in net.parameters())
+    opt.step()
     with torch.no_grad():
-        return net.eval()(batch).argmax(-1) == batch.y
-
-
-def test_a_small_model_overfits_a_rule_that_needs_message_passing():
-    gen = torch.Generator().manual_seed(5)
-    batch = Batch.from_data_list([toy_graph(gen) for _ in range(64)])
-    assert 0.1 < batch.y[:, 0].float().mean().item() < 0.9  # the rule is not a constant
-    right = train(3, batch)
-    assert right[batch.m].float().mean().item() >= 0.99
-    assert right[:, 0].float().mean().item() >= 0.99
-    # The control: without message passing the non-local half of the rule is out of reach.
-    assert train(0, batch, steps=150)[:, 0].float().mean().item() < 0.95
+        assert masked_cross_entropy(net(batch), target, mask) < before
 
 
 def test_reading_out_a_few_edges_gives_what_the_whole_graph_gives_there():

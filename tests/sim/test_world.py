@@ -23,6 +23,7 @@ def test_sampled_scene_is_at_rest_and_reads_back_as_drawn():
         scene.close()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n", [2, 8, 12])
 def test_scenes_of_many_sizes_can_be_drawn(n):
     objects = (

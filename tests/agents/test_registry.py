@@ -1,0 +1,114 @@
+"""Agents are a task planner and a motion generator, looked up by name."""
+
+import pytest
+
+from hsgplan.agents.hierarchical import HierarchicalAgent
+from hsgplan.agents.registry import (
+    AGENTS,
+    MOTION_GENERATORS,
+    TASK_PLANNERS,
+    agent_name,
+    agent_parts,
+    make_agent,
+)
+from hsgplan.domain.actions import Pick, Place, Push
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams
+from hsgplan.domain.predicates import in_grasp, inside, on
+from hsgplan.motion.generator import RandomMotion
+from hsgplan.planning.base import TaskDecision
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.outcome import Outcome, Status
+
+
+def test_every_registered_agent_names_registered_parts():
+    for planner, motion in AGENTS.values():
+        assert planner in TASK_PLANNERS and motion in MOTION_GENERATORS
+    assert agent_parts("oracle") == ("fd", "sampler")
+    assert agent_parts("regression+gnn") == ("regression", "gnn")
+    assert agent_name("regression", motion="mlp") == "regression+mlp"
+    assert agent_name("oracle") == "oracle"
+
+
+@pytest.mark.parametrize("bad", ["wizard", "regression+wand", "magic+gnn"])
+def test_unknown_names_are_refused_in_one_line(bad):
+    with pytest.raises(InvalidInputError, match="unknown") as e:
+        make_agent(bad)
+    assert "\n" not in str(e.value)
+
+
+def test_the_parts_are_composed_and_reset_together():
+    agent = make_agent("regression+random")
+    assert isinstance(agent, HierarchicalAgent) and agent.name == "regression+random"
+    assert agent.planner.name == "regression" and agent.motion.name == "random"
+
+
+def _scene_graph():
+    """Four objects standing on the table (poses only: no physics is needed to choose bins)."""
+    from hsgplan.domain.objects import object_type
+    from hsgplan.scene_graph.geometric import GeometricSceneGraph
+    from hsgplan.scene_graph.geometry import Pose
+
+    spots = {"cherries": (0.42, 0.05), "butter": (0.55, -0.10), "popcorn": (0.36, -0.12)}
+    return GeometricSceneGraph.from_poses(
+        {
+            name: Pose.from_xyz_yaw(x, y, object_type(name).height / 2, 0.0)
+            for name, (x, y) in spots.items()
+        }
+    )
+
+
+class _Script:
+    """A task planner that answers from a list: the composition, not the planning, is tested."""
+
+    name = "script"
+
+    def __init__(self, decisions):
+        self.decisions, self.resets = list(decisions), []
+
+    def reset(self, goal, seed):
+        self.resets.append(seed)
+
+    def next_action(self, state, goal):
+        return self.decisions.pop(0)
+
+
+def test_the_agent_passes_the_subgoal_and_the_action_to_the_motion_level():
+    sg = _scene_graph()
+    obj = sg.objects[0]
+    decisions = [
+        TaskDecision(Pick(obj), in_grasp(obj), 0.001),
+        TaskDecision(Place(obj, "shelf_a"), on(obj, "shelf_a"), 0.002),
+        TaskDecision(Push(obj, "shelf_a"), inside(obj, "shelf_a"), 0.003),
+        TaskDecision(None, None, 0.004, "regression stuck"),
+    ]
+    agent = HierarchicalAgent("test", _Script(decisions), RandomMotion())
+    goal = parse_goal(f"On({obj}, shelf_a)")
+    agent.reset(goal, 7)
+    assert agent.planner.resets == [7]
+    state = SymbolicSceneGraph.initial(sg.objects)
+    pick = agent.decide(sg, state, goal)
+    assert pick.params == PickParams(obj) and pick.subgoal == in_grasp(obj)
+    place = agent.decide(sg, state, goal)
+    assert isinstance(place.params, PlaceParams) and place.params.target == "shelf_a"
+    assert place.task_seconds == 0.002 and place.subgoal == on(obj, "shelf_a")
+    agent.observe(place.params, Outcome(Status.NO_IK, "", 0.0))
+    push = agent.decide(sg, state, goal)
+    assert isinstance(push.params, PushParams) and push.subgoal == inside(obj, "shelf_a")
+    stuck = agent.decide(sg, state, goal)
+    assert stuck.action is None and stuck.params is None and stuck.note == "regression stuck"
+
+
+def test_a_generator_does_not_propose_what_failed_for_good_this_episode():
+    sg = _scene_graph()
+    obj = sg.objects[0]
+    motion = RandomMotion()
+    motion.reset(3)
+    first = motion.propose(sg, Place(obj, "shelf_b"))
+    motion.observe(first, Outcome(Status.NO_PATH, "", 0.0))
+    motion.reset(3)  # the same episode seed: the same order...
+    assert motion.propose(sg, Place(obj, "shelf_b")) == first
+    motion.observe(first, Outcome(Status.NO_PATH, "", 0.0))
+    motion.rng.seed("random-motion-3")  # ...and after a failure, the next in that order
+    assert motion.propose(sg, Place(obj, "shelf_b")) != first
