@@ -1,5 +1,6 @@
 """Run folders that survive interruption: a configuration file and an append-only JSON-lines
-log of finished episodes, shared by `eval` and `eval-task`.
+log of finished work (`episodes.jsonl`), shared by every long job (`runner/items.py`); `collect`
+claims its work folder the same way.
 
 A run started again with the same configuration reads back what is logged and skips it; a
 folder made with another configuration is refused rather than mixed with.

@@ -1,5 +1,5 @@
-"""Task planners behind one interface: the learned regression planner, the forward baseline,
-and Fast Downward. Each returns the next action for a symbolic state and a goal.
+"""The learned task planners: the regression planner and the forward baseline, behind the
+interface of `planning/base.py` (Fast Downward's is in `planning/fast_downward.py`).
 
 The regression loop (the paper's phi): f_preimage gives the preimage of one goal literal (the
 query) in the context of the goal; a goal literal whose preimage names another unsatisfied goal
