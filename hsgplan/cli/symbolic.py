@@ -113,7 +113,7 @@ def goals(
     ] = None,
     stacking: Annotated[bool, typer.Option(help="Allow stacked goals.")] = True,
 ) -> None:
-    """Write random feasible goals, one per line (the distribution is in `symbolic/generator.py`)."""
+    """Write random feasible goals, one per line (distribution: `symbolic/generator.py`)."""
     from hsgplan.domain.goals import write_goal_file
     from hsgplan.symbolic.generator import check_size, random_goals
 

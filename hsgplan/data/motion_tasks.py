@@ -23,21 +23,21 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import object_type, objects_for_types
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
+from hsgplan.domain.room import Room
 from hsgplan.domain.world import (
+    GOAL_INTERIOR,
     INTERIOR_CAPACITY,
-    MAX_TOWER_LEVELS,
     OBJECT_TYPES,
     SHELVES,
     SURFACE_CAPACITY,
     SURFACES,
     Kind,
-    can_support,
     fits_inside,
 )
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MIN_OBJECTS, MAX_SCENE_OBJECTS = 2, len(OBJECT_TYPES)
-PUSH_SHELF = "shelf_a"
+PUSH_SHELF = GOAL_INTERIOR  # the task domain pushes only to fill the goals' interior
 P_STACK = 0.25  # chance that an object left to place goes on top of a bare one
 
 
@@ -127,29 +127,19 @@ def _arrange(
 ) -> list[Literal]:
     """On-literals for objects: `on_target` on the target surface, then `elsewhere` on any
     other surface with room or (with `P_STACK`) on a bare object, towers within their limit."""
-    room = {s: SURFACE_CAPACITY[s] - (taken or {}).get(s, 0) for s in SURFACES}
-    level: dict[str, int] = {}
-    bare: list[str] = []
+    room = Room.left(interiors=(), on_top=taken)
     literals = []
 
     def put(o: str, where: str) -> None:
         literals.append(on(o, where))
-        if where in room:
-            room[where] -= 1
-            level[o] = 1
-        else:
-            bare.remove(where)
-            level[o] = level[where] + 1
-        if can_support(object_type(o).name):
-            bare.append(o)
+        room.put_on(o, where)
 
     for o in on_target:
         put(o, target)
     for o in elsewhere:
-        bases = [b for b in bare if level[b] < MAX_TOWER_LEVELS]
+        bases = room.bases()
         if bases and rng.random() < P_STACK:
             put(o, rng.choice(bases))
             continue
-        surfaces = [s for s in SURFACES if room[s] > 0 and s != keep_off]
-        put(o, rng.choice(surfaces))
+        put(o, rng.choice([s for s in room.free_tops() if s != keep_off]))
     return literals

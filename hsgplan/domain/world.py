@@ -246,3 +246,16 @@ PUSH_DIST_RANGE = (0.08, 0.20)
 # Primitives an episode may take before it counts as an overstep (the paper's limit), in the
 # simulated world and in the symbolic loop alike.
 MAX_STEPS = 50
+
+# --- the paper's goal kinds ---
+
+# Goal literals put an object on one of these shelf tops, stack it on another object, or put it
+# into this shelf's interior (cans only, in evaluation goals); pushes go into the same shelf.
+GOAL_SHELF_TOPS: tuple[str, ...] = ("shelf_a", "shelf_b")
+GOAL_INTERIOR = "shelf_a"
+
+# --- friction ---
+
+# Lateral friction coefficients; PyBullet multiplies the two bodies' values at a contact.
+FIXTURE_FRICTION = 0.6  # the table and the shelves' walls and top boards
+OBJECT_FRICTION = 0.8  # the grocery objects

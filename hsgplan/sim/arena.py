@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from pybullet_utils.bullet_client import BulletClient
 
-from hsgplan.domain.world import REGIONS, SHELVES, TABLE, WALL, Rect, Shelf
+from hsgplan.domain.world import FIXTURE_FRICTION, REGIONS, SHELVES, TABLE, WALL, Rect, Shelf
 
 TABLE_THICKNESS = 0.05
 TABLE_COLOR = (0.82, 0.74, 0.62, 1.0)
@@ -16,7 +16,6 @@ REGION_COLORS = {
     "prepush_a": (0.72, 0.70, 0.86, 1.0),
     "prepush_b": (0.72, 0.70, 0.86, 1.0),
 }
-FRICTION = 0.6
 
 
 @dataclass(frozen=True)
@@ -37,7 +36,7 @@ def _box(bc: BulletClient, center, half, color, collide: bool = True) -> int:
     vis = bc.createVisualShape(bc.GEOM_BOX, halfExtents=half, rgbaColor=color)
     body = bc.createMultiBody(0, col, vis, basePosition=center)
     if collide:
-        bc.changeDynamics(body, -1, lateralFriction=FRICTION)
+        bc.changeDynamics(body, -1, lateralFriction=FIXTURE_FRICTION)
     return body
 
 

@@ -5,11 +5,10 @@ from __future__ import annotations
 from pybullet_utils.bullet_client import BulletClient
 
 from hsgplan.domain.objects import object_type
-from hsgplan.domain.world import Kind
+from hsgplan.domain.world import OBJECT_FRICTION, Kind
 from hsgplan.scene_graph.geometry import Pose
 
 MASS = {Kind.CAN: 0.30, Kind.BOX: 0.15}
-FRICTION = 0.8
 
 
 def spawn_object(bc: BulletClient, name: str, pose: Pose) -> int:
@@ -29,6 +28,6 @@ def spawn_object(bc: BulletClient, name: str, pose: Pose) -> int:
         MASS[t.kind], col, vis, basePosition=pose.position, baseOrientation=pose.orientation
     )
     bc.changeDynamics(
-        body, -1, lateralFriction=FRICTION, spinningFriction=0.001, rollingFriction=0.0005
+        body, -1, lateralFriction=OBJECT_FRICTION, spinningFriction=0.001, rollingFriction=0.0005
     )
     return body

@@ -16,28 +16,17 @@ Every goal drawn passes `check_literals`, by construction and by a final check.
 from __future__ import annotations
 
 import random
-from dataclasses import dataclass
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.feasibility import check_literals
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.objects import object_type, objects_for_types, sort_objects
 from hsgplan.domain.predicates import Literal, inside, on
-from hsgplan.domain.world import (
-    INTERIOR_CAPACITY,
-    MAX_OBJECTS,
-    MAX_TOWER_LEVELS,
-    OBJECT_TYPES,
-    SURFACE_CAPACITY,
-    Kind,
-    can_support,
-    fits_inside,
-)
+from hsgplan.domain.room import Room
+from hsgplan.domain.world import GOAL_INTERIOR, GOAL_SHELF_TOPS, MAX_OBJECTS, OBJECT_TYPES, Kind
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MIN_OBJECTS = 2
-GOAL_SHELF_TOPS = ("shelf_a", "shelf_b")
-GOAL_INTERIOR = "shelf_a"
 
 
 def check_size(n: int) -> None:
@@ -58,53 +47,27 @@ def random_objects(n: int, rng: random.Random) -> tuple[str, ...]:
     return sort_objects(objects_for_types(chosen))
 
 
-@dataclass
-class _Room:
-    """What is left on the surfaces while a goal or a state is drawn."""
-
-    top: dict[str, int]
-    interior: dict[str, int]
-
-
 def random_goal(n: int, rng: random.Random, stacking: bool = True) -> Goal:
     """One goal over n objects, drawn from the distribution in the module docstring."""
     objects = list(random_objects(n, rng))
     rng.shuffle(objects)
-    room = _Room(
-        {s: SURFACE_CAPACITY[s] for s in GOAL_SHELF_TOPS},
-        {GOAL_INTERIOR: INTERIOR_CAPACITY[GOAL_INTERIOR]},
-    )
-    level: dict[str, int] = {}
-    bare: list[str] = []
+    room = Room.left(GOAL_SHELF_TOPS, (GOAL_INTERIOR,))
     literals: list[Literal] = []
     for o in objects:
-        t = object_type(o)
-        kinds = [s for s in GOAL_SHELF_TOPS if room.top[s] > 0]
-        if (
-            t.kind is Kind.CAN
-            and fits_inside(t.name, GOAL_INTERIOR)
-            and room.interior[GOAL_INTERIOR]
-        ):
+        kinds: list[str] = room.free_tops()
+        if object_type(o).kind is Kind.CAN and room.free_interiors(o):
             kinds.append("inside")
-        bases = [b for b in bare if level[b] < MAX_TOWER_LEVELS] if stacking else []
+        bases = room.bases() if stacking else []
         if bases:
             kinds.append("stack")
         kind = rng.choice(kinds)
         if kind == "inside":
             literals.append(inside(o, GOAL_INTERIOR))
-            room.interior[GOAL_INTERIOR] -= 1
+            room.put_inside(o, GOAL_INTERIOR)
             continue
-        if kind == "stack":
-            base = rng.choice(bases)
-            literals.append(on(o, base))
-            bare.remove(base)
-            level[o] = level[base] + 1
-        else:
-            literals.append(on(o, kind))
-            room.top[kind] -= 1
-            level[o] = 1
-        if can_support(t.name):
-            bare.append(o)
+        where = rng.choice(bases) if kind == "stack" else kind
+        literals.append(on(o, where))
+        room.put_on(o, where)
     goal = Goal(frozenset(literals))
     check_literals(goal.literals)
     return goal
@@ -129,25 +92,15 @@ def random_state(
     """
     order = list(objects)
     rng.shuffle(order)
-    room = {s: SURFACE_CAPACITY[s] for s in SURFACE_CAPACITY}
-    bare: list[str] = []
-    level: dict[str, int] = {}
+    room = Room.left(interiors=())
     literals = []
     for o in order:
         options: list[str] = []
         if rng.random() < p_elsewhere:
-            options = [s for s in GOAL_SHELF_TOPS if room[s] > 0]
-            options += [b for b in bare if level[b] < MAX_TOWER_LEVELS]
+            options = room.free_tops(GOAL_SHELF_TOPS) + room.bases()
         if not options:
-            options = ["open_space"] if room["open_space"] > 0 else [s for s in room if room[s]]
+            options = room.free_tops(("open_space",)) or room.free_tops()
         target = rng.choice(options)
         literals.append(on(o, target))
-        if target in room:
-            room[target] -= 1
-            level[o] = 1
-        else:
-            bare.remove(target)
-            level[o] = level[target] + 1
-        if can_support(object_type(o).name):
-            bare.append(o)
+        room.put_on(o, target)
     return SymbolicSceneGraph.from_literals(objects, literals)

@@ -23,21 +23,17 @@ from dataclasses import dataclass
 from hsgplan.data.demos import Demo
 from hsgplan.domain.objects import objects_for_types, type_of
 from hsgplan.domain.predicates import Literal, Predicate, inside, on
+from hsgplan.domain.room import Room, can_carry
 from hsgplan.domain.world import (
-    INTERIOR_CAPACITY,
+    GOAL_INTERIOR,
+    GOAL_SHELF_TOPS,
     MAX_OBJECTS,
-    MAX_TOWER_LEVELS,
     OBJECT_TYPES,
     SHELVES,
     SURFACE_CAPACITY,
     SURFACES,
-    can_support,
-    fits_inside,
 )
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-
-GOAL_TOPS = ("shelf_a", "shelf_b")
-GOAL_INTERIOR = "shelf_a"
 
 
 @dataclass(frozen=True)
@@ -55,68 +51,54 @@ class Trajectory:
         return Trajectory(tuple(demo.symbolic_states()), goal)
 
 
-def _room(states: tuple[SymbolicSceneGraph, ...]) -> tuple[dict[str, int], dict[str, int]]:
-    """Free places on each surface and in each interior, in every state at once."""
-    top = {s: SURFACE_CAPACITY[s] - max(len(x.resting_on(s)) for x in states) for s in SURFACES}
-    interior = {s: INTERIOR_CAPACITY[s] - max(len(x.inside(s)) for x in states) for s in SHELVES}
-    return top, interior
-
-
 def _places(objects: list[str], states, rng: random.Random) -> list[Literal]:
     """Where each added object rests, unchanged through the trajectory."""
-    top, interior = _room(states)
-    level: dict[str, int] = {}
-    bare: list[str] = []
+    # what is free in every state at once
+    room = Room.left(
+        on_top={s: max(len(x.resting_on(s)) for x in states) for s in SURFACES},
+        inside={s: max(len(x.inside(s)) for x in states) for s in SHELVES},
+    )
     out = []
     for o in objects:
-        t = type_of(o)
-        options: list[tuple[str, str]] = [("on", s) for s in SURFACES if top[s] > 0]
-        options += [("on", b) for b in bare if level[b] < MAX_TOWER_LEVELS]
-        options += [("in", s) for s in SHELVES if interior[s] > 0 and fits_inside(t, s)]
+        options: list[tuple[str, str]] = [("on", s) for s in room.free_tops()]
+        options += [("on", b) for b in room.bases()]
+        options += [("in", s) for s in room.free_interiors(o)]
         # the open space is where most objects wait, as in the planner's start states
-        if top["open_space"] > 0 and rng.random() < 0.4:
+        if room.top["open_space"] > 0 and rng.random() < 0.4:
             options = [("on", "open_space")]
         kind, where = rng.choice(options)
         if kind == "in":
             out.append(inside(o, where))
-            interior[where] -= 1
-            continue
-        out.append(on(o, where))
-        if where in top:
-            top[where] -= 1
-            level[o] = 1
+            room.put_inside(o, where)
         else:
-            bare.remove(where)
-            level[o] = level[where] + 1
-        if can_support(t):
-            bare.append(o)
+            out.append(on(o, where))
+            room.put_on(o, where)
     return out
 
 
 def _extra_goals(objects: list[str], goal: frozenset[Literal], rng: random.Random):
     """Goal literals for some added objects, within the capacities the task goal leaves."""
-    top = {s: SURFACE_CAPACITY[s] - sum(lit.args[-1] == s for lit in goal) for s in GOAL_TOPS}
-    interior = INTERIOR_CAPACITY[GOAL_INTERIOR] - sum(lit.predicate is Predicate.IN for lit in goal)
-    bare: list[str] = []
+    # An In literal on shelf A also takes a place of its top here (its last argument is the
+    # shelf): stricter than needed, kept so that the copies stay as they were drawn.
+    room = Room.left(
+        GOAL_SHELF_TOPS,
+        (GOAL_INTERIOR,),
+        on_top={s: sum(lit.args[-1] == s for lit in goal) for s in GOAL_SHELF_TOPS},
+        inside={GOAL_INTERIOR: sum(lit.predicate is Predicate.IN for lit in goal)},
+    )
     out = []
     for o in objects:
-        t = type_of(o)
-        options = [on(o, s) for s in GOAL_TOPS if top[s] > 0]
-        if interior > 0 and fits_inside(t, GOAL_INTERIOR):
-            options.append(inside(o, GOAL_INTERIOR))
-        options += [on(o, b) for b in bare]
+        options = [on(o, s) for s in room.free_tops()]
+        options += [inside(o, s) for s in room.free_interiors(o)]
+        options += [on(o, b) for b in room.bases()]
         if not options or rng.random() < 0.3:
             continue
         lit = rng.choice(options)
         out.append(lit)
         if lit.predicate is Predicate.IN:
-            interior -= 1
-        elif lit.args[1] in top:
-            top[lit.args[1]] -= 1
-            if can_support(t):
-                bare.append(o)
+            room.put_inside(o, GOAL_INTERIOR)
         else:
-            bare.remove(lit.args[1])  # towers have two levels: the top carries nothing
+            room.put_on(o, lit.args[1])
     return frozenset(out)
 
 
@@ -185,9 +167,7 @@ def relocating_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Rand
     options += [
         b
         for b in traj.added
-        if state.holds(Literal(Predicate.CLEAR, (b,)))
-        and can_support(type_of(b))
-        and state.level(b) < MAX_TOWER_LEVELS
+        if state.holds(Literal(Predicate.CLEAR, (b,))) and can_carry(type_of(b), state.level(b))
     ]
     if not options:
         return None
@@ -201,9 +181,7 @@ def covering_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random
     bases = [
         b
         for b in demo
-        if state.holds(Literal(Predicate.CLEAR, (b,)))
-        and can_support(type_of(b))
-        and state.level(b) < MAX_TOWER_LEVELS
+        if state.holds(Literal(Predicate.CLEAR, (b,))) and can_carry(type_of(b), state.level(b))
     ]
     tops = [
         o
