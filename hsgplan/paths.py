@@ -20,9 +20,12 @@ HOME_VARIABLE = "HSGPLAN_HOME"
 CHECKPOINTS = Path("checkpoints")
 DATA = Path("data")
 TASK_CHECKPOINT = CHECKPOINTS / "task"
+PAPER_TASK_CHECKPOINT = CHECKPOINTS / "task-paper"  # the paper's recipe: 18 demonstrations alone
 MOTION_CHECKPOINTS = CHECKPOINTS / "motion"
 DEMOS = DATA / "demos" / "v1"
 MOTION_DATA = DATA / "motion"
+REACH_DATA = DATA / "reach" / "v1"  # primitives executed in the simulated world: f_reach's labels
+REACH_HELD_OUT = DATA / "reach" / "heldout"  # the same, another seed: f_reach is scored on it
 RUNS = Path("runs")
 
 

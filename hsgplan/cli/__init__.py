@@ -1,7 +1,7 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval), `data`
-(collect), `learn` (train task, eval-task), `motion` (train motion, eval-motion), `bench`.
+(collect), `learn` (train task, eval-task, eval-reach), `motion` (train motion, eval-motion), `bench`.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ app.add_typer(bench.app, name="bench")
 app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
 app.command("eval-task")(learn.eval_task)
+app.command("eval-reach")(learn.eval_reach)
 learn.train_app.command("motion")(motion.train_motion)
 app.command("eval-motion")(motion.eval_motion)
 

@@ -9,7 +9,8 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import err, out, refuses_bad_input
-from hsgplan.paths import DEMOS, MOTION_DATA
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.paths import DEMOS, MOTION_DATA, REACH_DATA
 
 app = typer.Typer(no_args_is_help=True, help="Collect datasets (resumable).")
 
@@ -76,4 +77,33 @@ def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir
         f"{summary.samples} {primitive} samples from {summary.trials} trials "
         f"({summary.samples / max(1, summary.trials):.0%} successful; {summary.chunks_run} "
         f"chunks run now, {summary.unstaged} scenes not staged) in {summary.dataset}"
+    )
+
+
+@app.command("reach")
+@refuses_bad_input
+def reach(
+    states: Annotated[int, typer.Option(help="Staged states (whole chunks of 8).")] = 2400,
+    seed: Annotated[int, typer.Option(help="Seed of the states and actions.")] = 0,
+    workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
+    ray: Annotated[
+        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
+    ] = None,
+    out_dir: Annotated[
+        Path, typer.Option("--out", help="Collection folder (resumed if it exists).")
+    ] = REACH_DATA,
+) -> None:
+    """Self-supervised reachability: primitives executed in the simulated world from staged
+    symbolic states, and what the world showed after each (f_reach's labels)."""
+    from hsgplan.evaluation.record_reach import STATES_PER_CHUNK, collect_reach
+
+    if workers < 1:
+        raise InvalidInputError(f"--workers {workers}: need at least one")
+    with Progress(console=err, transient=True) as progress:
+        bar = progress.add_task("chunks of staged states", total=-(-states // STATES_PER_CHUNK))
+        summary = collect_reach(out_dir, states, seed, workers, ray, lambda: progress.advance(bar))
+    statuses = ", ".join(f"{k} {v}" for k, v in sorted(summary.by_status.items()))
+    out.print(
+        f"{summary.trials} primitives executed from {summary.staged} of {summary.states} "
+        f"states ({statuses}) in {out_dir}"
     )

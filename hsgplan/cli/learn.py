@@ -19,7 +19,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
 )
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.paths import RUNS, TASK_CHECKPOINT
+from hsgplan.paths import REACH_HELD_OUT, RUNS, TASK_CHECKPOINT
 
 train_app = typer.Typer(no_args_is_help=True, help="Train the learned models (resumable).")
 REGRESSION = PlannerName("regression")
@@ -71,7 +71,7 @@ def eval_task(
     ] = False,
 ) -> None:
     """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
-    milliseconds per decision. Episodes are kept in the run folder (by default
+    wasted (inapplicable) actions per episode, milliseconds per decision. Episodes are kept in the run folder (by default
     runs/eval-task-PLANNER-SIZES-gGOALS-seedSEED) as they finish."""
     from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
 
@@ -81,7 +81,8 @@ def eval_task(
     size_list = parse_sizes(sizes)
     total = goals * len(size_list) if goals_file is None else None
     source = goals_file.stem if goals_file else f"g{goals}"
-    run_dir = run_dir or RUNS / f"eval-task-{planner}-{sizes}-{source}-seed{seed}"
+    tag = "" if checkpoint == TASK_CHECKPOINT else f"-{checkpoint.resolve().name}"
+    run_dir = run_dir or RUNS / f"eval-task-{planner}{tag}-{sizes}-{source}-seed{seed}"
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(f"{planner} episodes", total=total)
         episodes = evaluate_task(
@@ -108,6 +109,7 @@ def eval_task(
             n,
             fmt(v["success_rate"], ".3f"),
             fmt(v["plan_length_ratio"], ".3f"),
+            fmt(v["wasted_per_episode"], ".2f"),
             fmt(v["ms_per_decision"], ".1f"),
             str(v["episodes"]),
             ", ".join(f"{k} {c}" for k, c in sorted(v["failures"].items())) or "—",
@@ -116,7 +118,59 @@ def eval_task(
     ]
     print_table(
         f"{planner} in the symbolic loop, {goals} goals per size, seed {seed}",
-        ("objects", "success", "plan length / FD", "ms per decision", "episodes", "failures"),
+        (
+            "objects",
+            "success",
+            "plan length / FD",
+            "wasted actions",
+            "ms per decision",
+            "episodes",
+            "failures",
+        ),
+        rows,
+        markdown,
+    )
+
+
+@refuses_bad_input
+def eval_reach(
+    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = TASK_CHECKPOINT,
+    trials: Annotated[
+        Path, typer.Option(help="Held-out executed primitives (`hsgplan collect reach`).")
+    ] = REACH_HELD_OUT,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """f_reach against the simulated world: precision and recall of "reachable" on held-out
+    executed primitives, by the situation that decides them (hand full, surface full, ...)."""
+    from hsgplan.evaluation.reach_eval import evaluate_reach
+    from hsgplan.paths import shipped
+
+    report = evaluate_reach(shipped(checkpoint), shipped(trials))
+    if as_json:
+        print(json.dumps(report, indent=2))
+        return
+
+    def fmt(v):
+        return "—" if v is None else f"{v:.3f}"
+
+    rows = [
+        (
+            kind,
+            str(v["questions"]),
+            str(v["reachable"]),
+            fmt(v["precision"]),
+            fmt(v["recall"]),
+            fmt(v["false_yes_rate"]),
+            fmt(v["accuracy"]),
+        )
+        for kind, v in [*report["by_kind"].items(), ("all", report["overall"])]
+    ]
+    print_table(
+        f"f_reach of {checkpoint} on {report['trials']} executed primitives from {trials}",
+        ("question", "n", "reachable", "precision", "recall", "yes when not", "accuracy"),
         rows,
         markdown,
     )

@@ -1,7 +1,10 @@
 """Symbolic evaluation of task planners: the closed loop in the transition model, no physics.
 
 Each goal starts from a seeded random state (`random_state`); the planner picks an action, the
-transition model applies it, until the goal holds or 50 steps pass. Plan length is compared
+transition model applies it, until the goal holds or 50 steps pass. The transition model is the
+world here, never the planner's: an action whose preconditions fail leaves the state as it was
+and costs its step (a wasted action, counted per episode), as a failed primitive does in the
+simulated world. Plan length is compared
 with Fast Downward's plan from the same start (shortest plans up to 6 objects, weighted A*
 beyond), and every decision is timed.
 """
@@ -37,11 +40,13 @@ class TaskEpisode:
     fd_length: int
     subgoal_completion: float
     decision_ms: tuple[float, ...]
+    # actions whose preconditions did not hold: the state stayed, the step was spent
+    wasted: int = 0
 
 
 def run_task_episode(planner, goal: Goal, seed: int, fd_length: int) -> TaskEpisode:
     state = random_state(goal.objects, random.Random(f"task-{seed}"))
-    times, failure, steps = [], None, 0
+    times, failure, steps, wasted = [], None, 0, 0
     while not goal.satisfied_by(state):
         if steps >= MAX_STEPS:
             failure = Failure.OVERSTEP
@@ -51,15 +56,26 @@ def run_task_episode(planner, goal: Goal, seed: int, fd_length: int) -> TaskEpis
         if decision.action is None:
             failure = Failure.NO_SUBGOAL
             break
-        if why_not(state, decision.action) is not None:
-            failure = Failure.INAPPLICABLE
-            break
-        state = apply(state, decision.action)
         steps += 1
+        # As a primitive fails in the world, an inapplicable action changes nothing here and
+        # costs its step; the planner is told nothing but the state it observes again.
+        if why_not(state, decision.action) is not None:
+            wasted += 1
+            continue
+        state = apply(state, decision.action)
     done = sum(state.holds(lit) for lit in goal.literals) / len(goal.literals)
     failure = None if failure is None else str(failure)
     return TaskEpisode(
-        goal.size, seed, str(goal), failure is None, failure, steps, fd_length, done, tuple(times)
+        goal.size,
+        seed,
+        str(goal),
+        failure is None,
+        failure,
+        steps,
+        fd_length,
+        done,
+        tuple(times),
+        wasted,
     )
 
 
@@ -146,6 +162,7 @@ def summarize_task(episodes: Sequence[TaskEpisode]) -> dict:
             "subgoal_completion": sum(e.subgoal_completion for e in es) / len(es),
             "episodes": len(es),
             "failures": dict(Counter(e.failure for e in es if e.failure)),
+            "wasted_per_episode": sum(e.wasted for e in es) / len(es),
             "plan_length_ratio": (
                 statistics.mean(e.steps / e.fd_length for e in wins) if wins else None
             ),

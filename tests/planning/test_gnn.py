@@ -203,15 +203,16 @@ def test_the_scripted_network_gives_the_eager_outputs():
 
 
 @pytest.mark.filterwarnings("ignore:`torch.jit.freeze` is deprecated:DeprecationWarning")
-def test_the_inference_core_is_the_pyg_core_bit_for_bit():
+@pytest.mark.parametrize("pool", [False, True])
+def test_the_inference_core_is_the_pyg_core_bit_for_bit(pool):
     # the planner's decisions must not move: the same numbers, not merely close ones
     from hsgplan.planning.regression.gnn import _Core, _InferenceCore
 
     gen = torch.Generator().manual_seed(10)
-    net = model(rounds=3)
+    net = model(rounds=3, pool=pool)
     pyg = torch.jit.freeze(torch.jit.script(_Core(net).eval()))
     plain = torch.jit.freeze(torch.jit.script(_InferenceCore(net).eval()))
-    scripted = model(rounds=3).script()  # the same weights (same seed), as the planner runs it
+    scripted = model(rounds=3, pool=pool).script()  # the same weights (same seed)
     with torch.no_grad():
         # Six nodes at least, as every planner batch has (five fixtures and an object): below
         # five rows MKL multiplies another way and the last bits of `script` may differ.
@@ -219,8 +220,45 @@ def test_the_inference_core_is_the_pyg_core_bit_for_bit():
             g = complete_graph(n, 5, 4, gen)
             keep = (torch.rand(g.num_edges, generator=gen) < 0.6).nonzero().squeeze(1)
             weight = (torch.rand(len(keep), generator=gen) < 0.7).float()
+            batch = (torch.arange(n) >= n // 2).long()  # two graphs' worth of nodes
             args = (g.x, g.edge_index[:, keep], g.edge_attr[keep])
-            expected = pyg(*args, weight)
-            assert torch.equal(plain(*args, weight), expected)
-            assert torch.equal(scripted.computed(*args, weight).flatten(1), expected)
-            assert torch.equal(plain(*args, None), pyg(*args, None))
+            expected = pyg(*args, weight, batch)
+            assert torch.equal(plain(*args, weight, batch), expected)
+            # optimize_for_inference may fuse in another order: the last bits can differ
+            torch.testing.assert_close(
+                scripted.computed(*args, weight, batch).flatten(1), expected, rtol=1e-6, atol=1e-6
+            )
+            assert torch.equal(plain(*args, None, None), pyg(*args, None, None))
+
+
+def _silent_pair(x: torch.Tensor, gen: torch.Generator) -> Data:
+    """Nodes 0 and 1 related by nothing: only self loops pass messages."""
+    g = complete_graph(len(x), 5, 4, gen)
+    g.x = x
+    g.active = g.edge_index[0] == g.edge_index[1]
+    return g
+
+
+def test_without_pool_an_unrelated_node_changes_nothing_and_with_pool_it_does():
+    gen = torch.Generator().manual_seed(11)
+    x = torch.randn(3, 5, generator=gen)
+    g = _silent_pair(x, gen)
+    h = g.clone()
+    h.x = torch.cat([x[:2], torch.randn(1, 5, generator=gen)])  # node 2 alone differs
+    loop0 = 0  # node 0's self loop is edge 0
+    with torch.no_grad():
+        plain, pooled = model(), model(pool=True)
+        assert torch.equal(plain(g)[loop0], plain(h)[loop0])
+        assert not torch.allclose(pooled(g)[loop0], pooled(h)[loop0])
+
+
+def test_pooling_is_a_maximum_more_copies_of_a_node_change_nothing():
+    gen = torch.Generator().manual_seed(12)
+    x = torch.randn(3, 5, generator=gen)
+    g = _silent_pair(x, gen)
+    h = _silent_pair(torch.cat([x, x[2:]]), gen)  # node 3 repeats node 2
+    h.edge_attr = torch.zeros_like(h.edge_attr)
+    g.edge_attr = torch.zeros_like(g.edge_attr)
+    with torch.no_grad():
+        net = model(pool=True)
+        torch.testing.assert_close(net(h)[0], net(g)[0])

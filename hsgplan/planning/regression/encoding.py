@@ -274,11 +274,13 @@ def _template(nodes: tuple[str, ...]) -> _Template:
 
 
 @lru_cache(maxsize=256)
-def _batch(nodes: tuple[str, ...], k: int) -> tuple[torch.Tensor, np.ndarray]:
-    """[K N, NODE_DIM] node features and [2, K E] edge index of K graphs (read only, shared)."""
+def _batch(nodes: tuple[str, ...], k: int) -> tuple[torch.Tensor, np.ndarray, torch.Tensor]:
+    """[K N, NODE_DIM] node features, [2, K E] edge index and [K N] graph of each node, of K
+    graphs (read only, shared)."""
     t = _template(nodes)
     offsets = np.repeat(np.arange(k) * len(nodes), len(nodes) ** 2)
-    return torch.from_numpy(np.tile(t.x, (k, 1))), np.tile(t.edge_index, k) + offsets
+    batch = torch.arange(k).repeat_interleave(len(nodes))
+    return torch.from_numpy(np.tile(t.x, (k, 1))), np.tile(t.edge_index, k) + offsets, batch
 
 
 @lru_cache(maxsize=4)
@@ -307,7 +309,8 @@ class Computed:
 
     Shapes: x [K N, NODE_DIM]; edge_index [2, M]; edge_attr [M, EDGE_DIM]; weight [M] (1 on
     active edges, 0 on read-out-only ones); graph, edge [M] (which graph, which of its E edges);
-    row [K E] (the row of graph k's edge e, -1 where it is not computed).
+    row [K E] (the row of graph k's edge e, -1 where it is not computed); batch [K N] (the
+    graph of each node).
     """
 
     x: torch.Tensor
@@ -317,6 +320,7 @@ class Computed:
     graph: np.ndarray
     edge: np.ndarray
     row: np.ndarray
+    batch: torch.Tensor
 
     @property
     def valid(self) -> np.ndarray:
@@ -326,7 +330,7 @@ class Computed:
     @property
     def inputs(self) -> tuple[torch.Tensor, ...]:
         """The arguments of `EdgeClassifier.computed`."""
-        return self.x, self.edge_index, self.edge_attr, self.weight
+        return self.x, self.edge_index, self.edge_attr, self.weight, self.batch
 
 
 def touching(nodes: tuple[str, ...], args: list[tuple[str, ...]]) -> np.ndarray:
@@ -349,7 +353,7 @@ def encode_computed(
     slots = Slots.of(nodes)
     base, base_active = _state_edges(state)
     k, e = len(goals), len(nodes) ** 2
-    x, edge_index = _batch(nodes, k)
+    x, edge_index, batch = _batch(nodes, k)
     goal = [_goal_slots(nodes, g) for g in goals]
     ge, gp, gv = np.concatenate(goal).T
     ge = ge + np.repeat(np.arange(0, k * e, e), [len(g) for g in goal])  # k E + e
@@ -382,4 +386,5 @@ def encode_computed(
         graph=graph,
         edge=edge,
         row=row,
+        batch=batch,
     )

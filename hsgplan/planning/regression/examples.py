@@ -8,14 +8,17 @@ leaves it as it is. The network is asked about one achieved literal at a time (t
 a state s_tau (any state at or before t, as the planner sees the current state while regressing
 from far ahead) and g_{t+1}, and learns that literal's preimage (see `preimage_examples`).
 
-f_reach: the literals each demonstrated action adds are reachable in one primitive from the
-state before it; negatives are made, as the paper does, by altering those literals: here in
-every way (every subject, target and predicate), so that the network also meets, say, a push's
-target literal while the object is not yet in front of the shelf. An altered literal can still
-be reachable (placing on another surface is one primitive as well), so each is labelled by the
-symbolic transition model: reachable if one applicable action makes it true. Examples pair a
-state with the demonstrated action's literals and their alterations at once, and with each
-candidate alone, as the planner asks about whole subgoals and single literals.
+f_reach, two recipes; neither asks the hand-written transition model. Its question: does the
+primitive the heuristic names for a literal (`planning/heuristic.py`) make it hold?
+- The paper's (`paper_reach_examples`): what each demonstrated step changed is reachable from
+  the state before it; altering those literals (every subject, target and predicate) gives the
+  unreachable ones.
+- Ours (`world_reach_examples`): primitives executed in the simulated world from staged states
+  (`hsgplan collect reach`, `data/world_trials.py`) label every literal the heuristic maps to
+  the executed action by whether the world shows it afterwards; the demonstrated steps add
+  their changes as reachable.
+Examples pair a state with all its labelled literals at once, and with each alone, as the
+planner asks about single literals.
 
 The forward baseline learns, from (s_t, goal), the literals action t adds.
 """
@@ -29,12 +32,13 @@ import torch
 from torch_geometric.data import Data
 
 from hsgplan.data.demos import Demo
+from hsgplan.data.world_trials import WorldTrial
 from hsgplan.domain.objects import EntityKind, kind_of
 from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.planning.regression.augment import Trajectory, varied
 from hsgplan.planning.regression.encoding import DONT_CARE, FALSE, TRUE, Slots, encode
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.symbolic.transition import applicable_actions, apply
 
 
 @dataclass(frozen=True)
@@ -80,13 +84,15 @@ def _target(data: Data, literals) -> tuple[torch.Tensor, torch.Tensor]:
     return target, data.valid.clone()
 
 
-def preimage_examples(demos: list[Trajectory] | list[Demo], seed: int = 0) -> list[Example]:
+def preimage_examples(
+    demos: list[Trajectory] | list[Demo], seed: int = 0, vary: bool = True
+) -> list[Example]:
     """One example per literal an action achieved for the regressed subgoal (the query), asked
     from every state up to then, in the context of that subgoal. Its preimage: the literals the
     action consumed, the task goal's literals that already held (what had to come first, as a
     stack's base), and no other object in the hand (the previous scene graph's grasp state,
     which the changes alone never show). Added objects' goal literals are context, never
-    preimage, and the states asked from are `varied` (see `augment.py`)."""
+    preimage, and with `vary` the states asked from are `varied` (see `augment.py`)."""
     rng = random.Random(f"preimage-{seed}")
     out = []
     for traj in map(_trajectory, demos):
@@ -103,13 +109,15 @@ def preimage_examples(demos: list[Trajectory] | list[Demo], seed: int = 0) -> li
             for query in sorted(goals[t + 1] & added):
                 before = consumed | ((goals[t + 1] - added) & task)
                 for tau in range(t + 1):
-                    state = varied(traj, states[tau], rng)
+                    state = varied(traj, states[tau], rng) if vary else states[tau]
                     data = encode(state, goals[t + 1] | traj.extra_goal, [query])
                     out.append(Example(data, *_target(data, sorted(before) + empty_hand)))
     return out
 
 
 def _alterations(lit: Literal, state: SymbolicSceneGraph) -> set[Literal]:
+    """The paper's negatives: a literal of the next state altered in every way (another
+    subject, another target, the other binary predicate, the other unary predicate)."""
     objects = state.objects
     out = set()
     for o in objects:  # another subject
@@ -128,63 +136,81 @@ def _alterations(lit: Literal, state: SymbolicSceneGraph) -> set[Literal]:
     return out
 
 
-def _every_literal(state: SymbolicSceneGraph) -> set[Literal]:
-    out = set()
-    for o in state.objects:
-        out |= {Literal(Predicate.IN_GRASP, (o,)), Literal(Predicate.CLEAR, (o,))}
-        for x in state.nodes:
-            if x != o:
-                out.add(Literal(Predicate.ON, (o, x)))
-                if kind_of(x) is EntityKind.SHELF:
-                    out.add(Literal(Predicate.IN, (o, x)))
+def _labelled(state: SymbolicSceneGraph, labels: dict[Literal, bool]) -> Example:
+    data = encode(state, labels)
+    slots = Slots(tuple(data.names))
+    target = torch.zeros_like(data.goal)
+    mask = torch.zeros_like(data.valid)
+    for lit, yes in labels.items():
+        e, p = slots.slot(lit)
+        target[e, p] = int(yes)
+        mask[e, p] = True
+    return Example(data, target, mask)
+
+
+def _examples_of(state: SymbolicSceneGraph, labels: dict[Literal, bool], singles) -> list[Example]:
+    """The labels asked all at once, and the chosen ones each alone (as the planner asks)."""
+    out = [_labelled(state, labels)]
+    out += [_labelled(state, {lit: labels[lit]}) for lit in singles if len(labels) > 1]
     return out
 
 
-def reachable(state: SymbolicSceneGraph) -> set[Literal]:
-    """Literals that do not hold now and that one applicable action makes hold (labels, from
-    the model): positive ones made true, and negated ones (`not l`) made false."""
-    made, undone = set(), set()
-    for action in applicable_actions(state):
-        after = apply(state, action).literals
-        made |= after
-        undone |= state.literals - after
-    return (made - state.literals) | {lit.negated() for lit in undone}
+def demonstrated_reach(traj: Trajectory | Demo) -> list[tuple[SymbolicSceneGraph, set[Literal]]]:
+    """Per demonstrated step: the state before it and what one primitive changed, as literals
+    (those made true, and `not l` for those made false)."""
+    traj = _trajectory(traj)
+    out = []
+    for before, after in zip(traj.states, traj.states[1:], strict=False):
+        added, consumed = _changes(before, after)
+        out.append((before, added | {lit.negated() for lit in consumed}))
+    return out
 
 
-def reach_examples(demos: list[Trajectory] | list[Demo], seed: int = 0, singles: int = 12):
-    """Per demonstrated state: every candidate at once, and up to `singles` reachable and
-    `singles` unreachable candidates alone (sampled: a scene of twelve objects has hundreds)."""
+def paper_reach_examples(demos: list[Trajectory] | list[Demo], seed: int = 0, singles: int = 12):
+    """The paper's f_reach labels: what each demonstrated step changed is reachable from the
+    state before it; the alterations of what it made true are not (the paper labels them all
+    unreachable, though some are: placing on another free surface is one primitive too).
+    Every label at once, and up to `singles` of each class alone."""
     rng = random.Random(f"reach-{seed}")
     out = []
-    for traj in map(_trajectory, demos):
-        for t in range(len(traj.states) - 1):
-            state, after = traj.states[t], traj.states[t + 1]
-            if traj.added:  # the demonstrated step still shows, half the time
-                state = state if rng.random() < 0.5 else varied(traj, state, rng)
-            added, _ = _changes(state, after)
-            candidates = set(added)
-            for lit in added:
-                candidates |= _alterations(lit, state)
-            candidates |= _every_literal(state)
-            candidates = {c for c in candidates if not state.holds(c)}
-            # undoing, too; never both l and not l: one of them holds, and only those that do
-            # not hold are candidates
-            candidates |= {lit.negated() for lit in state.literals}
-            yes = reachable(state)
-            pos = sorted(c for c in candidates if c in yes)
-            neg = sorted(c for c in candidates if c not in yes)
+    for traj in demos:
+        for state, changed in demonstrated_reach(traj):
+            labels = dict.fromkeys(changed, True)
+            for lit in [c for c in changed if c.positive]:
+                for alt in _alterations(lit, state) - changed:
+                    if not state.holds(alt):
+                        labels[alt] = False
+            pos = sorted(c for c, y in labels.items() if y)
+            neg = sorted(c for c, y in labels.items() if not y)
             chosen = rng.sample(pos, min(singles, len(pos)))
             chosen += rng.sample(neg, min(singles, len(neg)))
-            for goal in [candidates] + [{c} for c in chosen]:
-                data = encode(state, goal)
-                slots = Slots(tuple(data.names))
-                target = torch.zeros_like(data.goal)
-                mask = torch.zeros_like(data.valid)
-                for c in goal:
-                    e, p = slots.slot(c)
-                    target[e, p] = int(c in yes)
-                    mask[e, p] = True
-                out.append(Example(data, target, mask))
+            out += _examples_of(state, labels, chosen)
+    return out
+
+
+def world_labels(trial: WorldTrial) -> dict[Literal, bool]:
+    """What one primitive executed in the simulated world says about reachability: each
+    literal the heuristic maps to that very action, reached if the primitive succeeded (the
+    world checks its intended effect and that nothing else was disturbed) and the literal
+    holds in the scene the world shows afterwards. A pick that lifts another object along,
+    say, reaches nothing."""
+    state, action = trial.state, trial.action
+    asked = [lit for lit in candidate_literals(state) if action_for(lit, state) == action]
+    return {lit: trial.succeeded and trial.after.holds(lit) for lit in asked}
+
+
+def world_reach_examples(trials: list[WorldTrial], demos: list[Trajectory] | list[Demo]):
+    """Our f_reach labels: every executed primitive's (`world_labels`), and the demonstrated
+    steps' changes as reachable. All at once and each alone."""
+    out = []
+    for trial in trials:
+        labels = world_labels(trial)
+        if labels:
+            out += _examples_of(trial.state, labels, sorted(labels))
+    for traj in demos:
+        for state, changed in demonstrated_reach(traj):
+            labels = dict.fromkeys(changed, True)
+            out += _examples_of(state, labels, sorted(labels))
     return out
 
 

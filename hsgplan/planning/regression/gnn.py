@@ -21,6 +21,17 @@ from torch_geometric.nn import MessagePassing
 from hsgplan.checkpoint import load_trained
 
 
+def graph_max(x: Tensor, batch: Tensor | None) -> Tensor:
+    """Each node's graph's elementwise maximum over its nodes, [N, F] -> [N, F]. `batch` [N]
+    names each node's graph (None: one graph)."""
+    if batch is None:
+        return x.amax(0, keepdim=True).expand_as(x)
+    size = int(batch.max()) + 1
+    out = x.new_full((size, x.size(1)), float("-inf"))
+    out = out.scatter_reduce(0, batch.unsqueeze(1).expand_as(x), x, reduce="amax")
+    return out.index_select(0, batch)
+
+
 def mlp(in_dim: int, hidden: int, out_dim: int) -> nn.Sequential:
     """The paper's shared module: two fully connected layers with a Leaky ReLU between them."""
     return nn.Sequential(nn.Linear(in_dim, hidden), nn.LeakyReLU(), nn.Linear(hidden, out_dim))
@@ -38,26 +49,39 @@ class RelationalLayer(MessagePassing):
     own update is still computed and read out). Where an input and output width match, the
     update is residual.
 
+    With `pool`, each node also sees the elementwise maximum of all node states in its graph.
+    Messages travel only along related pairs, so without it an object cannot know that another
+    one, related to nothing, is in the hand (and a pick would then fail); a maximum, unlike a
+    sum or a mean, does not change when more objects like those already there are added.
+
     Args:
         node_dim: width of the input node features.
         edge_dim: width of the input edge features.
         hidden: width of the hidden layers and of both outputs.
+        pool: whether nodes see the graph's max-pooled node states.
 
     Shapes:
         x: [N, node_dim]; edge_index: [2, E] (row 0 source, row 1 target); edge_attr:
-        [E, edge_dim]; edge_weight: [E] or None -> (x_new [N, hidden], edge_new [E, hidden]).
+        [E, edge_dim]; edge_weight: [E] or None; batch: [N] or None (one graph) ->
+        (x_new [N, hidden], edge_new [E, hidden]).
     """
 
-    def __init__(self, node_dim: int, edge_dim: int, hidden: int) -> None:
+    def __init__(self, node_dim: int, edge_dim: int, hidden: int, pool: bool = False) -> None:
         super().__init__(aggr="add")
         self.node_dim_in = node_dim  # `node_dim` is taken: MessagePassing's propagation axis
         self.edge_dim = edge_dim
         self.hidden = hidden
+        self.pool = pool
         self.edge_mlp = mlp(2 * node_dim + edge_dim, hidden, hidden)
-        self.node_mlp = mlp(node_dim + 2 * hidden, hidden, hidden)
+        self.node_mlp = mlp(node_dim * (2 if pool else 1) + 2 * hidden, hidden, hidden)
 
     def forward(
-        self, x: Tensor, edge_index: Tensor, edge_attr: Tensor, edge_weight: Tensor | None = None
+        self,
+        x: Tensor,
+        edge_index: Tensor,
+        edge_attr: Tensor,
+        edge_weight: Tensor | None = None,
+        batch: Tensor | None = None,
     ) -> tuple[Tensor, Tensor]:
         edge_new = self.edge_updater(edge_index, x=x, edge_attr=edge_attr)
         sent = edge_new if edge_weight is None else edge_new * edge_weight.unsqueeze(-1)
@@ -70,7 +94,8 @@ class RelationalLayer(MessagePassing):
             edge_attr=both,
             size=(x.size(0), x.size(0)),
         )
-        x_new = self.node_mlp(torch.cat([x, sums], dim=-1))
+        parts = [x, sums, graph_max(x, batch)] if self.pool else [x, sums]
+        x_new = self.node_mlp(torch.cat(parts, dim=-1))
         if self.node_dim_in == self.hidden:
             x_new = x_new + x
         if self.edge_dim == self.hidden:
@@ -87,7 +112,7 @@ class RelationalLayer(MessagePassing):
     def __repr__(self) -> str:
         return (
             f"{type(self).__name__}(node_dim={self.node_dim_in}, edge_dim={self.edge_dim}, "
-            f"hidden={self.hidden})"
+            f"hidden={self.hidden}, pool={self.pool})"
         )
 
 
@@ -101,6 +126,7 @@ class EdgeClassifierConfig:
     classes: int = 3
     hidden: int = 256
     rounds: int = 3
+    pool: bool = False  # max-pooled graph context in every layer (see `RelationalLayer`)
 
     def __post_init__(self) -> None:
         for name in ("node_dim", "edge_dim", "predicates", "hidden"):
@@ -110,6 +136,8 @@ class EdgeClassifierConfig:
             raise ValueError(f"classes must be an integer >= 2, got {self.classes!r}")
         if not isinstance(self.rounds, int) or self.rounds < 0:
             raise ValueError(f"rounds must be a non-negative integer, got {self.rounds!r}")
+        if not isinstance(self.pool, bool):
+            raise ValueError(f"pool must be true or false, got {self.pool!r}")
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -152,7 +180,9 @@ class EdgeClassifier(nn.Module):
         h = config.hidden
         self.node_encoder = mlp(config.node_dim, h, h)
         self.edge_encoder = mlp(config.edge_dim, h, h)
-        self.layers = nn.ModuleList(RelationalLayer(h, h, h) for _ in range(config.rounds))
+        self.layers = nn.ModuleList(
+            RelationalLayer(h, h, h, config.pool) for _ in range(config.rounds)
+        )
         self.head = mlp(3 * h, h, config.predicates * config.classes)
         # the computation on plain tensors, over these same modules; kept in a list so that it
         # is not registered twice (see `script`)
@@ -165,10 +195,9 @@ class EdgeClassifier(nn.Module):
 
         `optimize_for_inference` freezes and also stores each weight pre-transposed (a
         matmul and a bias add instead of a transpose per linear layer per call): 20% off a
-        planner call. Its outputs were the frozen module's bit for bit on 6160 planner
-        batches of the shipped checkpoint (2-12 objects); MKL multiplies matrices of fewer
-        than five rows another way, where the last bits can differ, and a planner batch has
-        six nodes (five fixtures and an object) and as many edges at least."""
+        planner call. Its outputs agree with the frozen module's to rounding (the test holds
+        them within 1e-6; it may fuse operations in another order, and MKL multiplies matrices
+        of fewer than five rows another way)."""
         self.eval()
         scripted = torch.jit.script(_InferenceCore(self).eval())
         with warnings.catch_warnings():
@@ -186,18 +215,21 @@ class EdgeClassifier(nn.Module):
             keep = (active | data.readout).nonzero().squeeze(1)
             edge_index, edge_attr, active = edge_index[:, keep], edge_attr[keep], active[keep]
         weight = active.float() if active is not None else None
-        logits = self._core[0](data.x.float(), edge_index, edge_attr.float(), weight)
+        batch = data.batch if "batch" in data else None
+        logits = self._core[0](data.x.float(), edge_index, edge_attr.float(), weight, batch)
         logits = logits.view(-1, self.config.predicates, self.config.classes)
         if keep is None:
             return logits
         full = logits.new_zeros(data.edge_index.shape[1], *logits.shape[1:])
         return full.index_copy(0, keep, logits)
 
-    def computed(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor, weight: Tensor) -> Tensor:
+    def computed(
+        self, x: Tensor, edge_index: Tensor, edge_attr: Tensor, weight: Tensor, batch: Tensor
+    ) -> Tensor:
         """`forward` on edges already cut to the computed ones (`encoding.encode_computed`):
         [M, predicates, classes] logits, one row per given edge. The planner's path, which
         skips building and cutting a `Data` per call."""
-        logits = self._core[0](x, edge_index, edge_attr, weight)
+        logits = self._core[0](x, edge_index, edge_attr, weight, batch)
         return logits.view(-1, self.config.predicates, self.config.classes)
 
 
@@ -213,12 +245,17 @@ class _Core(nn.Module):
         self.head = net.head
 
     def forward(
-        self, x: Tensor, edge_index: Tensor, edge_attr: Tensor, edge_weight: Tensor | None
+        self,
+        x: Tensor,
+        edge_index: Tensor,
+        edge_attr: Tensor,
+        edge_weight: Tensor | None,
+        batch: Tensor | None,
     ) -> Tensor:
         x = self.node_encoder(x)
         e = self.edge_encoder(edge_attr)
         for layer in self.layers:
-            x, e = layer(x, edge_index, e, edge_weight)
+            x, e = layer(x, edge_index, e, edge_weight, batch)
         return self.head(torch.cat([x[edge_index[0]], x[edge_index[1]], e], dim=-1))
 
 
@@ -236,9 +273,15 @@ class _InferenceCore(nn.Module):
         self.edge_mlps = nn.ModuleList(layer.edge_mlp for layer in net.layers)
         self.node_mlps = nn.ModuleList(layer.node_mlp for layer in net.layers)
         self.head = net.head
+        self.pool = net.config.pool
 
     def forward(
-        self, x: Tensor, edge_index: Tensor, edge_attr: Tensor, edge_weight: Tensor | None
+        self,
+        x: Tensor,
+        edge_index: Tensor,
+        edge_attr: Tensor,
+        edge_weight: Tensor | None,
+        batch: Tensor | None,
     ) -> Tensor:
         x = self.node_encoder(x)
         e = self.edge_encoder(edge_attr)
@@ -251,7 +294,11 @@ class _InferenceCore(nn.Module):
             received = sent.new_zeros(n, h).index_add_(0, dst, sent)
             sent_out = sent.new_zeros(n, h).index_add_(0, src, sent)
             # every layer is hidden -> hidden, so both updates are residual
-            x = node_mlp(torch.cat([x, received, sent_out], dim=-1)) + x
+            if self.pool:
+                parts = [x, received, sent_out, graph_max(x, batch)]
+            else:
+                parts = [x, received, sent_out]
+            x = node_mlp(torch.cat(parts, dim=-1)) + x
             e = edge_new + e
         return self.head(torch.cat([x.index_select(0, src), x.index_select(0, dst), e], dim=-1))
 

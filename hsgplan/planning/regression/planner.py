@@ -22,10 +22,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from hsgplan.domain.actions import Action, Pick, Place, Push
+from hsgplan.domain.actions import Action
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.predicates import Literal
 from hsgplan.planning.base import TaskDecision, push_after
+from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.encoding import (
     DONT_CARE,
     TRUE,
@@ -36,35 +37,12 @@ from hsgplan.planning.regression.encoding import (
 )
 from hsgplan.planning.regression.gnn import load_network
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.symbolic.transition import why_not
 
 MAX_DEPTH = 8
-BUFFER = "open_space"
 
 
 def _decision(action: Action, subgoal: Literal, start: float) -> TaskDecision:
     return TaskDecision(action, subgoal, time.perf_counter() - start, following=push_after(action))
-
-
-def action_for(lit: Literal, state: SymbolicSceneGraph) -> Action | None:
-    """The primitive and object that achieve one literal, if one does from this state."""
-    if lit.positive:
-        if lit.predicate is Predicate.IN_GRASP:
-            options = [Pick(lit.subject)]
-        elif lit.predicate is Predicate.ON:
-            options = [Place(*lit.args)]
-        elif lit.predicate is Predicate.IN:
-            options = [Push(*lit.args)]
-        else:  # Clear(x): lift what rests on x (x in the hand is cleared by placing it
-            # where the rest of the subgoal wants it, not by dropping it anywhere)
-            options = [Pick(o) for o in state.resting_on(lit.subject)]
-    elif lit.predicate is Predicate.IN_GRASP:  # let go of it
-        options = [Place(lit.subject, BUFFER)]
-    elif lit.predicate is Predicate.ON:  # take it off
-        options = [Pick(lit.subject)]
-    else:
-        options = []
-    return next((a for a in options if why_not(state, a) is None), None)
 
 
 @lru_cache(maxsize=4)
@@ -146,7 +124,8 @@ class RegressionPlanner:
             out[i].add(slots.valued(e, q, v))
         return [frozenset(x) for x in out]
 
-    def _reachable(self, state, lits: list[Literal]) -> list[bool]:
+    def reachable(self, state: SymbolicSceneGraph, lits: list[Literal]) -> list[bool]:
+        """f_reach on each literal alone: does the primitive the heuristic names reach it?"""
         # each literal's slot is on an edge its own goal makes active, so it is computed
         batch = encode_computed(state, [frozenset((lit,)) for lit in lits], [None] * len(lits))
         slots = Slots.of(state.nodes)
@@ -216,7 +195,7 @@ class RegressionPlanner:
             ask = [n.lit for n, _ in frontier + children if n.lit not in reach]
             ask = list(dict.fromkeys(ask))
             if ask:
-                reach.update(zip(ask, self._reachable(state, ask), strict=True))
+                reach.update(zip(ask, self.reachable(state, ask), strict=True))
             if found := self._choose(state, [n for n, _ in frontier if reach[n.lit]], avoid):
                 return found
             frontier = self._with_preimages(state, frontier)
@@ -254,15 +233,23 @@ class RegressionPlanner:
 
 
 class ForwardPlanner:
-    """The baseline: a network predicts the next subgoal from state and goal directly."""
+    """The baseline: a network predicts the next subgoal from state and goal directly.
+
+    It runs under the regression planner's rules: the heuristic names the action (no
+    preconditions checked), and an action already taken from this very state with this goal
+    (it failed, or came back here) is avoided while another of the network's top subgoals
+    names a different one."""
 
     name = "forward"
+    TOP = 20  # subgoals considered per decision, most probable first
 
     def __init__(self, checkpoint: Path) -> None:
         self.net = load_network(checkpoint / "forward")
+        self.reset(None, 0)
 
     def reset(self, goal: Goal | None, seed: int) -> None:
-        """Nothing to forget: the forward planner decides from the state alone."""
+        """A new episode: nothing remembered."""
+        self._taken: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
 
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
@@ -272,8 +259,15 @@ class ForwardPlanner:
         data = encode(state, goal.literals)
         probs = self.net(data).softmax(-1)[..., TRUE].masked_fill(~data.valid, 0.0)
         slots = Slots(tuple(data.names))
-        for flat in probs.flatten().argsort(descending=True).tolist()[:20]:
+        ranked = []
+        for flat in probs.flatten().argsort(descending=True).tolist()[: self.TOP]:
             lit = slots.literal(*divmod(flat, probs.shape[1]))
             if not state.holds(lit) and (action := action_for(lit, state)) is not None:
-                return _decision(action, lit, start)
-        return TaskDecision(None, None, time.perf_counter() - start, "no applicable subgoal")
+                ranked.append((lit, action))
+        taken = self._taken.setdefault((goal, state), set())
+        fresh = [(lit, a) for lit, a in ranked if a not in taken]
+        if not (fresh or ranked):
+            return TaskDecision(None, None, time.perf_counter() - start, "no subgoal")
+        lit, action = (fresh or ranked)[0]
+        taken.add(action)
+        return _decision(action, lit, start)

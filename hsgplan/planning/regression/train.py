@@ -1,11 +1,12 @@
 """Training the task planner's networks: `hsgplan train task`.
 
-Three edge classifiers are trained on the demonstrations, with cross-entropy: f_preimage
-(don't care / true / false per slot), f_reach (no / yes per supervised slot) and the forward
-baseline (the next subgoal). A checkpoint is a folder: `train_config.json`, and one folder per
-network with `model.safetensors` and `config.json` (the network's configuration). Training saves
-its progress (`progress.pt`, loaded with weights_only) every `save_every` epochs, and a run
-started again with the same configuration continues from there.
+Three edge classifiers are trained with cross-entropy: f_preimage (don't care / true / false per
+slot) and the forward baseline (the next subgoal) on the demonstrations (and their copies with
+added objects), f_reach (no / yes per supervised slot) on the labels its recipe names (see
+`examples.py`). A checkpoint is a folder: `train_config.json`, and one folder per network with
+`model.safetensors` and `config.json` (the network's configuration). Training saves its progress
+(`progress.pt`, loaded with weights_only) every `save_every` epochs, and a run started again
+with the same configuration continues from there.
 """
 
 from __future__ import annotations
@@ -20,15 +21,17 @@ import torch
 from torch_geometric.data import Batch
 
 from hsgplan import training
+from hsgplan.data.world_trials import load_world_trials
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.paths import DEMOS
+from hsgplan.paths import DEMOS, REACH_DATA, shipped
 from hsgplan.planning.regression.augment import trajectories
 from hsgplan.planning.regression.encoding import EDGE_DIM, NODE_DIM
 from hsgplan.planning.regression.examples import (
     Example,
     forward_examples,
+    paper_reach_examples,
     preimage_examples,
-    reach_examples,
+    world_reach_examples,
 )
 from hsgplan.planning.regression.gnn import (
     EdgeClassifier,
@@ -37,10 +40,16 @@ from hsgplan.planning.regression.gnn import (
 )
 
 NETWORKS = {"preimage": 3, "reach": 2, "forward": 3}
+REACH_SOURCES = ("world", "alterations")
 
 
 @dataclass(frozen=True)
 class TaskTrainConfig:
+    """How the task planner's networks are trained. The shipped checkpoints hold two recipes:
+    `checkpoints/task-paper` (the paper's: the 18 demonstrations alone, f_reach from their
+    alterations) and `checkpoints/task` (ours: copies with added objects, varied states,
+    f_reach from primitives executed in the simulated world)."""
+
     demos: str = str(DEMOS)
     seed: int = 0
     epochs: int = 8
@@ -50,11 +59,12 @@ class TaskTrainConfig:
     hidden: int = 32
     rounds: int = 3
     save_every: int = 2
-    copies: int = 20  # copies of each demonstration with added objects (`augment.py`)
-    reach_singles: int = 12  # single-literal reach questions per state and label
-    # f_reach learns from the first `reach_copies` copies only (None: all of them): its
-    # examples are many per state, f_preimage's few
-    reach_copies: int | None = None
+    copies: int = 20  # copies of each demonstration with added objects (`augment.py`); 0: none
+    vary: bool = True  # f_preimage also asked from varied states (`augment.varied`)
+    reach: str = "world"  # f_reach's labels: "world" (executed primitives) or "alterations"
+    world_trials: str = str(REACH_DATA)  # the executed primitives, for reach = "world"
+    reach_singles: int = 12  # alterations asked alone per state and label (reach = "alterations")
+    pool: bool = True  # max-pooled graph context in the networks (`gnn.RelationalLayer`)
 
     def __post_init__(self) -> None:
         for name in ("epochs", "batch_size", "hidden", "save_every", "reach_singles"):
@@ -63,10 +73,11 @@ class TaskTrainConfig:
         for name in ("rounds", "copies"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 0:
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: cannot be negative")
-        if self.reach_copies is not None and not 0 <= self.reach_copies <= self.copies:
-            raise InvalidInputError(
-                f"reach_copies {self.reach_copies!r}: between 0 and copies ({self.copies})"
-            )
+        for name in ("vary", "pool"):
+            if not isinstance(getattr(self, name), bool):
+                raise InvalidInputError(f"{name} {getattr(self, name)!r}: true or false")
+        if self.reach not in REACH_SOURCES:
+            raise InvalidInputError(f"reach {self.reach!r}: one of {', '.join(REACH_SOURCES)}")
 
     @staticmethod
     def from_json(d: dict) -> TaskTrainConfig:
@@ -76,15 +87,41 @@ class TaskTrainConfig:
         return TaskTrainConfig(**d)
 
 
-def _examples(name: str, trajs, config: TaskTrainConfig) -> list[Example]:
-    seed = config.seed
+def _examples(name: str, demos, trajs, config: TaskTrainConfig) -> dict[str, list[Example]]:
+    """A network's training examples by where their labels come from."""
+    n = len(demos)  # the demonstrations come first, then copy after copy
     if name == "reach":
-        copies = config.copies if config.reach_copies is None else config.reach_copies
-        n = len(trajs) // (config.copies + 1)  # the demonstrations, then copy after copy
-        return reach_examples(trajs[: n * (1 + copies)], seed, config.reach_singles)
-    if name == "preimage":
-        return preimage_examples(trajs, seed)
-    return forward_examples(trajs)
+        if config.reach == "alterations":
+            return {
+                "demonstrated changes and their alterations": paper_reach_examples(
+                    demos, config.seed, config.reach_singles
+                )
+            }
+        trials = load_world_trials(shipped(config.world_trials))
+        return {
+            "primitives executed in the simulated world": world_reach_examples(trials, []),
+            "demonstrated changes": world_reach_examples([], demos),
+        }
+    make = (
+        (lambda t: preimage_examples(t, config.seed, config.vary))
+        if name == "preimage"
+        else forward_examples
+    )
+    out = {"demonstrations": make(trajs[:n])}
+    if len(trajs) > n:
+        out["copies with added objects"] = make(trajs[n:])
+    return out
+
+
+def label_counts(examples: list[Example]) -> dict:
+    """How many examples, supervised slots, and slots of each class a list holds."""
+    slots = [e.target[e.mask] for e in examples]
+    counts = torch.bincount(torch.cat(slots), minlength=2) if slots else torch.zeros(2)
+    return {
+        "examples": len(examples),
+        "labels": int(counts.sum()),
+        "by_class": [int(c) for c in counts],
+    }
 
 
 def train_task(
@@ -92,7 +129,8 @@ def train_task(
     out: Path,
     on_epoch: Callable[[str, int, float], None] | None = None,
 ) -> None:
-    """Train (or go on training) the three networks into the checkpoint folder `out`."""
+    """Train (or go on training) the three networks into the checkpoint folder `out`; each
+    network's folder gets `labels.json`, its label counts by source."""
     from hsgplan.data.demos import load_demos
 
     demos = load_demos(Path(config.demos))
@@ -105,7 +143,11 @@ def train_task(
     for name, classes in NETWORKS.items():
         if (out / name / "model.safetensors").exists():
             continue  # finished earlier
-        examples = _examples(name, trajs, config)
+        by_source = _examples(name, demos, trajs, config)
+        (out / name).mkdir(exist_ok=True)
+        counts = {source: label_counts(ex) for source, ex in by_source.items()}
+        (out / name / "labels.json").write_text(json.dumps(counts, indent=2) + "\n")
+        examples = [e for ex in by_source.values() for e in ex]
         _train_one(name, classes, examples, config, out / name, on_epoch)
 
 
@@ -114,7 +156,9 @@ def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, o
     if training.finished(folder):
         return  # finished earlier
     torch.manual_seed(config.seed)
-    net_config = EdgeClassifierConfig(NODE_DIM, EDGE_DIM, 4, classes, config.hidden, config.rounds)
+    net_config = EdgeClassifierConfig(
+        NODE_DIM, EDGE_DIM, 4, classes, config.hidden, config.rounds, config.pool
+    )
     model = EdgeClassifier(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start = training.resume(folder, model, optim)

@@ -1,0 +1,89 @@
+"""The learned task planners decide without the hand-written rules: while a planner decides, no
+function of the transition model, PDDL, the goal generator, Fast Downward or the feasibility
+rules runs (any call, however reached, is caught by a profiler, not only direct imports). The
+symbolic loop around the planner is the world and steps the transition model between decisions."""
+
+import random
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+
+from hsgplan.domain.goals import parse_goal
+from hsgplan.evaluation.task_eval import run_task_episode
+from hsgplan.paths import TASK_CHECKPOINT, shipped
+from hsgplan.planning.regression.planner import ForwardPlanner, RegressionPlanner
+
+PACKAGE = Path(__import__("hsgplan").__file__).resolve().parent
+RULES = (
+    PACKAGE / "symbolic",
+    PACKAGE / "domain" / "feasibility.py",
+    PACKAGE / "planning" / "fast_downward.py",
+)
+GOALS = [
+    "On(cherries, shelf_a) & On(butter, cherries)",
+    "In(tomato_soup, shelf_a) & On(popcorn, shelf_b) & On(cream_cheese, shelf_a)",
+    "On(cherries, shelf_b) & On(butter, cherries) & In(alphabet_soup, shelf_a) & "
+    "On(popcorn, shelf_a) & In(tomato_soup, shelf_a) & On(cream_cheese, shelf_b)",
+]
+
+
+def _is_rule(filename: str, rules) -> bool:
+    path = Path(filename).resolve()
+    return any(path == r or r in path.parents for r in rules)
+
+
+@contextmanager
+def rules_forbidden(calls: list[str], rules=RULES):
+    """Every call into `rules` (folders or files) while inside, appended to `calls`."""
+
+    def profile(frame, event, arg):
+        if event == "call" and _is_rule(frame.f_code.co_filename, rules):
+            calls.append(f"{frame.f_code.co_filename}:{frame.f_code.co_name}")
+
+    sys.setprofile(profile)
+    try:
+        yield
+    finally:
+        sys.setprofile(None)
+
+
+class Guarded:
+    """A planner whose every decision runs under `rules_forbidden`."""
+
+    def __init__(self, planner, calls: list[str]) -> None:
+        self.planner, self.calls = planner, calls
+
+    def next_action(self, state, goal):
+        with rules_forbidden(self.calls):
+            return self.planner.next_action(state, goal)
+
+
+def test_the_profiler_catches_a_call_into_the_transition_model():
+    from hsgplan.symbolic.generator import random_state
+    from hsgplan.symbolic.transition import applicable_actions
+
+    calls: list[str] = []
+    goal = parse_goal(GOALS[0])
+    state = random_state(goal.objects, random.Random(0))
+    with rules_forbidden(calls):
+        applicable_actions(state)
+    assert any("applicable_actions" in c for c in calls)
+
+
+@pytest.mark.parametrize("kind", ["regression", "forward"])
+def test_a_learned_planner_decides_without_the_rules(kind):
+    checkpoint = shipped(TASK_CHECKPOINT)
+    for text in GOALS:
+        goal = parse_goal(text)
+        for seed in range(2):
+            calls: list[str] = []
+            if kind == "regression":
+                planner = RegressionPlanner(checkpoint, seed=seed)
+            else:
+                planner = ForwardPlanner(checkpoint)
+            planner.reset(goal, seed)
+            episode = run_task_episode(Guarded(planner, calls), goal, seed, 0)
+            assert episode.decision_ms, text  # decisions were made
+            assert calls == [], (text, seed, calls[:3])
