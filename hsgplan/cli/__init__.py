@@ -1,7 +1,8 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval), `data`
-(collect), `learn` (train task, eval-task, eval-reach), `motion` (train motion, eval-motion), `bench`.
+(collect), `learn` (train task, eval-task, eval-reach), `motion` (train motion, eval-motion),
+`bench`.
 """
 
 from __future__ import annotations

@@ -83,7 +83,7 @@ def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir
 @app.command("reach")
 @refuses_bad_input
 def reach(
-    states: Annotated[int, typer.Option(help="Staged states (whole chunks of 8).")] = 2400,
+    states: Annotated[int, typer.Option(help="Staged states (a rerun may ask for more).")] = 4000,
     seed: Annotated[int, typer.Option(help="Seed of the states and actions.")] = 0,
     workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
     ray: Annotated[
@@ -95,15 +95,22 @@ def reach(
 ) -> None:
     """Self-supervised reachability: primitives executed in the simulated world from staged
     symbolic states, and what the world showed after each (f_reach's labels)."""
-    from hsgplan.evaluation.record_reach import STATES_PER_CHUNK, collect_reach
+    from hsgplan.evaluation.record_reach import collect_reach
 
+    if states < 1:
+        raise InvalidInputError(f"--states {states}: need at least one")
     if workers < 1:
         raise InvalidInputError(f"--workers {workers}: need at least one")
     with Progress(console=err, transient=True) as progress:
-        bar = progress.add_task("chunks of staged states", total=-(-states // STATES_PER_CHUNK))
-        summary = collect_reach(out_dir, states, seed, workers, ray, lambda: progress.advance(bar))
-    statuses = ", ".join(f"{k} {v}" for k, v in sorted(summary.by_status.items()))
+        bar = progress.add_task("staged states", total=states)
+        summary = collect_reach(
+            out_dir, states, seed, workers, ray, lambda _: progress.advance(bar)
+        )
+    statuses = ", ".join(f"{k} {v}" for k, v in summary.by_status.items())
     out.print(
         f"{summary.trials} primitives executed from {summary.staged} of {summary.states} "
-        f"states ({statuses}) in {out_dir}"
+        f"states ({statuses or 'none'}); {summary.ran} run now in "
+        f"{summary.seconds:.1f} s; in {out_dir}",
+        highlight=False,
+        soft_wrap=True,
     )

@@ -71,8 +71,9 @@ def eval_task(
     ] = False,
 ) -> None:
     """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
-    wasted (inapplicable) actions per episode, milliseconds per decision. Episodes are kept in the run folder (by default
-    runs/eval-task-PLANNER-SIZES-gGOALS-seedSEED) as they finish."""
+    wasted (inapplicable) actions per episode, milliseconds per decision. Episodes are kept in
+    the run folder (by default runs/eval-task-PLANNER[-CHECKPOINT]-SIZES-gGOALS-seedSEED) as
+    they finish."""
     from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
 
     if workers < 1:

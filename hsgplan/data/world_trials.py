@@ -1,23 +1,33 @@
 """Primitives executed in the simulated world from staged symbolic states: f_reach's labels.
 
 Made by `hsgplan collect reach` (`evaluation/record_reach.py`). A collection is a run folder
-whose `episodes.jsonl` holds one line per chunk of consecutive staged states,
-`{"key": "SEED/CHUNK", "result": {"states": [R, ...]}}`, with per state
+(`runner/items.py`): `config.json` and `episodes.jsonl`, one line per staged state,
+`{"key": "SEED/INDEX", "result": R}`, with
 
-    R = {"staged": false}                         the arrangement could not be staged
-    R = {"staged": true, "objects": [names], "state": [literals],
+    R = {"staged": false}                         the drawn state could not be staged
+    R = {"objects": [names], "state": [literals],
          "trials": [{"action": "pick(x)", "status": S, "after": [literals] | null}, ...]}
 
-`state` is what the world showed once staged (placement literals, `str(Literal)`); each trial
-starts from it again: the action executed (`str(Action)`), the execution's status (a
-`sim.outcome.Status` value, or `no_parameters` when no parameter choice could be planned and
-nothing moved), and the symbolic state the world showed afterwards, null when something
-toppled or fell (the scene then maps to no clean state).
+`state` is the symbolic state the world showed once staged, as placement literals (On, In,
+InGrasp; `str(Literal)`; Clear is derived). Every trial starts from that same state: the action
+executed (`str(Action)`), the execution's status (a `sim.outcome.Status` value, or
+`no_parameters` when the action had no parameter choice at all), and the symbolic state the
+world showed afterwards (`map_symbols` of the scene), null when that mapping had anomalies
+(something toppled, fell, or rests in no clean way). A trial whose parameter choices all failed
+to plan moved nothing: its status is the last planning failure's and `after` is `state`.
+
+States are read with the world's limits off (`limits=False`): `after` is an observation, and a
+primitive may leave what no limit allows (a fifth object squeezed onto a shelf top).
+
+Collections made before states were logged one by one hold one line per chunk of consecutive
+states, `{"key": "SEED/CHUNK", "result": {"states": [R, ...]}}`, each R as above with
+`"staged": true` added; they read the same way.
 """
 
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,6 +40,7 @@ from hsgplan.sim.outcome import Status
 
 RESULTS = "episodes.jsonl"
 NO_PARAMETERS = "no_parameters"
+UNSTAGED: dict = {"staged": False}
 
 
 @dataclass(frozen=True)
@@ -48,51 +59,85 @@ class WorldTrial:
 
 
 def state_json(state: SymbolicSceneGraph) -> list[str]:
+    """A state's placement literals, sorted (Clear follows from them)."""
     return [str(lit) for lit in state.sorted_literals() if lit.predicate is not Predicate.CLEAR]
 
 
-def _state(objects: list[str], literals: list[str]) -> SymbolicSceneGraph:
+def read_state(objects: Sequence[str], literals: Sequence[str]) -> SymbolicSceneGraph:
     return SymbolicSceneGraph.from_literals(objects, map(parse_literal, literals), limits=False)
 
 
-def trials_of(result: dict) -> list[WorldTrial]:
-    """The trials of one logged result (none for a state that was not staged)."""
-    if not result.get("staged"):
+def state_row(state: SymbolicSceneGraph, trials: Sequence[WorldTrial]) -> dict:
+    """The logged result of a staged state and the trials run from it."""
+    if any(t.state != state for t in trials):
+        raise ValueError("every trial of a row starts from the row's state")
+    return {
+        "objects": list(state.objects),
+        "state": state_json(state),
+        "trials": [
+            {
+                "action": str(t.action),
+                "status": str(t.status),
+                "after": None if t.after is None else state_json(t.after),
+            }
+            for t in trials
+        ],
+    }
+
+
+def trials_of(row: dict) -> list[WorldTrial]:
+    """The trials of one logged result; none for a state that was not staged."""
+    if row.get("staged", True) is False:
         return []
-    objects = result["objects"]
-    state = _state(objects, result["state"])
+    objects = row["objects"]
+    state = read_state(objects, row["state"])
     return [
         WorldTrial(
             state,
             parse_action(t["action"]),
             str(t["status"]),
-            None if t["after"] is None else _state(objects, t["after"]),
+            None if t["after"] is None else read_state(objects, t["after"]),
         )
-        for t in result["trials"]
+        for t in row["trials"]
     ]
 
 
 def load_world_trials(folder: Path) -> list[WorldTrial]:
-    """Every trial of a collection, in the order of the staged states' keys."""
-    path = folder / RESULTS
+    """Every trial of a collection folder, states in key order, trials in the order run."""
+    path = Path(folder) / RESULTS
     if not path.is_file():
         raise InvalidInputError(f"'{folder}' holds no collection of executed primitives")
-    rows = {}
     try:
-        for line in path.read_text(encoding="utf-8").splitlines():
-            if not line.endswith("}"):
-                continue  # a line cut short by an interruption: its state is redone
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except UnicodeDecodeError as e:
+        raise InvalidInputError(f"'{path}' is damaged: not UTF-8 text ({e.reason})") from None
+    results: dict[tuple[int, ...], dict] = {}
+    for n, line in enumerate(lines, 1):
+        try:
             row = json.loads(line)
-            rows[str(row["key"])] = row["result"]
-        return [
-            t
-            for k in sorted(rows, key=_key_order)
-            for state in rows[k]["states"]
-            for t in trials_of(state)
-        ]
-    except (ValueError, KeyError, TypeError, UnicodeDecodeError) as e:
-        raise InvalidInputError(f"'{path}' is damaged: {e!r}") from e
+        except json.JSONDecodeError:
+            continue  # cut short by an interruption: the collector ran that state again
+        try:
+            results[_key_order(row["key"])] = row["result"]
+        except (KeyError, TypeError, ValueError) as e:
+            raise InvalidInputError(f"'{path}' line {n} is damaged: {_why(e)}") from None
+    trials: list[WorldTrial] = []
+    for key in sorted(results):
+        result = results[key]
+        try:
+            rows = result.get("states", [result])
+            trials += [t for row in rows for t in trials_of(row)]
+        except (AttributeError, KeyError, TypeError, ValueError) as e:
+            where = "/".join(map(str, key))
+            raise InvalidInputError(f"'{path}' state {where} is damaged: {_why(e)}") from None
+    return trials
 
 
-def _key_order(key: str) -> tuple[int, ...]:
+def _key_order(key) -> tuple[int, ...]:
+    if not isinstance(key, str):
+        raise TypeError(f"key {key!r} is not a string")
     return tuple(int(x) for x in key.split("/"))
+
+
+def _why(e: Exception) -> str:
+    return f"missing {e}" if isinstance(e, KeyError) else " ".join(str(e).split())

@@ -48,9 +48,10 @@ def kind_of_question(state: SymbolicSceneGraph, action: Action) -> QuestionKind:
         return QuestionKind.HAND_FULL
     if state.resting_on(action.obj):
         return QuestionKind.COVERED
-    if isinstance(action, Push) and len(state.inside(action.shelf)) >= INTERIOR_CAPACITY[
-        action.shelf
-    ]:
+    if (
+        isinstance(action, Push)
+        and len(state.inside(action.shelf)) >= INTERIOR_CAPACITY[action.shelf]
+    ):
         return QuestionKind.INTERIOR_FULL
     return QuestionKind.ORDINARY
 

@@ -1,25 +1,40 @@
 """`hsgplan collect reach`: primitives executed in the simulated world from staged symbolic
 states, the self-supervised labels of f_reach (format: `data/world_trials.py`).
 
-Nothing here asks the hand-written rules whether an action applies: a state is drawn, staged
-with physics, and each chosen action is planned and executed; what the world shows afterwards
-is recorded. The world refuses in its own ways: a pick while the hand is closed on another
-object has no plan, a place on a full surface finds no free spot, a pick from under another
-object disturbs it, a push into a full interior finds no free slot.
+Nothing here asks the hand-written rules (transition model, feasibility, PDDL) whether an action
+applies: a state is drawn, staged under physics, and each chosen action is planned and executed
+from it; what the world shows afterwards is recorded. The world refuses in its own ways: a pick
+while the hand holds another object or a place of an object not held is invalid, a place on a
+full surface finds no free spot, a push into a full interior finds no free slot.
 
-States (`draw_reach_state`), from `random.Random(f"reach-{seed}-{index}")`: 2 to 6 objects as
-the goal distribution draws them; one place is crowded in most states (a shelf top, a prepush
-region or a shelf interior, drawn uniformly, or none with probability 1/6), and each object
-goes there with probability 0.7 while it has room; otherwise onto a bare object that can carry
-it (probability 0.3, where there is one), into a shelf interior it fits (0.1), or onto a
-surface with room, uniformly. Then, with probability 1/2, one clear object not inside a shelf
-is in the hand. Per state up to `ACTIONS_PER_STATE` distinct actions the heuristic names for
-some literal (`planning.heuristic`) are executed, each from the staged state: the primitive
-(pick, place, push) uniform among those named, then the action uniform within it.
+States (`draw_reach_state`), from `random.Random(f"reach-{seed}-{index}")`:
+- n objects, n uniform in 2..8, drawn as the goal generator draws them (distinct types up to
+  six, the six and uniform duplicates beyond);
+- with probability `P_HOLD` (1/2) one of them, uniform, is in the hand (clear, not inside);
+- with probability `P_CROWDED_STATE` (5/6) one place is to be crowded, uniform among the two
+  shelf tops, the two prepush regions and the two shelf interiors;
+- the others, in uniformly shuffled order, go: to the crowded place with probability `P_CROWD`
+  while it has room (and, for an interior, the object fits); otherwise onto a bare object that
+  can carry it with probability `P_STACK` (towers of at most `MAX_TOWER_LEVELS`); otherwise to
+  a kind of place uniform among the open space, a shelf top, a prepush region and a shelf
+  interior (those with room for it), and within the kind uniformly.
+Every state is within the world's limits (capacities, towers, fit), counted with `Room`.
+
+Per staged state, up to `ACTIONS_PER_STATE` distinct actions among those the heuristic names for
+the state's candidate literals (`planning.heuristic`) are executed, each from the staged state
+again: a stratum uniform among those present (pick, push, a place of the held object on a
+surface, on an object, a place of an object not held), then the action uniform within it. An
+action's parameter choices (`motion.sampler.candidates`, best first) are planned in turn, at
+most `MAX_PARAMS`, and the first that plans is executed.
+
+A work item is one state, `(seed, index)`; each worker process stages its states in one scene
+(a new physics client costs more than staging and running a state). Staging resets everything
+a state's trials depend on, so a state's row does not depend on what its process ran before.
 """
 
 from __future__ import annotations
 
+import functools
 import random
 import time
 from collections import Counter
@@ -29,16 +44,17 @@ from pathlib import Path
 
 import numpy as np
 
-from hsgplan.data.world_trials import NO_PARAMETERS, WorldTrial, state_json, trials_of
-from hsgplan.domain.actions import Action
+from hsgplan.data.world_trials import NO_PARAMETERS, UNSTAGED, WorldTrial, state_row, trials_of
+from hsgplan.domain.actions import Action, Place
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import objects_for_types, sort_objects
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.room import Room
-from hsgplan.domain.world import OBJECT_TYPES, SHELVES, SURFACES
+from hsgplan.domain.world import OBJECT_TYPES, REGIONS, SHELVES, SURFACES
 from hsgplan.motion.sampler import candidates
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.runner.items import run_items
+from hsgplan.runner.run_folder import claim, logged_rows
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.motion_plans import PlanFailure, plan_primitive
@@ -47,63 +63,76 @@ from hsgplan.sim.scene import Scene
 from hsgplan.sim.staging import stage
 
 ACTIONS_PER_STATE = 6
-MAX_PARAMS = 5  # parameter choices planned, best first, before the action counts as failed
-STATES_PER_CHUNK = 8  # a unit of work: consecutive states in one fresh scene
-MIN_OBJECTS, MAX_OBJECTS = 2, 6
-P_CROWD, P_STACK, P_INSIDE, P_HOLD = 0.7, 0.3, 0.1, 0.5
+MAX_PARAMS = 5  # parameter choices planned, best first, before the action counts as refused
+MIN_OBJECTS, MAX_OBJECTS = 2, 8
+P_HOLD, P_CROWDED_STATE, P_CROWD, P_STACK = 0.5, 5 / 6, 0.85, 0.35
+
+OPEN = "open_space"
+TOPS = tuple(SHELVES)
+PREPUSH = tuple(r for r in REGIONS if r != OPEN)
+# a place to crowd: ("on", surface) or ("in", shelf)
+CROWDABLE = (*(("on", s) for s in TOPS + PREPUSH), *(("in", s) for s in SHELVES))
 
 
 def draw_reach_state(seed: int, index: int) -> SymbolicSceneGraph:
-    """A staged state's symbolic arrangement (see the module docstring)."""
+    """A state to stage (the distribution is in the module docstring)."""
     rng = random.Random(f"reach-{seed}-{index}")
-    n = rng.randint(MIN_OBJECTS, MAX_OBJECTS)
-    objects = sort_objects(objects_for_types(rng.sample(list(OBJECT_TYPES), n)))
+    objects = _objects(rng.randint(MIN_OBJECTS, MAX_OBJECTS), rng)
     order = list(objects)
     rng.shuffle(order)
-    crowd = rng.choice([None, *SURFACES[1:], *(f"in:{s}" for s in SHELVES)])
+    literals = [in_grasp(order.pop())] if rng.random() < P_HOLD else []
+    crowd = rng.choice(CROWDABLE) if rng.random() < P_CROWDED_STATE else None
     room = Room.left()
-    placed: list[Literal] = []
-    for o in order:
-        shelf = crowd[3:] if crowd and crowd.startswith("in:") else None
-        if shelf and shelf in room.free_interiors(o) and rng.random() < P_CROWD:
-            placed.append(inside(o, shelf))
-            room.put_inside(o, shelf)
-            continue
-        if crowd in room.top and room.top[crowd] > 0 and rng.random() < P_CROWD:
-            where = crowd
-        elif room.bases() and rng.random() < P_STACK:
-            where = rng.choice(room.bases())
-        elif room.free_interiors(o) and rng.random() < P_INSIDE:
-            shelf = rng.choice(room.free_interiors(o))
-            placed.append(inside(o, shelf))
-            room.put_inside(o, shelf)
-            continue
-        else:
-            where = rng.choice(room.free_tops())
-        placed.append(on(o, where))
-        room.put_on(o, where)
-    state = SymbolicSceneGraph.from_literals(objects, placed)
-    free = [
-        o
-        for o in state.objects
-        if not state.resting_on(o) and state.location(o).predicate.value == "On"
-    ]
-    if free and rng.random() < P_HOLD:
-        held = rng.choice(free)
-        placed = [lit for lit in placed if lit.subject != held] + [in_grasp(held)]
-        state = SymbolicSceneGraph.from_literals(objects, placed)
-    return state
+    literals += [_put(o, room, crowd, rng) for o in order]
+    return SymbolicSceneGraph.from_literals(objects, literals, limits=False)
 
 
-def choose_actions(state: SymbolicSceneGraph, rng: random.Random) -> list[Action]:
-    """Up to `ACTIONS_PER_STATE` distinct actions the heuristic names in this state."""
-    named = {action_for(lit, state) for lit in candidate_literals(state)}
-    named = sorted((a for a in named if a is not None), key=str)
+def _objects(n: int, rng: random.Random) -> tuple[str, ...]:
+    # `symbolic.generator.random_objects`, which this module may not import (pyproject.toml:
+    # f_reach's labels consult no module of the hand-written rules)
+    types = list(OBJECT_TYPES)
+    chosen = (
+        rng.sample(types, n) if n <= len(types) else types + rng.choices(types, k=n - len(types))
+    )
+    return sort_objects(objects_for_types(chosen))
+
+
+def _put(o: str, room: Room, crowd: tuple[str, str] | None, rng: random.Random) -> Literal:
+    if crowd is not None:
+        how, where = crowd
+        free = room.free_interiors(o) if how == "in" else room.free_tops()
+        if where in free and rng.random() < P_CROWD:
+            return _count(o, room, how, where)
+    if room.bases() and rng.random() < P_STACK:
+        return _count(o, room, "on", rng.choice(room.bases()))
+    kinds = [("on", room.free_tops(k)) for k in ((OPEN,), TOPS, PREPUSH)]
+    kinds.append(("in", room.free_interiors(o)))
+    how, places = rng.choice([(h, p) for h, p in kinds if p])
+    return _count(o, room, how, rng.choice(places))
+
+
+def _count(o: str, room: Room, how: str, where: str) -> Literal:
+    if how == "in":
+        room.put_inside(o, where)
+        return inside(o, where)
+    room.put_on(o, where)
+    return on(o, where)
+
+
+def choose_actions(
+    state: SymbolicSceneGraph, rng: random.Random, k: int = ACTIONS_PER_STATE
+) -> list[Action]:
+    """Up to k distinct actions the heuristic names in this state, stratified: pick, push,
+    a place of the held object on a surface, on an object, and a place of an object not held.
+    Places of an object not in the hand are most of what the heuristic names and the world
+    refuses them all alike; the held object's places onto a full surface are the rare
+    questions, so they get strata of their own."""
+    named = sorted({action_for(lit, state) for lit in candidate_literals(state)} - {None}, key=str)
     by_kind: dict[str, list[Action]] = {}
     for a in named:
-        by_kind.setdefault(type(a).__name__, []).append(a)
+        by_kind.setdefault(_stratum(a, state), []).append(a)
     chosen: list[Action] = []
-    while by_kind and len(chosen) < ACTIONS_PER_STATE:
+    while by_kind and len(chosen) < k:
         kind = rng.choice(sorted(by_kind))
         chosen.append(by_kind[kind].pop(rng.randrange(len(by_kind[kind]))))
         if not by_kind[kind]:
@@ -111,78 +140,114 @@ def choose_actions(state: SymbolicSceneGraph, rng: random.Random) -> list[Action
     return chosen
 
 
-def _execute(scene: Scene, action: Action) -> str:
-    """Plan the best parameter choices in turn and run the first that plans: the status."""
+def _stratum(action: Action, state: SymbolicSceneGraph) -> str:
+    if not isinstance(action, Place):
+        return type(action).__name__
+    if state.held() != action.obj:
+        return "place not held"
+    return "place on surface" if action.target in SURFACES else "place on object"
+
+
+def execute_action(scene: Scene, action: Action, max_params: int = MAX_PARAMS) -> tuple[str, bool]:
+    """Plan the best parameter choices in turn and execute the first that plans: its status and
+    True; when none plans, nothing moves: the last planning failure's status (`no_parameters`
+    without a choice) and False."""
     status = NO_PARAMETERS
-    for params in candidates(scene.scene_graph(), action)[:MAX_PARAMS]:
+    for params in candidates(scene.scene_graph(), action)[:max_params]:
         plan = plan_primitive(scene, params)
         if isinstance(plan, PlanFailure):
             status = str(plan.status)
             continue
-        return str(execute(scene, params, plan=plan).status)
-    return status
+        return str(execute(scene, params, plan=plan).status), True
+    return status, False
 
 
-def record_state(scene: Scene, seed: int, index: int) -> dict:
-    """Stage one drawn state and execute its chosen actions: the logged result."""
-    state = draw_reach_state(seed, index)
+def run_trials(
+    scene: Scene,
+    state: SymbolicSceneGraph,
+    actions: list[Action],
+    rng: random.Random,
+    max_params: int = MAX_PARAMS,
+) -> dict:
+    """Stage `state` in the scene (its objects replace the scene's) and execute each action
+    from it: the logged row, `UNSTAGED` when the state could not be staged."""
     for o in scene.objects:
         scene.remove_object(o)
     for o in state.objects:
         scene.add_object(o)
-    rng = random.Random(f"reach-actions-{seed}-{index}")
     scene.rng = np.random.default_rng(rng.getrandbits(64))
     if not stage(scene, state, rng):
-        return {"staged": False}
+        return dict(UNSTAGED)
     snapshot, held = scene.snapshot(), scene.robot.held_body
     trials = []
-    for action in choose_actions(state, rng):
-        # constraints are not part of a saved state: a grasp made by the last trial is let go
+    for action in actions:
+        # a grasp is a constraint, which a saved state leaves out: the last trial's is let go
+        # and the staged one made again
         scene.robot.detach()
         scene.restore(snapshot)
         if held is not None:
             scene.robot.attach(held)
-        status = _execute(scene, action)
-        mapping = map_symbols(scene.scene_graph())
-        after = None if mapping.anomalies else state_json(mapping.state)
-        trials.append({"action": str(action), "status": status, "after": after})
+        status, executed = execute_action(scene, action, max_params)
+        after: SymbolicSceneGraph | None = state
+        if executed:
+            mapping = map_symbols(scene.scene_graph())
+            after = None if mapping.anomalies else mapping.state
+        trials.append(WorldTrial(state, action, status, after))
     scene.bc.removeState(snapshot)
     scene.robot.detach()
-    return {
-        "staged": True,
-        "objects": list(state.objects),
-        "state": state_json(state),
-        "trials": trials,
-    }
+    return state_row(state, trials)
+
+
+def record_reach_state(
+    scene: Scene,
+    seed: int,
+    index: int,
+    actions_per_state: int = ACTIONS_PER_STATE,
+    max_params: int = MAX_PARAMS,
+) -> dict:
+    """Draw state `index` of `seed`, stage it and execute its chosen actions: the logged row."""
+    state = draw_reach_state(seed, index)
+    actions = choose_actions(
+        state, random.Random(f"reach-actions-{seed}-{index}"), actions_per_state
+    )
+    return run_trials(
+        scene, state, actions, random.Random(f"reach-stage-{seed}-{index}"), max_params
+    )
 
 
 @dataclass(frozen=True)
-class ReachChunk:
+class ReachItem:
+    """One state to stage: the unit of work and of what an interruption loses."""
+
     seed: int
-    chunk: int
+    index: int
+    actions_per_state: int = ACTIONS_PER_STATE
+    max_params: int = MAX_PARAMS
 
     @property
     def key(self) -> str:
-        return f"{self.seed}/{self.chunk}"
+        return f"{self.seed}/{self.index}"
 
 
-def run_reach_chunk(chunk: ReachChunk) -> dict:
-    """A chunk of consecutive states in a fresh scene: the worker entry point."""
-    start = chunk.chunk * STATES_PER_CHUNK
-    with Scene((), seed=chunk.seed) as scene:
-        return {
-            "states": [
-                record_state(scene, chunk.seed, i) for i in range(start, start + STATES_PER_CHUNK)
-            ]
-        }
+@functools.cache
+def _process_scene() -> Scene:
+    return Scene(())
+
+
+def run_reach_item(item: ReachItem) -> dict:
+    """The worker entry point (pool or Ray): one state, in this process's scene."""
+    return record_reach_state(
+        _process_scene(), item.seed, item.index, item.actions_per_state, item.max_params
+    )
 
 
 @dataclass(frozen=True)
 class ReachSummary:
-    states: int
+    states: int  # states asked for, logged before or run now
     staged: int
     trials: int
     by_status: dict[str, int]
+    ran: int  # states run by this call (the others were logged)
     seconds: float
 
 
@@ -192,31 +257,55 @@ def collect_reach(
     seed: int = 0,
     workers: int = 2,
     ray: str | None = None,
-    on_chunk: Callable[[], None] | None = None,
+    on_item: Callable[[dict], None] | None = None,
+    *,
+    actions_per_state: int = ACTIONS_PER_STATE,
+    max_params: int = MAX_PARAMS,
 ) -> ReachSummary:
-    """Collect `states` staged states (rounded up to whole chunks) into the run folder `out`;
-    a rerun keeps what was logged and runs only the missing chunks."""
-    if states < 1:
-        raise InvalidInputError(f"--states {states}: need at least one")
+    """Stage states 0..`states`-1 of `seed` and execute primitives from each, logged to the run
+    folder `out`. A rerun keeps what is logged and runs only the missing states, so `states`
+    may grow; a folder made with other settings is refused. `on_item` sees each state's row."""
+    for name, value in (
+        ("--states", states),
+        ("actions per state", actions_per_state),
+        ("parameter choices", max_params),
+    ):
+        if value < 1:
+            raise InvalidInputError(f"{name} {value}: need at least one")
     start = time.perf_counter()
-    chunks = [ReachChunk(seed, c) for c in range(-(-states // STATES_PER_CHUNK))]
-    config = {"kind": "reach", "seed": seed, "actions": ACTIONS_PER_STATE, "params": MAX_PARAMS}
-    results = run_items(
-        run_reach_chunk,
-        chunks,
-        key=lambda c: c.key,
+    config = {
+        "kind": "reach",
+        "unit": "state",
+        "seed": seed,
+        "actions_per_state": actions_per_state,
+        "max_params": max_params,
+    }
+    # claimed here first for a refusal that says what differs, and to count what is logged
+    claim(
+        out,
+        config,
+        f"'{out}' holds a reach collection made with other settings (seed, "
+        "actions per state, parameter choices, or an older layout); use another --out",
+    )
+    logged = {str(row.get("key")) for row in logged_rows(out) if isinstance(row, dict)}
+    items = [ReachItem(seed, i, actions_per_state, max_params) for i in range(states)]
+    rows = run_items(
+        run_reach_item,
+        items,
+        key=lambda item: item.key,
         run_dir=out,
         config=config,
         workers=workers,
         ray=ray,
-        on_result=on_chunk and (lambda _: on_chunk()),
+        on_result=on_item,
     )
-    rows = [r for result in results for r in result["states"]]
-    trials: list[WorldTrial] = [t for r in rows for t in trials_of(r)]
+    ran = sum(item.key not in logged for item in items)
+    trials: list[WorldTrial] = [t for row in rows for t in trials_of(row)]
     return ReachSummary(
-        len(rows),
-        sum(bool(r.get("staged")) for r in rows),
+        states,
+        sum(row.get("staged", True) is not False for row in rows),
         len(trials),
-        dict(Counter(t.status for t in trials)),
+        dict(sorted(Counter(t.status for t in trials).items())),
+        ran,
         time.perf_counter() - start,
     )

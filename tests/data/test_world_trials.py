@@ -1,4 +1,5 @@
-"""The format of executed primitives (`data/world_trials.py`): round trip and damaged files."""
+"""The format of primitives executed in the world (`data/world_trials.py`): rows read back as
+written, collections in key order, damaged ones refused in one line."""
 
 import json
 
@@ -6,50 +7,132 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hsgplan.data.world_trials import load_world_trials, state_json, trials_of
+from hsgplan.data.world_trials import (
+    UNSTAGED,
+    WorldTrial,
+    load_world_trials,
+    read_state,
+    state_json,
+    state_row,
+    trials_of,
+)
+from hsgplan.domain.actions import parse_action
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.predicates import Predicate, on
 from hsgplan.evaluation.record_reach import draw_reach_state
+from hsgplan.planning.heuristic import action_for, candidate_literals
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.outcome import Status
+
+STATUSES = [s.value for s in Status] + ["no_parameters"]
 
 
-def _row(state, action="pick(cherries)", status="invalid", after=None):
-    return {
-        "staged": True,
-        "objects": list(state.objects),
-        "state": state_json(state),
-        "trials": [{"action": action, "status": status, "after": after}],
-    }
-
-
-@settings(max_examples=40, deadline=None)
-@given(st.integers(0, 10_000))
-def test_a_logged_state_reads_back_as_it_was(index):
-    state = draw_reach_state(0, index)
-    row = json.loads(json.dumps(_row(state, after=state_json(state))))
-    (trial,) = trials_of(row)
-    assert trial.state == state and trial.after == state
-    assert str(trial.action) == "pick(cherries)" and not trial.succeeded
-
-
-def test_a_collection_folder_reads_in_key_order(tmp_path):
-    a, b = draw_reach_state(0, 1), draw_reach_state(0, 2)
-    lines = [
-        {"key": "0/10", "result": {"states": [_row(b)]}},
-        {"key": "0/2", "result": {"states": [_row(a), {"staged": False}]}},
+def _moved(state: SymbolicSceneGraph, obj: str) -> SymbolicSceneGraph:
+    """The state with `obj` on the open space: what a place or a stray push may leave."""
+    rest = [
+        lit for lit in state.literals if lit.subject != obj and lit.predicate is not Predicate.CLEAR
     ]
-    text = "\n".join(json.dumps(x) for x in lines) + "\n" + '{"key": "0/3", "res'
-    (tmp_path / "episodes.jsonl").write_text(text)
-    trials = load_world_trials(tmp_path)
-    assert [t.state for t in trials] == [a, b]  # 2 before 10; the cut line is left out
+    return SymbolicSceneGraph.from_literals(state.objects, [*rest, on(obj, "open_space")], False)
 
 
-def test_missing_and_damaged_collections_are_refused(tmp_path):
-    with pytest.raises(InvalidInputError, match="no collection"):
+@st.composite
+def rows(draw):
+    state = draw_reach_state(draw(st.integers(0, 3)), draw(st.integers(0, 10_000)))
+    actions = sorted({action_for(lit, state) for lit in candidate_literals(state)}, key=str)
+    trials = []
+    for _ in range(draw(st.integers(0, 4))):
+        after = draw(
+            st.sampled_from([None, state])
+            | st.sampled_from(state.objects).map(lambda o, s=state: _moved(s, o))
+        )
+        trials.append(
+            WorldTrial(
+                state, draw(st.sampled_from(actions)), draw(st.sampled_from(STATUSES)), after
+            )
+        )
+    return state, trials
+
+
+@settings(max_examples=60, deadline=None)
+@given(rows())
+def test_a_row_reads_back_as_it_was_written(row):
+    state, trials = row
+    written = json.loads(json.dumps(state_row(state, trials)))
+    assert set(written) == {"objects", "state", "trials"}
+    assert trials_of(written) == trials
+    assert read_state(written["objects"], written["state"]) == state
+
+
+def test_a_row_holds_the_trials_of_its_own_state_only():
+    a, b = draw_reach_state(0, 1), draw_reach_state(0, 2)
+    with pytest.raises(ValueError):
+        state_row(a, [WorldTrial(b, parse_action("pick(cherries)"), "invalid", b)])
+    trial = WorldTrial(a, parse_action("pick(cherries)"), "success", None)
+    assert not trial.succeeded  # the world toppled something: no clean state to read
+    assert WorldTrial(a, trial.action, "success", a).succeeded
+
+
+def _row(state, status="invalid"):
+    return state_row(state, [WorldTrial(state, parse_action("pick(cherries)"), status, state)])
+
+
+def _write(folder, lines):
+    (folder / "episodes.jsonl").write_text("".join(x + "\n" for x in lines))
+
+
+def test_a_collection_reads_in_key_order_past_cut_lines_and_unstaged_states(tmp_path):
+    a, b, c = (draw_reach_state(0, i) for i in range(3))
+    _write(
+        tmp_path,
+        [
+            json.dumps({"key": "0/10", "result": _row(b)}),
+            '{"key": "0/3", "result": {"objects": ["cherr',  # cut by an interruption, resumed
+            json.dumps({"key": "0/2", "result": _row(a)}),
+            json.dumps({"key": "0/3", "result": UNSTAGED}),
+            json.dumps({"key": "1/0", "result": _row(c)}),
+        ],
+    )
+    assert [t.state for t in load_world_trials(tmp_path)] == [a, b, c]  # 2 before 10
+
+
+def test_a_collection_of_chunks_of_states_reads_the_same(tmp_path):
+    a, b = draw_reach_state(0, 1), draw_reach_state(0, 2)
+    chunk = {"states": [{"staged": True, **_row(a)}, {"staged": False}, _row(b)]}
+    _write(tmp_path, [json.dumps({"key": "0/0", "result": chunk})])
+    assert [t.state for t in load_world_trials(tmp_path)] == [a, b]
+
+
+@pytest.mark.parametrize(
+    ("line", "match"),
+    [
+        ('{"key": "0/0", "result": {"objects": []}}', "state 0/0 is damaged: missing 'state'"),
+        ('{"key": "0/0"}', "line 1 is damaged: missing 'result'"),
+        ('{"key": "zero", "result": {}}', "line 1 is damaged"),
+        ('["0/0", {}]', "line 1 is damaged"),
+        ('{"key": "0/0", "result": [1]}', "state 0/0 is damaged"),
+        (
+            '{"key": "0/0", "result": {"objects": ["cherries"], "state": ["Under(cherries)"], '
+            '"trials": []}}',
+            "state 0/0 is damaged",
+        ),
+    ],
+)
+def test_a_damaged_collection_is_refused_in_one_line(tmp_path, line, match):
+    _write(tmp_path, [line])
+    with pytest.raises(InvalidInputError, match=match) as e:
         load_world_trials(tmp_path)
-    (tmp_path / "episodes.jsonl").write_text('{"key": "0/0", "result": {"states": [{}]}}\n')
-    assert load_world_trials(tmp_path) == []  # a state not staged
-    (tmp_path / "episodes.jsonl").write_text('{"key": "0/0", "result": {"stat": 1}}\n')
-    with pytest.raises(InvalidInputError, match="damaged"):
+    assert "\n" not in str(e.value)
+
+
+def test_a_missing_or_unreadable_collection_is_refused(tmp_path):
+    with pytest.raises(InvalidInputError, match="holds no collection"):
+        load_world_trials(tmp_path / "nowhere")
+    (tmp_path / "episodes.jsonl").write_bytes('{"key": "é"}\n'.encode("latin-1"))
+    with pytest.raises(InvalidInputError, match="not UTF-8"):
         load_world_trials(tmp_path)
-    (tmp_path / "episodes.jsonl").write_bytes("{\"key\": \"é\"}".encode("latin-1") + b"}")
-    with pytest.raises(InvalidInputError, match="damaged"):
-        load_world_trials(tmp_path)
+
+
+def test_state_json_lists_placements_only():
+    state = draw_reach_state(0, 5)
+    assert all(not x.startswith("Clear") for x in state_json(state))
+    assert read_state(state.objects, state_json(state)) == state

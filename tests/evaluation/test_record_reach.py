@@ -1,79 +1,160 @@
-"""Collecting executed primitives in the simulated world (`hsgplan collect reach`)."""
+"""Collecting primitives executed in the simulated world (`hsgplan collect reach`)."""
 
 import json
 import random
+import sys
+from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
+import hsgplan
 from hsgplan.cli import app
-from hsgplan.data.world_trials import load_world_trials
+from hsgplan.data.world_trials import load_world_trials, trials_of
 from hsgplan.domain.actions import Pick, Place, Push
+from hsgplan.domain.predicates import in_grasp, on
 from hsgplan.domain.world import INTERIOR_CAPACITY, SHELVES, SURFACE_CAPACITY
 from hsgplan.evaluation.record_reach import (
     ACTIONS_PER_STATE,
-    ReachChunk,
+    MAX_OBJECTS,
+    MIN_OBJECTS,
+    ReachItem,
     choose_actions,
     draw_reach_state,
-    run_reach_chunk,
+    record_reach_state,
+    run_reach_item,
+    run_trials,
 )
-from tests.agents.test_no_rules_at_inference import RULES, rules_forbidden
+from hsgplan.planning.heuristic import action_for, candidate_literals
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.scene import Scene
 
-# Building a state checks its structure and limits (`domain/feasibility.py`): the drawn states
-# are the world's; what the collector may not ask is whether an action applies.
-ACTION_RULES = tuple(r for r in RULES if r.name != "feasibility.py")
+BOUNDED = [s for s in SURFACE_CAPACITY if s != "open_space"]  # shelf tops, prepush regions
 
 
-def test_drawn_states_are_reproducible_and_hold_the_hard_situations():
+def _situations(s: SymbolicSceneGraph) -> set[str]:
+    found = set()
+    if s.held() is not None:
+        found.add("held")
+    if any(len(s.resting_on(x)) >= SURFACE_CAPACITY[x] for x in BOUNDED):
+        found.add("full surface")
+    if any(len(s.inside(x)) >= INTERIOR_CAPACITY[x] for x in SHELVES):
+        found.add("full interior")
+    if any(s.resting_on(o) for o in s.objects):
+        found.add("covered")
+    return found
+
+
+def test_drawn_states_are_reproducible_within_limits_and_often_hard():
     states = [draw_reach_state(3, i) for i in range(200)]
     assert states == [draw_reach_state(3, i) for i in range(200)]
-    held = sum(s.held() is not None for s in states)
-    full_top = sum(
-        any(len(s.resting_on(t)) >= c for t, c in SURFACE_CAPACITY.items() if t != "open_space")
-        for s in states
-    )
-    full_inside = sum(
-        any(len(s.inside(x)) >= INTERIOR_CAPACITY[x] for x in SHELVES) for s in states
-    )
-    covered = sum(any(s.resting_on(o) for o in s.objects) for s in states)
-    assert min(held, full_top, full_inside, covered) >= 10, (held, full_top, full_inside, covered)
+    assert states != [draw_reach_state(4, i) for i in range(200)]
+    for s in states:  # the world's limits (capacities, towers, fit) accept every one
+        assert SymbolicSceneGraph.from_literals(s.objects, s.literals, limits=True) == s
+    assert {len(s.objects) for s in states} == set(range(MIN_OBJECTS, MAX_OBJECTS + 1))
+    situations = [_situations(s) for s in states]
+    counts = {
+        k: sum(k in found for found in situations)
+        for k in ("held", "full surface", "full interior", "covered")
+    }
+    assert 70 <= counts["held"] <= 130, counts
+    assert min(counts["full surface"], counts["covered"]) >= 40, counts
+    assert counts["full interior"] >= 20, counts
+    for s in states:  # what is held rests on nothing and carries nothing
+        assert s.held() is None or not s.resting_on(s.held())
 
 
-def test_actions_are_distinct_and_of_every_kind_over_states():
+def test_actions_are_the_heuristics_distinct_and_of_every_kind():
     kinds = set()
     for i in range(30):
         state = draw_reach_state(0, i)
+        named = {action_for(lit, state) for lit in candidate_literals(state)}
         chosen = choose_actions(state, random.Random(i))
-        assert len(set(chosen)) == len(chosen) <= ACTIONS_PER_STATE
+        assert chosen == choose_actions(state, random.Random(i))
+        assert len(set(chosen)) == len(chosen) == min(ACTIONS_PER_STATE, len(named))
+        assert set(chosen) <= named
         kinds |= {type(a) for a in chosen}
     assert kinds == {Pick, Place, Push}
 
 
-def test_the_world_refuses_a_pick_while_the_hand_is_full_and_no_rule_is_asked():
-    calls: list[str] = []
-    with rules_forbidden(calls, ACTION_RULES):
-        result = run_reach_chunk(ReachChunk(0, 0))
-    assert calls == []
-    rows = [r for r in result["states"] if r["staged"]]
-    assert rows
-    full_hand_picks = [
-        t
-        for r in rows
-        for t in r["trials"]
-        if any(lit.startswith("InGrasp") for lit in r["state"]) and t["action"].startswith("pick")
-    ]
-    assert full_hand_picks and all(t["status"] != "success" for t in full_hand_picks)
+def test_the_world_refuses_a_pick_while_the_hand_holds_another_object():
+    state = SymbolicSceneGraph.from_literals(
+        ("cherries", "butter"), [in_grasp("butter"), on("cherries", "open_space")]
+    )
+    # the place first: the pick after it starts from the staged hand again, not the empty one
+    actions = [Place("butter", "open_space"), Pick("cherries"), Push("cherries", "shelf_a")]
+    with Scene(()) as scene:
+        row = run_trials(scene, state, actions, random.Random(0))
+    placed, pick, push = trials_of(row)
+    assert placed.status == "success" and placed.after.holds(on("butter", "open_space"))
+    assert pick.status == push.status == "invalid" and pick.after == push.after == state
 
 
-def test_collect_reach_runs_resumes_and_refuses_bad_counts(tmp_path):
+def test_a_state_is_recorded_the_same_whatever_its_process_ran_before():
+    with Scene(()) as scene:
+        first = record_reach_state(scene, 0, 5)
+    with Scene(()) as scene:
+        record_reach_state(scene, 0, 7)
+        again = record_reach_state(scene, 0, 5)
+    assert first == again and first["trials"]
+
+
+def test_the_collector_never_asks_the_transition_model(monkeypatch):
+    def forbidden(*args, **kwargs):
+        raise AssertionError("the transition model was asked")
+
+    for name in ("why_not", "apply", "applicable_actions"):
+        monkeypatch.setattr(f"hsgplan.symbolic.transition.{name}", forbidden)
+    # and any call into the rules' files however reached (feasibility is left out: building a
+    # state checks its structure there, which asks nothing about actions)
+    package = Path(hsgplan.__file__).resolve().parent
+    rules = (package / "symbolic", package / "planning" / "fast_downward.py")
+    calls = []
+
+    def profile(frame, event, arg):
+        path = Path(frame.f_code.co_filename)
+        if event == "call" and any(r == path or r in path.parents for r in rules):
+            calls.append(frame.f_code.co_name)
+
+    # in this process, where the patch holds (the collector's workers are fresh processes)
+    sys.setprofile(profile)
+    try:
+        rows = [run_reach_item(ReachItem(1, i)) for i in range(2)]
+    finally:
+        sys.setprofile(None)
+    assert calls == [] and sum(len(trials_of(r)) for r in rows) > 0
+
+
+@pytest.mark.slow
+def test_collect_reach_end_to_end_and_a_rerun_repeats_nothing(tmp_path):
     out = tmp_path / "reach"
-    args = ["collect", "reach", "--states", "8", "--workers", "1", "--out", str(out)]
+    args = ["collect", "reach", "--states", "2", "--workers", "1", "--out", str(out)]
     r = CliRunner().invoke(app, args)
     assert r.exit_code == 0, r.output
+    assert "; 2 run now" in r.stdout
     lines = (out / "episodes.jsonl").read_text().splitlines()
+    assert sorted(json.loads(x)["key"] for x in lines) == ["0/0", "0/1"]
     trials = load_world_trials(out)
-    assert len(lines) == 1 and len(trials) > 0
+    assert 0 < len(trials) <= 2 * ACTIONS_PER_STATE
+    assert f"{len(trials)} primitives executed" in r.stdout
     r = CliRunner().invoke(app, args)
-    assert r.exit_code == 0 and (out / "episodes.jsonl").read_text().splitlines() == lines
-    assert json.loads(lines[0])["key"] == "0/0"
-    r = CliRunner().invoke(app, ["collect", "reach", "--states", "-1", "--out", str(out)])
-    assert r.exit_code == 2 and "at least one" in r.stderr
+    assert r.exit_code == 0 and "; 0 run now" in r.stdout
+    assert (out / "episodes.jsonl").read_text().splitlines() == lines
+    r = CliRunner().invoke(app, [*args[:2], "--states", "3", *args[4:]])
+    assert r.exit_code == 0 and "; 1 run now" in r.stdout
+    assert (out / "episodes.jsonl").read_text().splitlines()[:2] == lines
+
+
+@pytest.mark.parametrize(
+    ("option", "value"), [("--states", "0"), ("--states", "-3"), ("--workers", "0")]
+)
+def test_bad_counts_are_refused_in_one_line(tmp_path, option, value):
+    r = CliRunner().invoke(app, ["collect", "reach", option, value, "--out", str(tmp_path)])
+    assert r.exit_code == 2 and "need at least one" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "config.json").exists()
+
+
+def test_a_folder_collected_with_other_settings_is_refused(tmp_path):
+    (tmp_path / "config.json").write_text('{"kind": "reach", "seed": 0}\n')
+    r = CliRunner().invoke(app, ["collect", "reach", "--states", "1", "--out", str(tmp_path)])
+    assert r.exit_code == 2 and "other settings" in r.stderr

@@ -64,7 +64,11 @@ class TaskTrainConfig:
     reach: str = "world"  # f_reach's labels: "world" (executed primitives) or "alterations"
     world_trials: str = str(REACH_DATA)  # the executed primitives, for reach = "world"
     reach_singles: int = 12  # alterations asked alone per state and label (reach = "alterations")
-    pool: bool = True  # max-pooled graph context in the networks (`gnn.RelationalLayer`)
+    # f_reach sees the max-pooled graph context (`gnn.RelationalLayer`): whether the hand is
+    # full is news from an object nothing relates. f_preimage and the forward baseline do not:
+    # a preimage is local, and with the pool f_preimage let crowded shelf tops elsewhere change
+    # a push's preimage (measured: On(x, prepush_a) dropped from In(x, shelf_a)'s).
+    reach_pool: bool = True
 
     def __post_init__(self) -> None:
         for name in ("epochs", "batch_size", "hidden", "save_every", "reach_singles"):
@@ -73,7 +77,7 @@ class TaskTrainConfig:
         for name in ("rounds", "copies"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 0:
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: cannot be negative")
-        for name in ("vary", "pool"):
+        for name in ("vary", "reach_pool"):
             if not isinstance(getattr(self, name), bool):
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: true or false")
         if self.reach not in REACH_SOURCES:
@@ -157,7 +161,13 @@ def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, o
         return  # finished earlier
     torch.manual_seed(config.seed)
     net_config = EdgeClassifierConfig(
-        NODE_DIM, EDGE_DIM, 4, classes, config.hidden, config.rounds, config.pool
+        NODE_DIM,
+        EDGE_DIM,
+        4,
+        classes,
+        config.hidden,
+        config.rounds,
+        name == "reach" and config.reach_pool,
     )
     model = EdgeClassifier(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
