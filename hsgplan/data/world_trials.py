@@ -18,10 +18,6 @@ to plan moved nothing: its status is the last planning failure's and `after` is 
 
 States are read with the world's limits off (`limits=False`): `after` is an observation, and a
 primitive may leave what no limit allows (a fifth object squeezed onto a shelf top).
-
-Collections made before states were logged one by one hold one line per chunk of consecutive
-states, `{"key": "SEED/CHUNK", "result": {"states": [R, ...]}}`, each R as above with
-`"staged": true` added; they read the same way.
 """
 
 from __future__ import annotations
@@ -125,8 +121,7 @@ def load_world_trials(folder: Path) -> list[WorldTrial]:
     for key in sorted(results):
         result = results[key]
         try:
-            rows = result.get("states", [result])
-            trials += [t for row in rows for t in trials_of(row)]
+            trials += trials_of(result)
         except (AttributeError, KeyError, TypeError, ValueError) as e:
             where = "/".join(map(str, key))
             raise InvalidInputError(f"'{path}' state {where} is damaged: {_why(e)}") from None

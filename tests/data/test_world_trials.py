@@ -95,13 +95,6 @@ def test_a_collection_reads_in_key_order_past_cut_lines_and_unstaged_states(tmp_
     assert [t.state for t in load_world_trials(tmp_path)] == [a, b, c]  # 2 before 10
 
 
-def test_a_collection_of_chunks_of_states_reads_the_same(tmp_path):
-    a, b = draw_reach_state(0, 1), draw_reach_state(0, 2)
-    chunk = {"states": [{"staged": True, **_row(a)}, {"staged": False}, _row(b)]}
-    _write(tmp_path, [json.dumps({"key": "0/0", "result": chunk})])
-    assert [t.state for t in load_world_trials(tmp_path)] == [a, b]
-
-
 @pytest.mark.parametrize(
     ("line", "match"),
     [

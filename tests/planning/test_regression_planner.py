@@ -9,7 +9,7 @@ from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.predicates import on
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT
-from hsgplan.planning.regression.planner import RegressionPlanner
+from hsgplan.planning.regression.planner import ForwardPlanner, RegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.symbolic.generator import random_state
 from hsgplan.symbolic.transition import apply, why_not
@@ -65,3 +65,19 @@ def _rollout(seed: int, state, goal, planner=None) -> list[str]:
             state = apply(state, decision.action)
     assert goal.satisfied_by(state), actions
     return actions
+
+
+def test_an_action_the_world_refused_is_not_taken_again_from_the_same_state():
+    # the planner is shown the state it acted from again: the action failed there
+    goal = parse_goal(GOALS[1])
+    state = random_state(goal.objects, random.Random(2))
+    for planner in (RegressionPlanner(TASK_CHECKPOINT, seed=0), ForwardPlanner(TASK_CHECKPOINT)):
+        planner.reset(goal, 0)
+        tried = []
+        for _ in range(3):
+            decision = planner.next_action(state, goal)
+            if decision.action is None:
+                break
+            assert decision.action not in tried, (type(planner).__name__, tried)
+            tried.append(decision.action)
+        assert tried

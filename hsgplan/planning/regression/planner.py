@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import random
 import time
+from collections import Counter
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -39,10 +40,17 @@ from hsgplan.planning.regression.gnn import load_network
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MAX_DEPTH = 8
+# A primitive can fail for motion reasons in the simulated world and succeed when tried again;
+# an action that failed this often from the very same state is not taken there again.
+GIVE_UP_AFTER = 2
 
 
 def _decision(action: Action, subgoal: Literal, start: float) -> TaskDecision:
     return TaskDecision(action, subgoal, time.perf_counter() - start, following=push_after(action))
+
+
+def _given_up(failures: Counter[Action] | None) -> set[Action]:
+    return {a for a, n in (failures or {}).items() if n >= GIVE_UP_AFTER}
 
 
 @lru_cache(maxsize=4)
@@ -103,7 +111,12 @@ class RegressionPlanner:
         """A new episode: the seed of the uniform serialisation, nothing remembered."""
         self.rng = random.Random(seed)
         self._taken: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
-        self._plan: tuple[Goal, list[tuple[Literal, frozenset[Literal]]]] | None = None
+        self._plan: tuple[Goal, list[tuple[Literal, frozenset[Literal]]], Literal] | None = None
+        # what the world said: an action after which the very same state was observed again
+        # failed there; the goal literal it served is tried after the others from then on
+        self._last: tuple[SymbolicSceneGraph, Action, Literal] | None = None
+        self._failed: dict[SymbolicSceneGraph, Counter[Action]] = {}
+        self._failed_roots: set[Literal] = set()
 
     def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
         # Read out the edges of the query's objects: a preimage names them (the active edges
@@ -126,14 +139,18 @@ class RegressionPlanner:
 
     def reachable(self, state: SymbolicSceneGraph, lits: list[Literal]) -> list[bool]:
         """f_reach on each literal alone: does the primitive the heuristic names reach it?"""
+        return [p > 0.5 for p in self.reach_scores(state, lits)]
+
+    def reach_scores(self, state: SymbolicSceneGraph, lits: list[Literal]) -> list[float]:
+        """f_reach's probability of "reachable" for each literal alone."""
         # each literal's slot is on an edge its own goal makes active, so it is computed
         batch = encode_computed(state, [frozenset((lit,)) for lit in lits], [None] * len(lits))
         slots = Slots.of(state.nodes)
         e = len(state.nodes) ** 2
         where = [slots.slot(lit) for lit in lits]
         rows = batch.row[[i * e + edge for i, (edge, _) in enumerate(where)]]
-        logits = self.reach.computed(*batch.inputs).numpy()[rows, [p for _, p in where]]
-        return (logits.argmax(-1) == 1).tolist()
+        logits = self.reach.computed(*batch.inputs)[rows, [p for _, p in where]]
+        return logits.softmax(-1)[:, 1].tolist()
 
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
@@ -141,9 +158,14 @@ class RegressionPlanner:
         unsatisfied = [lit for lit in _in_order(goal) if not state.holds(lit)]
         if not unsatisfied:
             return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
+        if self._last is not None and self._last[0] == state:
+            self._failed.setdefault(state, Counter())[self._last[1]] += 1
+            self._failed_roots.add(self._last[2])
+        failed_here = _given_up(self._failed.get(state))
         taken = self._taken.setdefault((goal, state), set())
         if (step := self._follow(state, goal, taken)) is not None:
             taken.add(step[1])
+            self._last = (state, step[1], step[2])
             return _decision(step[1], step[0], start)
         context = frozenset(goal.literals)
         roots = [_Node(lit, context, (lit,)) for lit in unsatisfied]
@@ -151,23 +173,38 @@ class RegressionPlanner:
         # A goal literal waits while its preimage names another unsatisfied goal literal; if
         # nothing is reached from the free ones (a dependency the network got wrong, or a
         # goal literal stuck behind a full shelf), the waiting ones are tried as well.
-        # An action already taken from this very state (with this goal) came back to it: it
-        # is avoided while any other is found, which breaks loops such as picking an object
-        # whose shelf is full and putting it back.
+        # An action already taken from this very state (with this goal) failed or came back
+        # to it: it is avoided while any other is found, and one that failed here
+        # `GIVE_UP_AFTER` times is not taken here again. This breaks loops such as picking an
+        # object whose shelf is full and putting it back.
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
-        for avoid in (taken, set()):
+        seen: dict[Literal, tuple[float, _Node]] = {}
+        for avoid in (taken, failed_here):
             for frontier in (free, [x for x in pairs if x not in free]):
-                found = self._search(state, frontier, avoid)
+                found = self._search(state, frontier, avoid, seen)
                 if found is not None:
-                    node, action = found
-                    taken.add(action)
-                    self._plan = (goal, list(reversed(node.chain)))
-                    return _decision(action, node.lit, start)
+                    return self._take(state, goal, *found, taken, start)
+            # Nothing reached: the literal f_reach finds likeliest (it learned the physical
+            # world, which refuses more than some other world would), before repeating
+            likely = [
+                (-p, _order(n.lit), n, a)
+                for p, n in seen.values()
+                if (a := action_for(n.lit, state)) is not None and a not in avoid
+            ]
+            if likely:
+                *_, node, action = min(likely, key=lambda x: x[:2])
+                return self._take(state, goal, node, action, taken, start)
         return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
 
-    def _follow(self, state, goal, avoid) -> tuple[Literal, Action] | None:
-        """The next step up the kept chain, if its preimage holds now."""
+    def _take(self, state, goal, node: _Node, action: Action, taken, start) -> TaskDecision:
+        taken.add(action)
+        self._plan = (goal, list(reversed(node.chain)), node.path[0])
+        self._last = (state, action, node.path[0])
+        return _decision(action, node.lit, start)
+
+    def _follow(self, state, goal, avoid) -> tuple[Literal, Action, Literal] | None:
+        """The next step up the kept chain, if its preimage holds now, and the chain's root."""
         if self._plan is None or self._plan[0] != goal:
             return None
         chain = self._plan[1]
@@ -176,17 +213,18 @@ class RegressionPlanner:
         if chain and all(state.holds(m) for m in chain[0][1]):
             action = action_for(chain[0][0], state)
             if action is not None and action not in avoid:
-                return chain[0][0], action
+                return chain[0][0], action, self._plan[2]
         self._plan = None
         return None
 
-    def _search(self, state, frontier, avoid):
+    def _search(self, state, frontier, avoid, seen):
         """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
 
         A node is reached when f_reach says so, or when its whole preimage already holds
         (then, by what a preimage means, one primitive achieves it). Where a level's
-        preimages are known, f_reach is asked about it and the next level in one call."""
-        reach: dict[Literal, bool] = {}
+        preimages are known, f_reach is asked about it and the next level in one call. `seen`
+        collects every literal met with f_reach's probability."""
+        reach: dict[Literal, float] = {}
         for _ in range(self.max_depth):
             if not frontier:
                 return None
@@ -195,8 +233,11 @@ class RegressionPlanner:
             ask = [n.lit for n, _ in frontier + children if n.lit not in reach]
             ask = list(dict.fromkeys(ask))
             if ask:
-                reach.update(zip(ask, self.reachable(state, ask), strict=True))
-            if found := self._choose(state, [n for n, _ in frontier if reach[n.lit]], avoid):
+                reach.update(zip(ask, self.reach_scores(state, ask), strict=True))
+            for n, _ in frontier:
+                seen.setdefault(n.lit, (reach[n.lit], n))
+            hits = [n for n, _ in frontier if reach[n.lit] > 0.5]
+            if found := self._choose(state, hits, avoid):
                 return found
             frontier = self._with_preimages(state, frontier)
             done = [n for n, pre in frontier if all(state.holds(m) for m in pre)]
@@ -209,6 +250,8 @@ class RegressionPlanner:
         hits = [
             (n, a) for n in nodes if (a := action_for(n.lit, state)) is not None and a not in avoid
         ]
+        # a goal literal whose action failed this episode waits while another one can go on
+        hits = [h for h in hits if h[0].path[0] not in self._failed_roots] or hits
         return self.rng.choice(hits) if hits else None  # the paper's uniform serialisation
 
     def _with_preimages(self, state, frontier):
@@ -238,7 +281,8 @@ class ForwardPlanner:
     It runs under the regression planner's rules: the heuristic names the action (no
     preconditions checked), and an action already taken from this very state with this goal
     (it failed, or came back here) is avoided while another of the network's top subgoals
-    names a different one."""
+    names a different one, and one that failed here (the state stayed) `GIVE_UP_AFTER` times is
+    not taken here again."""
 
     name = "forward"
     TOP = 20  # subgoals considered per decision, most probable first
@@ -250,6 +294,8 @@ class ForwardPlanner:
     def reset(self, goal: Goal | None, seed: int) -> None:
         """A new episode: nothing remembered."""
         self._taken: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
+        self._last: tuple[SymbolicSceneGraph, Action] | None = None
+        self._failed: dict[SymbolicSceneGraph, Counter[Action]] = {}
 
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
@@ -264,10 +310,15 @@ class ForwardPlanner:
             lit = slots.literal(*divmod(flat, probs.shape[1]))
             if not state.holds(lit) and (action := action_for(lit, state)) is not None:
                 ranked.append((lit, action))
+        if self._last is not None and self._last[0] == state:
+            self._failed.setdefault(state, Counter())[self._last[1]] += 1
+        failed_here = _given_up(self._failed.get(state))
         taken = self._taken.setdefault((goal, state), set())
         fresh = [(lit, a) for lit, a in ranked if a not in taken]
-        if not (fresh or ranked):
+        fresh = fresh or [(lit, a) for lit, a in ranked if a not in failed_here]
+        if not fresh:
             return TaskDecision(None, None, time.perf_counter() - start, "no subgoal")
-        lit, action = (fresh or ranked)[0]
+        lit, action = fresh[0]
         taken.add(action)
+        self._last = (state, action)
         return _decision(action, lit, start)
