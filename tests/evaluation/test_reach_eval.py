@@ -47,3 +47,23 @@ def test_scores_count_each_answer_once():
     assert j["precision"] == 0.5 and j["recall"] == 0.5
     assert j["false_yes_rate"] == 1 / 3 and j["accuracy"] == 3 / 5
     assert Scores().as_json()["precision"] is None
+
+
+def test_eval_reach_scores_the_shipped_planner_on_a_few_held_out_states(tmp_path):
+    import json
+    from pathlib import Path
+
+    from typer.testing import CliRunner
+
+    from hsgplan.cli import app
+
+    held_out = Path(__file__).resolve().parents[2] / "data" / "reach" / "heldout"
+    lines = (held_out / "episodes.jsonl").read_text().splitlines()[:5]
+    (tmp_path / "episodes.jsonl").write_text("\n".join(lines) + "\n")
+    r = CliRunner().invoke(app, ["eval-reach", "--trials", str(tmp_path), "--json"])
+    assert r.exit_code == 0, r.output
+    report = json.loads(r.stdout)
+    assert report["overall"]["questions"] == sum(v["questions"] for v in report["by_kind"].values())
+    assert report["overall"]["questions"] > 0
+    r = CliRunner().invoke(app, ["eval-reach", "--trials", str(tmp_path / "none")])
+    assert r.exit_code == 2 and "no collection" in r.stderr
