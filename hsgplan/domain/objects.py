@@ -6,6 +6,7 @@ A scene may hold several instances of one object type. The first is named by its
 
 from __future__ import annotations
 
+import random
 import re
 from collections.abc import Iterable
 from enum import StrEnum
@@ -92,3 +93,15 @@ def objects_for_types(type_names: Iterable[str]) -> tuple[str, ...]:
         counts[t] = counts.get(t, 0) + 1
         names.append(instance_name(t, counts[t]))
     return tuple(names)
+
+
+def draw_objects(n: int, rng: random.Random) -> tuple[str, ...]:
+    """n object instances, in canonical order: n distinct types drawn uniformly when n is at
+    most the number of types, else every type once and the rest uniformly with replacement.
+    The goal generator's objects and the reach collector's scenes are drawn this way."""
+    types = list(OBJECT_TYPES)
+    if n <= len(types):
+        chosen = rng.sample(types, n)
+    else:
+        chosen = types + rng.choices(types, k=n - len(types))
+    return sort_objects(objects_for_types(chosen))

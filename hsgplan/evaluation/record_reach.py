@@ -47,10 +47,10 @@ import numpy as np
 from hsgplan.data.world_trials import NO_PARAMETERS, UNSTAGED, WorldTrial, state_row, trials_of
 from hsgplan.domain.actions import Action, Place
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import objects_for_types, sort_objects
+from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.room import Room
-from hsgplan.domain.world import OBJECT_TYPES, REGIONS, SHELVES, SURFACES
+from hsgplan.domain.world import REGIONS, SHELVES, SURFACES
 from hsgplan.motion.sampler import candidates
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.runner.items import run_items
@@ -77,7 +77,7 @@ CROWDABLE = (*(("on", s) for s in TOPS + PREPUSH), *(("in", s) for s in SHELVES)
 def draw_reach_state(seed: int, index: int) -> SymbolicSceneGraph:
     """A state to stage (the distribution is in the module docstring)."""
     rng = random.Random(f"reach-{seed}-{index}")
-    objects = _objects(rng.randint(MIN_OBJECTS, MAX_OBJECTS), rng)
+    objects = draw_objects(rng.randint(MIN_OBJECTS, MAX_OBJECTS), rng)
     order = list(objects)
     rng.shuffle(order)
     literals = [in_grasp(order.pop())] if rng.random() < P_HOLD else []
@@ -85,16 +85,6 @@ def draw_reach_state(seed: int, index: int) -> SymbolicSceneGraph:
     room = Room.left()
     literals += [_put(o, room, crowd, rng) for o in order]
     return SymbolicSceneGraph.from_literals(objects, literals, limits=False)
-
-
-def _objects(n: int, rng: random.Random) -> tuple[str, ...]:
-    # `symbolic.generator.random_objects`, which this module may not import (pyproject.toml:
-    # f_reach's labels consult no module of the hand-written rules)
-    types = list(OBJECT_TYPES)
-    chosen = (
-        rng.sample(types, n) if n <= len(types) else types + rng.choices(types, k=n - len(types))
-    )
-    return sort_objects(objects_for_types(chosen))
 
 
 def _put(o: str, room: Room, crowd: tuple[str, str] | None, rng: random.Random) -> Literal:

@@ -20,10 +20,10 @@ import random
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.feasibility import check_literals
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.objects import object_type, objects_for_types, sort_objects
+from hsgplan.domain.objects import draw_objects, object_type
 from hsgplan.domain.predicates import Literal, inside, on
 from hsgplan.domain.room import Room
-from hsgplan.domain.world import GOAL_INTERIOR, GOAL_SHELF_TOPS, MAX_OBJECTS, OBJECT_TYPES, Kind
+from hsgplan.domain.world import GOAL_INTERIOR, GOAL_SHELF_TOPS, MAX_OBJECTS, Kind
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MIN_OBJECTS = 2
@@ -39,12 +39,7 @@ def check_size(n: int) -> None:
 def random_objects(n: int, rng: random.Random) -> tuple[str, ...]:
     """n object instances as the distribution above draws them, in canonical order."""
     check_size(n)
-    types = list(OBJECT_TYPES)
-    if n <= len(types):
-        chosen = rng.sample(types, n)
-    else:
-        chosen = types + rng.choices(types, k=n - len(types))
-    return sort_objects(objects_for_types(chosen))
+    return draw_objects(n, rng)
 
 
 def random_goal(n: int, rng: random.Random, stacking: bool = True) -> Goal:

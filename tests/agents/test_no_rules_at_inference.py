@@ -4,9 +4,6 @@ rules runs (any call, however reached, is caught by a profiler, not only direct 
 symbolic loop around the planner is the world and steps the transition model between decisions."""
 
 import random
-import sys
-from contextlib import contextmanager
-from pathlib import Path
 
 import pytest
 
@@ -14,39 +11,14 @@ from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT, shipped
 from hsgplan.planning.regression.planner import ForwardPlanner, RegressionPlanner
+from tests.forbidden_calls import rules_forbidden
 
-PACKAGE = Path(__import__("hsgplan").__file__).resolve().parent
-RULES = (
-    PACKAGE / "symbolic",
-    PACKAGE / "domain" / "feasibility.py",
-    PACKAGE / "planning" / "fast_downward.py",
-)
 GOALS = [
     "On(cherries, shelf_a) & On(butter, cherries)",
     "In(tomato_soup, shelf_a) & On(popcorn, shelf_b) & On(cream_cheese, shelf_a)",
     "On(cherries, shelf_b) & On(butter, cherries) & In(alphabet_soup, shelf_a) & "
     "On(popcorn, shelf_a) & In(tomato_soup, shelf_a) & On(cream_cheese, shelf_b)",
 ]
-
-
-def _is_rule(filename: str, rules) -> bool:
-    path = Path(filename).resolve()
-    return any(path == r or r in path.parents for r in rules)
-
-
-@contextmanager
-def rules_forbidden(calls: list[str], rules=RULES):
-    """Every call into `rules` (folders or files) while inside, appended to `calls`."""
-
-    def profile(frame, event, arg):
-        if event == "call" and _is_rule(frame.f_code.co_filename, rules):
-            calls.append(f"{frame.f_code.co_filename}:{frame.f_code.co_name}")
-
-    sys.setprofile(profile)
-    try:
-        yield
-    finally:
-        sys.setprofile(None)
 
 
 class Guarded:

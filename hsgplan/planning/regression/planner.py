@@ -1,5 +1,5 @@
 """The learned task planners: the regression planner and the forward baseline, behind the
-interface of `planning/base.py` (Fast Downward's is in `planning/fast_downward.py`).
+interface of `planning/base.py`.
 
 The regression loop (the paper's phi): f_preimage gives the preimage of one goal literal (the
 query) in the context of the goal; a goal literal whose preimage names another unsatisfied goal
@@ -278,7 +278,7 @@ class RegressionPlanner:
 class ForwardPlanner:
     """The baseline: a network predicts the next subgoal from state and goal directly.
 
-    It runs under the regression planner's rules: the heuristic names the action (no
+    It runs under the regression planner's loop-breaking: the heuristic names the action (no
     preconditions checked), and an action already taken from this very state with this goal
     (it failed, or came back here) is avoided while another of the network's top subgoals
     names a different one, and one that failed here (the state stayed) `GIVE_UP_AFTER` times is
