@@ -121,9 +121,14 @@ def agent_parts(name: str) -> tuple[str, str]:
     return AGENTS[name]
 
 
-def make_agent(name: str) -> HierarchicalAgent:
-    """An agent by name; an unknown name or a missing checkpoint is refused in one line."""
+def make_agent(
+    name: str, checkpoint: Path = TASK_CHECKPOINT, motion_checkpoints: Path = MOTION_CHECKPOINTS
+) -> HierarchicalAgent:
+    """An agent by name, its learned parts from these checkpoint folders; an unknown name or a
+    missing checkpoint is refused in one line."""
     from hsgplan.agents.hierarchical import HierarchicalAgent
 
     planner, motion = agent_parts(name)
-    return HierarchicalAgent(name, make_planner(planner), make_motion(motion))
+    return HierarchicalAgent(
+        name, make_planner(planner, checkpoint), make_motion(motion, motion_checkpoints)
+    )

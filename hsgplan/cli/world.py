@@ -21,7 +21,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
 )
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.paths import RUNS
+from hsgplan.paths import RUNS, shipped
 
 AGENT_HELP = "A registered agent: " + "; ".join(
     f"{name} ({planner} + {motion})" for name, (planner, motion) in AGENTS.items()
@@ -79,11 +79,25 @@ def demo(
 def evaluate(
     agent: AgentOption = ORACLE,
     planner: PlannerOption = None,
-    motion: MotionOption = None,
+    motion: Annotated[
+        str | None,
+        typer.Option(
+            help="Motion generators in place of the agent's, comma-separated (gnn,mlp,random): "
+            "one column each."
+        ),
+    ] = None,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-6.")] = "2-6",
     goals: Annotated[int, typer.Option(help="Random goals per size.")] = 50,
+    repeats: Annotated[int, typer.Option(help="Episodes per goal, each from its own scene.")] = 1,
     seed: Annotated[int, typer.Option(help="Seed of the goals and the episodes.")] = 0,
     goals_file: Annotated[Path | None, typer.Option(help="Goals from a file instead.")] = None,
+    checkpoint: Annotated[
+        Path | None, typer.Option(help="Task planner checkpoint (default: the shipped one).")
+    ] = None,
+    motion_checkpoints: Annotated[
+        Path | None,
+        typer.Option(help="Folder of motion networks, KIND-MODEL each (default: shipped)."),
+    ] = None,
     workers: Annotated[int, typer.Option(help="Episodes run side by side.")] = 2,
     run_dir: Annotated[
         Path | None,
@@ -93,44 +107,57 @@ def evaluate(
         str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
-    markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
-    ] = False,
+    markdown: Annotated[bool, typer.Option(help="Print Markdown tables (for the README).")] = False,
 ) -> None:
-    """Success rate and subgoal completion per problem size, with the failure taxonomy."""
+    """Success rate and subgoal completion per problem size and method, beside the paper's
+    Table 1, with the failure taxonomy and the time per level; writes table1.md, table1.png
+    and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
-    from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation, summarize
+    from hsgplan.evaluation.protocol import EvalConfig, checkpoints, episode_specs
+    from hsgplan.evaluation.table1 import Method, run_table, tables
 
     if workers < 1:
         raise InvalidInputError(f"--workers {workers}: need at least one")
-    agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
+    planner_name = planner and planner.value
+    if motion is None:
+        name = agent_name(agent.value, planner_name)
+        methods = [Method(name, name)]
+    else:
+        motions = [m.strip() for m in motion.split(",")]
+        if len(set(motions)) != len(motions) or "" in motions:
+            raise InvalidInputError(f"--motion '{motion}': name each generator once")
+        methods = [Method(m, agent_name(agent.value, planner_name, m)) for m in motions]
     config = EvalConfig(
-        agent, tuple(parse_sizes(sizes)), goals, seed, str(goals_file) if goals_file else None
+        "",
+        tuple(parse_sizes(sizes)),
+        goals,
+        seed,
+        str(goals_file) if goals_file else None,
+        repeats,
+        checkpoint and str(shipped(checkpoint)),
+        motion_checkpoints and str(shipped(motion_checkpoints)),
     )
-    make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
-    total = len(episode_specs(config))
-    folder = run_dir or RUNS / config.run_name()
+    total = len(episode_specs(config)) * len(methods)
+    for m in methods:  # an unknown name or a missing checkpoint: refused before any work
+        make_agent(m.agent, *checkpoints(config))
+    folder = run_dir or RUNS / _run_name(methods, config)
+    if folder.exists() and not folder.is_dir():
+        raise InvalidInputError(f"--out '{folder}' is a file")
     with Progress(console=err, transient=True) as progress:
-        task = progress.add_task(f"{agent} episodes", total=total)
-        records = run_evaluation(config, folder, workers, lambda r: progress.advance(task), ray)
-    report = summarize(records) | {"agent": agent, "seed": seed, "run": str(folder)}
+        task = progress.add_task(", ".join(m.agent for m in methods), total=total)
+        report = run_table(methods, config, folder, workers, ray, lambda r: progress.advance(task))
     if as_json:
         print(json.dumps(report, indent=2))
         return
-    rows = [
-        (
-            n,
-            f"{v['success_rate']:.2f}",
-            f"{v['subgoal_completion']:.2f}",
-            str(v["episodes"]),
-            ", ".join(f"{k} {c}" for k, c in sorted(v["failures"].items())) or "—",
-        )
-        for n, v in report["by_size"].items()
-    ]
-    source = f"goals from {goals_file}" if goals_file else f"{goals} goals per size"
-    print_table(
-        f"{agent}: {source}, seed {seed}",
-        ("objects", "success", "subgoal completion", "episodes", "failures"),
-        rows,
-        markdown,
-    )
+    for t in tables(report):
+        print_table(t.title, t.header, [list(r) for r in t.rows], markdown)
+        print()
+    if not markdown:
+        out.print(f"wrote {folder}/table1.md, table1.png, summary.json", highlight=False)
+
+
+def _run_name(methods, config) -> str:
+    source = Path(config.goals_file).stem if config.goals_file else f"g{config.goals}"
+    sizes = "-".join(map(str, config.sizes))
+    agents = "_".join(m.agent for m in methods)
+    return f"eval-{agents}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}"

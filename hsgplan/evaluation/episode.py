@@ -43,6 +43,7 @@ class EpisodeRecord:
     failure: str | None
     steps: tuple[StepRecord, ...]
     seconds: float
+    repeat: int = 0  # which of a goal's repeated episodes (the protocol runs each several times)
 
     def to_json(self) -> dict:
         return asdict(self)

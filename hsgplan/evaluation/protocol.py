@@ -1,25 +1,27 @@
-"""The evaluation protocol: which episodes an `eval` runs, running them, and what they sum to.
+"""The evaluation protocol: which episodes an `eval` runs, and running them.
 
 Goals come from the seeded generator (`goals` per size; the paper leaves stacking out of
-2-object goals, since its demonstrations cover them) or from a goal file. Each episode's seed
-is derived from the run's seed, the size and the goal's index, so any episode can be rerun
-alone. Finished episodes are appended to `episodes.jsonl` in the run folder as they finish: an
-interrupted run, started again with the same command, skips what is done.
+2-object goals, since its demonstrations cover them) or from a goal file; every goal is run
+`repeats` times (the paper runs each five times), each from its own start scene. Each
+episode's seed is derived from the run's seed, the size, the goal's index and the repeat, so
+any episode can be rerun alone. Finished episodes are appended to `episodes.jsonl` in the run
+folder as they finish: an interrupted run, started again with the same command, skips what is
+done. What the episodes sum to is `evaluation/summary.py`.
 """
 
 from __future__ import annotations
 
-import statistics
-from collections import Counter
-from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
-from functools import partial
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, replace
+from functools import lru_cache, partial
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.runner.items import run_items
+from hsgplan.runner.run_folder import CONFIG, add_wall_seconds
 from hsgplan.symbolic.generator import random_goals
 
 
@@ -30,11 +32,9 @@ class EvalConfig:
     goals: int
     seed: int
     goals_file: str | None = None
-
-    def run_name(self) -> str:
-        source = Path(self.goals_file).stem if self.goals_file else f"g{self.goals}"
-        sizes = "-".join(map(str, self.sizes))
-        return f"eval-{self.agent}-s{sizes}-{source}-seed{self.seed}"
+    repeats: int = 1
+    checkpoint: str | None = None  # the task planner's folder (None: the shipped one)
+    motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
 
 
 @dataclass(frozen=True)
@@ -43,6 +43,7 @@ class EpisodeSpec:
     index: int
     goal: str
     seed: int
+    repeat: int = 0
 
     @property
     def key(self) -> str:
@@ -52,6 +53,8 @@ class EpisodeSpec:
 def episode_specs(config: EvalConfig) -> list[EpisodeSpec]:
     if config.goals < 0:
         raise InvalidInputError(f"--goals {config.goals}: the number of goals cannot be negative")
+    if config.repeats < 1:
+        raise InvalidInputError(f"--repeats {config.repeats}: need at least one")
     by_size: dict[int, list[Goal]] = {}
     if config.goals_file:
         for g in read_goal_file(Path(config.goals_file)):
@@ -63,26 +66,44 @@ def episode_specs(config: EvalConfig) -> list[EpisodeSpec]:
         for n in config.sizes:
             by_size[n] = random_goals(n, config.goals, config.seed, stacking=n > 2)
     return [
-        EpisodeSpec(n, i, str(g), episode_seed(config.seed, n, i))
+        EpisodeSpec(n, i, str(g), episode_seed(config.seed, n, i, r), r)
         for n in sorted(by_size)
         for i, g in enumerate(by_size[n])
+        for r in range(config.repeats)
     ]
 
 
-def episode_seed(seed: int, size: int, index: int) -> int:
-    return (seed * 1_000_003 + size * 10_007 + index) % (2**31)
+def episode_seed(seed: int, size: int, index: int, repeat: int = 0) -> int:
+    return (seed * 1_000_003 + size * 10_007 + index + repeat * 7_919_111) % (2**31)
 
 
-def run_spec(agent_name: str, spec: EpisodeSpec) -> dict:
-    """One episode in this process (a worker): its record as JSON."""
+@lru_cache(maxsize=2)
+def _worker_agent(config: EvalConfig):
+    """One agent per worker process and configuration: `reset` starts every episode afresh,
+    and loading the networks once saves a third of a second an episode."""
     from hsgplan.agents.registry import make_agent
+
+    return make_agent(config.agent, *checkpoints(config))
+
+
+def checkpoints(config: EvalConfig) -> tuple[Path, Path]:
+    """The task planner's and the motion networks' folders an evaluation runs with."""
+    from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
+
+    return (
+        Path(config.checkpoint or TASK_CHECKPOINT),
+        Path(config.motion_checkpoints or MOTION_CHECKPOINTS),
+    )
+
+
+def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
+    """One episode in this process (a worker): its record as JSON."""
     from hsgplan.evaluation.episode import run_episode
     from hsgplan.sim.env import KitchenStorageEnv
 
-    record = run_episode(
-        KitchenStorageEnv(), make_agent(agent_name), parse_goal(spec.goal), spec.seed
-    )
-    return record.to_json()
+    agent = _worker_agent(config)
+    record = run_episode(KitchenStorageEnv(), agent, parse_goal(spec.goal), spec.seed)
+    return replace(record, repeat=spec.repeat).to_json()
 
 
 def run_evaluation(
@@ -92,32 +113,22 @@ def run_evaluation(
     on_episode: Callable[[EpisodeRecord], None] | None = None,
     ray: str | None = None,
 ) -> list[EpisodeRecord]:
-    """Run every episode not yet in `run_dir`, `workers` at a time; all records, in order."""
+    """Run every episode not yet in `run_dir`, `workers` at a time; all records, in order.
+    The wall-clock seconds spent running episodes are added to the run folder's timing."""
     specs = episode_specs(config)
-    rows = run_items(
-        partial(run_spec, config.agent),
-        specs,
-        key=lambda s: s.key,
-        run_dir=run_dir,
-        config=asdict(config) | {"sizes": list(config.sizes)},
-        workers=workers,
-        ray=ray,
-        on_result=on_episode and (lambda row: on_episode(EpisodeRecord.from_json(row))),
-    )
+    start = time.perf_counter()
+    try:
+        rows = run_items(
+            partial(run_spec, config),
+            specs,
+            key=lambda s: s.key,
+            run_dir=run_dir,
+            config=asdict(config) | {"sizes": list(config.sizes)},
+            workers=workers,
+            ray=ray,
+            on_result=on_episode and (lambda row: on_episode(EpisodeRecord.from_json(row))),
+        )
+    finally:
+        if run_dir is not None and (run_dir / CONFIG).exists():
+            add_wall_seconds(run_dir, time.perf_counter() - start)
     return [EpisodeRecord.from_json(row) for row in rows]
-
-
-def summarize(records: Sequence[EpisodeRecord]) -> dict:
-    """`{"by_size": {"2": {"success_rate", "subgoal_completion", "episodes", ...}, ...}}`."""
-    by_size: dict[str, dict] = {}
-    for n in sorted({r.size for r in records}):
-        rs = [r for r in records if r.size == n]
-        by_size[str(n)] = {
-            "success_rate": sum(r.success for r in rs) / len(rs),
-            "subgoal_completion": sum(r.subgoal_completion for r in rs) / len(rs),
-            "episodes": len(rs),
-            "failures": dict(Counter(r.failure for r in rs if r.failure)),
-            "median_steps": statistics.median(len(r.steps) for r in rs),
-            "median_seconds": statistics.median(r.seconds for r in rs),
-        }
-    return {"by_size": by_size}

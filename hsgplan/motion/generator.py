@@ -6,10 +6,14 @@ over the bins; `motion/sampler.py` holds the geometric sampler, the oracle's gen
 has no parameters, and a stack takes its position from the object below, so only a place onto
 a surface and a push are chosen over bins.
 
-`propose` is what an agent calls, once per step: the first of `ranked` that has not failed for
-good earlier in the episode (a generator that would propose the same failed bins in an
-unchanged scene takes its next-ranked proposal instead). The learned generators are single
-shot as in the paper: they ignore the dry run an agent may offer.
+`propose` is what an agent calls, once per step. The learned generators are single shot as in
+the paper: one proposal, no dry run (they ignore the one an agent may offer). The rule for
+failures: parameters whose execution failed for good (`DO_NOT_RETRY`) are remembered with the
+scene they failed in (`scene_key`: the held object and every pose to the centimetre); in that
+unchanged scene the generator proposes its next-ranked parameters instead, and once every
+choice has failed there it proposes its first choice again (a pick has only one), so that the
+task level, which sees the same state come back, decides what to do. In a changed scene
+everything may be proposed again.
 """
 
 from __future__ import annotations
@@ -61,7 +65,7 @@ class MotionGenerator(Protocol):
         following: Action | None = None,
         feasible: Feasibility | None = None,
     ) -> PrimitiveParams | None:
-        """Parameters for `action` in the scene `sg` (None when every choice has failed).
+        """Parameters for `action` in the scene `sg` (None when a generator has none to offer).
 
         `following` is the action the task planner expects next, where it knows one;
         `feasible`, when given, dry-runs a candidate (plans it without executing it)."""
@@ -70,22 +74,37 @@ class MotionGenerator(Protocol):
         """What executing the proposal came to."""
 
 
+def scene_key(sg: GeometricSceneGraph) -> tuple:
+    """The scene as the failure memory compares scenes: what is held, every pose to the cm."""
+    return sg.held, tuple((n.name, *(round(v * 100) for v in n.pose.position)) for n in sg.nodes)
+
+
 class SingleShotMemory:
-    """What every generator remembers within an episode: the parameters that failed for good."""
+    """What every generator remembers within an episode: the parameters that failed for good,
+    by the scene they failed in."""
 
     def __init__(self) -> None:
-        self.failed: set[PrimitiveParams] = set()
+        self.failed: dict[tuple, set[PrimitiveParams]] = {}
+        self._scene: tuple | None = None
 
     def reset(self, seed: int) -> None:
-        self.failed = set()
+        self.failed = {}
+        self._scene = None
+
+    def untried(self, sg: GeometricSceneGraph, options: list) -> list:
+        """The options that have not failed in this very scene (the one proposed in next)."""
+        self._scene = scene_key(sg)
+        failed = self.failed.get(self._scene, set())
+        return [o for o in options if o not in failed]
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
-        if outcome.status in DO_NOT_RETRY:
-            self.failed.add(params)
+        if outcome.status in DO_NOT_RETRY and self._scene is not None:
+            self.failed.setdefault(self._scene, set()).add(params)
 
 
 class _BinGenerator(SingleShotMemory):
-    """Picks and stacks need no choice; everything else is the first untried of `ranked`."""
+    """Picks and stacks need no choice; everything else is the first of `ranked` not failed in
+    this scene (the first of all when every one has)."""
 
     def ranked(self, sg: GeometricSceneGraph, subgoal: Literal) -> list[PlaceParams | PushParams]:
         raise NotImplementedError
@@ -98,11 +117,12 @@ class _BinGenerator(SingleShotMemory):
         feasible: Feasibility | None = None,
     ) -> PrimitiveParams | None:
         if isinstance(action, Pick):
-            return PickParams(action.obj)
-        if isinstance(action, Place) and action.target not in SURFACES:
-            return PlaceParams(action.obj, action.target)
-        ranked = self.ranked(sg, intended_literal(action))
-        return next((p for p in ranked if p not in self.failed), None)
+            ranked: list[PrimitiveParams] = [PickParams(action.obj)]
+        elif isinstance(action, Place) and action.target not in SURFACES:
+            ranked = [PlaceParams(action.obj, action.target)]
+        else:
+            ranked = list(self.ranked(sg, intended_literal(action)))
+        return (self.untried(sg, ranked) or ranked)[0]
 
 
 def _all_params(kind: MotionPrimitive, subgoal: Literal, flat: list[int]):

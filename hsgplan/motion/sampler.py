@@ -192,7 +192,8 @@ MAX_CHECKS = 30
 
 class GeometricSampler(SingleShotMemory):
     """The best-ranked candidate that passes a dry run (at most `MAX_CHECKS` are checked) and
-    has not failed for good this episode; without a dry run, the best-ranked one."""
+    has not failed for good in this scene; without a dry run, the best-ranked one. None when
+    every candidate has failed here (the oracle's episode ends: no parameters)."""
 
     name = "sampler"
 
@@ -203,7 +204,7 @@ class GeometricSampler(SingleShotMemory):
         following: Action | None = None,
         feasible: Feasibility | None = None,
     ) -> PrimitiveParams | None:
-        options = [c for c in candidates(sg, action, following) if c not in self.failed]
+        options = self.untried(sg, candidates(sg, action, following))
         return next(
             (c for c in options[:MAX_CHECKS] if feasible is None or feasible(c)),
             options[0] if options else None,

@@ -15,6 +15,7 @@ from hsgplan.domain.errors import InvalidInputError
 
 RESULTS = "episodes.jsonl"
 CONFIG = "config.json"
+TIMING = "timing.json"
 
 
 def claim(run_dir: Path, config: dict, refusal: str) -> None:
@@ -49,3 +50,18 @@ def logged_rows(run_dir: Path) -> list[dict]:
         except json.JSONDecodeError:
             continue
     return rows
+
+
+def add_wall_seconds(run_dir: Path, seconds: float) -> None:
+    """Add a session's wall-clock seconds to the folder's total (`timing.json`): a run
+    interrupted and resumed is timed over all its sessions."""
+    total = wall_seconds(run_dir) + seconds
+    (run_dir / TIMING).write_text(json.dumps({"wall_seconds": round(total, 3)}) + "\n")
+
+
+def wall_seconds(run_dir: Path) -> float:
+    """The folder's wall-clock seconds so far (0 when none were recorded)."""
+    try:
+        return float(json.loads((run_dir / TIMING).read_text())["wall_seconds"])
+    except (FileNotFoundError, json.JSONDecodeError, KeyError, TypeError, ValueError):
+        return 0.0

@@ -44,13 +44,14 @@ def test_the_parts_are_composed_and_reset_together():
     assert agent.planner.name == "regression" and agent.motion.name == "random"
 
 
-def _scene_graph():
-    """Four objects standing on the table (poses only: no physics is needed to choose bins)."""
+def _scene_graph(shift: float = 0.0):
+    """Three objects standing on the table (poses only: no physics is needed to choose bins);
+    `shift` moves the last one along x."""
     from hsgplan.domain.objects import object_type
     from hsgplan.scene_graph.geometric import GeometricSceneGraph
     from hsgplan.scene_graph.geometry import Pose
 
-    spots = {"cherries": (0.42, 0.05), "butter": (0.55, -0.10), "popcorn": (0.36, -0.12)}
+    spots = {"cherries": (0.42, 0.05), "butter": (0.55, -0.10), "popcorn": (0.36 + shift, -0.12)}
     return GeometricSceneGraph.from_poses(
         {
             name: Pose.from_xyz_yaw(x, y, object_type(name).height / 2, 0.0)
@@ -100,7 +101,7 @@ def test_the_agent_passes_the_subgoal_and_the_action_to_the_motion_level():
     assert stuck.action is None and stuck.params is None and stuck.note == "regression stuck"
 
 
-def test_a_generator_does_not_propose_what_failed_for_good_this_episode():
+def test_a_generator_does_not_propose_again_what_failed_in_the_same_scene():
     sg = _scene_graph()
     obj = sg.objects[0]
     motion = RandomMotion()
@@ -111,4 +112,23 @@ def test_a_generator_does_not_propose_what_failed_for_good_this_episode():
     assert motion.propose(sg, Place(obj, "shelf_b")) == first
     motion.observe(first, Outcome(Status.NO_PATH, "", 0.0))
     motion.rng.seed("random-motion-3")  # ...and after a failure, the next in that order
-    assert motion.propose(sg, Place(obj, "shelf_b")) != first
+    second = motion.propose(sg, Place(obj, "shelf_b"))
+    assert second != first
+    # a failure that may pass when tried again is not remembered
+    motion.observe(second, Outcome(Status.DROPPED, "", 0.0))
+    motion.rng.seed("random-motion-3")
+    assert motion.propose(sg, Place(obj, "shelf_b")) == second
+    # in a scene where something moved, what failed elsewhere may be proposed again
+    moved = _scene_graph(shift=0.03)
+    motion.rng.seed("random-motion-3")
+    assert motion.propose(moved, Place(obj, "shelf_b")) == first
+
+
+def test_a_pick_that_failed_is_offered_again_for_the_task_level_to_judge():
+    sg = _scene_graph()
+    obj = sg.objects[0]
+    motion = RandomMotion()
+    motion.reset(0)
+    pick = motion.propose(sg, Pick(obj))
+    motion.observe(pick, Outcome(Status.NO_IK, "", 0.0))
+    assert motion.propose(sg, Pick(obj)) == pick  # its only choice: single shot, no None

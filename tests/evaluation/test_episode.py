@@ -9,7 +9,8 @@ from hsgplan.agents.registry import make_agent
 from hsgplan.cli import app
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.episode import run_episode
-from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation, summarize
+from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation
+from hsgplan.evaluation.summary import summarize
 from hsgplan.sim.env import KitchenStorageEnv
 
 GOAL = "On(butter, cherries) & On(cherries, shelf_a) & In(tomato_soup, shelf_a)"
@@ -85,7 +86,7 @@ def test_eval_cli_json_shape(tmp_path):
     )
     assert r.exit_code == 0, r.output
     report = json.loads(r.stdout)
-    entry = report["by_size"]["2"]
+    entry = report["methods"]["oracle"]["by_size"]["2"]
     assert set(entry) >= {"success_rate", "subgoal_completion", "episodes"}
     assert entry["episodes"] == 1
 
@@ -128,7 +129,7 @@ def test_json_output_of_the_real_command_is_pure_json(tmp_path):
         text=True,
         check=True,
     )
-    assert json.loads(result.stdout)["by_size"]["2"]["episodes"] == 1
+    assert json.loads(result.stdout)["methods"]["oracle"]["by_size"]["2"]["episodes"] == 1
 
 
 def test_the_shipped_task_checkpoint_closes_the_loop_in_the_simulated_world():

@@ -9,7 +9,7 @@ from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.predicates import on
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT
-from hsgplan.planning.regression.planner import ForwardPlanner, RegressionPlanner
+from hsgplan.planning.regression.planner import GIVE_UP_AFTER, ForwardPlanner, RegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.symbolic.generator import random_state
 from hsgplan.symbolic.transition import apply, why_not
@@ -81,3 +81,16 @@ def test_an_action_the_world_refused_is_not_taken_again_from_the_same_state():
             assert decision.action not in tried, (type(planner).__name__, tried)
             tried.append(decision.action)
         assert tried
+
+
+def test_when_everything_failed_the_planner_tries_again_rather_than_stopping():
+    # In the world a failed primitive may pass with other parameters; a loop that never does
+    # ends at the step limit (the paper's overstep), not in a planner with nothing to say.
+    goal = parse_goal("On(cherries, shelf_a)")
+    state = random_state(goal.objects, random.Random(0))
+    for planner in (RegressionPlanner(TASK_CHECKPOINT, seed=0), ForwardPlanner(TASK_CHECKPOINT)):
+        planner.reset(goal, 0)
+        actions = [planner.next_action(state, goal).action for _ in range(40)]
+        assert None not in actions, (type(planner).__name__, actions)
+        # the first choice was given up, and taken again once nothing else was left
+        assert actions.count(actions[0]) > GIVE_UP_AFTER, (type(planner).__name__, actions)

@@ -41,7 +41,8 @@ from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MAX_DEPTH = 8
 # A primitive can fail for motion reasons in the simulated world and succeed when tried again;
-# an action that failed this often from the very same state is not taken there again.
+# an action that failed this often from the very same state is taken there again only when
+# nothing else is found.
 GIVE_UP_AFTER = 2
 
 
@@ -175,12 +176,15 @@ class RegressionPlanner:
         # goal literal stuck behind a full shelf), the waiting ones are tried as well.
         # An action already taken from this very state (with this goal) failed or came back
         # to it: it is avoided while any other is found, and one that failed here
-        # `GIVE_UP_AFTER` times is not taken here again. This breaks loops such as picking an
-        # object whose shelf is full and putting it back.
+        # `GIVE_UP_AFTER` times is not taken here while another is found. This breaks loops
+        # such as picking an object whose shelf is full and putting it back. When every one
+        # has been given up, the likeliest is tried again rather than stopping: in the world a
+        # primitive may pass on another try (other parameters), and a loop that never does
+        # ends at the step limit, the paper's overstep.
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
         seen: dict[Literal, tuple[float, _Node]] = {}
-        for avoid in (taken, failed_here):
+        for avoid in (taken, failed_here, set()):
             for frontier in (free, [x for x in pairs if x not in free]):
                 found = self._search(state, frontier, avoid, seen)
                 if found is not None:
@@ -282,7 +286,7 @@ class ForwardPlanner:
     preconditions checked), and an action already taken from this very state with this goal
     (it failed, or came back here) is avoided while another of the network's top subgoals
     names a different one, and one that failed here (the state stayed) `GIVE_UP_AFTER` times is
-    not taken here again."""
+    not taken here while another is found (the likeliest is tried again when none is)."""
 
     name = "forward"
     TOP = 20  # subgoals considered per decision, most probable first
@@ -315,7 +319,7 @@ class ForwardPlanner:
         failed_here = _given_up(self._failed.get(state))
         taken = self._taken.setdefault((goal, state), set())
         fresh = [(lit, a) for lit, a in ranked if a not in taken]
-        fresh = fresh or [(lit, a) for lit, a in ranked if a not in failed_here]
+        fresh = fresh or [(lit, a) for lit, a in ranked if a not in failed_here] or ranked
         if not fresh:
             return TaskDecision(None, None, time.perf_counter() - start, "no subgoal")
         lit, action = fresh[0]

@@ -1,0 +1,79 @@
+"""What a set of episodes sums to: success and subgoal completion per problem size, their
+spread over repeats, the failure taxonomy and the time spent per level.
+
+The failure taxonomy is the paper's (section 5.C): an **execution** failure is an episode lost
+to motion execution (a primitive failed in it: no IK, no path, dropped, an object knocked over
+or off the table, the effect not reached; the kind is the fatal anomaly, or else the status of
+the last primitive that failed), an **overstep** an episode in which every primitive did what
+it was asked (or was refused as inapplicable, a task-level mistake) and the step limit, or a
+planner with nothing reachable to offer, came first.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections import Counter
+from collections.abc import Sequence
+
+from hsgplan.evaluation.episode import EpisodeRecord
+from hsgplan.evaluation.failures import Failure
+from hsgplan.sim.outcome import Status
+
+EXECUTION = "execution"
+OVERSTEP = "overstep"
+# statuses of a primitive that failed in execution (an inapplicable one is the task level's)
+FAILED_EXECUTION = frozenset(s.value for s in Status) - {Status.SUCCESS, Status.INVALID}
+_ENDED_BY_EXECUTION = {Failure.KNOCKED_OVER, Failure.OFF_TABLE, Failure.NO_PARAMETERS}
+
+
+def failure_class(record: EpisodeRecord) -> tuple[str, str] | None:
+    """(class, kind) of a failed episode, None for a success."""
+    if record.success:
+        return None
+    if record.failure in _ENDED_BY_EXECUTION:
+        return EXECUTION, str(record.failure)
+    failed = [s.status for s in record.steps if s.status in FAILED_EXECUTION]
+    if failed:
+        return EXECUTION, failed[-1]
+    return OVERSTEP, "step limit" if record.failure == Failure.OVERSTEP else str(record.failure)
+
+
+def _spread(values_by_repeat: dict[int, list[float]]) -> float | None:
+    """Standard deviation over repeats of the per-repeat mean (None with a single repeat)."""
+    means = [sum(v) / len(v) for v in values_by_repeat.values()]
+    return statistics.pstdev(means) if len(means) > 1 else None
+
+
+def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
+    by_repeat: dict[int, list[EpisodeRecord]] = {}
+    for r in rs:
+        by_repeat.setdefault(r.repeat, []).append(r)
+    classes = [c for r in rs if (c := failure_class(r))]
+    return {
+        "success_rate": sum(r.success for r in rs) / len(rs),
+        "subgoal_completion": sum(r.subgoal_completion for r in rs) / len(rs),
+        "episodes": len(rs),
+        "repeats": len(by_repeat),
+        "success_std": _spread({k: [r.success for r in v] for k, v in by_repeat.items()}),
+        "completion_std": _spread(
+            {k: [r.subgoal_completion for r in v] for k, v in by_repeat.items()}
+        ),
+        "failures": dict(Counter(r.failure for r in rs if r.failure)),
+        "failure_classes": {
+            cls: dict(Counter(kind for c, kind in classes if c == cls))
+            for cls in (EXECUTION, OVERSTEP)
+        },
+        "median_steps": statistics.median(len(r.steps) for r in rs),
+        "median_seconds": statistics.median(r.seconds for r in rs),
+        "median_task_seconds": statistics.median(sum(s.task_seconds for s in r.steps) for r in rs),
+        # the motion level per episode: choosing parameters and executing them
+        "median_motion_seconds": statistics.median(
+            sum(s.motion_seconds + s.execution_seconds for s in r.steps) for r in rs
+        ),
+    }
+
+
+def summarize(records: Sequence[EpisodeRecord]) -> dict:
+    """`{"by_size": {"2": {"success_rate", "subgoal_completion", "episodes", ...}, ...}}`."""
+    sizes = sorted({r.size for r in records})
+    return {"by_size": {str(n): size_summary([r for r in records if r.size == n]) for n in sizes}}

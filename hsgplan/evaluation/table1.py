@@ -1,0 +1,200 @@
+"""The paper's Table 1 from our episodes: success / subgoal completion per problem size and
+motion generator, the paper's numbers beside ours, the spread over repeats, the failure
+taxonomy, the time per level, and a plot.
+
+`run_table` runs one evaluation per method (each in a run folder of its own under the table's
+folder, resumable as every evaluation is) and writes `table1.md`, `table1.png` and
+`summary.json` beside them.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from hsgplan.evaluation.episode import EpisodeRecord
+from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation
+from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, summarize
+from hsgplan.runner.run_folder import wall_seconds
+
+# Table 1 of the paper (success rate, subgoal completion), by motion generator and size.
+PAPER_TABLE1: dict[str, dict[int, tuple[float, float]]] = {
+    "random": {2: (0.71, 0.84), 3: (0.60, 0.81), 4: (0.50, 0.78), 5: (0.35, 0.67), 6: (0.18, 0.56)},
+    "mlp": {2: (0.85, 0.91), 3: (0.75, 0.87), 4: (0.69, 0.84), 5: (0.56, 0.76), 6: (0.44, 0.67)},
+    "gnn": {2: (0.92, 0.95), 3: (0.89, 0.95), 4: (0.84, 0.92), 5: (0.73, 0.87), 6: (0.67, 0.84)},
+}
+LABELS = {"gnn": "GNN", "mlp": "MLP", "random": "Random"}
+
+
+@dataclass(frozen=True)
+class Method:
+    """One column of the table: its name there and the agent that runs it."""
+
+    name: str
+    agent: str
+
+
+def label(method: str) -> str:
+    return LABELS.get(method, method)
+
+
+def run_table(
+    methods: list[Method],
+    config: EvalConfig,
+    out: Path,
+    workers: int = 2,
+    ray: str | None = None,
+    on_episode: Callable[[EpisodeRecord], None] | None = None,
+) -> dict:
+    """Every method's episodes (`config` with the method's agent) into `out/METHOD/`; the
+    summary, also written as `summary.json`, `table1.md` and `table1.png` in `out`."""
+    records = {}
+    for m in methods:
+        records[m.name] = run_evaluation(
+            replace(config, agent=m.agent), out / m.name, workers, on_episode, ray
+        )
+    report = {
+        "methods": {
+            m.name: {"agent": m.agent, "wall_seconds": wall_seconds(out / m.name)}
+            | summarize(records[m.name])
+            for m in methods
+        },
+        "goals": config.goals,
+        "goals_file": config.goals_file,
+        "repeats": config.repeats,
+        "seed": config.seed,
+        "run": str(out),
+    }
+    (out / "summary.json").write_text(json.dumps(report, indent=2) + "\n")
+    (out / "table1.md").write_text(markdown(report) + "\n")
+    from hsgplan.viz.plots import plot_success_by_size
+
+    plot_success_by_size(
+        {
+            label(m): {
+                int(n): (v["success_rate"], v["success_std"]) for n, v in s["by_size"].items()
+            }
+            for m, s in report["methods"].items()
+        },
+        {
+            label(m): {n: sr for n, (sr, _) in PAPER_TABLE1[m].items()}
+            for m in report["methods"]
+            if m in PAPER_TABLE1
+        },
+        out / "table1.png",
+    )
+    return report
+
+
+def total_episodes(methods: list[Method], config: EvalConfig) -> int:
+    return len(methods) * len(episode_specs(config))
+
+
+def _cell(v: dict) -> str:
+    sr, sc = f"{v['success_rate']:.2f}", f"{v['subgoal_completion']:.2f}"
+    if v.get("success_std") is not None:
+        sr += f" ± {v['success_std']:.2f}"
+    return f"{sr} / {sc}"
+
+
+def _kinds(counts: dict[str, int]) -> str:
+    total = sum(counts.values())
+    if not total:
+        return "0"
+    inner = ", ".join(f"{k} {c}" for k, c in sorted(counts.items(), key=lambda x: (-x[1], x[0])))
+    return f"{total} ({inner})"
+
+
+@dataclass(frozen=True)
+class TextTable:
+    title: str
+    header: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+
+    def markdown(self) -> str:
+        return "\n".join(
+            [
+                self.title,
+                "",
+                "| " + " | ".join(self.header) + " |",
+                "|" + "---:|" * len(self.header),
+                *("| " + " | ".join(r) + " |" for r in self.rows),
+            ]
+        )
+
+
+def tables(report: dict) -> list[TextTable]:
+    """Results beside the paper's, the failure taxonomy, the time per level."""
+    return [_results(report), _failures(report), _times(report)]
+
+
+def markdown(report: dict) -> str:
+    return "\n\n".join(t.markdown() for t in tables(report))
+
+
+def _sizes(methods: dict) -> list[int]:
+    return sorted({int(n) for s in methods.values() for n in s["by_size"]})
+
+
+def _results(report: dict) -> TextTable:
+    methods = report["methods"]
+    header = ["objects"]
+    for m in methods:
+        header += [label(m)] + ([f"{label(m)} (paper)"] if m in PAPER_TABLE1 else [])
+    rows = []
+    for n in _sizes(methods):
+        row = [str(n)]
+        for m, s in methods.items():
+            v = s["by_size"].get(str(n))
+            row.append(_cell(v) if v else "—")
+            if m in PAPER_TABLE1:
+                paper = PAPER_TABLE1[m].get(n)
+                row.append(f"{paper[0]:.2f} / {paper[1]:.2f}" if paper else "—")
+        rows.append(tuple(row))
+    source = report["goals_file"] or f"{report['goals']} random goals per size"
+    title = (
+        f"Success rate / subgoal completion: {source}, each run {report['repeats']} times "
+        f"(± the standard deviation of the success rate over the repeats), seed {report['seed']}"
+    )
+    return TextTable(title, tuple(header), tuple(rows))
+
+
+def _failures(report: dict) -> TextTable:
+    rows = []
+    for m, s in report["methods"].items():
+        for n in _sizes(report["methods"]):
+            if v := s["by_size"].get(str(n)):
+                failed = v["episodes"] - round(v["success_rate"] * v["episodes"])
+                fc = v["failure_classes"]
+                rows.append(
+                    (label(m), str(n), str(v["episodes"]), str(failed))
+                    + (_kinds(fc[EXECUTION]), _kinds(fc[OVERSTEP]))
+                )
+    title = (
+        "Failures: execution (a primitive failed; by the fatal anomaly or the last failed "
+        "primitive's status) and overstep (the step limit, or nothing reachable, with every "
+        "primitive having done what it was asked)"
+    )
+    header = ("method", "objects", "episodes", "failed", "execution", "overstep")
+    return TextTable(title, header, tuple(rows))
+
+
+def _times(report: dict) -> TextTable:
+    rows = []
+    for m, s in report["methods"].items():
+        for n in _sizes(report["methods"]):
+            if v := s["by_size"].get(str(n)):
+                task_ms, motion_s = v["median_task_seconds"] * 1000, v["median_motion_seconds"]
+                rows.append(
+                    (label(m), str(n), str(v["episodes"]), f"{task_ms:.1f}", f"{motion_s:.2f}", "")
+                )
+        episodes = sum(v["episodes"] for v in s["by_size"].values())
+        rows.append((label(m), "all", str(episodes), "", "", f"{s['wall_seconds'] / 60:.1f}"))
+    title = (
+        "Time per episode (medians): the task level's, and the motion level's (choosing "
+        "parameters and executing them); wall clock of each method's whole run"
+    )
+    header = ("method", "objects", "episodes", "task ms", "motion s", "wall min")
+    return TextTable(title, header, tuple(rows))

@@ -1,0 +1,52 @@
+"""Plots of evaluation results (matplotlib, written as PNG)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def plot_success_by_size(
+    ours: dict[str, dict[int, tuple[float, float | None]]],
+    paper: dict[str, dict[int, float]],
+    path: Path,
+) -> None:
+    """Success rate by problem size, one colour per method: ours solid (with the standard
+    deviation over repeats as error bars), the paper's dashed.
+
+    Args:
+        ours: method -> size -> (success rate, its standard deviation or None).
+        paper: method -> size -> the paper's success rate.
+        path: where the PNG goes.
+    """
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=120)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for k, (method, by_size) in enumerate(ours.items()):
+        colour = colours[k % len(colours)]
+        sizes = sorted(by_size)
+        rates = [by_size[n][0] for n in sizes]
+        errors = [by_size[n][1] or 0.0 for n in sizes]
+        ax.errorbar(sizes, rates, yerr=errors, color=colour, marker="o", capsize=3, label=method)
+        if method in paper:
+            ps = sorted(paper[method])
+            ax.plot(
+                ps,
+                [paper[method][n] for n in ps],
+                color=colour,
+                linestyle="--",
+                marker="x",
+                alpha=0.7,
+                label=f"{method} (paper)",
+            )
+    ax.set_xlabel("objects in the goal")
+    ax.set_ylabel("success rate")
+    ax.set_ylim(0, 1.02)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
