@@ -130,5 +130,5 @@ def run_evaluation(
         )
     finally:
         if run_dir is not None and (run_dir / CONFIG).exists():
-            add_wall_seconds(run_dir, time.perf_counter() - start)
+            add_wall_seconds(run_dir, time.perf_counter() - start, workers)
     return [EpisodeRecord.from_json(row) for row in rows]

@@ -17,7 +17,7 @@ from pathlib import Path
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, summarize
-from hsgplan.runner.run_folder import wall_seconds
+from hsgplan.runner.run_folder import read_timing
 
 # Table 1 of the paper (success rate, subgoal completion), by motion generator and size.
 PAPER_TABLE1: dict[str, dict[int, tuple[float, float]]] = {
@@ -57,8 +57,7 @@ def run_table(
         )
     report = {
         "methods": {
-            m.name: {"agent": m.agent, "wall_seconds": wall_seconds(out / m.name)}
-            | summarize(records[m.name])
+            m.name: {"agent": m.agent} | read_timing(out / m.name) | summarize(records[m.name])
             for m in methods
         },
         "goals": config.goals,
@@ -191,7 +190,9 @@ def _times(report: dict) -> TextTable:
                     (label(m), str(n), str(v["episodes"]), f"{task_ms:.1f}", f"{motion_s:.2f}", "")
                 )
         episodes = sum(v["episodes"] for v in s["by_size"].values())
-        rows.append((label(m), "all", str(episodes), "", "", f"{s['wall_seconds'] / 60:.1f}"))
+        workers = "/".join(str(w) for w in sorted({x["workers"] for x in s["sessions"]}))
+        wall = f"{s['wall_seconds'] / 60:.1f} ({workers or '?'} workers)"
+        rows.append((label(m), "all", str(episodes), "", "", wall))
     title = (
         "Time per episode (medians): the task level's, and the motion level's (choosing "
         "parameters and executing them); wall clock of each method's whole run"

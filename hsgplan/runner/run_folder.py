@@ -9,6 +9,7 @@ folder made with another configuration is refused rather than mixed with.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
@@ -52,16 +53,22 @@ def logged_rows(run_dir: Path) -> list[dict]:
     return rows
 
 
-def add_wall_seconds(run_dir: Path, seconds: float) -> None:
-    """Add a session's wall-clock seconds to the folder's total (`timing.json`): a run
-    interrupted and resumed is timed over all its sessions."""
-    total = wall_seconds(run_dir) + seconds
-    (run_dir / TIMING).write_text(json.dumps({"wall_seconds": round(total, 3)}) + "\n")
+def add_wall_seconds(run_dir: Path, seconds: float, workers: int) -> None:
+    """Add a session's wall-clock seconds to the folder's timing (`timing.json`), with the
+    workers it ran and the cores of the machine: a run interrupted and resumed is timed over
+    all its sessions."""
+    timing = read_timing(run_dir)
+    timing["wall_seconds"] = round(timing["wall_seconds"] + seconds, 3)
+    timing["sessions"].append(
+        {"seconds": round(seconds, 3), "workers": workers, "cores": os.cpu_count()}
+    )
+    (run_dir / TIMING).write_text(json.dumps(timing) + "\n")
 
 
-def wall_seconds(run_dir: Path) -> float:
-    """The folder's wall-clock seconds so far (0 when none were recorded)."""
+def read_timing(run_dir: Path) -> dict:
+    """`{"wall_seconds": total, "sessions": [...]}` (nothing recorded: 0 and none)."""
     try:
-        return float(json.loads((run_dir / TIMING).read_text())["wall_seconds"])
+        timing = json.loads((run_dir / TIMING).read_text())
+        return {"wall_seconds": float(timing["wall_seconds"]), "sessions": list(timing["sessions"])}
     except (FileNotFoundError, json.JSONDecodeError, KeyError, TypeError, ValueError):
-        return 0.0
+        return {"wall_seconds": 0.0, "sessions": []}
