@@ -8,8 +8,10 @@ from __future__ import annotations
 import time
 
 from hsgplan.agents.base import Decision
+from hsgplan.domain.actions import Pick, Push
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
+from hsgplan.domain.predicates import in_grasp
 from hsgplan.motion.generator import Feasibility, MotionGenerator
 from hsgplan.planning.base import TaskPlanner
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -44,10 +46,17 @@ class HierarchicalAgent:
         if task.action is None:
             return Decision(None, None, task.seconds, 0.0, task.note)
         start = time.perf_counter()
-        params = self.motion.propose(sg, task.action, task.following, feasible)
-        note = "" if params else f"every parameter choice for {task.action} failed"
+        action, subgoal = task.action, task.subgoal
+        params = self.motion.propose(sg, action, task.following, feasible)
+        if params is None and isinstance(action, Push) and sg.held is None:
+            # No push works from where the object stands (a generator that gives up, the
+            # geometric sampler): take it up, so that the task level puts it down elsewhere
+            # in the region, where the generator will not put it again.
+            action, subgoal = Pick(action.obj), in_grasp(action.obj)
+            params = self.motion.propose(sg, action, None, feasible)
+        note = "" if params else f"every parameter choice for {action} failed"
         seconds = time.perf_counter() - start
-        return Decision(task.action, params, task.seconds, seconds, note, task.subgoal)
+        return Decision(action, params, task.seconds, seconds, note, subgoal)
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
         self.motion.observe(params, outcome)

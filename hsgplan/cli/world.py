@@ -27,6 +27,7 @@ AGENT_HELP = "A registered agent: " + "; ".join(
     f"{name} ({planner} + {motion})" for name, (planner, motion) in AGENTS.items()
 )
 ORACLE = AgentName("oracle")
+PAPER = AgentName("paper")
 AgentOption = Annotated[AgentName, typer.Option(help=AGENT_HELP)]
 PlannerOption = Annotated[
     PlannerName | None, typer.Option(help="Task planner in place of the agent's.")
@@ -38,7 +39,7 @@ MotionOption = Annotated[
 
 @refuses_bad_input
 def demo(
-    agent: AgentOption = ORACLE,
+    agent: AgentOption = PAPER,
     planner: PlannerOption = None,
     motion: MotionOption = None,
     goal: Annotated[
@@ -62,17 +63,31 @@ def demo(
     g = parse_goal(goal) if goal else demo_goal(objects, seed)
     if out_dir.exists() and not out_dir.is_dir():
         raise InvalidInputError(f"--out '{out_dir}' is a file")
-    out.print(f"[bold]goal[/] ({g.size} objects, seed {seed}): {g}", highlight=False)
-    with err.status("running the episode"):
-        record = run_demo(agent, g, seed, out_dir)
-    for s in record.steps:
-        out.print(f"{s.step:>2}  {s.params:<55} {s.status}", highlight=False, markup=False)
+    out.print(
+        f"[bold]goal[/] ({g.size} objects, seed {seed}, agent {agent}): {g}",
+        highlight=False,
+        soft_wrap=True,
+    )
+    record = run_demo(agent, g, seed, out_dir, on_step=_print_step)
     verdict = "[green]success[/]" if record.success else f"[red]failed: {record.failure}[/]"
     out.print(
-        f"{verdict} in {len(record.steps)} steps, {record.seconds:.1f} s; "
+        f"{verdict} in {len(record.steps)} steps ({record.seconds:.0f} s with the pictures); "
         f"subgoal completion {record.subgoal_completion:.2f}"
     )
     out.print(f"wrote {out_dir}/episode.gif, {out_dir}/graphs/, {out_dir}/episode.json")
+
+
+def _print_step(s) -> None:
+    times = (
+        f"task {s.task_seconds * 1000:.1f} ms, motion {s.motion_seconds * 1000:.1f} ms, "
+        f"execution {s.execution_seconds:.2f} s"
+    )
+    out.print(
+        f"{s.step:>2}  {s.subgoal:<28} {s.params:<50} {s.status:<12} {times}",
+        highlight=False,
+        markup=False,
+        soft_wrap=True,
+    )
 
 
 @refuses_bad_input

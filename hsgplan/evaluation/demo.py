@@ -1,52 +1,83 @@
-"""One episode with pictures: a GIF from the fixed camera, a drawing of the symbolic scene
-graph at every step, and `episode.json` (seed, goal, actions, outcomes, timings)."""
+"""One episode with pictures: a GIF from two cameras with the current step and subgoal written
+on every frame, a drawing of the symbolic scene graph at every step, and `episode.json` (seed,
+goal, every decision with its subgoal, parameters, outcome and timings)."""
 
 from __future__ import annotations
 
 import json
 import random
+from collections.abc import Callable
 from pathlib import Path
 
 import imageio.v3 as iio
 
+from hsgplan.agents.base import Decision
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import Goal
-from hsgplan.evaluation.episode import EpisodeRecord, run_episode
+from hsgplan.domain.world import MAX_STEPS
+from hsgplan.evaluation.episode import EpisodeRecord, StepRecord, params_text, run_episode
 from hsgplan.sim.env import KitchenStorageEnv
-from hsgplan.sim.render import Camera
+from hsgplan.sim.render import DEMO_VIEWS
 from hsgplan.symbolic.generator import random_goal
+from hsgplan.viz.frames import compose
 from hsgplan.viz.scene_graph_drawing import draw_symbolic
 
-FRAME_EVERY = 6  # arm waypoints between two GIF frames
-HOLD = 4  # frames a step's end state stays on screen
+FRAME_EVERY = 12  # arm waypoints between two GIF frames
+HOLD = 5  # frames a step's end state stays on screen
 
 
 def demo_goal(objects: int, seed: int) -> Goal:
     return random_goal(objects, random.Random(f"demo-{seed}"), stacking=objects > 2)
 
 
-def run_demo(agent_name: str, goal: Goal, seed: int, out: Path) -> EpisodeRecord:
-    """Run the episode and write its pictures and record into `out`."""
+def run_demo(
+    agent_name: str,
+    goal: Goal,
+    seed: int,
+    out: Path,
+    on_step: Callable[[StepRecord], None] | None = None,
+) -> EpisodeRecord:
+    """Run the episode and write its pictures and record into `out`; `on_step` sees every
+    step as soon as it has been executed."""
     out.mkdir(parents=True, exist_ok=True)
     graphs = out / "graphs"
     graphs.mkdir(exist_ok=True)
-    env = KitchenStorageEnv(camera=Camera(width=320, height=240))
+    env = KitchenStorageEnv()
     frames = []
     waypoints = 0
+    caption = ["start", "", f"goal: {goal}"]
+
+    def snapshot():
+        views = [env.render(camera) for _, camera in DEMO_VIEWS]
+        return compose(views, [name for name, _ in DEMO_VIEWS], caption)
 
     def on_frame() -> None:
         nonlocal waypoints
         waypoints += 1
         if waypoints % FRAME_EVERY == 0:
-            frames.append(env.render())
+            frames.append(snapshot())
 
-    def on_step(record, obs) -> None:
-        frames.extend([env.render()] * HOLD)
+    def on_decide(step: int, d: Decision) -> None:
+        caption[:] = [
+            f"step {step} (of at most {MAX_STEPS}): {params_text(d.params)}",
+            f"subgoal: {d.subgoal}",
+            f"goal: {goal}",
+        ]
+
+    def on_step_done(record, obs) -> None:
+        if record is not None:
+            caption[0] += f"  ->  {record.status}"
+        if goal.satisfied_by(obs.symbols.state):
+            caption[0] += "   |   the goal holds"
+        frames.extend([snapshot()] * HOLD)
         k = 0 if record is None else record.step
         title = "start" if record is None else f"step {k}: {record.params} -> {record.status}"
         draw_symbolic(obs.symbols.state, graphs / f"step_{k:02d}.png", title, goal)
+        if record is not None and on_step:
+            on_step(record)
 
-    record = run_episode(env, make_agent(agent_name), goal, seed, on_frame, on_step)
-    iio.imwrite(out / "episode.gif", frames, duration=80, loop=0)
+    agent = make_agent(agent_name)
+    record = run_episode(env, agent, goal, seed, on_frame, on_step_done, on_decide)
+    iio.imwrite(out / "episode.gif", frames, duration=90, loop=0)
     (out / "episode.json").write_text(json.dumps(record.to_json(), indent=2) + "\n")
     return record

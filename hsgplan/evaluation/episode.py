@@ -10,7 +10,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
-from hsgplan.agents.base import Agent
+from hsgplan.agents.base import Agent, Decision
 from hsgplan.domain.goals import Goal
 from hsgplan.evaluation.failures import Failure
 from hsgplan.scene_graph.symbol_mapping import AnomalyKind
@@ -65,8 +65,10 @@ def run_episode(
     seed: int,
     on_frame: Callable[[], None] | None = None,
     on_step: Callable[[StepRecord | None, Observation], None] | None = None,
+    on_decide: Callable[[int, Decision], None] | None = None,
 ) -> EpisodeRecord:
-    """Run one episode; `on_step` sees the start (record None) and every step after it."""
+    """Run one episode; `on_decide` sees each decision (with its step number) before it is
+    executed, `on_step` the start (record None) and every step after it."""
     start = time.perf_counter()
     obs, _ = env.reset(seed, ResetOptions(goal))
     agent.reset(goal, seed)
@@ -86,6 +88,8 @@ def run_episode(
         if d.params is None:
             failure = Failure.NO_SUBGOAL if d.action is None else Failure.NO_PARAMETERS
             break
+        if on_decide:
+            on_decide(len(records) + 1, d)
         obs, _, _, _, info = env.step(d.params, on_frame)
         outcome = info["outcome"]
         agent.observe(d.params, outcome)

@@ -35,8 +35,9 @@ from hsgplan.domain.world import (
     spot_cells,
     surface_rect,
 )
-from hsgplan.motion.generator import Feasibility, SingleShotMemory
+from hsgplan.motion.generator import DO_NOT_RETRY, Feasibility, SingleShotMemory
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.sim.outcome import Outcome
 
 MIN_CLEARANCE = 0.015
 # The Panda hand, measured in PyBullet: about 21 cm long along the finger axis and 6 cm across,
@@ -107,9 +108,14 @@ def _on_rect(sg: GeometricSceneGraph, rect: Rect, ignore: str) -> tuple[list, li
 
 
 def place_candidates(
-    sg: GeometricSceneGraph, obj: str, target: str, next_push: bool = False
+    sg: GeometricSceneGraph,
+    obj: str,
+    target: str,
+    next_push: bool = False,
+    avoid: tuple[tuple[float, float], ...] = (),
 ) -> list[PlaceParams]:
-    """Place bins on a surface, best first; bins too close to other objects are left out.
+    """Place bins on a surface, best first; bins too close to other objects are left out, and
+    so are bins within `AVOID_RADIUS` of a spot in `avoid` (where pushes of `obj` failed).
 
     Bins where the hand would sweep into a taller neighbour (or a tall object would block a
     box's later grasp) go last. Otherwise bins are ranked by how close they come to the centre
@@ -138,7 +144,7 @@ def place_candidates(
                 (max(abs(x - o[0]) - hx - o[2], abs(y - o[1]) - hy - o[3]) for o in others),
                 default=1.0,
             )
-            if gap < MIN_CLEARANCE:
+            if gap < MIN_CLEARANCE or any(math.dist((x, y), a) < AVOID_RADIUS for a in avoid):
                 continue
             # The primitive turns a box a quarter turn when the hand would not fit the
             # other way: blocked means blocked both ways.
@@ -173,19 +179,26 @@ def push_candidates(sg: GeometricSceneGraph, obj: str, shelf: str) -> list[PushP
 
 
 def candidates(
-    sg: GeometricSceneGraph, action: Action, following: Action | None = None
+    sg: GeometricSceneGraph,
+    action: Action,
+    following: Action | None = None,
+    avoid: tuple[tuple[float, float], ...] = (),
 ) -> list[PrimitiveParams]:
-    """Every parameter choice for a symbolic action, best first."""
+    """Every parameter choice for a symbolic action, best first (`avoid`: spots where pushes
+    of the object failed, left out of a place that a push follows)."""
     if isinstance(action, Pick):
         return [PickParams(action.obj)]
     if isinstance(action, Place):
         next_push = (
             isinstance(following, Push) and action.target == SHELVES[following.shelf].prepush
         )
-        return list(place_candidates(sg, action.obj, action.target, next_push))
+        spots = avoid if next_push else ()
+        return list(place_candidates(sg, action.obj, action.target, next_push, spots))
     return list(push_candidates(sg, action.obj, action.shelf))
 
 
+# A place before a push stays this far from where a push of the object failed (m).
+AVOID_RADIUS = 0.04
 # Candidates dry-run per decision before the best-ranked one is tried regardless.
 MAX_CHECKS = 30
 
@@ -193,9 +206,28 @@ MAX_CHECKS = 30
 class GeometricSampler(SingleShotMemory):
     """The best-ranked candidate that passes a dry run (at most `MAX_CHECKS` are checked) and
     has not failed for good in this scene; without a dry run, the best-ranked one. None when
-    every candidate has failed here (the oracle's episode ends: no parameters)."""
+    every candidate has failed here.
+
+    Where a push failed for good it remembers the spot the object stood on, and a later place
+    of that object before a push puts it elsewhere: an agent whose push has no parameters left
+    takes the object up again (`agents/hierarchical.py`) and the region gets another try."""
 
     name = "sampler"
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.reset(0)
+
+    def reset(self, seed: int) -> None:
+        super().reset(seed)
+        self.push_failed_at: dict[str, list[tuple[float, float]]] = {}
+        self._sg: GeometricSceneGraph | None = None
+
+    def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
+        super().observe(params, outcome)
+        if isinstance(params, PushParams) and outcome.status in DO_NOT_RETRY and self._sg:
+            x, y, _ = self._sg.pose(params.obj).position
+            self.push_failed_at.setdefault(params.obj, []).append((x, y))
 
     def propose(
         self,
@@ -204,7 +236,9 @@ class GeometricSampler(SingleShotMemory):
         following: Action | None = None,
         feasible: Feasibility | None = None,
     ) -> PrimitiveParams | None:
-        options = self.untried(sg, candidates(sg, action, following))
+        self._sg = sg
+        avoid = tuple(self.push_failed_at.get(action.obj, ()))
+        options = self.untried(sg, candidates(sg, action, following, avoid))
         return next(
             (c for c in options[:MAX_CHECKS] if feasible is None or feasible(c)),
             options[0] if options else None,

@@ -95,10 +95,11 @@ class KitchenStorageEnv:
         self._checked[action] = (plan, time.perf_counter() - start)
         return True
 
-    def render(self) -> np.ndarray:
+    def render(self, camera: Camera | None = None) -> np.ndarray:
+        """An RGB image from `camera` (default: the env's fixed camera)."""
         if self.scene is None:
             raise RuntimeError("call reset() before render()")
-        return self.camera.capture(self.scene.bc)
+        return (camera or self.camera).capture(self.scene.bc)
 
     def close(self) -> None:
         if self.scene is not None:

@@ -132,3 +132,33 @@ def test_a_pick_that_failed_is_offered_again_for_the_task_level_to_judge():
     pick = motion.propose(sg, Pick(obj))
     motion.observe(pick, Outcome(Status.NO_IK, "", 0.0))
     assert motion.propose(sg, Pick(obj)) == pick  # its only choice: single shot, no None
+
+
+def test_a_push_with_no_parameters_left_takes_the_object_up_to_put_it_elsewhere():
+    # the oracle's recovery: no push works from where the can stands, so it is picked up and
+    # the next place before a push keeps away from that spot
+    from hsgplan.domain.objects import object_type
+    from hsgplan.motion.sampler import AVOID_RADIUS, GeometricSampler, place_xy
+    from hsgplan.scene_graph.geometric import GeometricSceneGraph
+    from hsgplan.scene_graph.geometry import Pose
+
+    can, spot = "alphabet_soup", (0.30, 0.38)
+    standing = GeometricSceneGraph.from_poses(
+        {can: Pose.from_xyz_yaw(*spot, object_type(can).height / 2, 0.0)}
+    )
+    push = TaskDecision(Push(can, "shelf_a"), inside(can, "shelf_a"), 0.001)
+    sampler = GeometricSampler()
+    agent = HierarchicalAgent("test", _Script([push] * 12), sampler)
+    goal = parse_goal(f"In({can}, shelf_a)")
+    agent.reset(goal, 0)
+    state = SymbolicSceneGraph.initial(standing.objects)
+    tried = []
+    while isinstance((d := agent.decide(standing, state, goal)).params, PushParams):
+        tried.append(d.params)
+        agent.observe(d.params, Outcome(Status.NO_PATH, "the hand would hit something", 0.0))
+    assert tried and len(set(tried)) == len(tried)  # every push once
+    assert d.action == Pick(can) and d.params == PickParams(can) and d.subgoal == in_grasp(can)
+    held = GeometricSceneGraph(standing.nodes, held=can)
+    place = sampler.propose(held, Place(can, "prepush_a"), Push(can, "shelf_a"))
+    x, y = place_xy(can, "prepush_a", place.x_bin, place.y_bin)
+    assert ((x - spot[0]) ** 2 + (y - spot[1]) ** 2) ** 0.5 >= AVOID_RADIUS

@@ -2,6 +2,7 @@
 
 import json
 
+import imageio.v3 as iio
 import pytest
 from typer.testing import CliRunner
 
@@ -97,8 +98,15 @@ def test_demo_writes_pictures_and_a_record(tmp_path):
     r = CliRunner().invoke(app, ["demo", "--objects", "2", "--seed", "1", "--out", str(out)])
     assert r.exit_code == 0, r.output
     assert (out / "episode.gif").stat().st_size > 10_000
+    first = iio.imread(out / "episode.gif", index=0)
+    assert first.shape[0] >= 480 and first.shape[1] >= 640  # two 640 x 480 views, a caption
     record = json.loads((out / "episode.json").read_text())
     assert record["seed"] == 1 and record["size"] == 2
+    assert record["agent"] == "paper"  # the paper's agent: regression planner, motion GNN
+    # every decision printed with its subgoal, parameters and outcome
+    lines = r.stdout.splitlines()
+    for s in record["steps"]:
+        assert any(s["subgoal"] in x and s["params"] in x and s["status"] in x for x in lines)
     graphs = sorted((out / "graphs").glob("step_*.png"))
     assert len(graphs) == len(record["steps"]) + 1
 
