@@ -108,6 +108,10 @@ BAD = [
     (["eval", "--goals", "many"], "valid integer"),
     (["eval-task", "--planner", "wizard"], "'wizard' is not one of 'regression'"),
     (["eval-motion", "--workers", "0"], "at least one"),
+    (["bench", "timing", "--goals", "0"], "at least one goal"),
+    (["bench", "timing", "--sizes", "1-3"], "between 2 and 12"),
+    (["bench", "timing", "--workers", "0"], "at least one"),
+    (["eval", "--agent", "search", "--motion", "gnn"], "no task planner or motion generator"),
 ]
 
 

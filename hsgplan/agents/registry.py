@@ -1,7 +1,8 @@
 """Agents, task planners and motion generators by name, as the CLI offers them.
 
 An agent is a task planner and a motion generator (`HierarchicalAgent`). The registered agents
-are named pairs; any other pair is asked for as `PLANNER+MOTION` (`regression+gnn`). Shipped
+are named pairs; any other pair is asked for as `PLANNER+MOTION` (`regression+gnn`). The
+search-based baseline plans both levels together and is an agent of its own (`search`). Shipped
 checkpoints are found as `hsgplan.paths` finds them, wherever the command runs.
 """
 
@@ -15,7 +16,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
 
 if TYPE_CHECKING:  # the names are read by the CLI's --help, which should not load torch
-    from hsgplan.agents.hierarchical import HierarchicalAgent
+    from hsgplan.agents.base import Agent
     from hsgplan.motion.generator import MotionGenerator
     from hsgplan.planning.base import TaskPlanner
 
@@ -84,6 +85,12 @@ AGENTS: dict[str, tuple[str, str]] = {
     "paper": ("regression", "gnn"),  # the paper's system: both levels learned
 }
 
+# agents that are not a task planner beside a motion generator: name -> what it is
+WHOLE_AGENTS: dict[str, str] = {
+    "search": "Fast Downward's plan refined by sampling and simulating, backtracking",
+}
+AGENT_NAMES = [*AGENTS, *WHOLE_AGENTS]
+
 
 def _known(what: str, name: str, names) -> None:
     if name not in names:
@@ -103,6 +110,12 @@ def make_motion(name: str, checkpoints: Path = MOTION_CHECKPOINTS) -> MotionGene
 def agent_name(agent: str, planner: str | None = None, motion: str | None = None) -> str:
     """The agent a command asks for: a registered one, with its planner or its motion
     generator replaced where `planner` or `motion` is given."""
+    if agent in WHOLE_AGENTS:
+        if planner or motion:
+            raise InvalidInputError(
+                f"the agent '{agent}' has no task planner or motion generator to replace"
+            )
+        return agent
     if planner is None and motion is None:
         agent_parts(agent)
         return agent
@@ -117,16 +130,23 @@ def agent_parts(name: str) -> tuple[str, str]:
         _known("task planner", planner, TASK_PLANNERS)
         _known("motion generator", motion, MOTION_GENERATORS)
         return planner, motion
-    _known("agent", name, list(AGENTS) + ["PLANNER+MOTION"])
+    _known("agent", name, AGENT_NAMES + ["PLANNER+MOTION"])
+    if name in WHOLE_AGENTS:
+        raise InvalidInputError(f"the agent '{name}' is not a task planner and a motion generator")
     return AGENTS[name]
 
 
 def make_agent(
     name: str, checkpoint: Path = TASK_CHECKPOINT, motion_checkpoints: Path = MOTION_CHECKPOINTS
-) -> HierarchicalAgent:
+) -> Agent:
     """An agent by name, its learned parts from these checkpoint folders; an unknown name or a
     missing checkpoint is refused in one line."""
     from hsgplan.agents.hierarchical import HierarchicalAgent
+
+    if name in WHOLE_AGENTS:
+        from hsgplan.agents.search import SearchAgent
+
+        return SearchAgent()
 
     planner, motion = agent_parts(name)
     return HierarchicalAgent(

@@ -1,6 +1,6 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
-One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval), `data`
+One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval, report), `data`
 (collect), `learn` (train task, eval-task, eval-reach), `motion` (train motion, eval-motion),
 `bench`.
 """
@@ -24,6 +24,7 @@ app.command()(symbolic.plan)
 app.command()(symbolic.goals)
 app.command()(world.demo)
 app.command("eval")(world.evaluate)
+app.command()(world.report)
 app.add_typer(bench.app, name="bench")
 app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")

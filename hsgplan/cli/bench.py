@@ -9,8 +9,9 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import err, parse_sizes, print_table, refuses_bad_input
-from hsgplan.paths import TASK_CHECKPOINT
+from hsgplan.cli.common import err, out, parse_sizes, print_table, refuses_bad_input
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.paths import RUNS, TASK_CHECKPOINT
 
 app = typer.Typer(no_args_is_help=True, help="Measure speed (medians over one run).")
 
@@ -130,6 +131,54 @@ def bench_task(
         cells,
         markdown,
     )
+
+
+@app.command("timing")
+@refuses_bad_input
+def bench_timing(
+    sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6,8,10",
+    goals: Annotated[int, typer.Option(help="Goals per size, the same for both agents.")] = 10,
+    seed: Annotated[int, typer.Option(help="Seed of the goals and the episodes.")] = 0,
+    workers: Annotated[
+        int, typer.Option(help="Episodes side by side (1: nothing competes for the core).")
+    ] = 1,
+    run_dir: Annotated[
+        Path | None,
+        typer.Option("--out", help="Run folder (resumed if it exists; default runs/NAME)."),
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """The paper's Table 2: task-planning and motion seconds per episode, ours (regression +
+    GNN) against the search-based baseline, on the same goals; writes table2.md, table2.png
+    and summary.json into the run folder."""
+    from hsgplan.agents.registry import make_agent
+    from hsgplan.benchmarks.timing import AGENTS, run_timing, tables, total_episodes
+
+    if workers < 1:
+        raise InvalidInputError(f"--workers {workers}: need at least one")
+    if goals < 1:
+        raise InvalidInputError(f"--goals {goals}: need at least one goal per size")
+    size_list = parse_sizes(sizes)
+    for agent in AGENTS.values():  # a missing checkpoint is refused before any work
+        make_agent(agent)
+    folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}"
+    if folder.exists() and not folder.is_dir():
+        raise InvalidInputError(f"--out '{folder}' is a file")
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task("ours, search", total=total_episodes(size_list, goals, seed))
+        report = run_timing(
+            size_list, goals, seed, folder, workers, lambda r: progress.advance(task)
+        )
+    if as_json:
+        print(json.dumps(report, indent=2))
+        return
+    for t in tables(report):
+        print_table(t.title, t.header, [list(r) for r in t.rows], markdown)
+    if not markdown:
+        out.print(f"wrote {folder}/table2.md, table2.png, summary.json", highlight=False)
 
 
 @app.command("collect")

@@ -13,7 +13,7 @@ from rich.console import Console
 from rich.table import Table
 from typer.core import TyperGroup
 
-from hsgplan.agents.registry import AGENTS, MOTION_GENERATORS, TASK_PLANNERS
+from hsgplan.agents.registry import AGENT_NAMES, MOTION_GENERATORS, TASK_PLANNERS
 from hsgplan.domain.errors import InvalidInputError
 
 out = Console()
@@ -66,7 +66,7 @@ def choice(what: str, names) -> type[StrEnum]:
     return StrEnum(what, {name: name for name in names})
 
 
-AgentName = choice("AgentName", AGENTS)
+AgentName = choice("AgentName", AGENT_NAMES)
 PlannerName = choice("PlannerName", TASK_PLANNERS)
 MotionName = choice("MotionName", MOTION_GENERATORS)
 

@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.agents.registry import AGENTS, agent_name
+from hsgplan.agents.registry import AGENTS, WHOLE_AGENTS, agent_name
 from hsgplan.cli.common import (
     AgentName,
     MotionName,
@@ -24,7 +24,8 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import RUNS, shipped
 
 AGENT_HELP = "A registered agent: " + "; ".join(
-    f"{name} ({planner} + {motion})" for name, (planner, motion) in AGENTS.items()
+    [f"{name} ({planner} + {motion})" for name, (planner, motion) in AGENTS.items()]
+    + [f"{name} ({what})" for name, what in WHOLE_AGENTS.items()]
 )
 ORACLE = AgentName("oracle")
 PAPER = AgentName("paper")
@@ -176,3 +177,26 @@ def _run_name(methods, config) -> str:
     sizes = "-".join(map(str, config.sizes))
     agents = "_".join(m.agent for m in methods)
     return f"eval-{agents}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}"
+
+
+@refuses_bad_input
+def report(
+    run_dir: Annotated[Path, typer.Argument(help="An eval run folder (holding summary.json).")],
+    failures: Annotated[
+        int, typer.Option(help="Failed episodes re-simulated and shown, GIF and graphs.")
+    ] = 6,
+) -> None:
+    """One self-contained HTML page for an eval run: its tables and plot, and failed episodes
+    re-simulated from their seeds (a GIF with each decision, the scene graphs around the
+    failing step). Writes RUN_DIR/report.html."""
+    from hsgplan.evaluation.report import build_report, read_summary, sample_failures
+
+    if failures < 0:
+        raise InvalidInputError(f"--failures {failures}: cannot be negative")
+    summary = read_summary(run_dir)
+    total = len(sample_failures(run_dir, list(summary["methods"]), failures))
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task("re-simulating failed episodes", total=total)
+        path = build_report(run_dir, failures, lambda r: progress.advance(task))
+    size = path.stat().st_size / 1e6
+    out.print(f"wrote {path} ({size:.1f} MB)", highlight=False)

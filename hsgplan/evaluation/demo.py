@@ -10,8 +10,10 @@ from collections.abc import Callable
 from pathlib import Path
 
 import imageio.v3 as iio
+import numpy as np
+from PIL import Image
 
-from hsgplan.agents.base import Decision
+from hsgplan.agents.base import Agent, Decision
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.world import MAX_STEPS
@@ -31,14 +33,22 @@ def demo_goal(objects: int, seed: int) -> Goal:
 
 
 def run_demo(
-    agent_name: str,
+    agent: str | Agent,
     goal: Goal,
     seed: int,
     out: Path,
     on_step: Callable[[StepRecord], None] | None = None,
+    scale: float = 1.0,
+    frame_every: int = FRAME_EVERY,
 ) -> EpisodeRecord:
     """Run the episode and write its pictures and record into `out`; `on_step` sees every
-    step as soon as it has been executed."""
+    step as soon as it has been executed.
+
+    Args:
+        agent: a registered agent's name (its shipped checkpoints), or the agent itself.
+        scale: the GIF's frames at this fraction of their size (a report keeps them small).
+        frame_every: arm waypoints between two frames.
+    """
     out.mkdir(parents=True, exist_ok=True)
     graphs = out / "graphs"
     graphs.mkdir(exist_ok=True)
@@ -49,12 +59,17 @@ def run_demo(
 
     def snapshot():
         views = [env.render(camera) for _, camera in DEMO_VIEWS]
-        return compose(views, [name for name, _ in DEMO_VIEWS], caption)
+        frame = compose(views, [name for name, _ in DEMO_VIEWS], caption)
+        if scale == 1.0:
+            return frame
+        h, w, _ = frame.shape
+        small = Image.fromarray(frame).resize((round(w * scale), round(h * scale)), Image.LANCZOS)
+        return np.asarray(small)
 
     def on_frame() -> None:
         nonlocal waypoints
         waypoints += 1
-        if waypoints % FRAME_EVERY == 0:
+        if waypoints % frame_every == 0:
             frames.append(snapshot())
 
     def on_decide(step: int, d: Decision) -> None:
@@ -76,7 +91,8 @@ def run_demo(
         if record is not None and on_step:
             on_step(record)
 
-    agent = make_agent(agent_name)
+    if isinstance(agent, str):
+        agent = make_agent(agent)
     record = run_episode(env, agent, goal, seed, on_frame, on_step_done, on_decide)
     iio.imwrite(out / "episode.gif", frames, duration=90, loop=0)
     (out / "episode.json").write_text(json.dumps(record.to_json(), indent=2) + "\n")

@@ -84,7 +84,7 @@ def run_episode(
         if env.steps >= env.max_steps:
             failure = Failure.OVERSTEP
             break
-        d = agent.decide(obs.scene_graph, obs.symbols.state, goal, feasible=env.check)
+        d = agent.decide(obs.scene_graph, obs.symbols.state, goal, feasible=env.lookahead)
         if d.params is None:
             failure = Failure.NO_SUBGOAL if d.action is None else Failure.NO_PARAMETERS
             break

@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import tempfile
 import time
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import unified_planning as up
@@ -84,15 +85,16 @@ class FastDownwardPlanner:
             name="fast-downward", params={"fast_downward_search_config": SATISFICING_SEARCH}
         )
 
-    def plan(self, state: SymbolicSceneGraph, goal: Goal) -> Plan:
-        """Plan from the state to the goal; every step is replayed in the transition model."""
+    def plan(self, state: SymbolicSceneGraph, goal: Goal, banned: Iterable[Action] = ()) -> Plan:
+        """Plan from the state to the goal, using none of the `banned` ground actions; every
+        step is replayed in the transition model."""
         start = time.perf_counter()
         missing = [o for o in goal.objects if o not in state.objects]
         if missing:
             raise InvalidInputError(f"the goal names '{missing[0]}', which is not in the scene")
         if goal.satisfied_by(state):
             return Plan((), (state,), time.perf_counter() - start, self.name)
-        problem = build_problem(state, goal).problem
+        problem = build_problem(state, goal, banned).problem
         optimal = self._optimal_for(state)
         # Fast Downward's driver writes `output.sas` into the working directory: planners
         # running side by side (test workers, data-collection pools) must not share one.

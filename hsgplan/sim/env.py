@@ -18,6 +18,7 @@ from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
+from hsgplan.sim.lookahead import Lookahead
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
 from hsgplan.sim.outcome import Outcome
 from hsgplan.sim.primitives import execute
@@ -60,6 +61,8 @@ class KitchenStorageEnv:
         self.goal: Goal | None = None
         self.steps = 0
         self._checked: dict[PrimitiveParams, tuple[MotionPlan, float]] = {}
+        # dry runs (as a feasibility check) and trials of whole plans, for agents that look ahead
+        self.lookahead = Lookahead(lambda: self.scene, self.check)
 
     def reset(self, seed: int, options: ResetOptions) -> tuple[Observation, dict]:
         self.close()

@@ -11,6 +11,7 @@ the object below; `decode` maps the grounded actions back to `Pick` / `Place` / 
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from unified_planning.model import Fluent, InstantaneousAction, Object, Problem
@@ -54,7 +55,12 @@ MAXLEVEL = Fluent("maxlevel", _B, n=NUM)
 CARRIER = Fluent("carrier", _B, o=OBJ)
 FITS = Fluent("fits", _B, o=OBJ, s=SHELF)
 PREPUSH = Fluent("prepush", _B, r=REGION, s=SHELF)
+# Ground actions a search-based planner has found no motion for, left out of its next plan.
+BANNED_PICK = Fluent("banned_pick", _B, o=OBJ)
+BANNED_PLACE = Fluent("banned_place", _B, o=OBJ, x=ENTITY)
+BANNED_PUSH = Fluent("banned_push", _B, o=OBJ, s=SHELF)
 FLUENTS = (ON, INSIDE, INGRASP, CLEAR, HANDEMPTY, COUNT, ICOUNT, LEVEL)
+BANS = (BANNED_PICK, BANNED_PLACE, BANNED_PUSH)
 STATICS = (SUCC, CAP, ICAP, MAXLEVEL, CARRIER, FITS, PREPUSH)
 
 MAX_NUM = max(max(SURFACE_CAPACITY.values()), max(INTERIOR_CAPACITY.values()), MAX_TOWER_LEVELS)
@@ -62,10 +68,15 @@ NUMS = [Object(f"n{i}", NUM) for i in range(MAX_NUM + 1)]
 N1 = NUMS[1]
 
 
-def _actions() -> list[InstantaneousAction]:
+def _actions(bans: bool = False) -> list[InstantaneousAction]:
+    """The domain's actions; with `bans`, each also requires its ground action not banned."""
+
+    def allowed(fluent, *args) -> list:
+        return [Not(fluent(*args))] if bans else []
+
     pick_s = InstantaneousAction("pick_from_surface", o=OBJ, s=SURFACE, n=NUM, m=NUM)
     o, s, n, m = pick_s.parameters
-    for c in (ON(o, s), CLEAR(o), HANDEMPTY, COUNT(s, m), SUCC(n, m)):
+    for c in (ON(o, s), CLEAR(o), HANDEMPTY, COUNT(s, m), SUCC(n, m), *allowed(BANNED_PICK, o)):
         pick_s.add_precondition(c)
     for f, v in (
         (ON(o, s), False),
@@ -80,7 +91,7 @@ def _actions() -> list[InstantaneousAction]:
 
     pick_o = InstantaneousAction("pick_from_object", o=OBJ, b=OBJ, k=NUM)
     o, b, k = pick_o.parameters
-    for c in (ON(o, b), CLEAR(o), HANDEMPTY, LEVEL(o, k)):
+    for c in (ON(o, b), CLEAR(o), HANDEMPTY, LEVEL(o, k), *allowed(BANNED_PICK, o)):
         pick_o.add_precondition(c)
     for f, v in (
         (ON(o, b), False),
@@ -94,7 +105,7 @@ def _actions() -> list[InstantaneousAction]:
 
     place_s = InstantaneousAction("place_on_surface", o=OBJ, s=SURFACE, n=NUM, m=NUM)
     o, s, n, m = place_s.parameters
-    for c in (INGRASP(o), COUNT(s, n), SUCC(n, m), CAP(s, m)):
+    for c in (INGRASP(o), COUNT(s, n), SUCC(n, m), CAP(s, m), *allowed(BANNED_PLACE, o, s)):
         place_s.add_precondition(c)
     for f, v in (
         (ON(o, s), True),
@@ -109,7 +120,15 @@ def _actions() -> list[InstantaneousAction]:
 
     place_o = InstantaneousAction("place_on_object", o=OBJ, b=OBJ, k=NUM, k2=NUM)
     o, b, k, k2 = place_o.parameters
-    for c in (INGRASP(o), CLEAR(b), CARRIER(b), LEVEL(b, k), SUCC(k, k2), MAXLEVEL(k2)):
+    for c in (
+        INGRASP(o),
+        CLEAR(b),
+        CARRIER(b),
+        LEVEL(b, k),
+        SUCC(k, k2),
+        MAXLEVEL(k2),
+        *allowed(BANNED_PLACE, o, b),
+    ):
         place_o.add_precondition(c)
     for f, v in (
         (ON(o, b), True),
@@ -134,6 +153,7 @@ def _actions() -> list[InstantaneousAction]:
         ICOUNT(s, p),
         SUCC(p, q),
         ICAP(s, q),
+        *allowed(BANNED_PUSH, o, s),
     ):
         push.add_precondition(c)
     for f, v in (
@@ -151,6 +171,7 @@ def _actions() -> list[InstantaneousAction]:
 
 
 ACTIONS = _actions()
+ACTIONS_WITH_BANS = _actions(bans=True)
 
 
 @dataclass(frozen=True)
@@ -161,12 +182,15 @@ class PddlProblem:
     entities: dict[str, Object]
 
 
-def build_problem(state: SymbolicSceneGraph, goal: Goal) -> PddlProblem:
-    """The planning problem of reaching `goal` from `state`."""
+def build_problem(
+    state: SymbolicSceneGraph, goal: Goal, banned: Iterable[Action] = ()
+) -> PddlProblem:
+    """The planning problem of reaching `goal` from `state` without any `banned` action."""
+    banned = tuple(banned)
     problem = Problem("kitchen_storage")
-    for f in FLUENTS + STATICS:
+    for f in FLUENTS + STATICS + (BANS if banned else ()):
         problem.add_fluent(f, default_initial_value=False)
-    for a in ACTIONS:
+    for a in ACTIONS_WITH_BANS if banned else ACTIONS:
         problem.add_action(a)
     ents: dict[str, Object] = {o: Object(o, OBJ) for o in state.objects}
     ents |= {r: Object(r, REGION) for r in REGIONS}
@@ -199,6 +223,8 @@ def build_problem(state: SymbolicSceneGraph, goal: Goal) -> PddlProblem:
         init(HANDEMPTY, True)
     for lit in state.literals:
         init(_fluent(lit, ents), True)
+    for a in banned:
+        init(_ban(a, ents), True)
     for lit in goal.literals:
         expr = _fluent(lit, ents)
         problem.add_goal(expr if lit.positive else Not(expr))
@@ -213,6 +239,14 @@ def _fluent(lit: Literal, ents: dict[str, Object]):
         Predicate.CLEAR: CLEAR,
     }[lit.predicate]
     return fluent(*(ents[a] for a in lit.args))
+
+
+def _ban(action: Action, ents: dict[str, Object]):
+    if isinstance(action, Pick):
+        return BANNED_PICK(ents[action.obj])
+    if isinstance(action, Place):
+        return BANNED_PLACE(ents[action.obj], ents[action.target])
+    return BANNED_PUSH(ents[action.obj], ents[action.shelf])
 
 
 def decode(name: str, args: list[str]) -> Action:

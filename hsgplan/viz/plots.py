@@ -50,3 +50,37 @@ def plot_success_by_size(
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def plot_times_by_size(series: dict[str, dict[str, dict[int, float]]], path: Path) -> None:
+    """Seconds per episode by problem size on a log scale, task planning (left) and motion
+    (right), one colour per solver.
+
+    Args:
+        series: solver -> level ("task" / "motion") -> size -> seconds.
+        path: where the PNG goes.
+    """
+    fig, axes = plt.subplots(1, 2, figsize=(9.6, 4.0), dpi=120, sharey=True)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for ax, level in zip(axes, ("task", "motion"), strict=True):
+        for k, (solver, levels) in enumerate(series.items()):
+            by_size = levels[level]
+            sizes = sorted(by_size)
+            dashed = "(paper)" in solver
+            ax.plot(
+                sizes,
+                [max(by_size[n], 1e-5) for n in sizes],
+                color=colours[k % len(colours)],
+                linestyle="--" if dashed else "-",
+                marker="x" if dashed else "o",
+                label=solver,
+            )
+        ax.set_yscale("log")
+        ax.set_xlabel("objects in the goal")
+        ax.set_title(f"{level} seconds per episode")
+        ax.grid(alpha=0.3, which="both")
+    axes[0].set_ylabel("seconds (log scale)")
+    axes[1].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)

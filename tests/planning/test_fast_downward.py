@@ -4,6 +4,7 @@ import random
 
 import pytest
 
+from hsgplan.domain.actions import Place
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.predicates import inside, on
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
@@ -65,6 +66,25 @@ def test_known_plan():
         "place(tomato_soup, prepush_a)",
         "push(tomato_soup, shelf_a)",
     ]
+
+
+def test_banned_actions_are_left_out_of_the_plan():
+    # butter must go somewhere before cream_cheese can be picked: banning where it went gives
+    # a plan that puts it elsewhere
+    start = SymbolicSceneGraph.from_literals(
+        ["cream_cheese", "butter"], [on("cream_cheese", "open_space"), on("butter", "cream_cheese")]
+    )
+    goal = parse_goal("On(cream_cheese, shelf_b)")
+    planner = FastDownwardPlanner(optimal=True)
+    first = planner.plan(start, goal)
+    away = next(a for a in first.actions if isinstance(a, Place) and a.obj == "butter")
+    second = planner.plan(start, goal, banned=[away])
+    assert away not in second.actions
+    assert any(isinstance(a, Place) and a.obj == "butter" for a in second.actions)
+    replay(second, start, goal)
+    # no plan reaches the goal without the action it names
+    with pytest.raises(NoPlanError, match="no sequence"):
+        planner.plan(start, goal, banned=[Place("cream_cheese", "shelf_b")])
 
 
 def test_goal_already_true_needs_no_plan():

@@ -1,0 +1,160 @@
+"""The paper's Table 2: seconds of task planning and of motion per episode, our agent
+(the learned regression planner and the motion GNN) against the search-based baseline
+(`agents/search.py`), in one run and on the same goals and start scenes.
+
+Each agent's episodes go into a run folder of its own (`ours/`, `search/`), resumable as every
+evaluation is; `table2.md`, `table2.png` and `summary.json` are written beside them. Times per
+episode are sums over its steps: the task level's seconds, and the motion level's (choosing
+parameters, the search's trials of its plans included, and executing them).
+"""
+
+from __future__ import annotations
+
+import json
+import statistics
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from pathlib import Path
+
+from hsgplan.evaluation.episode import EpisodeRecord
+from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation
+from hsgplan.evaluation.table1 import TextTable
+from hsgplan.viz.plots import plot_times_by_size
+
+# Table 2 of the paper (seconds per episode: task, motion), by solver and size.
+PAPER_TABLE2: dict[str, dict[int, tuple[float, float]]] = {
+    "pddlstream": {
+        2: (127.9, 23.5),
+        3: (251.7, 35.7),
+        4: (251.2, 62.9),
+        5: (322.2, 107.0),
+        6: (424.2, 276.9),
+    },
+    "paper": {2: (0.15, 18.1), 3: (0.13, 27.2), 4: (0.22, 36.5), 5: (0.29, 42.9), 6: (0.32, 49.4)},
+}
+# column -> registered agent
+AGENTS = {"ours": "paper", "search": "search"}
+LABELS = {
+    "ours": "ours",
+    "search": "search",
+    "pddlstream": "PDDLStream (paper)",
+    "paper": "theirs (paper)",
+}
+
+
+def _quartiles(values: list[float]) -> dict[str, float]:
+    if len(values) == 1:
+        return {"median": values[0], "q1": values[0], "q3": values[0]}
+    q1, median, q3 = statistics.quantiles(values, n=4, method="inclusive")
+    return {"median": median, "q1": q1, "q3": q3}
+
+
+def timing_summary(records: Sequence[EpisodeRecord]) -> dict:
+    """Medians and quartiles of an agent's seconds per episode, and its success rate."""
+    task = [sum(s.task_seconds for s in r.steps) for r in records]
+    motion = [sum(s.motion_seconds + s.execution_seconds for s in r.steps) for r in records]
+    t, m = _quartiles(task), _quartiles(motion)
+    return {
+        "task_s": t["median"],
+        "task_q1": t["q1"],
+        "task_q3": t["q3"],
+        "motion_s": m["median"],
+        "motion_q1": m["q1"],
+        "motion_q3": m["q3"],
+        "success_rate": sum(r.success for r in records) / len(records),
+        "episodes": len(records),
+    }
+
+
+def run_timing(
+    sizes: Sequence[int],
+    goals: int,
+    seed: int,
+    out: Path,
+    workers: int = 1,
+    on_episode: Callable[[EpisodeRecord], None] | None = None,
+) -> dict:
+    """Both agents' episodes into `out/AGENT/`; the summary, also written as `summary.json`,
+    `table2.md` and `table2.png` in `out`.
+
+    `{"by_size": {"2": {"ours": {"task_s", "motion_s", "success_rate", ...}, "search": {...}}}}`
+    """
+    config = EvalConfig("", tuple(sizes), goals, seed)
+    records = {
+        key: run_evaluation(replace(config, agent=agent), out / key, workers, on_episode)
+        for key, agent in AGENTS.items()
+    }
+    report = {
+        "by_size": {
+            str(n): {k: timing_summary([r for r in rs if r.size == n]) for k, rs in records.items()}
+            for n in sorted(set(sizes))
+        },
+        "goals": goals,
+        "seed": seed,
+        "workers": workers,
+        "run": str(out),
+    }
+    (out / "summary.json").write_text(json.dumps(report, indent=2) + "\n")
+    (out / "table2.md").write_text("\n\n".join(t.markdown() for t in tables(report)) + "\n")
+    plot_times_by_size(_series(report), out / "table2.png")
+    return report
+
+
+def total_episodes(sizes: Sequence[int], goals: int, seed: int) -> int:
+    return len(AGENTS) * len(episode_specs(EvalConfig("", tuple(sizes), goals, seed)))
+
+
+def _series(report: dict) -> dict[str, dict[str, dict[int, float]]]:
+    """label -> level ("task" / "motion") -> size -> median seconds, ours and the paper's."""
+    series: dict[str, dict[str, dict[int, float]]] = {}
+    for n, by_agent in report["by_size"].items():
+        for k, v in by_agent.items():
+            s = series.setdefault(LABELS[k], {"task": {}, "motion": {}})
+            s["task"][int(n)], s["motion"][int(n)] = v["task_s"], v["motion_s"]
+    for k, by_size in PAPER_TABLE2.items():
+        series[LABELS[k]] = {
+            "task": {n: t for n, (t, _) in by_size.items()},
+            "motion": {n: m for n, (_, m) in by_size.items()},
+        }
+    return series
+
+
+def _seconds(v: dict, level: str) -> str:
+    return f"{v[f'{level}_s']:.3g} ({v[f'{level}_q1']:.3g}–{v[f'{level}_q3']:.3g})"
+
+
+def tables(report: dict) -> list[TextTable]:
+    rows = []
+    for n, v in report["by_size"].items():
+        ours, search = v["ours"], v["search"]
+        paper = {k: PAPER_TABLE2[k].get(int(n)) for k in PAPER_TABLE2}
+        ratio = search["task_s"] / ours["task_s"] if ours["task_s"] > 0 else float("inf")
+        rows.append(
+            (
+                n,
+                _seconds(search, "task"),
+                _seconds(search, "motion"),
+                _seconds(ours, "task"),
+                _seconds(ours, "motion"),
+                f"{ratio:,.0f}×",
+                f"{search['success_rate']:.2f} / {ours['success_rate']:.2f}",
+                *(f"{p[0]:g} / {p[1]:g}" if p else "—" for p in paper.values()),
+            )
+        )
+    header = (
+        "objects",
+        "search task s",
+        "search motion s",
+        "ours task s",
+        "ours motion s",
+        "task speed-up",
+        "success search / ours",
+        "PDDLStream task / motion (paper)",
+        "theirs task / motion (paper)",
+    )
+    title = (
+        f"Seconds per episode, median (quartiles), {report['goals']} goals per size, seed "
+        f"{report['seed']}, {report['workers']} worker(s): the search baseline against ours, "
+        "beside the paper's Table 2"
+    )
+    return [TextTable(title, header, tuple(rows))]

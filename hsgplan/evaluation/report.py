@@ -1,0 +1,193 @@
+"""`hsgplan report RUN_DIR`: an `eval` run folder as one self-contained HTML page.
+
+The page holds the run's tables (results beside the paper's, the failure taxonomy, the time
+per level), its plot, and for a sample of failed episodes a GIF of the rollout, re-simulated
+from the episode's seed with each decision written on the frame, with the symbolic scene
+graphs before and after the failing step. Rollouts are kept in `RUN_DIR/report/` as they are
+made: a report interrupted and started again makes only those still missing.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.goals import parse_goal
+from hsgplan.evaluation.episode import EpisodeRecord
+from hsgplan.evaluation.protocol import EvalConfig, checkpoints
+from hsgplan.evaluation.summary import failure_class
+from hsgplan.evaluation.table1 import label, tables
+from hsgplan.runner.run_folder import CONFIG, logged_rows
+from hsgplan.viz.html_page import heading, image, page, paragraph, table
+
+REPORT = "report.html"
+ROLLOUTS = "report"
+GIF_SCALE = 0.5  # the rollouts' frames at half the demo's size: the page stays small
+FRAME_EVERY = 24
+
+
+@dataclass(frozen=True)
+class Rollout:
+    """A failed episode re-simulated: as logged, as re-run, and where its pictures are."""
+
+    method: str
+    logged: EpisodeRecord
+    rerun: EpisodeRecord
+    folder: Path
+
+    @property
+    def failing_step(self) -> int:
+        """The last step whose primitive failed, else the last step (0: none was taken)."""
+        failed = [s.step for s in self.rerun.steps if s.status != "success"]
+        return failed[-1] if failed else len(self.rerun.steps)
+
+    @property
+    def reproduced(self) -> bool:
+        a, b = self.logged, self.rerun
+        statuses = [(s.action, s.status) for s in a.steps] == [
+            (s.action, s.status) for s in b.steps
+        ]
+        return a.success == b.success and a.failure == b.failure and statuses
+
+
+def read_summary(run_dir: Path) -> dict:
+    path = run_dir / "summary.json"
+    if not run_dir.is_dir():
+        raise InvalidInputError(f"'{run_dir}' is not a folder")
+    if not path.exists():
+        raise InvalidInputError(f"'{run_dir}' holds no summary.json: not a finished eval run")
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise InvalidInputError(f"'{path}' is not valid JSON") from None
+    if not isinstance(summary, dict) or not isinstance(summary.get("methods"), dict):
+        raise InvalidInputError(f"'{path}' is not an eval summary (no methods)")
+    return summary
+
+
+def sample_failures(
+    run_dir: Path, methods: list[str], count: int
+) -> list[tuple[str, EpisodeRecord]]:
+    """Up to `count` failed episodes, taken in turn from each method and, within one, from each
+    kind of failure in turn (the commonest first), so that the sample shows as many kinds as
+    it can."""
+    queues: list[list[tuple[str, EpisodeRecord]]] = []
+    for m in methods:
+        by_kind: dict[tuple[str, str], list[tuple[str, EpisodeRecord]]] = {}
+        rows = logged_rows(run_dir / m)
+        records = [EpisodeRecord.from_json(r["result"]) for r in rows if "result" in r]
+        for r in sorted(records, key=lambda r: (r.size, r.seed)):
+            if c := failure_class(r):
+                by_kind.setdefault(c, []).append((m, r))
+        queues.append(_round_robin(sorted(by_kind.values(), key=lambda v: -len(v))))
+    return _round_robin(queues)[:count]
+
+
+def _round_robin(lists: list[list]) -> list:
+    """The first item of every list, then the second of every list that has one, and so on."""
+    return [x[i] for i in range(max(map(len, lists), default=0)) for x in lists if i < len(x)]
+
+
+def rollout(run_dir: Path, method: str, agent: str, record: EpisodeRecord) -> Rollout:
+    """The episode re-simulated with the method's agent and checkpoints (made once, kept)."""
+    from hsgplan.agents.registry import make_agent
+    from hsgplan.evaluation.demo import run_demo
+
+    folder = run_dir / ROLLOUTS / f"{method}-{record.size}-{record.seed}"
+    done = folder / "episode.json"
+    if not done.exists():
+        config = EvalConfig(**json.loads((run_dir / method / CONFIG).read_text()))
+        partial = folder.with_name(folder.name + ".partial")
+        shutil.rmtree(partial, ignore_errors=True)
+        run_demo(
+            make_agent(agent, *checkpoints(config)),
+            parse_goal(record.goal),
+            record.seed,
+            partial,
+            scale=GIF_SCALE,
+            frame_every=FRAME_EVERY,
+        )
+        partial.rename(folder)
+    rerun = EpisodeRecord.from_json(json.loads(done.read_text()))
+    return Rollout(method, record, rerun, folder)
+
+
+def build_report(
+    run_dir: Path, failures: int = 6, on_rollout: Callable[[Rollout], None] | None = None
+) -> Path:
+    """Write `RUN_DIR/report.html` (written whole or not at all) and return its path."""
+    summary = read_summary(run_dir)
+    methods = list(summary["methods"])
+    parts = [
+        paragraph(
+            f"Run folder {run_dir}: {summary.get('goals')} goals per size, "
+            f"{summary.get('repeats')} repeat(s), seed {summary.get('seed')}; methods: "
+            + ", ".join(f"{label(m)} ({summary['methods'][m]['agent']})" for m in methods),
+            "caption",
+        )
+    ]
+    for t in tables(summary):
+        parts += [heading(2, t.title.split(":")[0]), paragraph(t.title, "caption")]
+        parts.append(table(t.header, t.rows, text_columns=("method", "execution", "overstep")))
+    if (run_dir / "table1.png").exists():
+        parts.append(image(run_dir / "table1.png", "success rate by problem size"))
+    sample = sample_failures(run_dir, methods, failures)
+    parts.append(heading(2, f"Failed episodes ({len(sample)} shown)"))
+    if not sample:
+        parts.append(paragraph("No episode of this run failed."))
+    for method, record in sample:
+        r = rollout(run_dir, method, summary["methods"][method]["agent"], record)
+        parts.append(_episode(r))
+        if on_rollout:
+            on_rollout(r)
+    path = run_dir / REPORT
+    tmp = path.with_suffix(".html.tmp")
+    tmp.write_text(page(f"Evaluation report: {run_dir.name}", parts), encoding="utf-8")
+    tmp.replace(path)
+    return path
+
+
+def _episode(r: Rollout) -> str:
+    rec = r.logged
+    cls, kind = failure_class(rec) or ("", "")
+    k = r.failing_step
+    parts = [
+        '<div class="episode">',
+        heading(3, f"{label(r.method)}, {rec.size} objects, seed {rec.seed}: {cls} ({kind})"),
+        paragraph(f"goal: {rec.goal}"),
+    ]
+    if not r.reproduced:
+        parts.append(
+            paragraph(
+                "The re-simulation ended otherwise than the logged episode "
+                f"({r.rerun.failure or 'success'} after {len(r.rerun.steps)} steps; logged: "
+                f"{rec.failure} after {len(rec.steps)}); "
+                "the pictures show the re-simulation.",
+                "warn",
+            )
+        )
+    rows = [
+        (str(s.step), s.subgoal, s.params, s.status, s.detail, f"{s.task_seconds * 1000:.1f}")
+        for s in r.rerun.steps
+    ]
+    parts.append(
+        table(
+            ("step", "subgoal", "primitive", "outcome", "why", "task ms"),
+            rows,
+            text_columns=("subgoal", "primitive", "outcome", "why"),
+        )
+    )
+    parts.append(image(r.folder / "episode.gif", f"rollout of seed {rec.seed}"))
+    graphs = r.folder / "graphs"
+    before, after = graphs / f"step_{max(k - 1, 0):02d}.png", graphs / f"step_{k:02d}.png"
+    parts.append(paragraph(f"The symbolic scene graph before and after step {k}:", "caption"))
+    parts.append(
+        '<div class="graphs">'
+        + "".join(image(p, p.stem) for p in (before, after) if p.exists())
+        + "</div></div>"
+    )
+    return "".join(parts)
