@@ -7,17 +7,17 @@ from __future__ import annotations
 import json
 import random
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import imageio.v3 as iio
-import numpy as np
-from PIL import Image
 
 from hsgplan.agents.base import Agent, Decision
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord, params_text, run_episode
+from hsgplan.runner.engines import one_core
 from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.render import DEMO_VIEWS
 from hsgplan.symbolic.generator import random_goal
@@ -49,6 +49,7 @@ def run_demo(
         scale: the GIF's frames at this fraction of their size (a report keeps them small).
         frame_every: arm waypoints between two frames.
     """
+    one_core()  # beside other busy processes, two threads make each planner call 20x slower
     out.mkdir(parents=True, exist_ok=True)
     graphs = out / "graphs"
     graphs.mkdir(exist_ok=True)
@@ -57,14 +58,14 @@ def run_demo(
     waypoints = 0
     caption = ["start", "", f"goal: {goal}"]
 
+    cameras = [
+        replace(c, width=round(c.width * scale), height=round(c.height * scale))
+        for _, c in DEMO_VIEWS
+    ]
+
     def snapshot():
-        views = [env.render(camera) for _, camera in DEMO_VIEWS]
-        frame = compose(views, [name for name, _ in DEMO_VIEWS], caption)
-        if scale == 1.0:
-            return frame
-        h, w, _ = frame.shape
-        small = Image.fromarray(frame).resize((round(w * scale), round(h * scale)), Image.LANCZOS)
-        return np.asarray(small)
+        views = [env.render(camera) for camera in cameras]
+        return compose(views, [name for name, _ in DEMO_VIEWS], caption, scale)
 
     def on_frame() -> None:
         nonlocal waypoints

@@ -15,8 +15,9 @@ from contextlib import contextmanager
 from hsgplan.domain.errors import InvalidInputError
 
 
-def _one_core() -> None:
-    """A worker's first act, before anything imports torch: one thread for its math. Two
+def one_core() -> None:
+    """A worker's first act, before anything imports torch (or any process that runs
+    episodes itself: the demo, the report): one thread for its math. Two
     processes each spinning two OpenMP threads on two cores were measured to turn 20 ms
     planner calls into 1.5 s ones."""
     for var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -25,13 +26,16 @@ def _one_core() -> None:
         sys.modules["torch"].set_num_threads(1)
 
 
+_one_core = one_core  # the name pools started before the rename look up in their children
+
+
 class LocalEngine:
     """A process pool (spawned: children forked from a process with torch loaded hang), one
     core per worker."""
 
     def __init__(self, workers: int) -> None:
         context = multiprocessing.get_context("spawn")
-        self.pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_one_core)
+        self.pool = ProcessPoolExecutor(workers, mp_context=context, initializer=one_core)
         # finished futures in the order they finished: waiting on thousands of pending ones
         # at every step would cost time quadratic in the job's size
         self.finished: queue.SimpleQueue[Future] = queue.SimpleQueue()
