@@ -19,7 +19,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import EvalConfig, checkpoints
-from hsgplan.evaluation.summary import failure_class
+from hsgplan.evaluation.summary import FAILED_EXECUTION, failure_class
 from hsgplan.evaluation.table1 import label, tables
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 from hsgplan.viz.html_page import heading, image, page, paragraph, table
@@ -41,9 +41,10 @@ class Rollout:
 
     @property
     def failing_step(self) -> int:
-        """The last step whose primitive failed, else the last step (0: none was taken)."""
-        failed = [s.step for s in self.rerun.steps if s.status != "success"]
-        return failed[-1] if failed else len(self.rerun.steps)
+        """The first step whose primitive failed in execution (where the episode went wrong),
+        else the last step (0: none was taken)."""
+        failed = [s.step for s in self.rerun.steps if s.status in FAILED_EXECUTION]
+        return failed[0] if failed else len(self.rerun.steps)
 
     @property
     def reproduced(self) -> bool:
@@ -170,18 +171,14 @@ def _episode(r: Rollout) -> str:
                 "warn",
             )
         )
-    rows = [
-        (str(s.step), s.subgoal, s.params, s.status, s.detail, f"{s.task_seconds * 1000:.1f}")
-        for s in r.rerun.steps
-    ]
+    parts.append(image(r.folder / "episode.gif", f"rollout of seed {rec.seed}"))
     parts.append(
         table(
             ("step", "subgoal", "primitive", "outcome", "why", "task ms"),
-            rows,
+            _collapsed(r.rerun.steps),
             text_columns=("subgoal", "primitive", "outcome", "why"),
         )
     )
-    parts.append(image(r.folder / "episode.gif", f"rollout of seed {rec.seed}"))
     graphs = r.folder / "graphs"
     before, after = graphs / f"step_{max(k - 1, 0):02d}.png", graphs / f"step_{k:02d}.png"
     parts.append(paragraph(f"The symbolic scene graph before and after step {k}:", "caption"))
@@ -191,3 +188,24 @@ def _episode(r: Rollout) -> str:
         + "</div></div>"
     )
     return "".join(parts)
+
+
+def _collapsed(steps) -> list[tuple[str, ...]]:
+    """One row per step, a run of identical steps (the same primitive failing the same way)
+    as one row naming its first and last step."""
+    rows: list[tuple[str, ...]] = []
+    run: list = []
+    for s in [*steps, None]:
+        if run and (s is None or not _same(run[0], s)):
+            first, last = run[0], run[-1]
+            label = str(first.step) if len(run) == 1 else f"{first.step}–{last.step} (×{len(run)})"
+            ms = f"{first.task_seconds * 1000:.1f}"
+            rows.append((label, first.subgoal, first.params, first.status, first.detail, ms))
+            run = []
+        if s is not None:
+            run.append(s)
+    return rows
+
+
+def _same(a, b) -> bool:
+    return (a.subgoal, a.params, a.status, a.detail) == (b.subgoal, b.params, b.status, b.detail)

@@ -10,7 +10,7 @@ import pytest
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord
 from hsgplan.evaluation.protocol import EvalConfig, episode_specs
-from hsgplan.evaluation.report import build_report, read_summary, sample_failures
+from hsgplan.evaluation.report import _collapsed, build_report, read_summary, sample_failures
 from hsgplan.evaluation.summary import summarize
 from hsgplan.runner.run_folder import CONFIG, RESULTS
 
@@ -104,3 +104,12 @@ def test_the_page_loads_in_a_browser_with_every_image_and_no_console_error(tmp_p
     # the rollout's GIF and the two scene graphs (no plot: this folder has none)
     assert len(widths) == 3 and all(w > 0 for w in widths), widths
     assert tables == 4 and "Evaluation report" in heading
+
+
+def test_a_run_of_identical_failed_steps_is_one_row():
+    steps = [
+        StepRecord(k, "InGrasp(butter)", "pick(butter)", "pick(obj=butter)", status, "", 0, 0, 0)
+        for k, status in enumerate(["success", "no_ik", "no_ik", "no_ik"], start=1)
+    ]
+    rows = _collapsed(steps)
+    assert [r[0] for r in rows] == ["1", "2–4 (×3)"] and rows[1][3] == "no_ik"
