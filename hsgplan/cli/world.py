@@ -142,7 +142,13 @@ def evaluate(
         motions = [m.strip() for m in motion.split(",")]
         if len(set(motions)) != len(motions) or "" in motions:
             raise InvalidInputError(f"--motion '{motion}': name each generator once")
-        methods = [Method(m, agent_name(agent.value, planner_name, m)) for m in motions]
+        agents = [agent_name(agent.value, planner_name, m) for m in motions]
+        # a column is named by its generator (and set beside the paper's) only where the task
+        # planner is the paper's; other planners' columns carry their agent's whole name
+        paper_planner = all(a.startswith("regression+") for a in agents)
+        methods = [
+            Method(m if paper_planner else a, a) for m, a in zip(motions, agents, strict=True)
+        ]
     config = EvalConfig(
         "",
         tuple(parse_sizes(sizes)),
