@@ -112,6 +112,8 @@ BAD = [
     (["bench", "timing", "--sizes", "1-3"], "between 2 and 12"),
     (["bench", "timing", "--workers", "0"], "at least one"),
     (["eval", "--agent", "search", "--motion", "gnn"], "no task planner or motion generator"),
+    (["report", "/nonexistent/run"], "is not a folder"),
+    (["report", "/nonexistent/run", "--failures", "-1"], "cannot be negative"),
 ]
 
 

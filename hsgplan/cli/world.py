@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.agents.registry import AGENTS, WHOLE_AGENTS, agent_name
+from hsgplan.agents.registry import AGENTS, WHOLE_AGENTS, agent_name, agent_parts
 from hsgplan.cli.common import (
     AgentName,
     MotionName,
@@ -145,7 +145,7 @@ def evaluate(
         agents = [agent_name(agent.value, planner_name, m) for m in motions]
         # a column is named by its generator (and set beside the paper's) only where the task
         # planner is the paper's; other planners' columns carry their agent's whole name
-        paper_planner = all(a.startswith("regression+") for a in agents)
+        paper_planner = all(agent_parts(a)[0] == "regression" for a in agents)
         methods = [
             Method(m if paper_planner else a, a) for m, a in zip(motions, agents, strict=True)
         ]
@@ -195,14 +195,17 @@ def report(
     """One self-contained HTML page for an eval run: its tables and plot, and failed episodes
     re-simulated from their seeds (a GIF with each decision, the scene graphs around the
     failing step). Writes RUN_DIR/report.html."""
-    from hsgplan.evaluation.report import build_report, read_summary, sample_failures
+    from hsgplan.evaluation.report import build_report
 
     if failures < 0:
         raise InvalidInputError(f"--failures {failures}: cannot be negative")
-    summary = read_summary(run_dir)
-    total = len(sample_failures(run_dir, list(summary["methods"]), failures))
     with Progress(console=err, transient=True) as progress:
-        task = progress.add_task("re-simulating failed episodes", total=total)
-        path = build_report(run_dir, failures, lambda r: progress.advance(task))
+        task = progress.add_task("re-simulating failed episodes", total=None)
+        path = build_report(
+            run_dir,
+            failures,
+            on_rollout=lambda r: progress.advance(task),
+            on_sample=lambda n: progress.update(task, total=n),
+        )
     size = path.stat().st_size / 1e6
     out.print(f"wrote {path} ({size:.1f} MB)", highlight=False)

@@ -118,9 +118,13 @@ def rollout(run_dir: Path, method: str, agent: str, record: EpisodeRecord) -> Ro
 
 
 def build_report(
-    run_dir: Path, failures: int = 6, on_rollout: Callable[[Rollout], None] | None = None
+    run_dir: Path,
+    failures: int = 6,
+    on_rollout: Callable[[Rollout], None] | None = None,
+    on_sample: Callable[[int], None] | None = None,
 ) -> Path:
-    """Write `RUN_DIR/report.html` (written whole or not at all) and return its path."""
+    """Write `RUN_DIR/report.html` (written whole or not at all) and return its path;
+    `on_sample` hears how many failed episodes will be re-simulated, `on_rollout` each one."""
     summary = read_summary(run_dir)
     methods = list(summary["methods"])
     parts = [
@@ -137,6 +141,8 @@ def build_report(
     if (run_dir / "table1.png").exists():
         parts.append(image(run_dir / "table1.png", "success rate by problem size"))
     sample = sample_failures(run_dir, methods, failures)
+    if on_sample:
+        on_sample(len(sample))
     parts.append(heading(2, f"Failed episodes ({len(sample)} shown)"))
     if not sample:
         parts.append(paragraph("No episode of this run failed."))

@@ -26,9 +26,6 @@ def one_core() -> None:
         sys.modules["torch"].set_num_threads(1)
 
 
-_one_core = one_core  # the name pools started before the rename look up in their children
-
-
 class LocalEngine:
     """A process pool (spawned: children forked from a process with torch loaded hang), one
     core per worker."""
