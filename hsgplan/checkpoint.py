@@ -1,12 +1,18 @@
-"""Finished networks on disk: a folder with `model.safetensors` and `config.json` (the network's
-configuration). Inference reads them from here and never imports training code; the trainers
-write them through `hsgplan.training`.
+"""Finished networks on disk: a folder with `model.safetensors`, `config.json` (the network's
+configuration) and `manifest.json` (the size and SHA-256 of both). Inference reads them from
+here and never imports training code; the trainers write them through `hsgplan.training`.
+
+Writes are atomic (a temporary file renamed) and the manifest is written last, so a folder is
+finished exactly when its manifest matches its files: an interrupted save, a truncated or
+replaced file, or weights that are not finite are refused on load in one line.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
-from collections.abc import Callable
+import os
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -16,12 +22,70 @@ from safetensors.torch import load_file, save_file
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import shipped
 
-WEIGHTS, CONFIG = "model.safetensors", "config.json"
+WEIGHTS, CONFIG, MANIFEST = "model.safetensors", "config.json", "manifest.json"
+
+
+def _tmp(path: Path) -> Path:
+    return path.with_name(f".{path.name}.tmp")
+
+
+def _digest(path: Path) -> dict:
+    data = path.read_bytes()
+    return {"bytes": len(data), "sha256": hashlib.sha256(data).hexdigest()}
+
+
+def non_finite(state: dict[str, torch.Tensor]) -> list[str]:
+    """The tensors of a state dict holding NaN or infinity."""
+    return [k for k, t in state.items() if t.is_floating_point() and not torch.isfinite(t).all()]
 
 
 def save_trained(folder: Path, model: torch.nn.Module, config: dict) -> None:
-    save_file(model.state_dict(), folder / WEIGHTS)
-    (folder / CONFIG).write_text(json.dumps(config, indent=2) + "\n")
+    """Write a finished network; non-finite weights (a diverged training) are refused."""
+    state = model.state_dict()
+    if bad := non_finite(state):
+        raise InvalidInputError(
+            f"training diverged: {bad[0]} holds NaN or infinity; nothing was saved in "
+            f"'{folder}' (lower lr)"
+        )
+    (folder / MANIFEST).unlink(missing_ok=True)  # unfinished until the manifest is back
+    save_file(state, _tmp(folder / WEIGHTS))
+    os.replace(_tmp(folder / WEIGHTS), folder / WEIGHTS)
+    _tmp(folder / CONFIG).write_text(json.dumps(config, indent=2) + "\n")
+    os.replace(_tmp(folder / CONFIG), folder / CONFIG)
+    write_manifest(folder)
+
+
+def write_manifest(folder: Path) -> None:
+    """The size and checksum of a network's files, the mark of a finished folder."""
+    manifest = {name: _digest(folder / name) for name in (WEIGHTS, CONFIG)}
+    _tmp(folder / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n")
+    os.replace(_tmp(folder / MANIFEST), folder / MANIFEST)
+
+
+def verify(folder: Path, what: str = "network") -> None:
+    """Refuse, in one line, a folder whose files are missing or do not match its manifest."""
+    for name in (WEIGHTS, CONFIG, MANIFEST):
+        if not (folder / name).is_file():
+            raise InvalidInputError(f"no trained {what} in '{folder}' ({name} is missing)")
+    try:
+        manifest = json.loads((folder / MANIFEST).read_bytes())
+        expected = {name: dict(manifest[name]) for name in (WEIGHTS, CONFIG)}
+    except (ValueError, KeyError, TypeError, OSError):
+        raise InvalidInputError(f"'{folder / MANIFEST}' is damaged; train it again") from None
+    for name in (WEIGHTS, CONFIG):
+        if _digest(folder / name) != expected[name]:
+            raise InvalidInputError(
+                f"'{folder / name}' does not match its manifest (damaged or replaced); "
+                "train it again"
+            )
+
+
+def is_finished(folder: Path) -> bool:
+    try:
+        verify(folder)
+    except InvalidInputError:
+        return False
+    return True
 
 
 def load_trained(
@@ -31,16 +95,41 @@ def load_trained(
     what: str,
 ) -> tuple[torch.nn.Module, Any]:
     """(network in eval mode, its configuration) from a finished folder, found as
-    `hsgplan.paths.shipped` finds it; a missing or corrupted one raises InvalidInputError with
-    one line."""
+    `hsgplan.paths.shipped` finds it; a missing, damaged or non-finite one raises
+    InvalidInputError with one line."""
     folder = shipped(folder)
+    verify(folder, what)
     try:
-        config = from_json(json.loads((folder / CONFIG).read_text()))
+        config = from_json(json.loads((folder / CONFIG).read_bytes()))
         model = build(config)
-        model.load_state_dict(load_file(folder / WEIGHTS))
-    except FileNotFoundError:
-        raise InvalidInputError(f"no trained {what} in '{folder}'") from None
-    except Exception as e:  # corrupted weights or config: one line, not a traceback
+        state = load_file(folder / WEIGHTS)
+        model.load_state_dict(state)
+    except InvalidInputError as e:
         raise InvalidInputError(f"'{folder}' is not a usable checkpoint ({e})") from None
+    except Exception as e:  # a foreign config or weights of another shape: one line
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise InvalidInputError(f"'{folder}' is not a usable checkpoint ({first})") from None
+    if bad := non_finite(state):
+        raise InvalidInputError(f"'{folder}' holds NaN or infinite weights ({bad[0]})")
     model.eval()
     return model, config
+
+
+def fingerprint(folders: Iterable[Path]) -> str:
+    """One SHA-256 over every file of these folders or files (folders recursively, in name
+    order): a run folder records it, so that results of one checkpoint (or data) are never
+    resumed under another."""
+    h = hashlib.sha256()
+    for folder in sorted({shipped(f) for f in folders}):
+        if folder.is_file():
+            files, folder = [folder], folder.parent
+        elif folder.is_dir():
+            files = sorted(p for p in folder.rglob("*") if p.is_file())
+        else:
+            files = []
+        for path in files:
+            if path.name.startswith(".") or path.suffix in (".pt", ".tmp"):
+                continue  # training leftovers are not what a run is evaluated with
+            h.update(str(path.relative_to(folder)).encode() + b"\0")
+            h.update(hashlib.sha256(path.read_bytes()).digest())
+    return h.hexdigest()

@@ -14,9 +14,9 @@ def _model_and_optim():
 
 def test_progress_is_saved_and_resumed(tmp_path):
     model, optim = _model_and_optim()
-    training.save_progress(tmp_path, model, optim, 5)
+    training.save_progress(tmp_path, model, optim, 5, "data-a")
     other, other_optim = _model_and_optim()
-    assert training.resume(tmp_path, other, other_optim) == 5
+    assert training.resume(tmp_path, other, other_optim, "data-a") == 5
     assert torch.equal(other.weight, model.weight)
 
 
@@ -24,6 +24,43 @@ def test_corrupted_progress_is_refused_in_one_line_and_left_in_place(tmp_path):
     (tmp_path / training.PROGRESS).write_bytes(b"not a checkpoint")
     model, optim = _model_and_optim()
     with pytest.raises(InvalidInputError, match="delete it to train from the start") as e:
-        training.resume(tmp_path, model, optim)
+        training.resume(tmp_path, model, optim, "data-a")
     assert "\n" not in str(e.value)
     assert (tmp_path / training.PROGRESS).read_bytes() == b"not a checkpoint"
+
+
+def test_progress_on_other_data_is_refused(tmp_path):
+    model, optim = _model_and_optim()
+    training.save_progress(tmp_path, model, optim, 5, "data-a")
+    with pytest.raises(InvalidInputError, match="other training data"):
+        training.resume(tmp_path, *_model_and_optim(), "data-b")
+
+
+def test_nan_weights_are_refused_at_save_and_at_load(tmp_path):
+    model, _ = _model_and_optim()
+    with torch.no_grad():
+        model.weight[0, 0] = float("nan")
+    with pytest.raises(InvalidInputError, match="NaN or infinity"):
+        training.finish(tmp_path, model, {})
+    assert not any(tmp_path.iterdir())  # nothing saved
+    from safetensors.torch import save_file
+
+    from hsgplan.checkpoint import load_trained, write_manifest
+
+    save_file(model.state_dict(), tmp_path / "model.safetensors")  # written by hand
+    (tmp_path / "config.json").write_text("{}")
+    write_manifest(tmp_path)
+    with pytest.raises(InvalidInputError, match="NaN or infinite"):
+        load_trained(tmp_path, lambda d: d, lambda c: torch.nn.Linear(3, 2), "network")
+
+
+def test_a_damaged_or_replaced_checkpoint_file_is_not_finished(tmp_path):
+    model, _ = _model_and_optim()
+    training.finish(tmp_path, model, {"a": 1})
+    assert training.finished(tmp_path)
+    weights = tmp_path / "model.safetensors"
+    weights.write_bytes(weights.read_bytes()[:-8])  # truncated
+    assert not training.finished(tmp_path)
+    training.finish(tmp_path, model, {"a": 1})
+    (tmp_path / "config.json").unlink()
+    assert not training.finished(tmp_path)

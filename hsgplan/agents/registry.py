@@ -136,6 +136,25 @@ def agent_parts(name: str) -> tuple[str, str]:
     return AGENTS[name]
 
 
+LEARNED_PLANNERS = ("regression", "forward")
+LEARNED_MOTION = ("gnn", "mlp")
+
+
+def agent_checkpoints(
+    name: str, checkpoint: Path = TASK_CHECKPOINT, motion_checkpoints: Path = MOTION_CHECKPOINTS
+) -> list[Path]:
+    """The checkpoint folders an agent reads (what a run of it is fingerprinted by)."""
+    if name in WHOLE_AGENTS:
+        return []
+    planner, motion = agent_parts(name)
+    folders = [checkpoint] if planner in LEARNED_PLANNERS else []
+    if motion in LEARNED_MOTION:
+        from hsgplan.domain.parameters import MotionPrimitive
+
+        folders += [motion_checkpoints / f"{kind.value}-{motion}" for kind in MotionPrimitive]
+    return folders
+
+
 def make_agent(
     name: str, checkpoint: Path = TASK_CHECKPOINT, motion_checkpoints: Path = MOTION_CHECKPOINTS
 ) -> Agent:

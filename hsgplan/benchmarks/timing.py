@@ -17,8 +17,16 @@ from dataclasses import replace
 from pathlib import Path
 
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation
+from hsgplan.evaluation.protocol import (
+    EVAL_KIND,
+    EvalConfig,
+    episode_specs,
+    run_config,
+    run_evaluation,
+    run_refusal,
+)
 from hsgplan.evaluation.table1 import TextTable
+from hsgplan.runner.run_folder import check_claim, claim
 from hsgplan.viz.plots import plot_times_by_size
 
 # Table 2 of the paper (seconds per episode: task, motion), by solver and size.
@@ -80,6 +88,13 @@ def run_timing(
     `{"by_size": {"2": {"ours": {"task_s", "motion_s", "success_rate", ...}, "search": {...}}}}`
     """
     config = EvalConfig("", tuple(sizes), goals, seed)
+    table = {"sizes": list(config.sizes), "goals": goals, "seed": seed}
+    refusal = f"'{out}' holds a timing run with other sizes, goals or seed; use another --out"
+    check_claim(out, "bench-timing", table, refusal)  # every refusal before anything is written
+    for key, agent in AGENTS.items():
+        run = replace(config, agent=agent)
+        check_claim(out / key, EVAL_KIND, run_config(run), run_refusal(out / key))
+    claim(out, "bench-timing", table, refusal)
     records = {
         key: run_evaluation(replace(config, agent=agent), out / key, workers, on_episode)
         for key, agent in AGENTS.items()

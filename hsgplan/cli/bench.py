@@ -9,7 +9,17 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import err, out, parse_sizes, print_table, refuses_bad_input
+from hsgplan.cli.common import (
+    err,
+    input_path,
+    out,
+    out_folder,
+    parse_sizes,
+    print_table,
+    refuses_bad_input,
+    shown,
+)
+from hsgplan.domain.checks import MAX_EPISODES, MAX_GOALS, MAX_SAMPLES, MAX_SEED, MAX_WORKERS
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import RUNS, TASK_CHECKPOINT
 
@@ -20,8 +30,10 @@ app = typer.Typer(no_args_is_help=True, help="Measure speed (medians over one ru
 @refuses_bad_input
 def bench_sim(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
-    episodes: Annotated[int, typer.Option(help="Oracle episodes per size.")] = 5,
-    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    episodes: Annotated[
+        int, typer.Option(help="Oracle episodes per size.", min=1, max=MAX_EPISODES)
+    ] = 5,
+    seed: Annotated[int, typer.Option(help="Random seed.", min=0, max=MAX_SEED)] = 0,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")
     ] = False,
@@ -49,8 +61,8 @@ def bench_sim(
 @refuses_bad_input
 def bench_symbolic(
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
-    goals: Annotated[int, typer.Option(help="Goals per size.")] = 20,
-    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    goals: Annotated[int, typer.Option(help="Goals per size.", min=1, max=MAX_GOALS)] = 20,
+    seed: Annotated[int, typer.Option(help="Random seed.", min=0, max=MAX_SEED)] = 0,
     optimal_max_size: Annotated[
         int, typer.Option(help="Largest size the optimal search is timed on.")
     ] = 8,
@@ -91,9 +103,11 @@ def bench_symbolic(
 @refuses_bad_input
 def bench_task(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
-    goals: Annotated[int, typer.Option(help="Goals per size.")] = 20,
-    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
-    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = TASK_CHECKPOINT,
+    goals: Annotated[int, typer.Option(help="Goals per size.", min=1, max=MAX_GOALS)] = 20,
+    seed: Annotated[int, typer.Option(help="Random seed.", min=0, max=MAX_SEED)] = 0,
+    checkpoint: Annotated[
+        Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
+    ] = TASK_CHECKPOINT,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")
@@ -137,14 +151,28 @@ def bench_task(
 @refuses_bad_input
 def bench_timing(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6,8,10",
-    goals: Annotated[int, typer.Option(help="Goals per size, the same for both agents.")] = 10,
-    seed: Annotated[int, typer.Option(help="Seed of the goals and the episodes.")] = 0,
+    goals: Annotated[
+        int,
+        typer.Option(help="Goals per size, the same for both agents.", min=1, max=MAX_GOALS),
+    ] = 10,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the goals and the episodes.", min=0, max=MAX_SEED)
+    ] = 0,
     workers: Annotated[
-        int, typer.Option(help="Episodes side by side (1: nothing competes for the core).")
+        int,
+        typer.Option(
+            help="Episodes side by side (1: nothing competes for the core).",
+            min=1,
+            max=MAX_WORKERS,
+        ),
     ] = 1,
     run_dir: Annotated[
         Path | None,
-        typer.Option("--out", help="Run folder (resumed if it exists; default runs/NAME)."),
+        typer.Option(
+            "--out",
+            help="Run folder (resumed if it exists; default runs/NAME).",
+            parser=out_folder,
+        ),
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
@@ -157,16 +185,10 @@ def bench_timing(
     from hsgplan.agents.registry import make_agent
     from hsgplan.benchmarks.timing import AGENTS, run_timing, tables, total_episodes
 
-    if workers < 1:
-        raise InvalidInputError(f"--workers {workers}: need at least one")
-    if goals < 1:
-        raise InvalidInputError(f"--goals {goals}: need at least one goal per size")
     size_list = parse_sizes(sizes)
     for agent in AGENTS.values():  # a missing checkpoint is refused before any work
         make_agent(agent)
     folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}"
-    if folder.exists() and not folder.is_dir():
-        raise InvalidInputError(f"--out '{folder}' is a file")
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("ours, search", total=total_episodes(size_list, goals, seed))
         report = run_timing(
@@ -178,15 +200,17 @@ def bench_timing(
     for t in tables(report):
         print_table(t.title, t.header, [list(r) for r in t.rows], markdown)
     if not markdown:
-        out.print(f"wrote {folder}/table2.md, table2.png, summary.json", highlight=False)
+        out.print(f"wrote {shown(folder)}/table2.md, table2.png, summary.json", highlight=False)
 
 
 @app.command("collect")
 @refuses_bad_input
 def bench_collect(
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
-    samples: Annotated[int, typer.Option(help="Successful samples per primitive.")] = 300,
-    workers: Annotated[int, typer.Option(help="Processes.")] = 2,
+    samples: Annotated[
+        int, typer.Option(help="Successful samples per primitive.", min=1, max=MAX_SAMPLES)
+    ] = 300,
+    workers: Annotated[int, typer.Option(help="Processes.", min=1, max=MAX_WORKERS)] = 2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")
@@ -194,9 +218,10 @@ def bench_collect(
 ) -> None:
     """Successful motion samples per second of the collector (wall time, start-up included)."""
     from hsgplan.benchmarks.collect import bench_collect as run
-    from hsgplan.domain.errors import InvalidInputError
 
-    kinds = [p.strip() for p in primitives.split(",") if p.strip()]
+    kinds = [p.strip() for p in primitives.split(",")]
+    if "" in kinds or len(set(kinds)) != len(kinds):
+        raise InvalidInputError(f"--primitives '{primitives}': name place, push or both, once")
     for p in kinds:
         if p not in ("place", "push"):
             raise InvalidInputError(f"primitive '{p}': place or push")

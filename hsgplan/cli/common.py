@@ -3,17 +3,19 @@
 from __future__ import annotations
 
 import functools
-import json
 import sys
 from enum import StrEnum
 from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
 from typer.core import TyperGroup
 
 from hsgplan.agents.registry import AGENT_NAMES, MOTION_GENERATORS, TASK_PLANNERS
+from hsgplan.domain.checks import check_output, read_json
 from hsgplan.domain.errors import InvalidInputError
 
 out = Console()
@@ -31,8 +33,7 @@ class OneLineErrors(TyperGroup):
             if type(e).__name__ == "NoArgsIsHelpError":
                 e.show()
             else:
-                message = " ".join(e.format_message().split())
-                err.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+                print_error(" ".join(e.format_message().split()))
             code = e.exit_code
         except typer.Abort:
             err.print("aborted")
@@ -43,21 +44,70 @@ class OneLineErrors(TyperGroup):
         return code
 
 
+def shown(value) -> str:
+    """User text (a path, a name) inside a Rich-markup message, shown as typed."""
+    return escape(str(value))
+
+
+def print_error(message: str) -> None:
+    """The one error line. The message often echoes what the user typed: it is printed as
+    text, never read as Rich markup (`--goal '[/]'` once crashed this printer)."""
+    err.print(Text.assemble(("error:", "bold red"), " ", message), highlight=False, soft_wrap=True)
+
+
 def refuses_bad_input(fn):
-    """Bad input becomes one line on stderr and exit code 2, never a traceback."""
+    """Bad input becomes one line on stderr and exit code 2, never a traceback. A place the
+    system will not let us write (a full disk, a read-only folder) is told the same way: the
+    checks at the door catch what they can foresee, this catches the rest."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         try:
             return fn(*args, **kwargs)
         except InvalidInputError as e:
-            err.print(f"[bold red]error:[/] {e}", highlight=False, markup=True, soft_wrap=True)
+            print_error(str(e))
+            raise typer.Exit(2) from None
+        except OSError as e:
+            where = f"'{e.filename}': " if e.filename else ""
+            print_error(f"{where}{e.strerror or e}")
             raise typer.Exit(2) from None
         except KeyboardInterrupt:
             err.print("interrupted")
             raise typer.Exit(130) from None
 
     return wrapper
+
+
+def _output(kind: str):
+    def parse(text) -> Path:
+        try:
+            check_output(text, kind)
+        except InvalidInputError as e:
+            raise typer.BadParameter(str(e)) from None
+        return Path(str(text)).expanduser()
+
+    parse.__name__ = f"out_{kind}"
+    return parse
+
+
+# `parser=` of every --out option: refused at the door, before the command makes anything
+out_folder = _output("folder")
+out_file = _output("file")
+
+
+def input_path(text) -> Path:
+    """`parser=` of options naming something to read: an empty name is refused (a Path of ''
+    would silently be the current folder)."""
+    if not str(text).strip():
+        raise typer.BadParameter("an empty path")
+    return Path(str(text)).expanduser()
+
+
+def check_ray(address: str | None) -> None:
+    """`--ray` checked at the door (see `hsgplan.runner.engines.check_ray_address`)."""
+    from hsgplan.runner.engines import check_ray_address
+
+    check_ray_address(address)
 
 
 def choice(what: str, names) -> type[StrEnum]:
@@ -73,17 +123,7 @@ MotionName = choice("MotionName", MOTION_GENERATORS)
 
 def read_config(path: Path | None) -> dict:
     """The settings in a `--config` JSON file (none without a file), refused in one line."""
-    if path is None:
-        return {}
-    try:
-        settings = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise InvalidInputError(f"--config '{path}' does not exist") from None
-    except json.JSONDecodeError:
-        raise InvalidInputError(f"--config '{path}' is not valid JSON") from None
-    if not isinstance(settings, dict):
-        raise InvalidInputError(f"--config '{path}' must hold one JSON object")
-    return settings
+    return {} if path is None else read_json(path, "--config")
 
 
 def parse_sizes(text: str) -> list[int]:

@@ -8,9 +8,15 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import err, out, refuses_bad_input
-from hsgplan.domain.errors import InvalidInputError
-from hsgplan.paths import DEMOS, MOTION_DATA, REACH_DATA
+from hsgplan.cli.common import check_ray, err, out, out_folder, refuses_bad_input, shown
+from hsgplan.domain.checks import (
+    MAX_SAMPLES,
+    MAX_SEED,
+    MAX_STATES,
+    MAX_TASKS_PER_CHUNK,
+    MAX_WORKERS,
+)
+from hsgplan.paths import RUNS
 
 app = typer.Typer(no_args_is_help=True, help="Collect datasets (resumable).")
 
@@ -18,10 +24,13 @@ app = typer.Typer(no_args_is_help=True, help="Collect datasets (resumable).")
 @app.command("demos")
 @refuses_bad_input
 def demos(
-    seed: Annotated[int, typer.Option(help="Seed of the demonstration scenes.")] = 0,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the demonstration scenes.", min=0, max=MAX_SEED)
+    ] = 0,
     out_dir: Annotated[
-        Path, typer.Option("--out", help="Dataset folder (resumed if it exists).")
-    ] = DEMOS,
+        Path,
+        typer.Option("--out", help="Dataset folder (resumed if it exists).", parser=out_folder),
+    ] = RUNS / "collect-demos",
 ) -> None:
     """Record the paper's 18 short demonstrations with the oracle in the simulated world."""
     from hsgplan.data.demos import TASKS
@@ -33,7 +42,7 @@ def demos(
         done = collect_demos(out_dir, seed, command, lambda d: progress.advance(task))
         progress.update(task, completed=len(TASKS))
     steps = sum(len(d.actions) for d in done)
-    out.print(f"{len(done)} demonstrations, {steps} transitions, in {out_dir}")
+    out.print(f"{len(done)} demonstrations, {steps} transitions, in {shown(out_dir)}")
 
 
 def _collect_command(primitive: str, default_samples: int):
@@ -41,17 +50,34 @@ def _collect_command(primitive: str, default_samples: int):
 
     @refuses_bad_input
     def command(
-        samples: Annotated[int, typer.Option(help="Successful trials to collect.")] = (
-            default_samples
-        ),
-        workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
-        seed: Annotated[int, typer.Option(help="Seed of the scene and parameter stream.")] = 0,
+        samples: Annotated[
+            int, typer.Option(help="Successful trials to collect.", min=0, max=MAX_SAMPLES)
+        ] = default_samples,
+        workers: Annotated[
+            int,
+            typer.Option(help="Processes (or Ray tasks in flight / 2).", min=1, max=MAX_WORKERS),
+        ] = 2,
+        seed: Annotated[
+            int, typer.Option(help="Seed of the scene and parameter stream.", min=0, max=MAX_SEED)
+        ] = 0,
         ray: Annotated[
             str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
         ] = None,
-        out_dir: Annotated[Path, typer.Option("--out", help="Dataset folder.")] = MOTION_DATA,
-        tasks_per_chunk: Annotated[int, typer.Option(help="Tasks per unit of work.")] = 32,
+        out_dir: Annotated[
+            Path,
+            typer.Option(
+                "--out",
+                help="Dataset folder (default: runs/collect-motion; the shipped data/motion "
+                "is never written unless named).",
+                parser=out_folder,
+            ),
+        ] = RUNS / "collect-motion",
+        tasks_per_chunk: Annotated[
+            int,
+            typer.Option(help="Tasks per unit of work.", min=1, max=MAX_TASKS_PER_CHUNK),
+        ] = 32,
     ) -> None:
+        check_ray(ray)
         _collect(primitive, samples, workers, seed, ray, out_dir, tasks_per_chunk)
 
     command.__doc__ = (
@@ -76,31 +102,37 @@ def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir
     out.print(
         f"{summary.samples} {primitive} samples from {summary.trials} trials "
         f"({summary.samples / max(1, summary.trials):.0%} successful; {summary.chunks_run} "
-        f"chunks run now, {summary.unstaged} scenes not staged) in {summary.dataset}"
+        f"chunks run now, {summary.unstaged} scenes not staged) in {shown(summary.dataset)}"
     )
 
 
 @app.command("reach")
 @refuses_bad_input
 def reach(
-    states: Annotated[int, typer.Option(help="Staged states (a rerun may ask for more).")] = 4000,
-    seed: Annotated[int, typer.Option(help="Seed of the states and actions.")] = 0,
-    workers: Annotated[int, typer.Option(help="Processes (or Ray tasks in flight / 2).")] = 2,
+    states: Annotated[
+        int,
+        typer.Option(help="Staged states (a rerun may ask for more).", min=1, max=MAX_STATES),
+    ] = 4000,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the states and actions.", min=0, max=MAX_SEED)
+    ] = 0,
+    workers: Annotated[
+        int,
+        typer.Option(help="Processes (or Ray tasks in flight / 2).", min=1, max=MAX_WORKERS),
+    ] = 2,
     ray: Annotated[
         str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
     ] = None,
     out_dir: Annotated[
-        Path, typer.Option("--out", help="Collection folder (resumed if it exists).")
-    ] = REACH_DATA,
+        Path,
+        typer.Option("--out", help="Collection folder (resumed if it exists).", parser=out_folder),
+    ] = RUNS / "collect-reach",
 ) -> None:
     """Self-supervised reachability: primitives executed in the simulated world from staged
     symbolic states, and what the world showed after each (f_reach's labels)."""
     from hsgplan.evaluation.record_reach import collect_reach
 
-    if states < 1:
-        raise InvalidInputError(f"--states {states}: need at least one")
-    if workers < 1:
-        raise InvalidInputError(f"--workers {workers}: need at least one")
+    check_ray(ray)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("staged states", total=states)
         summary = collect_reach(
@@ -110,7 +142,7 @@ def reach(
     out.print(
         f"{summary.trials} primitives executed from {summary.staged} of {summary.states} "
         f"states ({statuses or 'none'}); {summary.ran} run now in "
-        f"{summary.seconds:.1f} s; in {out_dir}",
+        f"{summary.seconds:.1f} s; in {shown(out_dir)}",
         highlight=False,
         soft_wrap=True,
     )

@@ -12,13 +12,16 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     PlannerName,
     err,
+    input_path,
     out,
+    out_folder,
     parse_sizes,
     print_table,
     read_config,
     refuses_bad_input,
+    shown,
 )
-from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.checks import MAX_GOALS, MAX_SEED, MAX_WORKERS
 from hsgplan.paths import REACH_HELD_OUT, RUNS, TASK_CHECKPOINT
 
 train_app = typer.Typer(no_args_is_help=True, help="Train the learned models (resumable).")
@@ -28,9 +31,22 @@ REGRESSION = PlannerName("regression")
 @train_app.command("task")
 @refuses_bad_input
 def train_task(
-    config: Annotated[Path | None, typer.Option(help="Training configuration (JSON).")] = None,
-    out_dir: Annotated[Path, typer.Option("--out", help="Checkpoint folder.")] = TASK_CHECKPOINT,
-    seed: Annotated[int | None, typer.Option(help="Overrides the configuration's seed.")] = None,
+    config: Annotated[
+        Path | None, typer.Option(help="Training configuration (JSON).", parser=input_path)
+    ] = None,
+    out_dir: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            help="Checkpoint folder (default: runs/train-task; a shipped checkpoint is never "
+            "written unless named).",
+            parser=out_folder,
+        ),
+    ] = RUNS / "train-task",
+    seed: Annotated[
+        int | None,
+        typer.Option(help="Overrides the configuration's seed.", min=0, max=MAX_SEED),
+    ] = None,
 ) -> None:
     """Train f_preimage, f_reach and the forward baseline on the demonstrations."""
     from hsgplan.planning.regression.train import TaskTrainConfig
@@ -49,21 +65,33 @@ def train_task(
             progress.update(bars[name], completed=epoch, description=f"{name} loss {loss:.4f}")
 
         run(cfg, out_dir, on_epoch)
-    out.print(f"trained f_preimage, f_reach and the forward baseline into {out_dir}")
+    out.print(f"trained f_preimage, f_reach and the forward baseline into {shown(out_dir)}")
 
 
 @refuses_bad_input
 def eval_task(
     planner: Annotated[PlannerName, typer.Option(help="Task planner.")] = REGRESSION,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
-    goals: Annotated[int, typer.Option(help="Random goals per size.")] = 500,
-    seed: Annotated[int, typer.Option(help="Seed of the goals and start states.")] = 0,
-    goals_file: Annotated[Path | None, typer.Option(help="Goals from a file instead.")] = None,
-    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = TASK_CHECKPOINT,
-    workers: Annotated[int, typer.Option(help="Episodes run side by side.")] = 2,
+    goals: Annotated[int, typer.Option(help="Random goals per size.", min=0, max=MAX_GOALS)] = 500,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the goals and start states.", min=0, max=MAX_SEED)
+    ] = 0,
+    goals_file: Annotated[
+        Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
+    ] = None,
+    checkpoint: Annotated[
+        Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
+    ] = TASK_CHECKPOINT,
+    workers: Annotated[
+        int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
+    ] = 2,
     run_dir: Annotated[
         Path | None,
-        typer.Option("--out", help="Run folder (resumed if it exists; default runs/NAME)."),
+        typer.Option(
+            "--out",
+            help="Run folder (resumed if it exists; default runs/NAME).",
+            parser=out_folder,
+        ),
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
@@ -76,8 +104,6 @@ def eval_task(
     they finish."""
     from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
 
-    if workers < 1:
-        raise InvalidInputError(f"--workers {workers}: need at least one")
     planner = planner.value
     size_list = parse_sizes(sizes)
     total = goals * len(size_list) if goals_file is None else None
@@ -135,9 +161,14 @@ def eval_task(
 
 @refuses_bad_input
 def eval_reach(
-    checkpoint: Annotated[Path, typer.Option(help="Task planner checkpoint.")] = TASK_CHECKPOINT,
+    checkpoint: Annotated[
+        Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
+    ] = TASK_CHECKPOINT,
     trials: Annotated[
-        Path, typer.Option(help="Held-out executed primitives (`hsgplan collect reach`).")
+        Path,
+        typer.Option(
+            help="Held-out executed primitives (`hsgplan collect reach`).", parser=input_path
+        ),
     ] = REACH_HELD_OUT,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[

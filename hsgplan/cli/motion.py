@@ -3,41 +3,70 @@
 from __future__ import annotations
 
 import json
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import err, out, print_table, read_config, refuses_bad_input
-from hsgplan.paths import MOTION_CHECKPOINTS
+from hsgplan.cli.common import (
+    err,
+    input_path,
+    out,
+    out_folder,
+    print_table,
+    read_config,
+    refuses_bad_input,
+    shown,
+)
+from hsgplan.domain.checks import MAX_SEED, MAX_TRIALS, MAX_WORKERS
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.paths import MOTION_CHECKPOINTS, RUNS
+
+
+class Primitive(StrEnum):
+    place = "place"
+    push = "push"
+
+
+class Model(StrEnum):
+    gnn = "gnn"
+    mlp = "mlp"
 
 
 @refuses_bad_input
 def train_motion(
-    primitive: Annotated[str, typer.Option(help="place or push.")] = "place",
-    model: Annotated[str, typer.Option(help="gnn or mlp.")] = "gnn",
-    config: Annotated[Path | None, typer.Option(help="Training configuration (JSON).")] = None,
+    primitive: Annotated[Primitive, typer.Option(help="place or push.")] = Primitive.place,
+    model: Annotated[Model, typer.Option(help="gnn or mlp.")] = Model.gnn,
+    config: Annotated[
+        Path | None, typer.Option(help="Training configuration (JSON).", parser=input_path)
+    ] = None,
     out_dir: Annotated[
         Path | None,
         typer.Option(
-            "--out", help="Checkpoint folder (default: checkpoints/motion/PRIMITIVE-MODEL)."
+            "--out",
+            help="Checkpoint folder (default: runs/train-motion-PRIMITIVE-MODEL; a shipped "
+            "checkpoint is never written unless named).",
+            parser=out_folder,
         ),
     ] = None,
     data: Annotated[
-        Path | None, typer.Option(help="Dataset folder (overrides the config).")
+        Path | None,
+        typer.Option(help="Dataset folder (overrides the config).", parser=input_path),
     ] = None,
 ) -> None:
     """Train a motion network (config loss: ce on the successes, bce on every trial)."""
     from hsgplan.motion.train import MotionTrainConfig
     from hsgplan.motion.train import train_motion as run
 
+    primitive, model = primitive.value, model.value
     settings = read_config(config)
     settings |= {"primitive": primitive, "model": model}
     if data is not None:
         settings["data"] = str(data)
     cfg = MotionTrainConfig.from_json(settings)
-    folder = out_dir or MOTION_CHECKPOINTS / f"{primitive}-{model}"
+    folder = out_dir or RUNS / f"train-motion-{primitive}-{model}"
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task(f"{primitive} {model}", total=cfg.epochs)
 
@@ -47,21 +76,29 @@ def train_motion(
             )
 
         run(cfg, folder, on_epoch)
-    out.print(f"trained the {model} {primitive} network into {folder}")
+    out.print(f"trained the {model} {primitive} network into {shown(folder)}")
 
 
 @refuses_bad_input
 def eval_motion(
-    trials: Annotated[int, typer.Option(help="Fresh scenes per primitive.")] = 200,
-    seed: Annotated[int, typer.Option(help="Seed of the evaluation scenes.")] = 0,
+    trials: Annotated[
+        int, typer.Option(help="Fresh scenes per primitive.", min=1, max=MAX_TRIALS)
+    ] = 200,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the evaluation scenes.", min=0, max=MAX_SEED)
+    ] = 0,
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
     checkpoints: Annotated[
-        Path, typer.Option(help="Folder of motion checkpoints.")
+        Path, typer.Option(help="Folder of motion checkpoints.", parser=input_path)
     ] = MOTION_CHECKPOINTS,
-    workers: Annotated[int, typer.Option(help="Processes.")] = 2,
+    workers: Annotated[int, typer.Option(help="Processes.", min=1, max=MAX_WORKERS)] = 2,
     run_dir: Annotated[
         Path | None,
-        typer.Option("--out", help="Run folder (resumed if it exists); none: nothing is kept."),
+        typer.Option(
+            "--out",
+            help="Run folder (resumed if it exists); none: nothing is kept.",
+            parser=out_folder,
+        ),
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
@@ -72,7 +109,9 @@ def eval_motion(
     training scenes), per primitive and crowding level; every model sees the same scenes."""
     from hsgplan.evaluation.motion_eval import MODELS, evaluate_motion
 
-    kinds = [p.strip() for p in primitives.split(",") if p.strip()]
+    kinds = [p.strip() for p in primitives.split(",")]
+    if "" in kinds or len(set(kinds)) != len(kinds):
+        raise InvalidInputError(f"--primitives '{primitives}': name place, push or both, each once")
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("scenes", total=trials * len(kinds))
         report = evaluate_motion(

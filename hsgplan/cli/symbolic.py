@@ -9,7 +9,9 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli.common import err, out, refuses_bad_input
+from hsgplan.cli.common import err, out, refuses_bad_input, shown
+from hsgplan.cli.common import out_file as file_to_write
+from hsgplan.domain.checks import MAX_GOALS, MAX_SEED
 from hsgplan.domain.errors import InvalidInputError
 
 
@@ -106,10 +108,14 @@ def plan(
 @refuses_bad_input
 def goals(
     objects: Annotated[int, typer.Option(help="Objects per goal (2-12).")],
-    count: Annotated[int, typer.Option(help="How many goals.")],
-    seed: Annotated[int, typer.Option(help="Random seed; the same seed gives the same goals.")] = 0,
+    count: Annotated[int, typer.Option(help="How many goals.", min=0, max=MAX_GOALS)],
+    seed: Annotated[
+        int,
+        typer.Option(help="Random seed; the same seed gives the same goals.", min=0, max=MAX_SEED),
+    ] = 0,
     out_file: Annotated[
-        Path | None, typer.Option("--out", help="Goal file to write (default: stdout).")
+        Path | None,
+        typer.Option("--out", help="Goal file to write (default: stdout).", parser=file_to_write),
     ] = None,
     stacking: Annotated[bool, typer.Option(help="Allow stacked goals.")] = True,
 ) -> None:
@@ -127,7 +133,5 @@ def goals(
         for g in drawn:
             print(g)
         return
-    if out_file.exists() and out_file.is_dir():
-        raise InvalidInputError(f"--out '{out_file}' is a directory")
     write_goal_file(out_file, drawn, header=header)
-    err.print(f"wrote {len(drawn)} goals to {out_file}")
+    err.print(f"wrote {len(drawn)} goals to {shown(out_file)}")

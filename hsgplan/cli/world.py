@@ -14,14 +14,20 @@ from hsgplan.cli.common import (
     AgentName,
     MotionName,
     PlannerName,
+    check_ray,
     err,
+    input_path,
     out,
+    out_folder,
     parse_sizes,
     print_table,
     refuses_bad_input,
+    shown,
 )
+from hsgplan.domain.checks import MAX_FAILURES, MAX_GOALS, MAX_REPEATS, MAX_SEED, MAX_WORKERS
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import RUNS, shipped
+from hsgplan.runner.run_folder import check_own
 
 AGENT_HELP = "A registered agent: " + "; ".join(
     [f"{name} ({planner} + {motion})" for name, (planner, motion) in AGENTS.items()]
@@ -47,9 +53,12 @@ def demo(
         str | None, typer.Option(help="Goal literals (default: a random goal).")
     ] = None,
     objects: Annotated[int, typer.Option(help="Objects in the random goal (2-12).")] = 4,
-    seed: Annotated[int, typer.Option(help="Seed for the goal and the scene.")] = 0,
-    out_dir: Annotated[Path, typer.Option("--out", help="Folder for the pictures.")] = RUNS
-    / "demo",
+    seed: Annotated[
+        int, typer.Option(help="Seed for the goal and the scene.", min=0, max=MAX_SEED)
+    ] = 0,
+    out_dir: Annotated[
+        Path, typer.Option("--out", help="Folder for the pictures.", parser=out_folder)
+    ] = RUNS / "demo",
 ) -> None:
     """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record."""
     from hsgplan.agents.registry import make_agent
@@ -62,20 +71,19 @@ def demo(
     if goal is None:
         check_size(objects)
     g = parse_goal(goal) if goal else demo_goal(objects, seed)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InvalidInputError(f"--out '{out_dir}' is a file")
+    check_own(out_dir, "episode.json", "demo")
     out.print(
         f"[bold]goal[/] ({g.size} objects, seed {seed}, agent {agent}): {g}",
         highlight=False,
         soft_wrap=True,
     )
     record = run_demo(agent, g, seed, out_dir, on_step=_print_step)
-    verdict = "[green]success[/]" if record.success else f"[red]failed: {record.failure}[/]"
+    verdict = "[green]success[/]" if record.success else f"[red]failed: {shown(record.failure)}[/]"
     out.print(
         f"{verdict} in {len(record.steps)} steps ({record.seconds:.0f} s with the pictures); "
         f"subgoal completion {record.subgoal_completion:.2f}"
     )
-    out.print(f"wrote {out_dir}/episode.gif, {out_dir}/graphs/, {out_dir}/episode.json")
+    out.print(f"wrote {shown(out_dir)}/episode.gif, graphs/, episode.json")
 
 
 def _print_step(s) -> None:
@@ -103,21 +111,38 @@ def evaluate(
         ),
     ] = None,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-6.")] = "2-6",
-    goals: Annotated[int, typer.Option(help="Random goals per size.")] = 50,
-    repeats: Annotated[int, typer.Option(help="Episodes per goal, each from its own scene.")] = 1,
-    seed: Annotated[int, typer.Option(help="Seed of the goals and the episodes.")] = 0,
-    goals_file: Annotated[Path | None, typer.Option(help="Goals from a file instead.")] = None,
+    goals: Annotated[int, typer.Option(help="Random goals per size.", min=0, max=MAX_GOALS)] = 50,
+    repeats: Annotated[
+        int,
+        typer.Option(help="Episodes per goal, each from its own scene.", min=1, max=MAX_REPEATS),
+    ] = 1,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the goals and the episodes.", min=0, max=MAX_SEED)
+    ] = 0,
+    goals_file: Annotated[
+        Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
+    ] = None,
     checkpoint: Annotated[
-        Path | None, typer.Option(help="Task planner checkpoint (default: the shipped one).")
+        Path | None,
+        typer.Option(help="Task planner checkpoint (default: the shipped one).", parser=input_path),
     ] = None,
     motion_checkpoints: Annotated[
         Path | None,
-        typer.Option(help="Folder of motion networks, KIND-MODEL each (default: shipped)."),
+        typer.Option(
+            help="Folder of motion networks, KIND-MODEL each (default: shipped).",
+            parser=input_path,
+        ),
     ] = None,
-    workers: Annotated[int, typer.Option(help="Episodes run side by side.")] = 2,
+    workers: Annotated[
+        int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
+    ] = 2,
     run_dir: Annotated[
         Path | None,
-        typer.Option("--out", help="Run folder (resumed if it exists; default runs/NAME)."),
+        typer.Option(
+            "--out",
+            help="Run folder (resumed if it exists; default runs/NAME).",
+            parser=out_folder,
+        ),
     ] = None,
     ray: Annotated[
         str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
@@ -132,8 +157,6 @@ def evaluate(
     from hsgplan.evaluation.protocol import EvalConfig, checkpoints, episode_specs
     from hsgplan.evaluation.table1 import Method, run_table, tables
 
-    if workers < 1:
-        raise InvalidInputError(f"--workers {workers}: need at least one")
     planner_name = planner and planner.value
     if motion is None:
         name = agent_name(agent.value, planner_name)
@@ -163,8 +186,7 @@ def evaluate(
     for m in methods:  # an unknown name or a missing checkpoint: refused before any work
         make_agent(m.agent, *checkpoints(config))
     folder = run_dir or RUNS / _run_name(methods, config)
-    if folder.exists() and not folder.is_dir():
-        raise InvalidInputError(f"--out '{folder}' is a file")
+    check_ray(ray)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(", ".join(m.agent for m in methods), total=total)
         report = run_table(methods, config, folder, workers, ray, lambda r: progress.advance(task))
@@ -175,7 +197,7 @@ def evaluate(
         print_table(t.title, t.header, [list(r) for r in t.rows], markdown)
         print()
     if not markdown:
-        out.print(f"wrote {folder}/table1.md, table1.png, summary.json", highlight=False)
+        out.print(f"wrote {shown(folder)}/table1.md, table1.png, summary.json", highlight=False)
 
 
 def _run_name(methods, config) -> str:
@@ -187,9 +209,17 @@ def _run_name(methods, config) -> str:
 
 @refuses_bad_input
 def report(
-    run_dir: Annotated[Path, typer.Argument(help="An eval run folder (holding summary.json).")],
+    run_dir: Annotated[
+        Path,
+        typer.Argument(help="An eval run folder (holding summary.json).", parser=input_path),
+    ],
     failures: Annotated[
-        int, typer.Option(help="Failed episodes re-simulated and shown, GIF and graphs.")
+        int,
+        typer.Option(
+            help="Failed episodes re-simulated and shown, GIF and graphs.",
+            min=0,
+            max=MAX_FAILURES,
+        ),
     ] = 6,
 ) -> None:
     """One self-contained HTML page for an eval run: its tables and plot, and failed episodes
@@ -197,8 +227,6 @@ def report(
     failing step). Writes RUN_DIR/report.html."""
     from hsgplan.evaluation.report import build_report
 
-    if failures < 0:
-        raise InvalidInputError(f"--failures {failures}: cannot be negative")
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("re-simulating failed episodes", total=None)
         path = build_report(
@@ -208,4 +236,4 @@ def report(
             on_sample=lambda n: progress.update(task, total=n),
         )
     size = path.stat().st_size / 1e6
-    out.print(f"wrote {path} ({size:.1f} MB)", highlight=False)
+    out.print(f"wrote {shown(path)} ({size:.1f} MB)", highlight=False)

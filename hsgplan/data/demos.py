@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from hsgplan.domain.actions import Action, parse_action
+from hsgplan.domain.checks import read_json, read_text
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal
 from hsgplan.paths import shipped
@@ -96,7 +97,7 @@ def load_demos(folder: Path) -> list[Demo]:
     """The demonstrations of a dataset folder (found as `hsgplan.paths.shipped` finds it),
     checked; bad input raises InvalidInputError."""
     folder = shipped(folder)
-    meta = read_json(folder / META)
+    meta = read_json(folder / META, "demonstration metadata")
     if meta.get("format") != FORMAT or meta.get("version") != VERSION:
         raise InvalidInputError(f"'{folder}' is not a version {VERSION} demonstration dataset")
     demos = read_demos(folder / DEMOS, tolerate_cut=False)
@@ -105,20 +106,11 @@ def load_demos(folder: Path) -> list[Demo]:
     return demos
 
 
-def read_json(path: Path) -> dict:
-    if not path.is_file():
-        raise InvalidInputError(f"'{path}' does not exist")
-    try:
-        return json.loads(path.read_text())
-    except json.JSONDecodeError:
-        raise InvalidInputError(f"'{path}' is not valid JSON") from None
-
-
 def read_demos(path: Path, tolerate_cut: bool) -> list[Demo]:
     if not path.exists():
         return []
     demos = []
-    for n, line in enumerate(path.read_text().splitlines(), start=1):
+    for n, line in enumerate(read_text(path, "demonstrations").splitlines(), start=1):
         if not line.strip():
             continue
         try:

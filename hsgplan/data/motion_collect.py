@@ -10,6 +10,8 @@ the chunks, in whatever order they finished, and however often the run was inter
 
 from __future__ import annotations
 
+import os
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,9 +23,10 @@ from hsgplan.data.motion_trials import ATTEMPTS_PER_TASK, TASKS_PER_CHUNK, run_c
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.runner.engines import engine
-from hsgplan.runner.run_folder import claim
+from hsgplan.runner.run_folder import check_own, claim
 
 WORK = "work"
+REJECTED = "rejected"
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,16 @@ class CollectConfig:
         if self.tasks_per_chunk < 1:
             raise InvalidInputError(f"tasks per chunk {self.tasks_per_chunk}: at least one")
 
+    def dataset_settings(self) -> dict:
+        """What decides a dataset's rows (the chunking does not), kept in its manifest."""
+        return {
+            "primitive": self.primitive.value,
+            "seed": self.seed,
+            "samples": self.samples,
+            "attempts_per_task": ATTEMPTS_PER_TASK[self.primitive],
+            "schema_version": store.SCHEMA_VERSION,
+        }
+
 
 @dataclass(frozen=True)
 class CollectSummary:
@@ -51,21 +64,49 @@ class CollectSummary:
     chunks_run: int  # chunks this call ran (the rest were on disk)
     unstaged: int
     dataset: Path
+    set_aside: int = 0  # damaged or foreign chunk files moved to `rejected/` and run again
 
 
 def work_folder(out: Path, primitive: MotionPrimitive, seed: int) -> Path:
     return out / WORK / f"{primitive.value}-seed{seed}"
 
 
-def _done_chunks(folder: Path) -> dict[int, int]:
-    """Successful trials in each chunk on disk; a damaged chunk file is removed (it runs again)."""
-    done = {}
-    for path in sorted(folder.glob("chunk-*.npz")):
+def check_out(config: CollectConfig, out: Path) -> None:
+    """Refuse, before anything is written, an output folder that is not a motion dataset
+    folder, and a dataset file there made with other settings (or with none recorded: the
+    shipped data without its manifest): collections never overwrite data they did not make."""
+    if not (out / WORK).is_dir():
+        check_own(out, store.SCHEMA, "motion dataset")
+    dataset = out / f"{config.primitive.value}.npz"
+    if dataset.exists():
+        made = store.read_manifest(dataset)
+        if made is None or {k: v for k, v in made.items() if k != "sha256"} != (
+            config.dataset_settings()
+        ):
+            was = f" (samples {made.get('samples')}, seed {made.get('seed')})" if made else ""
+            raise InvalidInputError(
+                f"'{dataset}' holds a dataset collected with other settings{was}; use another --out"
+            )
+
+
+def _done_chunks(config: CollectConfig, folder: Path) -> tuple[dict[int, int], int]:
+    """Successful trials in each chunk on disk, and how many files were set aside: a damaged
+    chunk, or one that is not the chunk its name says, is moved to `rejected/` (never kept,
+    never silently deleted) and runs again."""
+    for leftover in folder.glob(".*.tmp"):
+        leftover.unlink()  # a write cut short
+    done, rejected = {}, 0
+    for k, path in store.chunk_files(folder).items():
         try:
-            done[int(path.stem.split("-")[1])] = int(store.load(path).ok.sum())
+            data, _ = store.load_chunk(
+                path, config.primitive, config.seed, k, config.tasks_per_chunk
+            )
+            done[k] = int(data.ok.sum())
         except InvalidInputError:
-            path.unlink()
-    return done
+            (folder / REJECTED).mkdir(exist_ok=True)
+            os.replace(path, folder / REJECTED / f"{path.name}.{time.time_ns()}")
+            rejected += 1
+    return done, rejected
 
 
 def _prefix_done(done: dict[int, int], samples: int) -> int | None:
@@ -86,26 +127,30 @@ def collect(
 
     `progress` is told the number of successes on disk after every finished chunk.
     """
+    check_out(config, out)
     folder = work_folder(out, config.primitive, config.seed)
     claim(
         folder,
+        "collect-motion",
         {
             "primitive": config.primitive.value,
             "seed": config.seed,
             "tasks_per_chunk": config.tasks_per_chunk,
             "attempts_per_task": ATTEMPTS_PER_TASK[config.primitive],
             "schema_version": store.SCHEMA_VERSION,
+            "chunk_format": store.CHUNK_FORMAT,
         },
         f"'{folder}' holds chunks made with other collection settings; use another --out",
     )
-    done = _done_chunks(folder)
+    store.write_schema(out)
+    done, rejected = _done_chunks(config, folder)
     ran = 0
     if progress:
         progress(sum(done.values()))
     if _prefix_done(done, config.samples) is None:
         with engine(config.workers, config.ray_address) as runner:
             ran = _run(runner, config, folder, done, progress)
-    return _pack(config, out, folder, done, ran)
+    return _pack(config, out, folder, done, ran, rejected)
 
 
 def _run(runner, config: CollectConfig, folder: Path, done: dict[int, int], progress) -> int:
@@ -132,17 +177,26 @@ def _run(runner, config: CollectConfig, folder: Path, done: dict[int, int], prog
     return ran
 
 
-def _pack(config: CollectConfig, out: Path, folder: Path, done, ran: int) -> CollectSummary:
+def _pack(
+    config: CollectConfig, out: Path, folder: Path, done, ran: int, rejected: int
+) -> CollectSummary:
     n_chunks = _prefix_done(done, config.samples) or 0
-    parts = [store.load(store.chunk_path(folder, k)) for k in range(n_chunks)]
-    unstaged = sum(store.unstaged_of(store.chunk_path(folder, k)) for k in range(n_chunks))
-    trials = store.concat(config.primitive, parts)
+    chunks = [
+        store.load_chunk(
+            store.chunk_path(folder, k), config.primitive, config.seed, k, config.tasks_per_chunk
+        )
+        for k in range(n_chunks)
+    ]
+    unstaged = sum(u for _, u in chunks)
+    trials = store.concat(config.primitive, [data for data, _ in chunks])
     order = np.lexsort((trials.attempt, trials.task))
     ok = order[trials.ok[order]][: config.samples]
     dataset = out / f"{config.primitive.value}.npz"
     store.save(dataset, trials.take(ok))
+    store.write_manifest(dataset, config.dataset_settings())
     # Every trial up to the last sample, failures included: what a success classifier learns from.
     upto = order[: int(np.flatnonzero(order == ok[-1])[0]) + 1] if len(ok) else ok
-    store.save(out / f"{config.primitive.value}_trials.npz", trials.take(upto))
-    store.write_schema(out)
-    return CollectSummary(len(ok), len(trials), ran, unstaged, dataset)
+    every = out / f"{config.primitive.value}_trials.npz"
+    store.save(every, trials.take(upto))
+    store.write_manifest(every, config.dataset_settings())
+    return CollectSummary(len(ok), len(trials), ran, unstaged, dataset, rejected)

@@ -22,9 +22,10 @@ About 190 bytes a row before compression.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
-import zipfile
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,8 +41,10 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.outcome import Status
 
 SCHEMA_VERSION = 1
+CHUNK_FORMAT = 2  # 2: a chunk carries its index and seed, checked on load
 STATUSES: tuple[Status, ...] = tuple(Status)
 TYPES: tuple[str, ...] = tuple(OBJECT_TYPES)
+SCHEMA = "schema.json"
 FIELDS = ("task", "attempt", "status", "crowding", "obj", "target", "bins", "poses")
 
 
@@ -105,37 +108,76 @@ def from_trials(primitive: MotionPrimitive, trials: list[Trial]) -> MotionData:
     )
 
 
-def save(path: Path, data: MotionData, **extra: int) -> None:
-    """Write atomically (a temporary file renamed), so an interruption leaves no half file."""
-    tmp = path.with_name(path.name + ".tmp.npz")
+def save(path: Path, data: MotionData, **extra: np.ndarray) -> None:
+    """Write atomically (a temporary file renamed), so an interruption leaves no half file;
+    the temporary name never looks like a chunk or a dataset."""
+    tmp = path.with_name(f".{path.name}.tmp")
     arrays = {f: getattr(data, f) for f in FIELDS}
-    np.savez_compressed(tmp, primitive=np.array(data.primitive.value), **arrays, **extra)
+    with open(tmp, "wb") as f:
+        np.savez_compressed(f, primitive=np.array(data.primitive.value), **arrays, **extra)
     os.replace(tmp, path)
 
 
 def load(path: Path) -> MotionData:
     """Read a dataset or chunk file; a missing or damaged file is refused in one line."""
-    if not path.exists():
+    return _read(path)[0]
+
+
+def _read(path: Path) -> tuple[MotionData, dict[str, int]]:
+    """The rows and the integer extras (a chunk's index, seed, unstaged count) of a file."""
+    if not path.is_file():
         raise InvalidInputError(f"'{path}': no such motion data file")
     try:
         with np.load(path, allow_pickle=False) as z:
-            return MotionData(MotionPrimitive(str(z["primitive"])), *(z[f] for f in FIELDS))
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as e:
+            data = MotionData(MotionPrimitive(str(z["primitive"])), *(z[f] for f in FIELDS))
+            extras = {k: int(z[k]) for k in z.files if k not in FIELDS and k != "primitive"}
+    except Exception as e:  # zip, numpy and value errors alike: a damaged file, one line
         raise InvalidInputError(f"'{path}' is not a readable motion data file ({e})") from None
+    n = len(data.task)
+    shapes = [getattr(data, f).shape[:1] == (n,) for f in FIELDS]
+    if not all(shapes) or data.bins.shape[1:] != (2,) or data.poses.shape[1:] != (len(TYPES), 7):
+        raise InvalidInputError(f"'{path}' does not follow the motion data schema")
+    return data, extras
 
 
-def unstaged_of(path: Path) -> int:
-    with np.load(path, allow_pickle=False) as z:
-        return int(z["unstaged"])
+CHUNK_NAME = re.compile(r"chunk-(\d{6})\.npz")
 
 
 def chunk_path(folder: Path, chunk: int) -> Path:
     return folder / f"chunk-{chunk:06d}.npz"
 
 
+def chunk_files(folder: Path) -> dict[int, Path]:
+    """The chunk files of a work folder by index (nothing else that lies there)."""
+    found = {}
+    for path in folder.iterdir():
+        if m := CHUNK_NAME.fullmatch(path.name):
+            found[int(m.group(1))] = path
+    return dict(sorted(found.items()))
+
+
 def save_chunk(folder: Path, result: ChunkResult) -> None:
     data = from_trials(result.primitive, list(result.trials))
-    save(chunk_path(folder, result.chunk), data, unstaged=np.array(result.unstaged))
+    extras = {"unstaged": result.unstaged, "chunk": result.chunk, "seed": result.seed}
+    save(chunk_path(folder, result.chunk), data, **{k: np.array(v) for k, v in extras.items()})
+
+
+def load_chunk(
+    path: Path, primitive: MotionPrimitive, seed: int, chunk: int, tasks_per_chunk: int
+) -> tuple[MotionData, int]:
+    """A chunk's rows and unstaged count, checked to be the chunk its name says of this
+    collection: a damaged chunk, or one copied from another place, is refused in one line."""
+    data, extras = _read(path)
+    tasks = range(chunk * tasks_per_chunk, (chunk + 1) * tasks_per_chunk)
+    own = (
+        data.primitive is primitive
+        and extras.get("chunk") == chunk
+        and extras.get("seed") == seed
+        and all(int(t) in tasks for t in np.unique(data.task))
+    )
+    if not own or "unstaged" not in extras:
+        raise InvalidInputError(f"'{path}' is not chunk {chunk} of this collection")
+    return data, extras["unstaged"]
 
 
 def concat(primitive: MotionPrimitive, parts: list[MotionData]) -> MotionData:
@@ -154,4 +196,43 @@ def write_schema(folder: Path) -> None:
         "fields": FIELDS,
         "description": "Schema" + doc,
     }
-    (folder / "schema.json").write_text(json.dumps(schema, indent=1) + "\n")
+    tmp = folder / ".schema.json.tmp"
+    tmp.write_text(json.dumps(schema, indent=1) + "\n")
+    os.replace(tmp, folder / SCHEMA)
+
+
+def manifest_path(dataset: Path) -> Path:
+    return dataset.with_suffix(".json")
+
+
+def write_manifest(dataset: Path, settings: dict) -> None:
+    """What made a dataset file, and its checksum, as `place.json` beside `place.npz`."""
+    manifest = settings | {"sha256": hashlib.sha256(dataset.read_bytes()).hexdigest()}
+    tmp = dataset.with_name(f".{dataset.stem}.json.tmp")
+    tmp.write_text(json.dumps(manifest, indent=1) + "\n")
+    os.replace(tmp, manifest_path(dataset))
+
+
+def read_manifest(dataset: Path) -> dict | None:
+    """A dataset file's manifest (None when there is none or it cannot be read)."""
+    try:
+        manifest = json.loads(manifest_path(dataset).read_bytes())
+    except (OSError, ValueError):
+        return None
+    return manifest if isinstance(manifest, dict) else None
+
+
+def load_dataset(path: Path) -> MotionData:
+    """A dataset file, checked against its manifest's checksum where it has one: a file
+    replaced or damaged since it was collected is refused in one line."""
+    manifest = read_manifest(path)
+    if (
+        manifest
+        and path.is_file()
+        and (hashlib.sha256(path.read_bytes()).hexdigest() != manifest.get("sha256"))
+    ):
+        raise InvalidInputError(
+            f"'{path}' does not match its manifest {manifest_path(path).name} "
+            "(damaged or replaced); collect it again"
+        )
+    return load(path)

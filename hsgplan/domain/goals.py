@@ -13,6 +13,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
+from hsgplan.domain.checks import read_text
 from hsgplan.domain.errors import GoalSyntaxError, InvalidInputError, UnknownNameError
 from hsgplan.domain.feasibility import check_literals
 from hsgplan.domain.objects import kind_of, sort_objects
@@ -146,16 +147,17 @@ def goal_of(literals: Iterable[Literal]) -> Goal:
 def write_goal_file(path: Path, goals: Iterable[Goal], header: str = "") -> None:
     """One goal per line, after optional `#` comment lines."""
     lines = [f"# {h}" for h in header.splitlines()] + [str(g) for g in goals]
-    Path(path).write_text("\n".join(lines) + "\n")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp")  # an existing file is replaced whole or kept
+    tmp.write_text("\n".join(lines) + "\n")
+    tmp.replace(path)
 
 
 def read_goal_file(path: Path) -> list[Goal]:
     """Every goal in a goal file; a bad line raises with its line number."""
-    p = Path(path)
-    if not p.is_file():
-        raise InvalidInputError(f"goal file '{path}' does not exist")
     goals = []
-    for n, line in enumerate(p.read_text().splitlines(), start=1):
+    for n, line in enumerate(read_text(Path(path), "goal file").splitlines(), start=1):
         text = line.strip()
         if not text or text.startswith("#"):
             continue

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from hsgplan.checkpoint import fingerprint
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import stage_task, try_params
 from hsgplan.domain.errors import InvalidInputError
@@ -136,6 +137,8 @@ def evaluate_motion(
     With `run_dir`, finished chunks are kept there and a run started again skips them."""
     if trials < 1:
         raise InvalidInputError(f"--trials {trials}: need at least one")
+    if not primitives:
+        raise InvalidInputError("--primitives names none: place, push or place,push")
     kinds = []
     for p in primitives:
         if p not in ("place", "push"):
@@ -158,10 +161,14 @@ def evaluate_motion(
         chunks,
         key=lambda c: c.key,
         run_dir=run_dir,
+        kind="eval-motion",
         config={
             "primitives": [k.value for k in kinds],
             "seed": seed,
             "checkpoints": str(checkpoints),
+            "fingerprint": fingerprint(
+                shipped(checkpoints) / f"{k.value}-{f}" for k in kinds for f in FOLDERS.values()
+            ),
         },
         workers=workers,
         on_result=on_chunk,

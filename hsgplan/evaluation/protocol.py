@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, fields, replace
 from functools import lru_cache, partial
 from pathlib import Path
 
+from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.evaluation.episode import EpisodeRecord
@@ -86,6 +87,44 @@ def _worker_agent(config: EvalConfig):
     return make_agent(config.agent, *checkpoints(config))
 
 
+EVAL_KIND = "eval"
+
+
+def run_config(config: EvalConfig) -> dict:
+    """What an evaluation's run folder is claimed with: its settings and a fingerprint of the
+    checkpoints its agent reads and of its goal file, so that a resumed run never mixes
+    episodes of one checkpoint with another's."""
+    from hsgplan.agents.registry import agent_checkpoints
+    from hsgplan.checkpoint import fingerprint
+
+    folders = agent_checkpoints(config.agent, *checkpoints(config))
+    files = [Path(config.goals_file)] if config.goals_file else []
+    return asdict(config) | {
+        "sizes": list(config.sizes),
+        "fingerprint": fingerprint([*folders, *files]),
+    }
+
+
+def read_eval_config(run_dir: Path) -> EvalConfig:
+    """The configuration an evaluation's run folder was claimed with; one line if damaged."""
+    saved = read_json(run_dir / CONFIG, "run configuration")
+    names = {f.name for f in fields(EvalConfig)}
+    try:
+        config = EvalConfig(**{k: v for k, v in saved.items() if k in names})
+        return replace(config, sizes=tuple(config.sizes))
+    except TypeError:
+        raise InvalidInputError(
+            f"'{run_dir / CONFIG}' is not an evaluation's configuration"
+        ) from None
+
+
+def run_refusal(run_dir: Path) -> str:
+    return (
+        f"'{run_dir}' holds episodes of another configuration, checkpoint or goal file; "
+        "use another --out"
+    )
+
+
 def checkpoints(config: EvalConfig) -> tuple[Path, Path]:
     """The task planner's and the motion networks' folders an evaluation runs with."""
     from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
@@ -123,12 +162,13 @@ def run_evaluation(
             specs,
             key=lambda s: s.key,
             run_dir=run_dir,
-            config=asdict(config) | {"sizes": list(config.sizes)},
+            kind=EVAL_KIND,
+            config=run_config(config),
             workers=workers,
             ray=ray,
             on_result=on_episode and (lambda row: on_episode(EpisodeRecord.from_json(row))),
         )
     finally:
-        if run_dir is not None and (run_dir / CONFIG).exists():
+        if run_dir is not None and (run_dir / CONFIG).is_file():
             add_wall_seconds(run_dir, time.perf_counter() - start, workers)
     return [EpisodeRecord.from_json(row) for row in rows]

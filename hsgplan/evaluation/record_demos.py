@@ -9,10 +9,12 @@ from collections.abc import Callable
 from pathlib import Path
 
 from hsgplan.agents.registry import make_agent
-from hsgplan.data.demos import DEMOS, FORMAT, META, TASKS, VERSION, Demo, read_demos, read_json
+from hsgplan.data.demos import DEMOS, FORMAT, META, TASKS, VERSION, Demo, read_demos
+from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.episode import run_episode
+from hsgplan.runner.run_folder import check_own
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.env import KitchenStorageEnv
 
@@ -49,11 +51,12 @@ def collect_demos(
     out: Path, seed: int, command: str = "", on_demo: Callable[[Demo], None] | None = None
 ) -> list[Demo]:
     """Record every task not yet in `out` (appending as each finishes); all demos, in order."""
+    check_own(out, META, "demonstration set")  # never into another command's folder
     out.mkdir(parents=True, exist_ok=True)
     meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
     meta_path = out / META
     if meta_path.exists():
-        saved = read_json(meta_path)
+        saved = read_json(meta_path, "demonstration metadata")
         if saved.get("seed") != seed or saved.get("version") != VERSION:
             raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
     else:

@@ -273,6 +273,7 @@ def collect_reach(
     # claimed here first for a refusal that says what differs, and to count what is logged
     claim(
         out,
+        "reach",
         config,
         f"'{out}' holds a reach collection made with other settings (seed, "
         "actions per state, parameter choices, or an older layout); use another --out",
@@ -284,6 +285,7 @@ def collect_reach(
         items,
         key=lambda item: item.key,
         run_dir=out,
+        kind="reach",
         config=config,
         workers=workers,
         ray=ray,

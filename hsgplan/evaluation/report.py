@@ -15,13 +15,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import EvalConfig, checkpoints
+from hsgplan.evaluation.protocol import checkpoints, read_eval_config
 from hsgplan.evaluation.summary import FAILED_EXECUTION, failure_class
 from hsgplan.evaluation.table1 import label, tables
-from hsgplan.runner.run_folder import CONFIG, logged_rows
+from hsgplan.runner.run_folder import logged_rows
 from hsgplan.viz.html_page import heading, image, page, paragraph, table
 
 REPORT = "report.html"
@@ -61,11 +62,8 @@ def read_summary(run_dir: Path) -> dict:
         raise InvalidInputError(f"'{run_dir}' is not a folder")
     if not path.exists():
         raise InvalidInputError(f"'{run_dir}' holds no summary.json: not a finished eval run")
-    try:
-        summary = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError):
-        raise InvalidInputError(f"'{path}' is not valid JSON") from None
-    if not isinstance(summary, dict) or not isinstance(summary.get("methods"), dict):
+    summary = read_json(path, "eval summary")
+    if not isinstance(summary.get("methods"), dict):
         raise InvalidInputError(f"'{path}' is not an eval summary (no methods)")
     return summary
 
@@ -80,7 +78,12 @@ def sample_failures(
     for m in methods:
         by_kind: dict[tuple[str, str], list[tuple[str, EpisodeRecord]]] = {}
         rows = logged_rows(run_dir / m)
-        records = [EpisodeRecord.from_json(r["result"]) for r in rows if "result" in r]
+        records = []
+        for r in rows:
+            try:
+                records.append(EpisodeRecord.from_json(r["result"]))
+            except (KeyError, TypeError, ValueError):
+                continue  # a damaged row is not shown (the eval would run its episode again)
         for r in sorted(records, key=lambda r: (r.size, r.seed)):
             if c := failure_class(r):
                 by_kind.setdefault(c, []).append((m, r))
@@ -101,7 +104,7 @@ def rollout(run_dir: Path, method: str, agent: str, record: EpisodeRecord) -> Ro
     folder = run_dir / ROLLOUTS / f"{method}-{record.size}-{record.seed}"
     done = folder / "episode.json"
     if not done.exists():
-        config = EvalConfig(**json.loads((run_dir / method / CONFIG).read_text()))
+        config = read_eval_config(run_dir / method)
         partial = folder.with_name(folder.name + ".partial")
         shutil.rmtree(partial, ignore_errors=True)
         run_demo(

@@ -11,13 +11,20 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation
+from hsgplan.evaluation.protocol import (
+    EVAL_KIND,
+    EvalConfig,
+    episode_specs,
+    run_config,
+    run_evaluation,
+    run_refusal,
+)
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, summarize
-from hsgplan.runner.run_folder import read_timing
+from hsgplan.runner.run_folder import check_claim, claim, read_timing
 
 # Table 1 of the paper (success rate, subgoal completion), by motion generator and size.
 PAPER_TABLE1: dict[str, dict[int, tuple[float, float]]] = {
@@ -36,6 +43,9 @@ class Method:
     agent: str
 
 
+TABLE_KIND = "eval-table"
+
+
 def label(method: str) -> str:
     return LABELS.get(method, method)
 
@@ -50,6 +60,16 @@ def run_table(
 ) -> dict:
     """Every method's episodes (`config` with the method's agent) into `out/METHOD/`; the
     summary, also written as `summary.json`, `table1.md` and `table1.png` in `out`."""
+    # every refusal before anything is written: the table's folder, then each method's
+    table = {k: v for k, v in asdict(config).items() if k != "agent"} | {
+        "sizes": list(config.sizes)
+    }
+    refusal = f"'{out}' holds a table of another configuration or goal file; use another --out"
+    check_claim(out, TABLE_KIND, table, refusal)
+    for m in methods:
+        method = replace(config, agent=m.agent)
+        check_claim(out / m.name, EVAL_KIND, run_config(method), run_refusal(out / m.name))
+    claim(out, TABLE_KIND, table, refusal)
     records = {}
     for m in methods:
         records[m.name] = run_evaluation(

@@ -18,7 +18,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from hsgplan.agents.registry import make_planner
+from hsgplan.agents.registry import LEARNED_PLANNERS, make_planner
+from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.domain.world import MAX_STEPS
@@ -136,12 +137,24 @@ def evaluate_task(
             for n in sizes
             for i, g in enumerate(random_goals(n, goals, seed, stacking=n > 2))
         ]
+    if not jobs:
+        raise InvalidInputError(
+            f"'{goals_file}' holds no goal of the sizes asked for"
+            if goals_file
+            else "--goals 0: nothing to evaluate"
+        )
+    learned = [checkpoint] if planner in LEARNED_PLANNERS else []
     rows = run_items(
         run_task_job,
         [TaskJob(planner, str(checkpoint), str(g), s) for g, s in jobs],
         key=lambda job: job.key,
         run_dir=run_dir,
-        config={"planner": planner, "checkpoint": str(checkpoint)},
+        kind="eval-task",
+        config={
+            "planner": planner,
+            "checkpoint": str(checkpoint),
+            "fingerprint": fingerprint([*learned, *([goals_file] if goals_file else [])]),
+        },
         workers=workers,
         on_result=on_episode and (lambda row: on_episode(_episode(row))),
     )

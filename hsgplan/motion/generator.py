@@ -137,7 +137,10 @@ class LearnedMotion(_BinGenerator):
     def __init__(self, name: str, folders: dict[MotionPrimitive, Path]) -> None:
         super().__init__()
         self.name = name
-        self.nets = {kind: load_motion_net(folder) for kind, folder in folders.items()}
+        self.nets = {
+            kind: load_motion_net(folder, kind.value, name.split("_")[0])
+            for kind, folder in folders.items()
+        }
 
     def scores(self, sg: GeometricSceneGraph, subgoal: Literal) -> torch.Tensor:
         """Logits over the flattened bin pairs: [bins[0] * bins[1]]."""

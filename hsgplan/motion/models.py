@@ -184,8 +184,20 @@ def build(config: MotionNetConfig) -> nn.Module:
     return GraphMotionNet(config) if config.model == "gnn" else FlatMotionNet(config)
 
 
-def load_motion_net(folder: Path) -> nn.Module:
-    """A trained network from its folder; a missing or corrupted one raises InvalidInputError."""
+def load_motion_net(
+    folder: Path, primitive: str | None = None, model_name: str | None = None
+) -> nn.Module:
+    """A trained network from its folder; a missing or corrupted one, or one trained for
+    another primitive or model than asked (a push network in a place folder), raises
+    InvalidInputError."""
     model, config = load_trained(folder, MotionNetConfig.from_json, build, "motion network")
+    for what, asked, found in (
+        ("primitive", primitive, config.primitive),
+        ("model", model_name, config.model),
+    ):
+        if asked is not None and asked != found:
+            raise InvalidInputError(
+                f"'{folder}' holds a {found} network where a {asked} one belongs ({what})"
+            )
     model.config = config
     return model

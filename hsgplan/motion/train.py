@@ -11,7 +11,6 @@ that a run started again with the same configuration continues from there.
 
 from __future__ import annotations
 
-import json
 import random
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -22,7 +21,16 @@ import torch
 from torch_geometric.data import Batch, Data
 
 from hsgplan import training
-from hsgplan.data.motion_store import MotionData, load
+from hsgplan.checkpoint import fingerprint
+from hsgplan.data.motion_store import MotionData, load_dataset
+from hsgplan.domain.checks import (
+    MAX_SAMPLES,
+    MAX_SEED,
+    MAX_WORKERS,
+    check_fields,
+    from_settings,
+    setting,
+)
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import BINS, MotionPrimitive
 from hsgplan.domain.predicates import inside, on
@@ -36,31 +44,28 @@ class MotionTrainConfig:
     primitive: str = "place"
     model: str = "gnn"
     data: str = str(MOTION_DATA)
-    seed: int = 0
-    epochs: int = 40
-    lr: float = 1e-3
-    batch_size: int = 64
-    hidden: int = 256  # the paper's widths
-    embed: int = 32
-    rounds: int = 2
-    save_every: int = 5
-    samples: int | None = None  # the first this many samples of the dataset (None: all)
+    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    epochs: int = setting(40, lo=1, hi=10_000)
+    lr: float = setting(1e-3, above=0, hi=10)
+    batch_size: int = setting(64, lo=1, hi=65_536)
+    hidden: int = setting(256, lo=1, hi=4096)  # the paper's widths
+    embed: int = setting(32, lo=1, hi=1024)
+    rounds: int = setting(2, lo=0, hi=16)
+    save_every: int = setting(5, lo=1, hi=10_000)
+    # the first this many samples of the dataset (None: all)
+    samples: int | None = setting(None, lo=1, hi=MAX_SAMPLES)
     # The networks are small: measured on 2 busy cores, 2 threads trained ten times slower
     # than 1 (they fight the simulation workers for the cores).
-    threads: int = 1
+    threads: int = setting(1, lo=1, hi=MAX_WORKERS)
     loss: str = "ce"  # "ce" (successes, the paper's) or "bce" (every trial)
     head: str = "mlp"  # the GNN's head: "mlp" (the paper's) or "bins" (`models.BinQueryHead`)
 
     def __post_init__(self) -> None:
+        check_fields(self)
         if self.primitive not in ("place", "push"):
             raise InvalidInputError(f"primitive '{self.primitive}': place or push")
-        for name in ("epochs", "batch_size", "save_every", "threads"):
-            if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
-                raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
         if self.loss not in ("ce", "bce"):
             raise InvalidInputError(f"loss '{self.loss}': ce or bce")
-        if self.samples is not None and self.samples < 1:
-            raise InvalidInputError(f"samples {self.samples!r}: need a positive integer or null")
         self.net_config()  # refuses a bad model name or width
 
     def net_config(self) -> MotionNetConfig:
@@ -71,23 +76,20 @@ class MotionTrainConfig:
 
     @staticmethod
     def from_json(d: dict) -> MotionTrainConfig:
-        unknown = set(d) - set(MotionTrainConfig.__dataclass_fields__)
-        if unknown:
-            raise InvalidInputError(f"unknown training setting(s): {', '.join(sorted(unknown))}")
-        return MotionTrainConfig(**d)
+        return from_settings(MotionTrainConfig, d)
 
 
 def _training_rows(config: MotionTrainConfig) -> MotionData:
     """The first `samples` successes, and with `bce` every trial up to the last of them."""
     folder = shipped(config.data)
-    data = load(folder / f"{config.primitive}.npz")
+    data = load_dataset(folder / f"{config.primitive}.npz")
     if config.samples is not None:
         data = data.take(slice(0, config.samples))
     if len(data) == 0:
         raise InvalidInputError(f"no successful {config.primitive} samples in '{folder}'")
     if config.loss == "ce":
         return data
-    trials = load(folder / f"{config.primitive}_trials.npz")
+    trials = load_dataset(folder / f"{config.primitive}_trials.npz")
     last = (int(data.task[-1]), int(data.attempt[-1]))
     keep = [(int(t), int(a)) <= last for t, a in zip(trials.task, trials.attempt, strict=True)]
     return trials.take(np.array(keep, dtype=bool))
@@ -121,20 +123,22 @@ def train_motion(
     on_epoch: Callable[[int, float], None] | None = None,
 ) -> None:
     """Train (or go on training) one motion network into the checkpoint folder `out`."""
-    out.mkdir(parents=True, exist_ok=True)
-    saved = out / "train_config.json"
-    if saved.exists() and json.loads(saved.read_text()) != asdict(config):
-        raise InvalidInputError(f"'{out}' holds a checkpoint trained with another configuration")
-    saved.write_text(json.dumps(asdict(config), indent=2) + "\n")
+    rows = _training_rows(config)  # a missing or damaged dataset: refused before any write
+    folder = shipped(config.data)
+    files = [folder / f"{config.primitive}.npz"]
+    if config.loss == "bce":
+        files.append(folder / f"{config.primitive}_trials.npz")
+    data = fingerprint(files)
+    training.claim(out, asdict(config), [out])
     if training.finished(out):
         return  # finished earlier
-    examples = grounded_examples(_training_rows(config))
+    examples = grounded_examples(rows)
     torch.set_num_threads(config.threads)
     torch.manual_seed(config.seed)
     net_config = config.net_config()
     model = build(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
-    start = training.resume(out, model, optim)
+    start = training.resume(out, model, optim, data)
     for epoch in range(start, config.epochs):
         order = list(range(len(examples)))
         random.Random(f"{config.seed}-{epoch}").shuffle(order)
@@ -146,8 +150,9 @@ def train_motion(
             loss.backward()
             optim.step()
             total += loss.detach().item() * batch.num_graphs
+        training.check_loss(total, f"the {config.model} {config.primitive} network", epoch + 1)
         if on_epoch:
             on_epoch(epoch + 1, total / len(examples))
         if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
-            training.save_progress(out, model, optim, epoch + 1)
+            training.save_progress(out, model, optim, epoch + 1, data)
     training.finish(out, model, net_config.to_json())

@@ -7,6 +7,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import queue
+import socket
 import sys
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -52,11 +53,37 @@ class LocalEngine:
         self.pool.shutdown(wait=False, cancel_futures=True)
 
 
+RAY_CONNECT_SECONDS = 3.0
+
+
+def check_ray_address(address: str | None) -> None:
+    """Refuse in one line, within seconds, a `--ray` address that cannot work: empty, or a
+    HOST:PORT where nothing answers (Ray itself would retry it for minutes)."""
+    if address is None or address in ("local", "auto"):
+        return
+    if not address.strip():
+        raise InvalidInputError(
+            "--ray '': give an address (HOST:PORT, ray://HOST:PORT or auto) or 'local'"
+        )
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise InvalidInputError(
+            f"--ray '{address}': expected HOST:PORT, ray://HOST:PORT, auto or local"
+        )
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), RAY_CONNECT_SECONDS).close()
+    except OSError as e:
+        raise InvalidInputError(
+            f"--ray '{address}': nothing answers there ({e.strerror or type(e).__name__})"
+        ) from None
+
+
 class RayEngine:
     """The same work on a Ray cluster: `address` as `ray.init` takes it ("auto", "ray://...",
     or "local" to start a private instance on this machine)."""
 
     def __init__(self, address: str, workers: int) -> None:
+        check_ray_address(address)
         try:
             import ray
         except ImportError:

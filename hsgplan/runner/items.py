@@ -29,6 +29,7 @@ def run_items(
     key: Callable[[Item], Hashable],
     *,
     run_dir: Path | None = None,
+    kind: str = "",
     config: dict | None = None,
     workers: int = 2,
     ray: str | None = None,
@@ -36,13 +37,22 @@ def run_items(
 ) -> list[Any]:
     """`work(item)` for every item not yet logged in `run_dir`; every result, in item order.
 
-    `config` is what the run folder is claimed with (a folder made with another one is refused
-    in one line); `on_result` sees each result once, those read back first.
+    `kind` (the command) and `config` are what the run folder is claimed with (a folder of
+    another kind or made with another configuration is refused in one line); `config` should
+    fingerprint whatever produced the results (`hsgplan.checkpoint.fingerprint`), so that a
+    resumed run never mixes rows of another checkpoint with new ones. `on_result` sees each
+    result once, those read back first.
     """
     keys = [str(key(item)) for item in items]
     done: dict[str, Any] = {}
     if run_dir is not None:
-        claim(run_dir, config or {}, f"'{run_dir}' holds a run with another configuration")
+        claim(
+            run_dir,
+            kind,
+            config or {},
+            f"'{run_dir}' holds a {kind} run with another configuration or other checkpoints; "
+            "use another --out",
+        )
         for row in logged_rows(run_dir):
             if isinstance(row, dict) and "key" in row and "result" in row:
                 done[str(row["key"])] = row["result"]

@@ -12,6 +12,7 @@ import json
 import os
 from pathlib import Path
 
+from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 
 RESULTS = "episodes.jsonl"
@@ -19,19 +20,56 @@ CONFIG = "config.json"
 TIMING = "timing.json"
 
 
-def claim(run_dir: Path, config: dict, refusal: str) -> None:
-    """Make `run_dir` the home of a run with `config`; `refusal` is the one-line error when it
-    already holds a run with another configuration."""
+def claim(run_dir: Path, kind: str, config: dict, refusal: str) -> None:
+    """Make `run_dir` the home of a `kind` run with `config`. Refused in one line, before
+    anything is written: a folder of another kind (a checkpoint, a dataset, another command's
+    run), a folder holding files but no run, and a run with another configuration (`refusal`,
+    which says what to do)."""
+    if check_claim(run_dir, kind, config, refusal):
+        return
     run_dir.mkdir(parents=True, exist_ok=True)
+    write_atomically(run_dir / CONFIG, json.dumps({"kind": kind} | config) + "\n")
+
+
+def check_claim(run_dir: Path, kind: str, config: dict, refusal: str) -> bool:
+    """`claim`'s refusals without writing anything; whether the folder is already this run's."""
+    config = {"kind": kind} | config
     saved = run_dir / CONFIG
-    if saved.exists():
-        try:
-            other = json.loads(saved.read_text())
-        except json.JSONDecodeError:
-            raise InvalidInputError(f"'{saved}' is not valid JSON") from None
+    if run_dir.exists() and not run_dir.is_dir():
+        raise InvalidInputError(f"'{run_dir}' is a file, not a run folder")
+    if saved.exists() or saved.is_symlink():
+        other = read_json(saved, "run configuration")
+        if other.get("kind") != kind:
+            what = f"a {other['kind']} run" if isinstance(other.get("kind"), str) else "no run"
+            raise InvalidInputError(
+                f"'{run_dir}' is not a {kind} run folder (it holds {what}); use another --out"
+            )
         if other != config:
             raise InvalidInputError(refusal)
-    saved.write_text(json.dumps(config) + "\n")
+        return True
+    if run_dir.is_dir() and any(run_dir.iterdir()):
+        raise InvalidInputError(
+            f"'{run_dir}' holds other files and no {kind} run; use another --out"
+        )
+    return False
+
+
+def check_own(folder: Path, marker: str, kind: str) -> None:
+    """Refuse a folder that holds files but not `marker`, the file every `kind` folder has:
+    a folder another command made is never written into."""
+    if folder.exists() and not folder.is_dir():
+        raise InvalidInputError(f"'{folder}' is a file, not a folder")
+    if folder.is_dir() and any(folder.iterdir()) and not (folder / marker).is_file():
+        raise InvalidInputError(
+            f"'{folder}' holds other files and no {kind} ({marker}); use another --out"
+        )
+
+
+def write_atomically(path: Path, text: str) -> None:
+    """A temporary file renamed over `path`: an interruption leaves the old file or the new."""
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
 
 
 def logged_rows(run_dir: Path) -> list[dict]:
@@ -40,7 +78,9 @@ def logged_rows(run_dir: Path) -> list[dict]:
     results = run_dir / RESULTS
     if not results.exists():
         return []
-    text = results.read_text()
+    if not results.is_file():
+        raise InvalidInputError(f"'{results}' is not a file; this run folder is damaged")
+    text = results.read_bytes().decode("utf-8", errors="replace")
     if text and not text.endswith("\n"):
         with open(results, "a") as log:
             log.write("\n")
@@ -62,7 +102,7 @@ def add_wall_seconds(run_dir: Path, seconds: float, workers: int) -> None:
     timing["sessions"].append(
         {"seconds": round(seconds, 3), "workers": workers, "cores": os.cpu_count()}
     )
-    (run_dir / TIMING).write_text(json.dumps(timing) + "\n")
+    write_atomically(run_dir / TIMING, json.dumps(timing) + "\n")
 
 
 def read_timing(run_dir: Path) -> dict:
@@ -70,5 +110,5 @@ def read_timing(run_dir: Path) -> dict:
     try:
         timing = json.loads((run_dir / TIMING).read_text())
         return {"wall_seconds": float(timing["wall_seconds"]), "sessions": list(timing["sessions"])}
-    except (FileNotFoundError, json.JSONDecodeError, KeyError, TypeError, ValueError):
+    except (OSError, json.JSONDecodeError, KeyError, TypeError, ValueError):
         return {"wall_seconds": 0.0, "sessions": []}

@@ -57,10 +57,10 @@ def test_eval_motion_cli_prints_json(checkpoints):
 @pytest.mark.parametrize(
     "args,message",
     [
-        (["collect", "place", "--samples", "-3"], "cannot be negative"),
+        (["collect", "place", "--samples", "-3"], "greater than or equal to 0"),
         (["eval-motion", "--checkpoints", "nowhere", "--trials", "2"], "no trained motion"),
         (["eval-motion", "--primitives", "pour"], "place or push"),
-        (["train", "motion", "--model", "cnn"], "model 'cnn'"),
+        (["train", "motion", "--model", "cnn"], "'cnn' is not one of 'gnn', 'mlp'"),
         (["train", "motion", "--data", "nowhere"], "no such motion data"),
     ],
 )

@@ -150,7 +150,7 @@ def test_collect_reach_end_to_end_and_a_rerun_repeats_nothing(tmp_path):
 )
 def test_bad_counts_are_refused_in_one_line(tmp_path, option, value):
     r = CliRunner().invoke(app, ["collect", "reach", option, value, "--out", str(tmp_path)])
-    assert r.exit_code == 2 and "need at least one" in r.stderr
+    assert r.exit_code == 2 and "greater than or equal to 1" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "config.json").exists()
 
 

@@ -67,6 +67,9 @@ def test_refuses_what_is_not_a_finished_eval_run(tmp_path):
     with pytest.raises(InvalidInputError, match="no summary.json"):
         read_summary(tmp_path)
     (tmp_path / "summary.json").write_bytes(b"\xff\xfe{")
+    with pytest.raises(InvalidInputError, match="not UTF-8"):
+        read_summary(tmp_path)
+    (tmp_path / "summary.json").write_text("{")
     with pytest.raises(InvalidInputError, match="not valid JSON"):
         read_summary(tmp_path)
     (tmp_path / "summary.json").write_text('{"by_size": {}}')

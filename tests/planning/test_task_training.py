@@ -6,6 +6,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
+from hsgplan.checkpoint import write_manifest
 from hsgplan.cli import app
 from hsgplan.data.demos import load_demos
 from hsgplan.domain.actions import Pick, Place
@@ -118,7 +119,13 @@ def test_broken_checkpoints_are_refused(tmp_path):
         load_network(tmp_path)
     (tmp_path / "config.json").write_text('{"node_dim": 3}')
     (tmp_path / "model.safetensors").write_bytes(b"not a tensor file")
+    with pytest.raises(InvalidInputError, match="manifest.json is missing"):
+        load_network(tmp_path)
+    write_manifest(tmp_path)  # files that match a manifest but are no network
     with pytest.raises(InvalidInputError, match="not a usable checkpoint"):
+        load_network(tmp_path)
+    (tmp_path / "config.json").write_text('{"node_dim": 4}')  # changed after the manifest
+    with pytest.raises(InvalidInputError, match="does not match its manifest"):
         load_network(tmp_path)
 
 

@@ -21,7 +21,9 @@ import torch
 from torch_geometric.data import Batch
 
 from hsgplan import training
+from hsgplan.checkpoint import fingerprint
 from hsgplan.data.world_trials import load_world_trials
+from hsgplan.domain.checks import MAX_SEED, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import DEMOS, REACH_DATA, shipped
 from hsgplan.planning.regression.augment import trajectories
@@ -51,19 +53,21 @@ class TaskTrainConfig:
     f_reach from primitives executed in the simulated world)."""
 
     demos: str = str(DEMOS)
-    seed: int = 0
-    epochs: int = 8
-    lr: float = 1e-3
-    batch_size: int = 32
+    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    epochs: int = setting(8, lo=1, hi=10_000)
+    lr: float = setting(1e-3, above=0, hi=10)
+    batch_size: int = setting(32, lo=1, hi=65_536)
     # the paper has 256 hidden units; 32 solved every size as well (README) and is faster
-    hidden: int = 32
-    rounds: int = 3
-    save_every: int = 2
-    copies: int = 20  # copies of each demonstration with added objects (`augment.py`); 0: none
+    hidden: int = setting(32, lo=1, hi=4096)
+    rounds: int = setting(3, lo=0, hi=16)
+    save_every: int = setting(2, lo=1, hi=10_000)
+    # copies of each demonstration with added objects (`augment.py`); 0: none
+    copies: int = setting(20, lo=0, hi=1000)
     vary: bool = True  # f_preimage also asked from varied states (`augment.varied`)
     reach: str = "world"  # f_reach's labels: "world" (executed primitives) or "alterations"
     world_trials: str = str(REACH_DATA)  # the executed primitives, for reach = "world"
-    reach_singles: int = 12  # alterations asked alone per state and label (reach = "alterations")
+    # alterations asked alone per state and label (reach = "alterations")
+    reach_singles: int = setting(12, lo=1, hi=1000)
     # f_reach sees the max-pooled graph context (`gnn.RelationalLayer`): whether the hand is
     # full is news from an object nothing relates. f_preimage and the forward baseline do not:
     # a preimage is local, and with the pool f_preimage let crowded shelf tops elsewhere change
@@ -71,24 +75,13 @@ class TaskTrainConfig:
     reach_pool: bool = True
 
     def __post_init__(self) -> None:
-        for name in ("epochs", "batch_size", "hidden", "save_every", "reach_singles"):
-            if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
-                raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
-        for name in ("rounds", "copies"):
-            if not isinstance(getattr(self, name), int) or getattr(self, name) < 0:
-                raise InvalidInputError(f"{name} {getattr(self, name)!r}: cannot be negative")
-        for name in ("vary", "reach_pool"):
-            if not isinstance(getattr(self, name), bool):
-                raise InvalidInputError(f"{name} {getattr(self, name)!r}: true or false")
+        check_fields(self)
         if self.reach not in REACH_SOURCES:
             raise InvalidInputError(f"reach {self.reach!r}: one of {', '.join(REACH_SOURCES)}")
 
     @staticmethod
     def from_json(d: dict) -> TaskTrainConfig:
-        unknown = set(d) - set(TaskTrainConfig.__dataclass_fields__)
-        if unknown:
-            raise InvalidInputError(f"unknown training setting(s): {', '.join(sorted(unknown))}")
-        return TaskTrainConfig(**d)
+        return from_settings(TaskTrainConfig, d)
 
 
 def _examples(name: str, demos, trajs, config: TaskTrainConfig) -> dict[str, list[Example]]:
@@ -138,24 +131,24 @@ def train_task(
     from hsgplan.data.demos import load_demos
 
     demos = load_demos(Path(config.demos))
-    out.mkdir(parents=True, exist_ok=True)
-    saved = out / "train_config.json"
-    if saved.exists() and json.loads(saved.read_text()) != asdict(config):
-        raise InvalidInputError(f"'{out}' holds a checkpoint trained with another configuration")
-    saved.write_text(json.dumps(asdict(config), indent=2) + "\n")
+    sources = [config.demos] + ([config.world_trials] if config.reach == "world" else [])
+    data = fingerprint(Path(s) for s in sources)
+    training.claim(out, asdict(config), [out / name for name in NETWORKS])
     trajs = trajectories(demos, config.copies, config.seed)
     for name, classes in NETWORKS.items():
-        if (out / name / "model.safetensors").exists():
+        if training.finished(out / name):
             continue  # finished earlier
         by_source = _examples(name, demos, trajs, config)
         (out / name).mkdir(exist_ok=True)
         counts = {source: label_counts(ex) for source, ex in by_source.items()}
         (out / name / "labels.json").write_text(json.dumps(counts, indent=2) + "\n")
         examples = [e for ex in by_source.values() for e in ex]
-        _train_one(name, classes, examples, config, out / name, on_epoch)
+        _train_one(name, classes, examples, config, out / name, on_epoch, data)
 
 
-def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, on_epoch) -> None:
+def _train_one(
+    name, classes, examples, config: TaskTrainConfig, folder: Path, on_epoch, data: str
+) -> None:
     folder.mkdir(exist_ok=True)
     if training.finished(folder):
         return  # finished earlier
@@ -171,22 +164,23 @@ def _train_one(name, classes, examples, config: TaskTrainConfig, folder: Path, o
     )
     model = EdgeClassifier(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
-    start = training.resume(folder, model, optim)
-    data = [e.as_data() for e in examples]
+    start = training.resume(folder, model, optim, data)
+    graphs = [e.as_data() for e in examples]
     for epoch in range(start, config.epochs):
         rng = random.Random(f"{config.seed}-{name}-{epoch}")
-        order = list(range(len(data)))
+        order = list(range(len(graphs)))
         rng.shuffle(order)
         total = 0.0
         for i in range(0, len(order), config.batch_size):
-            batch = Batch.from_data_list([data[j] for j in order[i : i + config.batch_size]])
+            batch = Batch.from_data_list([graphs[j] for j in order[i : i + config.batch_size]])
             loss = masked_cross_entropy(model(batch), batch.target, batch.mask)
             optim.zero_grad()
             loss.backward()
             optim.step()
             total += loss.detach().item() * batch.num_graphs
+        training.check_loss(total, name, epoch + 1)
         if on_epoch:
-            on_epoch(name, epoch + 1, total / len(data))
+            on_epoch(name, epoch + 1, total / len(graphs))
         if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
-            training.save_progress(folder, model, optim, epoch + 1)
+            training.save_progress(folder, model, optim, epoch + 1, data)
     training.finish(folder, model, net_config.to_json())

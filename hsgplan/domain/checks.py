@@ -1,0 +1,161 @@
+"""Checks of what enters from outside: the bounds of every count a command takes, the values of
+a configuration read from JSON, and text files read defensively. Each refusal is one
+`InvalidInputError` line that names the value and the bound it breaks.
+
+The bounds are generous for real use and small enough that no count can hang a command before
+its progress bar shows (a billion goals would be drawn in memory for minutes first).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+import types
+import typing
+from pathlib import Path
+from typing import Any
+
+from hsgplan.domain.errors import InvalidInputError
+
+MAX_SEED = 2**32 - 1  # numpy's and torch's seeders both take it
+MAX_WORKERS = 256
+MAX_GOALS = 100_000  # `goals --count`, `eval --goals` and `eval-task --goals` (per size)
+MAX_REPEATS = 100
+MAX_SAMPLES = 1_000_000  # `collect place/push --samples`
+MAX_STATES = 1_000_000  # `collect reach --states`
+MAX_TRIALS = 100_000  # `eval-motion --trials` (per primitive)
+MAX_EPISODES = 10_000  # `bench sim --episodes`
+MAX_FAILURES = 1_000  # `report --failures`
+MAX_TASKS_PER_CHUNK = 100_000
+
+
+def bounded(lo: float | None = None, hi: float | None = None, above: float | None = None) -> dict:
+    """Field metadata for `check_fields`: `lo <= v <= hi`, or `v > above` (a learning rate)."""
+    return {"lo": lo, "hi": hi, "above": above}
+
+
+def setting(default: Any, **bounds: float | None) -> Any:
+    """A dataclass field with a default and the bounds `check_fields` holds it to."""
+    return dataclasses.field(default=default, metadata=bounded(**bounds))
+
+
+def _allowed(hint) -> tuple[type, ...]:
+    """The plain types a field's annotation admits (`int | None` -> int, NoneType)."""
+    if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union:
+        return tuple(a for arg in typing.get_args(hint) for a in _allowed(arg))
+    return (hint,)
+
+
+def _check_value(name: str, value: Any, allowed: tuple[type, ...], meta) -> Any:
+    if value is None and type(None) in allowed:
+        return value
+    if bool in allowed:
+        if not isinstance(value, bool):
+            raise InvalidInputError(f"{name} {value!r}: true or false")
+        return value
+    if str in allowed:
+        if not isinstance(value, str):
+            raise InvalidInputError(f"{name} {value!r}: need a string")
+        return value
+    if int in allowed and float not in allowed:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise InvalidInputError(f"{name} {value!r}: need an integer")
+    elif float in allowed:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise InvalidInputError(f"{name} {value!r}: need a number")
+        if not math.isfinite(value):
+            raise InvalidInputError(f"{name} {value!r}: need a finite number")
+        value = float(value)
+    lo, hi, above = meta.get("lo"), meta.get("hi"), meta.get("above")
+    if lo is not None and value < lo:
+        raise InvalidInputError(f"{name} {value!r}: must be at least {lo}")
+    if hi is not None and value > hi:
+        raise InvalidInputError(f"{name} {value!r}: must be at most {hi}")
+    if above is not None and value <= above:
+        raise InvalidInputError(f"{name} {value!r}: must be greater than {above}")
+    return value
+
+
+def check_fields(config) -> None:
+    """Every field of a frozen dataclass against its annotation and its `setting` bounds;
+    called by its `__post_init__`, so a configuration built from JSON or in code is checked
+    alike. Integers given for float fields are stored as floats."""
+    hints = typing.get_type_hints(type(config))
+    for f in dataclasses.fields(config):
+        value = _check_value(f.name, getattr(config, f.name), _allowed(hints[f.name]), f.metadata)
+        object.__setattr__(config, f.name, value)
+
+
+def from_settings(cls, settings: Any, what: str = "training setting"):
+    """An instance of the dataclass `cls` from a JSON object; unknown keys and values of the
+    wrong type or out of bounds are refused in one line."""
+    if not isinstance(settings, dict):
+        raise InvalidInputError(f"the {what}s must be one JSON object")
+    unknown = set(settings) - {f.name for f in dataclasses.fields(cls)}
+    if unknown:
+        raise InvalidInputError(f"unknown {what}(s): {', '.join(sorted(map(str, unknown)))}")
+    return cls(**settings)
+
+
+def read_text(path: Path, what: str) -> str:
+    """A UTF-8 text file (a byte-order mark is allowed); anything else refused in one line."""
+    path = Path(path)
+    if path.is_dir():
+        raise InvalidInputError(f"{what} '{path}' is a folder, not a file")
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise InvalidInputError(f"{what} '{path}' does not exist") from None
+    except OSError as e:
+        raise InvalidInputError(f"{what} '{path}' cannot be read ({e.strerror})") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise InvalidInputError(f"{what} '{path}' is not UTF-8 text") from None
+
+
+def _no_constant(token: str):
+    raise ValueError(f"{token} is not a JSON number")
+
+
+def read_json(path: Path, what: str, shape: type = dict) -> Any:
+    """A JSON file holding one value of type `shape`; strict JSON (no NaN or Infinity)."""
+    text = read_text(path, what)
+    try:
+        value = json.loads(text, parse_constant=_no_constant)
+    except ValueError as e:
+        raise InvalidInputError(f"{what} '{path}' is not valid JSON ({e})") from None
+    if not isinstance(value, shape):
+        kind = {dict: "one JSON object", list: "a JSON list"}.get(shape, shape.__name__)
+        raise InvalidInputError(f"{what} '{path}' must hold {kind}")
+    return value
+
+
+SYSTEM_TREES = ("/proc", "/sys", "/dev")
+
+
+def check_output(path: Path, kind: str = "folder") -> None:
+    """Refuse, before anything is written, a place output cannot go: a `kind` ("folder" or
+    "file") where something else stands, a path under a file, a system tree, a folder we may
+    not write in. A missing folder on the way is fine: it is made."""
+    text = str(path)
+    if not text.strip():
+        raise InvalidInputError("an empty path; name a place for the output")
+    path = Path(text).expanduser()
+    resolved = path.resolve()
+    if any(resolved == Path(t) or Path(t) in resolved.parents for t in SYSTEM_TREES):
+        raise InvalidInputError(f"'{text}' is in a system tree, not a place for output")
+    if path.exists():
+        if kind == "folder" and not path.is_dir():
+            raise InvalidInputError(f"'{text}' is a file, not a folder")
+        if kind == "file" and not path.is_file():
+            what = "a folder" if path.is_dir() else "not a regular file"
+            raise InvalidInputError(f"'{text}' is {what}; name a file")
+    nearest = next(p for p in (resolved, *resolved.parents) if p.exists())
+    if not nearest.is_dir():
+        raise InvalidInputError(f"'{text}' is under '{nearest}', which is a file")
+    target = nearest if nearest == resolved or kind == "folder" else resolved
+    if not os.access(target if target.exists() else nearest, os.W_OK):
+        raise InvalidInputError(f"'{text}': no permission to write in '{nearest}'")
