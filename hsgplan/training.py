@@ -31,7 +31,9 @@ def claim(out: Path, config: dict, networks: list[Path]) -> None:
         raise InvalidInputError(f"'{out}' is a file, not a checkpoint folder")
     if saved.exists() or saved.is_symlink():
         other = read_json(saved, "training configuration")
-        started = any((n / f).exists() for n in networks for f in (MANIFEST, WEIGHTS, PROGRESS))
+        started = any(
+            (n / f).exists() for n in {out, *networks} for f in (MANIFEST, WEIGHTS, PROGRESS)
+        )
         if other != config and started:
             raise InvalidInputError(
                 f"'{out}' holds a checkpoint trained with another configuration; use another --out"

@@ -103,3 +103,54 @@ def test_bad_collection_settings_are_refused(tmp_path):
     damaged.write_bytes(b"not a zip")
     with pytest.raises(InvalidInputError, match="not a readable"):
         store.load(damaged)
+
+
+@pytest.mark.slow
+def test_foreign_damaged_and_leftover_chunks_are_set_aside_and_redone(tmp_path):
+    config = CollectConfig(PLACE, 4, workers=1, tasks_per_chunk=CHUNK)
+    first = collect(config, tmp_path)
+    before = store.load(tmp_path / "place.npz")
+    chunks = work_folder(tmp_path, PLACE, 0)
+    names = sorted(p.name for p in chunks.glob("chunk-*.npz"))
+    assert len(names) >= 2, names
+    # chunk 1 copied over chunk 0 once gave another dataset with exit 0
+    (chunks / names[0]).write_bytes((chunks / names[1]).read_bytes())
+    (chunks / "chunk-000007.npz").write_bytes(b"")  # a 0-byte chunk blocked resume
+    (chunks / ".chunk-000003.npz.tmp").write_bytes(b"half")  # a write cut short
+    (chunks / "chunk-000003.npz.tmp.npz").write_bytes(b"old layout")  # once a traceback
+    (tmp_path / "place.npz").unlink()
+    (tmp_path / "place.json").unlink()
+    again = collect(config, tmp_path)
+    assert again.set_aside == 2 and again.chunks_run >= 1
+    assert _same(store.load(tmp_path / "place.npz"), before)
+    assert len(list((chunks / "rejected").iterdir())) == 2  # kept for a look, not deleted
+    assert not (chunks / ".chunk-000003.npz.tmp").exists()
+    assert first.samples == again.samples == 4
+
+
+def test_a_dataset_is_never_overwritten_by_other_settings(tmp_path):
+    shipped = tmp_path / "data"
+    collect(CollectConfig(PLACE, 0, tasks_per_chunk=CHUNK), shipped)
+    dataset = (shipped / "place.npz").read_bytes()
+    # `collect place --samples 60` once replaced the shipped 14,573 rows with 60, exit 0
+    with pytest.raises(InvalidInputError, match="other settings"):
+        collect(CollectConfig(PLACE, 60, tasks_per_chunk=CHUNK), shipped)
+    (shipped / "place.json").unlink()  # a dataset with no record of what made it
+    with pytest.raises(InvalidInputError, match="other settings"):
+        collect(CollectConfig(PLACE, 0, tasks_per_chunk=CHUNK), shipped)
+    assert (shipped / "place.npz").read_bytes() == dataset
+    foreign = tmp_path / "run"
+    foreign.mkdir()
+    (foreign / "episodes.jsonl").write_text("{}\n")
+    with pytest.raises(InvalidInputError, match="no motion dataset"):
+        collect(CollectConfig(PLACE, 0), foreign)
+    assert sorted(p.name for p in foreign.iterdir()) == ["episodes.jsonl"]
+
+
+def test_a_replaced_dataset_is_refused_by_its_manifest(tmp_path):
+    collect(CollectConfig(PLACE, 0, tasks_per_chunk=CHUNK), tmp_path)
+    store.load_dataset(tmp_path / "place.npz")
+    replaced = store.from_trials(PLACE, [])
+    store.save(tmp_path / "place.npz", replaced, extra=np.array(1))  # readable, but not it
+    with pytest.raises(InvalidInputError, match="does not match its manifest"):
+        store.load_dataset(tmp_path / "place.npz")
