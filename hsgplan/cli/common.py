@@ -128,21 +128,22 @@ def read_config(path: Path | None) -> dict:
 
 def parse_sizes(text: str) -> list[int]:
     """`2-6`, `2,4,6` or `3` as a list of sizes."""
-    sizes: list[int] = []
-    try:
-        for part in text.split(","):
-            lo, _, hi = part.strip().partition("-")
-            sizes += list(range(int(lo), int(hi or lo) + 1))
-    except ValueError:
-        raise InvalidInputError(
-            f"--sizes '{text}': expected a range like 2-6 or a list like 2,4,6"
-        ) from None
     from hsgplan.symbolic.generator import check_size
 
+    sizes: list[int] = []
+    for part in text.split(","):
+        lo, _, hi = part.strip().partition("-")
+        try:
+            ends = (int(lo), int(hi or lo))
+        except ValueError:
+            raise InvalidInputError(
+                f"--sizes '{text}': expected a range like 2-6 or a list like 2,4,6"
+            ) from None
+        for n in ends:  # the ends first: a range to a billion is refused, not built
+            check_size(n)
+        sizes += [n for n in range(ends[0], ends[1] + 1) if n not in sizes]
     if not sizes:
         raise InvalidInputError(f"--sizes '{text}' names no size")
-    for n in sizes:
-        check_size(n)
     return sizes
 
 

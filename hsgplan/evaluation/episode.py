@@ -70,7 +70,8 @@ def run_episode(
     """Run one episode; `on_decide` sees each decision (with its step number) before it is
     executed, `on_step` the start (record None) and every step after it."""
     start = time.perf_counter()
-    obs, _ = env.reset(seed, ResetOptions(goal))
+    _, info = env.reset(seed=seed, options=ResetOptions(goal))
+    obs: Observation = info["observation"]
     agent.reset(goal, seed)
     if on_step:
         on_step(None, obs)
@@ -90,7 +91,8 @@ def run_episode(
             break
         if on_decide:
             on_decide(len(records) + 1, d)
-        obs, _, _, _, info = env.step(d.params, on_frame)
+        _, _, _, _, info = env.step(d.params, on_frame)
+        obs = info["observation"]
         outcome = info["outcome"]
         agent.observe(d.params, outcome)
         record = StepRecord(

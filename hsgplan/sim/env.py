@@ -1,8 +1,10 @@
-"""`KitchenStorageEnv`: the world behind a Gymnasium-style interface.
+"""`KitchenStorageEnv`: the world as a Gymnasium env (`gymnasium.make(ENV_ID)`).
 
-Actions are parametrised primitives (`PickParams`, `PlaceParams`, `PushParams`); observations
-carry the geometric scene graph and, when rendering is on, an RGB image from the fixed camera.
-The reward is 1 on the step where the goal first holds.
+Actions are parametrised primitives: the `Dict` of `Discrete`s in `gym_spaces`, or the typed
+`PickParams`, `PlaceParams`, `PushParams` the agents use. Observations are numeric for
+Gymnasium; the typed one (the geometric scene graph, its symbols and, when rendering is on, an
+RGB image from the fixed camera) is in `info["observation"]`. The reward is 1 on the step where
+the goal holds.
 """
 
 from __future__ import annotations
@@ -11,20 +13,25 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import gymnasium
 import numpy as np
 
-from hsgplan.domain.goals import Goal
+from hsgplan.domain.goals import Goal, parse_goal
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
+from hsgplan.sim.gym_spaces import action_space, decode, encode, observation_space
 from hsgplan.sim.lookahead import Lookahead
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
-from hsgplan.sim.outcome import Outcome
+from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sampler import sample_scene
 from hsgplan.sim.scene import Scene
+from hsgplan.symbolic.generator import check_size, random_goals
+
+ENV_ID = "hsgplan/KitchenStorage-v0"
 
 
 @dataclass(frozen=True)
@@ -42,21 +49,41 @@ class ResetOptions:
     p_elsewhere: float = 0.3
 
 
-class KitchenStorageEnv:
+class KitchenStorageEnv(gymnasium.Env):
     """One episode at a time; `reset` builds a fresh scene from the seed.
 
+    The Gymnasium observation is numeric (`gym_spaces.observation_space`); the typed one the
+    agents read (`Observation`: the scene graphs) is `info["observation"]`. `step` takes an
+    action of `action_space` or a typed `PrimitiveParams`.
+
     Args:
-        render: put an RGB image in every observation.
+        render: put an RGB image in every typed observation.
         camera: the fixed camera used for images.
         max_steps: after this many primitives an episode is truncated.
+        objects: the size of the random goal drawn when `reset` is given none.
+        render_mode: "rgb_array" (what `render()` returns) or None.
     """
 
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
+
     def __init__(
-        self, render: bool = False, camera: Camera | None = None, max_steps: int = MAX_STEPS
+        self,
+        render: bool = False,
+        camera: Camera | None = None,
+        max_steps: int = MAX_STEPS,
+        objects: int = 3,
+        render_mode: str | None = None,
     ):
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
+        check_size(objects)  # refused here, not at the first reset
+        self.render_mode = render_mode
+        self.observation_space = observation_space()
+        self.action_space = action_space()
         self.render_images = render
         self.camera = camera or Camera()
         self.max_steps = max_steps
+        self.objects = objects
         self.scene: Scene | None = None
         self.goal: Goal | None = None
         self.steps = 0
@@ -64,29 +91,46 @@ class KitchenStorageEnv:
         # dry runs (as a feasibility check) and trials of whole plans, for agents that look ahead
         self.lookahead = Lookahead(lambda: self.scene, self.check)
 
-    def reset(self, seed: int, options: ResetOptions) -> tuple[Observation, dict]:
+    def reset(
+        self, *, seed: int | None = None, options: ResetOptions | dict | None = None
+    ) -> tuple[dict, dict]:
+        """A fresh scene. With a seed, the scene is that seed's (the same seed, the same
+        episode); without one it is drawn from `np_random`. `options`: a `ResetOptions`, or
+        `{"goal": Goal or goal text, "p_elsewhere": float}`, or None for a random goal of
+        `objects` objects drawn from the scene's seed."""
+        super().reset(seed=seed)
+        scene_seed = seed if seed is not None else int(self.np_random.integers(2**31))
+        options = _options(options, self.objects, scene_seed)
         self.close()
         self.goal = options.goal
-        self.scene, _ = sample_scene(options.goal.objects, seed, options.p_elsewhere)
+        self.scene, _ = sample_scene(options.goal.objects, scene_seed, options.p_elsewhere)
         self.steps = 0
         self._checked.clear()
-        return self._observe(), {"seed": seed}
+        typed = self._observe()
+        return self._encode(typed), {"seed": scene_seed, "observation": typed}
 
     def step(
-        self, action: PrimitiveParams, on_frame: Callable[[], None] | None = None
-    ) -> tuple[Observation, float, bool, bool, dict]:
+        self, action: PrimitiveParams | dict, on_frame: Callable[[], None] | None = None
+    ) -> tuple[dict, float, bool, bool, dict]:
         if self.scene is None or self.goal is None:
             raise RuntimeError("call reset() before step()")
-        plan, plan_seconds = self._checked.get(action, (None, 0.0))
-        outcome: Outcome = execute(self.scene, action, on_frame, plan)
-        # A plan from a dry run is part of this primitive's cost: its time is added back.
-        outcome = Outcome(outcome.status, outcome.detail, outcome.seconds + plan_seconds)
+        params = (
+            action if isinstance(action, PrimitiveParams) else decode(self.goal.objects, action)
+        )
+        if isinstance(params, str):  # nothing to execute: a step spent, nothing moved
+            outcome = Outcome(Status.INVALID, params, 0.0)
+        else:
+            plan, plan_seconds = self._checked.get(params, (None, 0.0))
+            outcome = execute(self.scene, params, on_frame, plan)
+            # A plan from a dry run is part of this primitive's cost: its time is added back.
+            outcome = Outcome(outcome.status, outcome.detail, outcome.seconds + plan_seconds)
         self._checked.clear()
         self.steps += 1
-        obs = self._observe()
-        done = self.goal.satisfied_by(obs.symbols.state)
+        typed = self._observe()
+        done = self.goal.satisfied_by(typed.symbols.state)
         truncated = not done and self.steps >= self.max_steps
-        return obs, float(done), done, truncated, {"outcome": outcome}
+        info = {"outcome": outcome, "observation": typed}
+        return self._encode(typed), float(done), done, truncated, info
 
     def check(self, action: PrimitiveParams) -> bool:
         """A dry run: whether the primitive can be planned in the scene as it is. Nothing
@@ -98,7 +142,7 @@ class KitchenStorageEnv:
         self._checked[action] = (plan, time.perf_counter() - start)
         return True
 
-    def render(self, camera: Camera | None = None) -> np.ndarray:
+    def render(self, camera: Camera | None = None) -> np.ndarray | None:
         """An RGB image from `camera` (default: the env's fixed camera)."""
         if self.scene is None:
             raise RuntimeError("call reset() before render()")
@@ -112,3 +156,23 @@ class KitchenStorageEnv:
     def _observe(self) -> Observation:
         sg = self.scene.scene_graph()
         return Observation(sg, map_symbols(sg), self.render() if self.render_images else None)
+
+    def _encode(self, typed: Observation) -> dict:
+        return encode(self.goal.objects, typed.scene_graph, typed.symbols.state)
+
+
+def _options(options: ResetOptions | dict | None, objects: int, seed: int) -> ResetOptions:
+    if isinstance(options, ResetOptions):
+        return options
+    options = options or {}
+    goal = options.get("goal")
+    if goal is None:
+        goal = random_goals(objects, 1, seed)[0]
+    if isinstance(goal, str):
+        goal = parse_goal(goal)
+    if not isinstance(goal, Goal):
+        raise ValueError("options['goal']: a Goal or goal text")
+    return ResetOptions(goal, float(options.get("p_elsewhere", ResetOptions.p_elsewhere)))
+
+
+gymnasium.register(id=ENV_ID, entry_point="hsgplan.sim.env:KitchenStorageEnv")

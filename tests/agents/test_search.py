@@ -25,7 +25,8 @@ def test_solves_a_three_object_goal():
 def test_follows_its_plan_and_plans_again_when_a_step_fails():
     goal = parse_goal("On(butter, shelf_b)")
     env = KitchenStorageEnv()
-    obs, _ = env.reset(5, ResetOptions(goal))
+    _, info = env.reset(seed=5, options=ResetOptions(goal))
+    obs = info["observation"]
     assert not goal.satisfied_by(obs.symbols.state)
     agent = SearchAgent()
     agent.reset(goal, 5)
@@ -40,7 +41,8 @@ def test_follows_its_plan_and_plans_again_when_a_step_fails():
 def test_without_a_world_to_try_plans_in_it_offers_nothing():
     goal = parse_goal("On(butter, shelf_b)")
     env = KitchenStorageEnv()
-    obs, _ = env.reset(3, ResetOptions(goal))
+    _, info = env.reset(seed=3, options=ResetOptions(goal))
+    obs = info["observation"]
     d = SearchAgent().decide(obs.scene_graph, obs.symbols.state, goal, env.check)
     assert d.action is None and "world" in d.note
     env.close()

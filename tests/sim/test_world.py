@@ -63,13 +63,15 @@ def test_same_seed_same_scene_other_seed_other_scene():
 def test_env_reset_step_render():
     env = KitchenStorageEnv(render=True)
     goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)")
-    obs, info = env.reset(seed=2, options=ResetOptions(goal))
+    _, info = env.reset(seed=2, options=ResetOptions(goal))
+    obs = info["observation"]
     try:
         assert info["seed"] == 2
         assert obs.scene_graph.objects == ("cherries", "butter")
         assert obs.rgb.shape == (env.camera.height, env.camera.width, 3)
         assert obs.rgb.dtype == np.uint8 and obs.rgb.std() > 5  # a picture, not a blank
-        obs, reward, done, truncated, info = env.step(PickParams("cherries"))
+        _, reward, done, truncated, info = env.step(PickParams("cherries"))
+        obs = info["observation"]
         assert info["outcome"].ok and reward == 0.0 and not done and not truncated
         assert obs.symbols.state.held() == "cherries"
         assert env.check(PickParams("butter")) is False  # the hand is full
