@@ -89,7 +89,7 @@ BAD = [
     (["demo", "--objects", "40"], "between 2 and 12"),
     (["demo", "--agent", "wizard"], "'wizard' is not one of 'oracle'"),
     (["demo", "--goal", "On(butter, butter)"], "itself"),
-    (["eval", "--sizes", "2", "--goals", "-1"], "greater than or equal to 0"),
+    (["eval", "--sizes", "2", "--goals", "0"], "greater than or equal to 1"),
     (["eval", "--sizes", "2", "--workers", "0"], "greater than or equal to 1"),
     (["eval", "--motion", "wizard"], "unknown motion generator 'wizard'"),
     (

@@ -74,6 +74,22 @@ def timing_summary(records: Sequence[EpisodeRecord]) -> dict:
     }
 
 
+TIMING_KIND = "bench-timing"
+
+
+def check_timing_folder(sizes: Sequence[int], goals: int, seed: int, out: Path) -> tuple[dict, str]:
+    """Every refusal of the run folders before anything is written; what the top folder is
+    claimed with and its refusal."""
+    config = EvalConfig("", tuple(sizes), goals, seed)
+    table = {"sizes": list(config.sizes), "goals": goals, "seed": seed}
+    refusal = f"'{out}' holds a timing run with other sizes, goals or seed; use another --out"
+    check_claim(out, TIMING_KIND, table, refusal)
+    for key, agent in AGENTS.items():
+        run = replace(config, agent=agent)
+        check_claim(out / key, EVAL_KIND, run_config(run), run_refusal(out / key))
+    return table, refusal
+
+
 def run_timing(
     sizes: Sequence[int],
     goals: int,
@@ -88,13 +104,8 @@ def run_timing(
     `{"by_size": {"2": {"ours": {"task_s", "motion_s", "success_rate", ...}, "search": {...}}}}`
     """
     config = EvalConfig("", tuple(sizes), goals, seed)
-    table = {"sizes": list(config.sizes), "goals": goals, "seed": seed}
-    refusal = f"'{out}' holds a timing run with other sizes, goals or seed; use another --out"
-    check_claim(out, "bench-timing", table, refusal)  # every refusal before anything is written
-    for key, agent in AGENTS.items():
-        run = replace(config, agent=agent)
-        check_claim(out / key, EVAL_KIND, run_config(run), run_refusal(out / key))
-    claim(out, "bench-timing", table, refusal)
+    table, refusal = check_timing_folder(sizes, goals, seed, out)
+    claim(out, TIMING_KIND, table, refusal)
     records = {
         key: run_evaluation(replace(config, agent=agent), out / key, workers, on_episode)
         for key, agent in AGENTS.items()

@@ -21,6 +21,7 @@ from hsgplan.cli.common import (
 )
 from hsgplan.domain.checks import MAX_EPISODES, MAX_GOALS, MAX_SAMPLES, MAX_SEED, MAX_WORKERS
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.paths import RUNS, TASK_CHECKPOINT
 
 app = typer.Typer(no_args_is_help=True, help="Measure speed (medians over one run).")
@@ -64,7 +65,10 @@ def bench_symbolic(
     goals: Annotated[int, typer.Option(help="Goals per size.", min=1, max=MAX_GOALS)] = 20,
     seed: Annotated[int, typer.Option(help="Random seed.", min=0, max=MAX_SEED)] = 0,
     optimal_max_size: Annotated[
-        int, typer.Option(help="Largest size the optimal search is timed on.")
+        int,
+        typer.Option(
+            help="Largest size the optimal search is timed on (0: none).", min=0, max=MAX_OBJECTS
+        ),
     ] = 8,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
     markdown: Annotated[
@@ -183,12 +187,19 @@ def bench_timing(
     GNN) against the search-based baseline, on the same goals; writes table2.md, table2.png
     and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
-    from hsgplan.benchmarks.timing import AGENTS, run_timing, tables, total_episodes
+    from hsgplan.benchmarks.timing import (
+        AGENTS,
+        check_timing_folder,
+        run_timing,
+        tables,
+        total_episodes,
+    )
 
     size_list = parse_sizes(sizes)
+    folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}"
+    check_timing_folder(size_list, goals, seed, folder)  # cheap refusals before the agents load
     for agent in AGENTS.values():  # a missing checkpoint is refused before any work
         make_agent(agent)
-    folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}"
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("ours, search", total=total_episodes(size_list, goals, seed))
         report = run_timing(

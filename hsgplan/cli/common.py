@@ -132,9 +132,9 @@ def parse_sizes(text: str) -> list[int]:
 
     sizes: list[int] = []
     for part in text.split(","):
-        lo, _, hi = part.strip().partition("-")
+        lo, dash, hi = part.strip().partition("-")
         try:
-            ends = (int(lo), int(hi or lo))
+            ends = (int(lo), int(hi if dash else lo))
         except ValueError:
             raise InvalidInputError(
                 f"--sizes '{text}': expected a range like 2-6 or a list like 2,4,6"

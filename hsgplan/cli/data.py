@@ -51,7 +51,7 @@ def _collect_command(primitive: str, default_samples: int):
     @refuses_bad_input
     def command(
         samples: Annotated[
-            int, typer.Option(help="Successful trials to collect.", min=0, max=MAX_SAMPLES)
+            int, typer.Option(help="Successful trials to collect.", min=1, max=MAX_SAMPLES)
         ] = default_samples,
         workers: Annotated[
             int,

@@ -72,7 +72,7 @@ def train_task(
 def eval_task(
     planner: Annotated[PlannerName, typer.Option(help="Task planner.")] = REGRESSION,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
-    goals: Annotated[int, typer.Option(help="Random goals per size.", min=0, max=MAX_GOALS)] = 500,
+    goals: Annotated[int, typer.Option(help="Random goals per size.", min=1, max=MAX_GOALS)] = 500,
     seed: Annotated[
         int, typer.Option(help="Seed of the goals and start states.", min=0, max=MAX_SEED)
     ] = 0,

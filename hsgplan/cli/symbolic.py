@@ -108,7 +108,7 @@ def plan(
 @refuses_bad_input
 def goals(
     objects: Annotated[int, typer.Option(help="Objects per goal (2-12).")],
-    count: Annotated[int, typer.Option(help="How many goals.", min=0, max=MAX_GOALS)],
+    count: Annotated[int, typer.Option(help="How many goals.", min=1, max=MAX_GOALS)],
     seed: Annotated[
         int,
         typer.Option(help="Random seed; the same seed gives the same goals.", min=0, max=MAX_SEED),

@@ -111,7 +111,7 @@ def evaluate(
         ),
     ] = None,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-6.")] = "2-6",
-    goals: Annotated[int, typer.Option(help="Random goals per size.", min=0, max=MAX_GOALS)] = 50,
+    goals: Annotated[int, typer.Option(help="Random goals per size.", min=1, max=MAX_GOALS)] = 50,
     repeats: Annotated[
         int,
         typer.Option(help="Episodes per goal, each from its own scene.", min=1, max=MAX_REPEATS),
@@ -155,7 +155,7 @@ def evaluate(
     and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.evaluation.protocol import EvalConfig, checkpoints, episode_specs
-    from hsgplan.evaluation.table1 import Method, run_table, tables
+    from hsgplan.evaluation.table1 import Method, check_table, run_table, tables
 
     planner_name = planner and planner.value
     if motion is None:
@@ -183,10 +183,11 @@ def evaluate(
         motion_checkpoints and str(shipped(motion_checkpoints)),
     )
     total = len(episode_specs(config)) * len(methods)
-    for m in methods:  # an unknown name or a missing checkpoint: refused before any work
-        make_agent(m.agent, *checkpoints(config))
     folder = run_dir or RUNS / _run_name(methods, config)
     check_ray(ray)
+    check_table(methods, config, folder)  # the cheap refusals first: loading agents takes seconds
+    for m in methods:  # an unknown name or a missing checkpoint: refused before any work
+        make_agent(m.agent, *checkpoints(config))
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(", ".join(m.agent for m in methods), total=total)
         report = run_table(methods, config, folder, workers, ray, lambda r: progress.advance(task))

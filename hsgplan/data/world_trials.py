@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from hsgplan.domain.actions import Action, parse_action
+from hsgplan.domain.checks import read_json, read_text
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_literal
 from hsgplan.domain.predicates import Predicate
@@ -103,10 +104,10 @@ def load_world_trials(folder: Path) -> list[WorldTrial]:
     path = Path(folder) / RESULTS
     if not path.is_file():
         raise InvalidInputError(f"'{folder}' holds no collection of executed primitives")
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except UnicodeDecodeError as e:
-        raise InvalidInputError(f"'{path}' is damaged: not UTF-8 text ({e.reason})") from None
+    made = read_json(Path(folder) / "config.json", "collection configuration")
+    if made.get("kind") != "reach":
+        raise InvalidInputError(f"'{folder}' is not a collection of executed primitives")
+    lines = read_text(path, "collection").splitlines()
     results: dict[tuple[int, ...], dict] = {}
     for n, line in enumerate(lines, 1):
         try:

@@ -104,6 +104,8 @@ def read_text(path: Path, what: str) -> str:
     path = Path(path)
     if path.is_dir():
         raise InvalidInputError(f"{what} '{path}' is a folder, not a file")
+    if path.exists() and not path.is_file():  # a FIFO or a device would block or never end
+        raise InvalidInputError(f"{what} '{path}' is not a regular file")
     try:
         data = path.read_bytes()
     except FileNotFoundError:

@@ -50,6 +50,20 @@ def label(method: str) -> str:
     return LABELS.get(method, method)
 
 
+def check_table(methods: list[Method], config: EvalConfig, out: Path) -> tuple[dict, str]:
+    """Every refusal of a table's run folders before anything is written (the table's own,
+    then each method's); what the table folder is claimed with and its refusal."""
+    table = {k: v for k, v in asdict(config).items() if k != "agent"} | {
+        "sizes": list(config.sizes)
+    }
+    refusal = f"'{out}' holds a table of another configuration or goal file; use another --out"
+    check_claim(out, TABLE_KIND, table, refusal)
+    for m in methods:
+        method = replace(config, agent=m.agent)
+        check_claim(out / m.name, EVAL_KIND, run_config(method), run_refusal(out / m.name))
+    return table, refusal
+
+
 def run_table(
     methods: list[Method],
     config: EvalConfig,
@@ -60,15 +74,7 @@ def run_table(
 ) -> dict:
     """Every method's episodes (`config` with the method's agent) into `out/METHOD/`; the
     summary, also written as `summary.json`, `table1.md` and `table1.png` in `out`."""
-    # every refusal before anything is written: the table's folder, then each method's
-    table = {k: v for k, v in asdict(config).items() if k != "agent"} | {
-        "sizes": list(config.sizes)
-    }
-    refusal = f"'{out}' holds a table of another configuration or goal file; use another --out"
-    check_claim(out, TABLE_KIND, table, refusal)
-    for m in methods:
-        method = replace(config, agent=m.agent)
-        check_claim(out / m.name, EVAL_KIND, run_config(method), run_refusal(out / m.name))
+    table, refusal = check_table(methods, config, out)
     claim(out, TABLE_KIND, table, refusal)
     records = {}
     for m in methods:

@@ -77,6 +77,7 @@ def _row(state, status="invalid"):
 
 
 def _write(folder, lines):
+    (folder / "config.json").write_text('{"kind": "reach"}\n')
     (folder / "episodes.jsonl").write_text("".join(x + "\n" for x in lines))
 
 
@@ -121,6 +122,12 @@ def test_a_missing_or_unreadable_collection_is_refused(tmp_path):
     with pytest.raises(InvalidInputError, match="holds no collection"):
         load_world_trials(tmp_path / "nowhere")
     (tmp_path / "episodes.jsonl").write_bytes('{"key": "é"}\n'.encode("latin-1"))
+    with pytest.raises(InvalidInputError, match="config.json' does not exist"):
+        load_world_trials(tmp_path)  # a folder that is no collection
+    (tmp_path / "config.json").write_text('{"kind": "eval"}')
+    with pytest.raises(InvalidInputError, match="not a collection of executed primitives"):
+        load_world_trials(tmp_path)
+    (tmp_path / "config.json").write_text('{"kind": "reach"}')
     with pytest.raises(InvalidInputError, match="not UTF-8"):
         load_world_trials(tmp_path)
 
