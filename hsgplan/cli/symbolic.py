@@ -32,8 +32,10 @@ def _scene(goal_text: str, objects: str | None, init: str | None):
 
     goal = parse_goal(goal_text)
     names = list(goal.objects)
-    if objects:
+    if objects is not None:
         given = [o.strip() for o in objects.split(",") if o.strip()]
+        if not given:
+            raise InvalidInputError(f"--objects '{objects}' names no object")
         for o in given:
             kind_of(o)
         missing = [o for o in goal.objects if o not in given]

@@ -127,6 +127,8 @@ def read_json(path: Path, what: str, shape: type = dict) -> Any:
     text = read_text(path, what)
     try:
         value = json.loads(text, parse_constant=_no_constant)
+    except RecursionError:
+        raise InvalidInputError(f"{what} '{path}' is nested too deeply to be read") from None
     except ValueError as e:
         raise InvalidInputError(f"{what} '{path}' is not valid JSON ({e})") from None
     if not isinstance(value, shape):

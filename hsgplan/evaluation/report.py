@@ -65,6 +65,14 @@ def read_summary(run_dir: Path) -> dict:
     summary = read_json(path, "eval summary")
     if not isinstance(summary.get("methods"), dict):
         raise InvalidInputError(f"'{path}' is not an eval summary (no methods)")
+    try:  # the tables read every field the page shows: a summary they cannot read is refused
+        tables(summary)
+        for m, s in summary["methods"].items():
+            if not isinstance(s["agent"], str):
+                raise TypeError(f"method {m}'s agent")
+    except (KeyError, TypeError, ValueError, AttributeError, IndexError) as e:
+        what = f"missing {e}" if isinstance(e, KeyError) else " ".join(str(e).split())
+        raise InvalidInputError(f"'{path}' is not an eval summary ({what})") from None
     return summary
 
 
