@@ -20,7 +20,7 @@ PROGRESS = "progress.pt"
 TRAIN_CONFIG = "train_config.json"
 
 
-def claim(out: Path, config: dict, networks: list[Path]) -> None:
+def claim(out: Path, config: dict) -> None:
     """Make `out` the checkpoint folder of a training with `config` (its `train_config.json`).
     Refused in one line, before anything is written: a file, a folder holding other things
     (a dataset, a run, another kind of checkpoint), and a checkpoint trained or in training
@@ -31,9 +31,9 @@ def claim(out: Path, config: dict, networks: list[Path]) -> None:
         raise InvalidInputError(f"'{out}' is a file, not a checkpoint folder")
     if saved.exists() or saved.is_symlink():
         other = read_json(saved, "training configuration")
-        started = any(
-            (n / f).exists() for n in {out, *networks} for f in (MANIFEST, WEIGHTS, PROGRESS)
-        )
+        # anything trained or in training anywhere below (a task checkpoint keeps its networks
+        # in subfolders): another kind of checkpoint is never trained over
+        started = any(next(out.rglob(f), None) for f in (MANIFEST, WEIGHTS, PROGRESS))
         if other != config and started:
             raise InvalidInputError(
                 f"'{out}' holds a checkpoint trained with another configuration; use another --out"

@@ -93,7 +93,12 @@ def test_training_never_writes_into_a_foreign_folder(tmp_path):
     # a finished motion checkpoint: retraining it as a task planner would replace it
     motion_before = _tree(motion)
     _refused(run("train", "task", "--out", motion), "trained with another configuration")
+    task = tmp_path / "task"
+    shutil.copytree(home() / TASK_CHECKPOINT, task)
+    task_before = _tree(task)  # its networks live in subfolders
+    _refused(run("train", "motion", "--out", task), "trained with another configuration")
     assert _tree(run_folder) == before and _tree(motion) == motion_before
+    assert _tree(task) == task_before
 
 
 def test_eval_never_writes_into_a_checkpoint_folder(tmp_path):

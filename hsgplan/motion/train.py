@@ -129,7 +129,7 @@ def train_motion(
     if config.loss == "bce":
         files.append(folder / f"{config.primitive}_trials.npz")
     data = fingerprint(files)
-    training.claim(out, asdict(config), [out])
+    training.claim(out, asdict(config))
     if training.finished(out):
         return  # finished earlier
     examples = grounded_examples(rows)
