@@ -80,7 +80,7 @@ BAD = [
         "not in the scene",
     ),
     (["plan", "--goal", "On(cherries, shelf_b)", "--init", "In(cherries, shelf_a)"], "no sequence"),
-    (["goals", "--objects", "4", "--count", "-3"], "greater than or equal to 0"),
+    (["goals", "--objects", "4", "--count", "-3"], "greater than or equal to 1"),
     (["goals", "--objects", "13", "--count", "3"], "between 2 and 12"),
     (["goals", "--objects", "0", "--count", "3"], "between 2 and 12"),
     (["bench", "symbolic", "--sizes", "2-x"], "expected a range"),

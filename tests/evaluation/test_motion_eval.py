@@ -57,7 +57,7 @@ def test_eval_motion_cli_prints_json(checkpoints):
 @pytest.mark.parametrize(
     "args,message",
     [
-        (["collect", "place", "--samples", "-3"], "greater than or equal to 0"),
+        (["collect", "place", "--samples", "-3"], "greater than or equal to 1"),
         (["eval-motion", "--checkpoints", "nowhere", "--trials", "2"], "no trained motion"),
         (["eval-motion", "--primitives", "pour"], "place or push"),
         (["train", "motion", "--model", "cnn"], "'cnn' is not one of 'gnn', 'mlp'"),

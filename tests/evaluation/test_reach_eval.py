@@ -60,6 +60,7 @@ def test_eval_reach_scores_the_shipped_planner_on_a_few_held_out_states(tmp_path
     held_out = Path(__file__).resolve().parents[2] / "data" / "reach" / "heldout"
     lines = (held_out / "episodes.jsonl").read_text().splitlines()[:5]
     (tmp_path / "episodes.jsonl").write_text("\n".join(lines) + "\n")
+    (tmp_path / "config.json").write_bytes((held_out / "config.json").read_bytes())
     r = CliRunner().invoke(app, ["eval-reach", "--trials", str(tmp_path), "--json"])
     assert r.exit_code == 0, r.output
     report = json.loads(r.stdout)
