@@ -17,14 +17,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import (
-    EVAL_KIND,
-    EvalConfig,
-    episode_specs,
-    run_config,
-    run_evaluation,
-    run_refusal,
-)
+from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.table1 import TextTable
 from hsgplan.runner.run_folder import check_claim, claim
 from hsgplan.viz.plots import plot_times_by_size
@@ -84,9 +77,7 @@ def check_timing_folder(sizes: Sequence[int], goals: int, seed: int, out: Path) 
     table = {"sizes": list(config.sizes), "goals": goals, "seed": seed}
     refusal = f"'{out}' holds a timing run with other sizes, goals or seed; use another --out"
     check_claim(out, TIMING_KIND, table, refusal)
-    for key, agent in AGENTS.items():
-        run = replace(config, agent=agent)
-        check_claim(out / key, EVAL_KIND, run_config(run), run_refusal(out / key))
+    check_runs(config, out, AGENTS)
     return table, refusal
 
 

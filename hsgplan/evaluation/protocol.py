@@ -22,7 +22,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.runner.items import run_items
-from hsgplan.runner.run_folder import CONFIG, add_wall_seconds
+from hsgplan.runner.run_folder import CONFIG, add_wall_seconds, check_claim
 from hsgplan.symbolic.generator import random_goals
 
 
@@ -118,11 +118,16 @@ def read_eval_config(run_dir: Path) -> EvalConfig:
         ) from None
 
 
-def run_refusal(run_dir: Path) -> str:
-    return (
-        f"'{run_dir}' holds episodes of another configuration, checkpoint or goal file; "
-        "use another --out"
-    )
+def check_runs(config: EvalConfig, out: Path, agents: dict[str, str]) -> None:
+    """Refuse, before anything is written, a folder `out/NAME` (one per agent) that is no
+    evaluation's or holds episodes of another configuration, checkpoint or goal file."""
+    for name, agent in agents.items():
+        run_dir = out / name
+        refusal = (
+            f"'{run_dir}' holds episodes of another configuration, checkpoint or goal file; "
+            "use another --out"
+        )
+        check_claim(run_dir, EVAL_KIND, run_config(replace(config, agent=agent)), refusal)
 
 
 def checkpoints(config: EvalConfig) -> tuple[Path, Path]:

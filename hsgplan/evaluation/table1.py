@@ -15,14 +15,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import (
-    EVAL_KIND,
-    EvalConfig,
-    episode_specs,
-    run_config,
-    run_evaluation,
-    run_refusal,
-)
+from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, summarize
 from hsgplan.runner.run_folder import check_claim, claim, read_timing
 
@@ -58,9 +51,7 @@ def check_table(methods: list[Method], config: EvalConfig, out: Path) -> tuple[d
     }
     refusal = f"'{out}' holds a table of another configuration or goal file; use another --out"
     check_claim(out, TABLE_KIND, table, refusal)
-    for m in methods:
-        method = replace(config, agent=m.agent)
-        check_claim(out / m.name, EVAL_KIND, run_config(method), run_refusal(out / m.name))
+    check_runs(config, out, {m.name: m.agent for m in methods})
     return table, refusal
 
 
