@@ -10,10 +10,10 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import (
+    RunFolder,
     err,
     input_path,
     out,
-    out_folder,
     parse_sizes,
     print_table,
     refuses_bad_input,
@@ -170,14 +170,7 @@ def bench_timing(
             max=MAX_WORKERS,
         ),
     ] = 1,
-    run_dir: Annotated[
-        Path | None,
-        typer.Option(
-            "--out",
-            help="Run folder (resumed if it exists; default runs/NAME).",
-            parser=out_folder,
-        ),
-    ] = None,
+    run_dir: RunFolder = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")

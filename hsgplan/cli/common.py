@@ -6,6 +6,7 @@ import functools
 import sys
 from enum import StrEnum
 from pathlib import Path
+from typing import Annotated
 
 import typer
 from rich.console import Console
@@ -93,6 +94,15 @@ def _output(kind: str):
 # `parser=` of every --out option: refused at the door, before the command makes anything
 out_folder = _output("folder")
 out_file = _output("file")
+
+
+# the --out of every resumable job (eval, eval-task, bench timing)
+RunFolder = Annotated[
+    Path | None,
+    typer.Option(
+        "--out", help="Run folder (resumed if it exists; default runs/NAME).", parser=out_folder
+    ),
+]
 
 
 def input_path(text) -> Path:

@@ -11,6 +11,7 @@ from rich.progress import Progress
 
 from hsgplan.cli.common import (
     PlannerName,
+    RunFolder,
     err,
     input_path,
     out,
@@ -85,14 +86,7 @@ def eval_task(
     workers: Annotated[
         int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
     ] = 2,
-    run_dir: Annotated[
-        Path | None,
-        typer.Option(
-            "--out",
-            help="Run folder (resumed if it exists; default runs/NAME).",
-            parser=out_folder,
-        ),
-    ] = None,
+    run_dir: RunFolder = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")

@@ -14,6 +14,7 @@ from hsgplan.cli.common import (
     AgentName,
     MotionName,
     PlannerName,
+    RunFolder,
     check_ray,
     err,
     input_path,
@@ -136,14 +137,7 @@ def evaluate(
     workers: Annotated[
         int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
     ] = 2,
-    run_dir: Annotated[
-        Path | None,
-        typer.Option(
-            "--out",
-            help="Run folder (resumed if it exists; default runs/NAME).",
-            parser=out_folder,
-        ),
-    ] = None,
+    run_dir: RunFolder = None,
     ray: Annotated[
         str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
     ] = None,

@@ -160,6 +160,5 @@ def check_output(path: Path, kind: str = "folder") -> None:
     nearest = next(p for p in (resolved, *resolved.parents) if p.exists())
     if not nearest.is_dir():
         raise InvalidInputError(f"'{text}' is under '{nearest}', which is a file")
-    target = nearest if nearest == resolved or kind == "folder" else resolved
-    if not os.access(target if target.exists() else nearest, os.W_OK):
+    if not os.access(nearest, os.W_OK):  # the path itself when it exists, else its folder
         raise InvalidInputError(f"'{text}': no permission to write in '{nearest}'")
