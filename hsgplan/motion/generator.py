@@ -9,11 +9,15 @@ a surface and a push are chosen over bins.
 `propose` is what an agent calls, once per step. The learned generators are single shot as in
 the paper: one proposal, no dry run (they ignore the one an agent may offer). The rule for
 failures: parameters whose execution failed for good (`DO_NOT_RETRY`) are remembered with the
-scene they failed in (`scene_key`: the held object and every pose to the centimetre); in that
-unchanged scene the generator proposes its next-ranked parameters instead, and once every
-choice has failed there it proposes its first choice again (a pick has only one), so that the
-task level, which sees the same state come back, decides what to do. In a changed scene
-everything may be proposed again.
+scene they failed in (`scene_key`: the held object and every pose to the centimetre). In a
+scene where nothing has failed, a generator proposes its first choice (a network its
+best-scored bins). In a scene where something has failed, it draws from its own distribution
+over the bins not yet failed there (a network: the softmax of its scores; Random: uniform),
+seeded per episode: a network's next-ranked bins are the failed bins' neighbours, which fail
+for the same reason, so taking them in order wastes the steps a draw spreads over the places
+the network still believes in. Once every choice has failed there it proposes its first
+choice again (a pick has only one), so that the task level, which sees the same state come
+back, decides what to do. In a changed scene everything may be proposed again.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from typing import Protocol
 import torch
 from torch_geometric.data import Batch
 
-from hsgplan.domain.actions import Action, Pick, Place, intended_literal
+from hsgplan.domain.actions import Action, Pick, Place, Push, intended_literal
 from hsgplan.domain.parameters import (
     BINS,
     MotionPrimitive,
@@ -46,6 +50,9 @@ from hsgplan.sim.outcome import Outcome, Status
 Feasibility = Callable[[PrimitiveParams], bool]
 # Failures that say these parameters will not work here; anything else may be tried again.
 DO_NOT_RETRY = frozenset({Status.NO_IK, Status.NO_PATH, Status.EFFECT_NOT_REACHED, Status.INVALID})
+# Failed pushes of an object since it was put down, after which a bin generator gives up on the
+# spot (see `_BinGenerator`).
+PUSH_TRIES = 3
 
 
 def primitive_of(subgoal: Literal) -> MotionPrimitive:
@@ -75,8 +82,12 @@ class MotionGenerator(Protocol):
 
 
 def scene_key(sg: GeometricSceneGraph) -> tuple:
-    """The scene as the failure memory compares scenes: what is held, every pose to the cm."""
-    return sg.held, tuple((n.name, *(round(v * 100) for v in n.pose.position)) for n in sg.nodes)
+    """The scene as the failure memory compares scenes: what is held, and every other object's
+    pose to the cm. The held object's pose is the grasp's, different after every pick; where it
+    may go depends on the rest of the scene."""
+    return sg.held, tuple(
+        (n.name, *(round(v * 100) for v in n.pose.position)) for n in sg.nodes if n.name != sg.held
+    )
 
 
 class SingleShotMemory:
@@ -103,11 +114,52 @@ class SingleShotMemory:
 
 
 class _BinGenerator(SingleShotMemory):
-    """Picks and stacks need no choice; everything else is the first of `ranked` not failed in
-    this scene (the first of all when every one has)."""
+    """Picks and stacks need no choice; everything else is the first of `ranked` in a scene
+    where nothing has failed, else a draw (`redraw`) from the ones not failed in this scene
+    (the first of all when every one has).
+
+    A spot in a prepush region can leave no push that works (the hand would hit a neighbour,
+    the line is blocked). After `PUSH_TRIES` failed pushes of an object since it was put down,
+    the generator gives up on the spot: it proposes nothing (the agent then takes the object
+    up, as it does for the geometric sampler) and counts the place that put it there as failed
+    in that scene, so that putting it down again draws another spot."""
+
+    name = "bins"
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.rng = random.Random(f"{self.name}-motion-0")
+        self._placed: dict[str, tuple[tuple, PlaceParams]] = {}
+        self._push_failures: dict[str, int] = {}
+
+    def reset(self, seed: int) -> None:
+        super().reset(seed)
+        self.rng = random.Random(f"{self.name}-motion-{seed}")
+        self._placed, self._push_failures = {}, {}
+
+    def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
+        scene = self._scene
+        super().observe(params, outcome)
+        if isinstance(params, PushParams) and outcome.status in DO_NOT_RETRY:
+            self._push_failures[params.obj] = self._push_failures.get(params.obj, 0) + 1
+        elif outcome.status is Status.SUCCESS and not isinstance(params, PushParams):
+            self._push_failures.pop(params.obj, None)
+            self._placed.pop(params.obj, None)
+            if isinstance(params, PlaceParams) and scene is not None:
+                self._placed[params.obj] = (scene, params)
+
+    def _give_up(self, obj: str) -> None:
+        if obj in self._placed:
+            scene, params = self._placed.pop(obj)
+            self.failed.setdefault(scene, set()).add(params)
+        self._push_failures.pop(obj, None)
 
     def ranked(self, sg: GeometricSceneGraph, subgoal: Literal) -> list[PlaceParams | PushParams]:
         raise NotImplementedError
+
+    def redraw(self, untried: list[PlaceParams | PushParams]) -> PlaceParams | PushParams:
+        """One of `untried` (in `ranked`'s order, never empty) after a failure in this scene."""
+        return untried[0]
 
     def propose(
         self,
@@ -120,9 +172,15 @@ class _BinGenerator(SingleShotMemory):
             ranked: list[PrimitiveParams] = [PickParams(action.obj)]
         elif isinstance(action, Place) and action.target not in SURFACES:
             ranked = [PlaceParams(action.obj, action.target)]
+        elif isinstance(action, Push) and self._push_failures.get(action.obj, 0) >= PUSH_TRIES:
+            self._give_up(action.obj)
+            return None
         else:
             ranked = list(self.ranked(sg, intended_literal(action)))
-        return (self.untried(sg, ranked) or ranked)[0]
+        untried = self.untried(sg, ranked)
+        if not untried or len(untried) == len(ranked):
+            return ranked[0]
+        return self.redraw(untried)
 
 
 def _all_params(kind: MotionPrimitive, subgoal: Literal, flat: list[int]):
@@ -135,8 +193,9 @@ class LearnedMotion(_BinGenerator):
     """A trained motion network (GNN or MLP) per primitive, from checkpoint folders."""
 
     def __init__(self, name: str, folders: dict[MotionPrimitive, Path]) -> None:
-        super().__init__()
         self.name = name
+        super().__init__()
+        self._weights: dict[PlaceParams | PushParams, float] = {}
         self.nets = {
             kind: load_motion_net(folder, kind.value, name.split("_")[0])
             for kind, folder in folders.items()
@@ -149,8 +208,18 @@ class LearnedMotion(_BinGenerator):
             return net(Batch.from_data_list([ground(sg, subgoal)]))[0]
 
     def ranked(self, sg: GeometricSceneGraph, subgoal: Literal) -> list[PlaceParams | PushParams]:
-        order = torch.argsort(self.scores(sg, subgoal), descending=True, stable=True)
-        return _all_params(primitive_of(subgoal), subgoal, order.tolist())
+        scores = self.scores(sg, subgoal)
+        order = torch.argsort(scores, descending=True, stable=True)
+        params = _all_params(primitive_of(subgoal), subgoal, order.tolist())
+        probs = torch.softmax(scores.double(), dim=0)[order].tolist()
+        self._weights = dict(zip(params, probs, strict=True))
+        return params
+
+    def redraw(self, untried: list[PlaceParams | PushParams]) -> PlaceParams | PushParams:
+        weights = [self._weights[p] for p in untried]
+        if not sum(weights) > 0.0:  # every remaining bin underflowed: the best of them
+            return untried[0]
+        return self.rng.choices(untried, weights=weights)[0]
 
 
 class RandomMotion(_BinGenerator):
@@ -160,11 +229,7 @@ class RandomMotion(_BinGenerator):
 
     def __init__(self, seed: int = 0) -> None:
         super().__init__()
-        self.rng = random.Random(f"random-motion-{seed}")
-
-    def reset(self, seed: int) -> None:
-        super().reset(seed)
-        self.rng = random.Random(f"random-motion-{seed}")
+        self.reset(seed)
 
     def ranked(self, sg: GeometricSceneGraph, subgoal: Literal) -> list[PlaceParams | PushParams]:
         check_subgoal(subgoal, sg)

@@ -111,12 +111,11 @@ class RegressionPlanner:
     def reset(self, goal: Goal | None, seed: int) -> None:
         """A new episode: the seed of the uniform serialisation, nothing remembered."""
         self.rng = random.Random(seed)
-        self._taken: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
+        self._taken: dict[tuple[Goal, SymbolicSceneGraph], Counter[Action]] = {}
         self._plan: tuple[Goal, list[tuple[Literal, frozenset[Literal]]], Literal] | None = None
         # what the world said: an action after which the very same state was observed again
         # failed there; the goal literal it served is tried after the others from then on
         self._last: tuple[SymbolicSceneGraph, Action, Literal] | None = None
-        self._failed: dict[SymbolicSceneGraph, Counter[Action]] = {}
         self._failed_roots: set[Literal] = set()
 
     def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
@@ -160,12 +159,10 @@ class RegressionPlanner:
         if not unsatisfied:
             return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
         if self._last is not None and self._last[0] == state:
-            self._failed.setdefault(state, Counter())[self._last[1]] += 1
             self._failed_roots.add(self._last[2])
-        failed_here = _given_up(self._failed.get(state))
-        taken = self._taken.setdefault((goal, state), set())
+        taken = self._taken.setdefault((goal, state), Counter())
         if (step := self._follow(state, goal, taken)) is not None:
-            taken.add(step[1])
+            taken[step[1]] += 1
             self._last = (state, step[1], step[2])
             return _decision(step[1], step[0], start)
         context = frozenset(goal.literals)
@@ -175,18 +172,19 @@ class RegressionPlanner:
         # nothing is reached from the free ones (a dependency the network got wrong, or a
         # goal literal stuck behind a full shelf), the waiting ones are tried as well.
         # An action already taken from this very state (with this goal) failed or came back
-        # to it: it is avoided while any other is found, and one that failed here
-        # `GIVE_UP_AFTER` times is not taken here while another is found. This breaks loops
-        # such as picking an object whose shelf is full and putting it back. When every one
-        # has been given up, the likeliest is tried again rather than stopping: in the world a
-        # primitive may pass on another try (other parameters), and a loop that never does
-        # ends at the step limit, the paper's overstep.
+        # to it: it is avoided while any other is found. This breaks loops such as picking an
+        # object whose shelf is full and putting it back. Once every action found here has
+        # been taken here, the least often taken goes again (uniformly among equals), rather
+        # than stopping: in the world a primitive may pass on another try (the motion level
+        # draws other parameters), and a failed action is tried as often as the detours that
+        # only came back here (put the object down, take it up again), never the detour for
+        # ever. A loop that never passes ends at the step limit, the paper's overstep.
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
         seen: dict[Literal, tuple[float, _Node]] = {}
-        for avoid in (taken, failed_here, set()):
+        for avoid, counts in ((set(taken), None), (set(), taken)):
             for frontier in (free, [x for x in pairs if x not in free]):
-                found = self._search(state, frontier, avoid, seen)
+                found = self._search(state, frontier, avoid, seen, counts)
                 if found is not None:
                     return self._take(state, goal, *found, taken, start)
             # Nothing reached: the literal f_reach finds likeliest (it learned the physical
@@ -202,7 +200,7 @@ class RegressionPlanner:
         return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
 
     def _take(self, state, goal, node: _Node, action: Action, taken, start) -> TaskDecision:
-        taken.add(action)
+        taken[action] += 1
         self._plan = (goal, list(reversed(node.chain)), node.path[0])
         self._last = (state, action, node.path[0])
         return _decision(action, node.lit, start)
@@ -221,7 +219,7 @@ class RegressionPlanner:
         self._plan = None
         return None
 
-    def _search(self, state, frontier, avoid, seen):
+    def _search(self, state, frontier, avoid, seen, counts=None):
         """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
 
         A node is reached when f_reach says so, or when its whole preimage already holds
@@ -241,21 +239,27 @@ class RegressionPlanner:
             for n, _ in frontier:
                 seen.setdefault(n.lit, (reach[n.lit], n))
             hits = [n for n, _ in frontier if reach[n.lit] > 0.5]
-            if found := self._choose(state, hits, avoid):
+            if found := self._choose(state, hits, avoid, counts):
                 return found
             frontier = self._with_preimages(state, frontier)
             done = [n for n, pre in frontier if all(state.holds(m) for m in pre)]
-            if found := self._choose(state, done, avoid):
+            if found := self._choose(state, done, avoid, counts):
                 return found
             frontier = children if known else self._children(state, frontier)
         return None
 
-    def _choose(self, state, nodes: list[_Node], avoid):
+    def _choose(self, state, nodes: list[_Node], avoid, counts: Counter[Action] | None = None):
+        """One of the nodes' actions not in `avoid`: with `counts` (how often each was taken
+        here), one of the least taken."""
         hits = [
             (n, a) for n in nodes if (a := action_for(n.lit, state)) is not None and a not in avoid
         ]
-        # a goal literal whose action failed this episode waits while another one can go on
-        hits = [h for h in hits if h[0].path[0] not in self._failed_roots] or hits
+        if counts is None:
+            # a goal literal whose action failed this episode waits while another one can go on
+            hits = [h for h in hits if h[0].path[0] not in self._failed_roots] or hits
+        elif hits:
+            least = min(counts[a] for _, a in hits)
+            hits = [h for h in hits if counts[h[1]] == least]
         return self.rng.choice(hits) if hits else None  # the paper's uniform serialisation
 
     def _with_preimages(self, state, frontier):
