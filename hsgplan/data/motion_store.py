@@ -40,7 +40,7 @@ from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.outcome import Status
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2  # 2: a place that leaves an object unpickable is labelled `blocks_pick`
 CHUNK_FORMAT = 2  # 2: a chunk carries its index and seed, checked on load
 STATUSES: tuple[Status, ...] = tuple(Status)
 TYPES: tuple[str, ...] = tuple(OBJECT_TYPES)

@@ -7,7 +7,11 @@ which process or machine ran it or what that process ran before. In each staged 
 collector saves the physics state and tries `ATTEMPTS_PER_TASK[primitive]` parameter choices,
 drawn uniformly over the bins, each from that same state. A trial is a training sample when the
 primitive's intended literal holds afterwards and nothing else was knocked out of place
-(`hsgplan.sim.outcome.verify`).
+(`hsgplan.sim.outcome.verify`), and, for a place, when it leaves every object on the target
+surface that could be taken up before (a pick dry run with the hand empty) still able to be
+taken up, the placed one included (`Status.BLOCKS_PICK` otherwise): a place that walls in a
+neighbour, or itself, succeeds now and makes a later pick fail, which is the commonest way a
+long episode fails (README, Table 1).
 """
 
 from __future__ import annotations
@@ -18,8 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgplan.data.motion_tasks import MotionTask, draw_task
-from hsgplan.domain.parameters import BINS, MotionPrimitive, params_for
+from hsgplan.domain.parameters import BINS, MotionPrimitive, PickParams, params_for
+from hsgplan.domain.predicates import Predicate
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
 from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.scene import Scene
@@ -122,6 +128,31 @@ def release(scene: Scene, staged: StagedTask) -> None:
     scene.bc.removeState(staged.snapshot)
 
 
+def pickable(scene: Scene, objects: list[str]) -> set[str]:
+    """The objects a pick could take up from the scene as it is (dry runs; the hand empty)."""
+    return {o for o in objects if isinstance(plan_primitive(scene, PickParams(o)), MotionPlan)}
+
+
+def _neighbours(task: MotionTask) -> list[str]:
+    """The objects resting directly on a place task's target surface."""
+    state = task.state
+    return [
+        o
+        for o in state.objects
+        if o != task.obj
+        and state.location(o).predicate is Predicate.ON
+        and state.location(o).args[1] == task.target
+    ]
+
+
+def _pickable_before(scene: Scene, staged: StagedTask) -> set[str]:
+    """The neighbours that could be taken up before the place, the held object set aside."""
+    scene.restore(staged.snapshot)
+    scene.robot.detach()
+    scene.park(staged.task.obj)
+    return pickable(scene, _neighbours(staged.task))
+
+
 def run_task(scene: Scene, task: MotionTask) -> list[Trial] | None:
     """Stage a task and try `ATTEMPTS_PER_TASK` uniformly drawn bin pairs in it; None when
     the arrangement could not be staged."""
@@ -130,9 +161,13 @@ def run_task(scene: Scene, task: MotionTask) -> list[Trial] | None:
         return None
     trials = []
     nx, ny = BINS[task.primitive]
+    place = task.primitive is MotionPrimitive.PLACE
+    wanted = _pickable_before(scene, staged) | {task.obj} if place else set()
     for attempt in range(ATTEMPTS_PER_TASK[task.primitive]):
         bins = (staged.rng.randrange(nx), staged.rng.randrange(ny))
         outcome = try_params(scene, staged, params_for(task.primitive, task.obj, task.target, bins))
+        if place and outcome.ok and pickable(scene, sorted(wanted)) != wanted:
+            outcome = Outcome(Status.BLOCKS_PICK, "cannot be taken up any more", outcome.seconds)
         trials.append(
             Trial(
                 task.index,

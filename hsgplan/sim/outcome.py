@@ -23,6 +23,9 @@ class Status(StrEnum):
     OFF_TABLE = "off_table"  # some object fell off the table
     DISTURBED = "disturbed"  # another object was moved out of place
     EFFECT_NOT_REACHED = "effect_not_reached"  # the intended predicate does not hold
+    # Motion data only (`hsgplan.data.motion_trials`): the place reached its effect but left an
+    # object on that surface, or the placed one, that can no longer be taken up.
+    BLOCKS_PICK = "blocks_pick"
 
 
 @dataclass(frozen=True)

@@ -154,3 +154,58 @@ def test_a_replaced_dataset_is_refused_by_its_manifest(tmp_path):
     store.save(tmp_path / "place.npz", replaced, extra=np.array(1))  # readable, but not it
     with pytest.raises(InvalidInputError, match="does not match its manifest"):
         store.load_dataset(tmp_path / "place.npz")
+
+
+def test_an_object_walled_in_across_its_narrow_side_cannot_be_taken_up():
+    # What the place labels rest on: the fingers close across a box's narrow side, so a
+    # neighbour close beside that side takes the room they need; one beyond it does not.
+    from hsgplan.data.motion_trials import pickable
+    from hsgplan.domain.objects import object_type
+    from hsgplan.scene_graph.geometry import Pose
+    from hsgplan.sim.scene import Scene
+
+    box, other = object_type("cream_cheese"), "butter"
+    z = box.height / 2 + 0.001
+    with Scene(("cream_cheese", other), seed=0) as scene:
+        scene.set_pose("cream_cheese", Pose.from_xyz_yaw(0.45, 0.0, z, 0.0))
+        # the narrow side is the box's local x: the neighbour 5 mm beyond it, then 12 cm away
+        for gap, expected in ((0.005, set()), (0.12, {"cream_cheese"})):
+            x = 0.45 + box.size[0] / 2 + gap + object_type(other).size[0] / 2
+            scene.set_pose(other, Pose.from_xyz_yaw(x, 0.0, z, 0.0))
+            assert pickable(scene, ["cream_cheese"]) == expected, gap
+
+
+def test_a_place_that_leaves_an_object_unable_to_be_taken_up_is_no_sample():
+    # Replayed from the staged state, a trial labelled `blocks_pick` leaves some object on the
+    # target (that could be taken up before) or the placed one unable to be taken up, and a
+    # successful one leaves all of them able.
+    from hsgplan.data.motion_trials import (
+        _pickable_before,
+        pickable,
+        release,
+        run_task,
+        stage_task,
+        try_params,
+    )
+    from hsgplan.domain.parameters import params_for
+    from hsgplan.sim.outcome import Status
+    from hsgplan.sim.scene import Scene
+
+    seen = set()
+    with Scene((), seed=0) as scene:
+        for index in range(40):
+            task = draw_task(PLACE, 0, index)
+            trials = run_task(scene, task) or []
+            labelled = [t for t in trials if t.status in (Status.SUCCESS, Status.BLOCKS_PICK)]
+            if not labelled:
+                continue
+            staged = stage_task(scene, task)
+            wanted = _pickable_before(scene, staged) | {task.obj}
+            for t in labelled:
+                try_params(scene, staged, params_for(PLACE, task.obj, task.target, t.bins))
+                assert (pickable(scene, sorted(wanted)) == wanted) == t.ok, (index, t)
+                seen.add(t.status)
+            release(scene, staged)
+            if seen == {Status.SUCCESS, Status.BLOCKS_PICK}:
+                break
+    assert seen == {Status.SUCCESS, Status.BLOCKS_PICK}

@@ -6,7 +6,7 @@ import random
 
 from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.predicates import on
+from hsgplan.domain.predicates import in_grasp, on
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT
 from hsgplan.planning.regression.planner import GIVE_UP_AFTER, ForwardPlanner, RegressionPlanner
@@ -94,3 +94,25 @@ def test_when_everything_failed_the_planner_tries_again_rather_than_stopping():
         assert None not in actions, (type(planner).__name__, actions)
         # the first choice was given up, and taken again once nothing else was left
         assert actions.count(actions[0]) > GIVE_UP_AFTER, (type(planner).__name__, actions)
+
+
+def test_an_action_that_keeps_failing_is_tried_again_as_often_as_the_detour():
+    # Holding cream cheese, whose place on shelf B fails every time (the world refuses it);
+    # the detour the planner finds (put it down, take it up again) comes back to the same
+    # state. The failed place must keep its turn instead of being given up for the detour.
+    goal = parse_goal("On(cream_cheese, shelf_b) & On(popcorn, cream_cheese)")
+    holding = SymbolicSceneGraph.from_literals(
+        ["popcorn", "cream_cheese"], [on("popcorn", "open_space"), in_grasp("cream_cheese")]
+    )
+    refused = Place("cream_cheese", "shelf_b")
+    planner, state, actions = RegressionPlanner(TASK_CHECKPOINT, seed=0), holding, []
+    planner.reset(goal, 0)
+    for _ in range(30):
+        action = planner.next_action(state, goal).action
+        assert action is not None
+        actions.append(action)
+        if action != refused and why_not(state, action) is None:
+            state = apply(state, action)
+    assert actions[0] == refused
+    at_start = sum(1 for a in actions if a == refused)
+    assert at_start >= 5, [str(a) for a in actions]

@@ -190,12 +190,12 @@ class RegressionPlanner:
             # Nothing reached: the literal f_reach finds likeliest (it learned the physical
             # world, which refuses more than some other world would), before repeating
             likely = [
-                (-p, _order(n.lit), n, a)
+                (counts[a] if counts else 0, -p, _order(n.lit), n, a)
                 for p, n in seen.values()
                 if (a := action_for(n.lit, state)) is not None and a not in avoid
             ]
             if likely:
-                *_, node, action = min(likely, key=lambda x: x[:2])
+                *_, node, action = min(likely, key=lambda x: x[:3])
                 return self._take(state, goal, node, action, taken, start)
         return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
 

@@ -1,0 +1,115 @@
+"""The bin generators' rules for failures (`hsgplan.motion.generator`), on hand-made scene graphs
+and a network stand-in with fixed scores: no checkpoint, no physics."""
+
+from collections import Counter
+
+import torch
+
+from hsgplan.domain.actions import Pick, Place, Push
+from hsgplan.domain.objects import object_type
+from hsgplan.domain.parameters import BINS, MotionPrimitive, PlaceParams, PushParams
+from hsgplan.motion.generator import PUSH_TRIES, LearnedMotion, RandomMotion, _BinGenerator
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.outcome import Outcome, Status
+
+HELD = "butter"
+NX, NY = BINS[MotionPrimitive.PLACE]
+
+
+class _FixedScores(LearnedMotion):
+    """A learned generator whose network always scores the bins the same way."""
+
+    def __init__(self, logits: torch.Tensor) -> None:
+        self.name = "fixed"
+        _BinGenerator.__init__(self)
+        self._weights = {}
+        self.logits = logits
+
+    def scores(self, sg, subgoal) -> torch.Tensor:
+        return self.logits
+
+
+def _scene(held_at: tuple[float, float] = (0.0, 0.0), shift: float = 0.0) -> GeometricSceneGraph:
+    """Cherries on the table, butter held (its pose is wherever the hand is)."""
+    poses = {
+        "cherries": Pose.from_xyz_yaw(0.42 + shift, 0.05, object_type("cherries").height / 2, 0.0),
+        HELD: Pose.from_xyz_yaw(*held_at, 0.3, 0.0),
+    }
+    return GeometricSceneGraph.from_poses(poses, held=HELD)
+
+
+def _place(x: int, y: int) -> PlaceParams:
+    return PlaceParams(HELD, "shelf_a", x, y)
+
+
+def _logits(**bins: float) -> torch.Tensor:
+    """Scores of -inf but for the named bins ('b_x_y' = score)."""
+    logits = torch.full((NX * NY,), -1e9)
+    for name, score in bins.items():
+        _, x, y = name.split("_")
+        logits[int(x) * NY + int(y)] = score
+    return logits
+
+
+def test_a_network_proposes_its_best_bins_and_after_a_failure_draws_from_its_own_distribution():
+    # The failed bins' neighbour (0, 1) scores next best, but (5, 5) holds three times the
+    # probability of (0, 1) once (0, 0) has failed: a draw, not the next in rank.
+    logits = _logits(b_0_0=10.0, b_0_1=5.0, b_5_5=5.0 + float(torch.log(torch.tensor(3.0))))
+    draws = Counter()
+    for seed in range(200):
+        motion = _FixedScores(logits)
+        motion.reset(seed)
+        first = motion.propose(_scene(), Place(HELD, "shelf_a"))
+        assert first == _place(0, 0)  # single shot: the best
+        motion.observe(first, Outcome(Status.NO_IK, "", 0.0))
+        draws[motion.propose(_scene(), Place(HELD, "shelf_a"))] += 1
+    assert set(draws) == {_place(0, 1), _place(5, 5)}
+    assert 120 <= draws[_place(5, 5)] <= 180  # about three in four
+    # the same episode seed, the same draw
+    again = _FixedScores(logits)
+    again.reset(7)
+    again.observe(again.propose(_scene(), Place(HELD, "shelf_a")), Outcome(Status.NO_IK, "", 0.0))
+    replay = _FixedScores(logits)
+    replay.reset(7)
+    replay.observe(replay.propose(_scene(), Place(HELD, "shelf_a")), Outcome(Status.NO_IK, "", 0))
+    place = Place(HELD, "shelf_a")
+    assert again.propose(_scene(), place) == replay.propose(_scene(), place)
+
+
+def test_a_failure_is_remembered_by_the_scene_around_the_held_object():
+    motion = _FixedScores(_logits(b_0_0=10.0, b_0_1=9.0))
+    motion.reset(0)
+    failed = motion.propose(_scene(held_at=(0.1, 0.1)), Place(HELD, "shelf_a"))
+    motion.observe(failed, Outcome(Status.NO_IK, "", 0.0))
+    # put down and taken up again: the hand holds it elsewhere, the rest is as it was
+    assert motion.propose(_scene(held_at=(0.4, -0.2)), Place(HELD, "shelf_a")) == _place(0, 1)
+    # something else moved: everything may be proposed again
+    assert motion.propose(_scene(shift=0.05), Place(HELD, "shelf_a")) == failed
+
+
+def test_after_failed_pushes_a_generator_gives_up_the_spot_and_draws_another_one_for_the_object():
+    can = "cherries"
+    pose = {can: Pose.from_xyz_yaw(0.30, 0.38, object_type(can).height / 2, 0.0)}
+    held, standing = (
+        GeometricSceneGraph.from_poses(pose, held=can),
+        GeometricSceneGraph.from_poses(pose),
+    )
+    motion = RandomMotion()
+    motion.reset(0)
+    spot = motion.propose(held, Place(can, "prepush_a"))
+    motion.observe(spot, Outcome(Status.SUCCESS, "", 0.0))
+    pushes = []
+    for _ in range(PUSH_TRIES):
+        pushes.append(motion.propose(standing, Push(can, "shelf_a")))
+        assert isinstance(pushes[-1], PushParams)
+        motion.observe(pushes[-1], Outcome(Status.NO_PATH, "", 0.0))
+    assert motion.propose(standing, Push(can, "shelf_a")) is None  # the agent takes it up
+    motion.observe(motion.propose(standing, Pick(can)), Outcome(Status.SUCCESS, "", 0.0))
+    # put down again in the same scene: never the spot no push worked from
+    for seed in range(30):
+        motion.rng.seed(seed)
+        assert motion.propose(held, Place(can, "prepush_a")) != spot
+    # once put down elsewhere, pushes get their tries again
+    motion.observe(motion.propose(held, Place(can, "prepush_a")), Outcome(Status.SUCCESS, "", 0))
+    assert isinstance(motion.propose(standing, Push(can, "shelf_a")), PushParams)
