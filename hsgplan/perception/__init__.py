@@ -1,0 +1,1 @@
+"""f_p: object poses from camera images (DOPE-style keypoints, PnP, several views)."""

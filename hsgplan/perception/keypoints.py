@@ -1,0 +1,86 @@
+"""An object's cuboid keypoints and a fixed camera's pinhole model, as DOPE uses them.
+
+DOPE describes every object by the 9 keypoints of its bounding cuboid: the 8 corners and the
+centroid. Here a cuboid is the object type's resting box (`ObjectType.size`, centred on the
+object's frame, as the simulated bodies are built). The camera is the renderer's
+(`hsgplan.sim.render.Camera`: a PyBullet view and vertical field of view), written in OpenCV's
+convention (x right, y down, z forward; pixel centres at integer coordinates) so that
+`cv2.solvePnP` can invert it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from hsgplan.domain.objects import object_type
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.render import Camera
+
+KEYPOINTS = 9  # 8 corners, then the centroid
+# Corner order: x, y, z signs, x slowest; fixed so that a network's maps name the same corner.
+CORNER_SIGNS = np.array(
+    [(sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64
+)
+
+
+def cuboid(obj: str) -> np.ndarray:
+    """The object's 9 keypoints in its own frame, metres: [9, 3]."""
+    half = np.asarray(object_type(obj).size, dtype=np.float64) / 2
+    return np.vstack([CORNER_SIGNS * half, np.zeros((1, 3))])
+
+
+def in_world(obj: str, pose: Pose) -> np.ndarray:
+    """The object's 9 keypoints where `pose` puts it: [9, 3]."""
+    m = pose.matrix()
+    return cuboid(obj) @ m[:3, :3].T + m[:3, 3]
+
+
+@dataclass(frozen=True)
+class PinholeCamera:
+    """A camera as OpenCV sees it.
+
+    Attributes:
+        matrix: intrinsics K, [3, 3].
+        world_to_camera: the extrinsic transform, [4, 4].
+        width, height: image size in pixels.
+    """
+
+    matrix: np.ndarray
+    world_to_camera: np.ndarray
+    width: int
+    height: int
+
+    @staticmethod
+    def of(camera: Camera) -> PinholeCamera:
+        """The pinhole model of a renderer camera (square pixels, vertical field of view)."""
+        f = (camera.height / 2) / math.tan(math.radians(camera.fov) / 2)
+        # A rendered pixel i spans [i, i + 1) in normalised device coordinates: its centre,
+        # OpenCV's integer coordinate, is half a pixel in.
+        k = np.array(
+            [[f, 0.0, camera.width / 2 - 0.5], [0.0, f, camera.height / 2 - 0.5], [0, 0, 1]]
+        )
+        eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
+        forward = (target - eye) / np.linalg.norm(target - eye)
+        right = np.cross(forward, (0.0, 0.0, 1.0))
+        right /= np.linalg.norm(right)
+        down = np.cross(forward, right)
+        rotation = np.vstack([right, down, forward])
+        m = np.eye(4)
+        m[:3, :3], m[:3, 3] = rotation, -rotation @ eye
+        return PinholeCamera(k, m, camera.width, camera.height)
+
+    def to_camera(self, points: np.ndarray) -> np.ndarray:
+        """World points in the camera's frame: [N, 3] -> [N, 3]."""
+        return points @ self.world_to_camera[:3, :3].T + self.world_to_camera[:3, 3]
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """Pixel coordinates (u right, v down) of world points: [N, 3] -> [N, 2]."""
+        p = self.to_camera(points) @ self.matrix.T
+        return p[:, :2] / p[:, 2:3]
+
+    def camera_to_world(self) -> np.ndarray:
+        """The inverse extrinsic transform: [4, 4]."""
+        return np.linalg.inv(self.world_to_camera)

@@ -1,0 +1,116 @@
+"""An object's pose from its keypoints in one or several fixed views (OpenCV's PnP).
+
+DOPE's last step: with the cuboid known (the object type's size), the pose that projects it
+onto the detected keypoints is the solution of a perspective-n-point problem. Views are fused
+as the paper fuses its real robot's viewpoints: each view's estimate is refined by minimising
+the reprojection error over the keypoints of every view at once, starting from the view whose
+own fit is best.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from hsgplan.perception.keypoints import PinholeCamera, cuboid
+from hsgplan.scene_graph.geometry import Pose
+
+MIN_POINTS = 5  # solvePnP's iterative solver needs 4; one more guards against a bad peak
+
+
+@dataclass(frozen=True)
+class ViewKeypoints:
+    """An object's keypoints as one view saw them.
+
+    Attributes:
+        camera: the view.
+        pixels: [9, 2] pixel coordinates, NaN where a keypoint was not found.
+    """
+
+    camera: PinholeCamera
+    pixels: np.ndarray
+
+
+@dataclass(frozen=True)
+class PoseEstimate:
+    pose: Pose
+    reprojection_px: float  # root mean square over the keypoints used, all views
+    points: int  # keypoints used, all views
+
+
+def estimate_pose(obj: str, views: list[ViewKeypoints]) -> PoseEstimate | None:
+    """The object's pose in the world from its keypoints in the given views; None when no
+    view has `MIN_POINTS` keypoints."""
+    model = cuboid(obj)
+    fits = []
+    for view in views:
+        found = ~np.isnan(view.pixels).any(axis=1)
+        if found.sum() < MIN_POINTS:
+            continue
+        ok, rvec, tvec = cv2.solvePnP(
+            model[found], view.pixels[found], view.camera.matrix, None, flags=cv2.SOLVEPNP_EPNP
+        )
+        if not ok:
+            continue
+        ok, rvec, tvec = cv2.solvePnP(
+            model[found],
+            view.pixels[found],
+            view.camera.matrix,
+            None,
+            rvec,
+            tvec,
+            useExtrinsicGuess=True,
+            flags=cv2.SOLVEPNP_ITERATIVE,
+        )
+        if ok:
+            world = view.camera.camera_to_world() @ _matrix(rvec, tvec)
+            fits.append((_error(model, views, world), world))
+    if not fits:
+        return None
+    best = min(fits, key=lambda f: f[0][0])[1]
+    fused = _refine(model, views, best)
+    world = min((best, fused), key=lambda m: _error(model, views, m)[0])
+    rms, used = _error(model, views, world)
+    return PoseEstimate(Pose.from_matrix(world), rms, used)
+
+
+def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, :3] = cv2.Rodrigues(rvec)[0]
+    m[:3, 3] = tvec.ravel()
+    return m
+
+
+def _residuals(model: np.ndarray, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
+    points = model @ world[:3, :3].T + world[:3, 3]
+    out = []
+    for view in views:
+        found = ~np.isnan(view.pixels).any(axis=1)
+        out.append((view.camera.project(points[found]) - view.pixels[found]).ravel())
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+def _error(model, views, world) -> tuple[float, int]:
+    r = _residuals(model, views, world)
+    return (float(np.sqrt(np.mean(r**2))) if r.size else float("inf")), r.size // 2
+
+
+def _refine(model: np.ndarray, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
+    """Gauss-Newton on the pose (rotation vector, translation) over every view's keypoints."""
+    rvec, tvec = cv2.Rodrigues(world[:3, :3])[0].ravel(), world[:3, 3].copy()
+    x = np.concatenate([rvec, tvec])
+    for _ in range(10):
+        r = _residuals(model, views, _matrix(x[:3], x[3:]))
+        jac = np.empty((r.size, 6))
+        for i in range(6):
+            step = np.zeros(6)
+            step[i] = 1e-6
+            jac[:, i] = (_residuals(model, views, _matrix(*np.split(x + step, 2))) - r) / 1e-6
+        dx = np.linalg.lstsq(jac, -r, rcond=None)[0]
+        x = x + dx
+        if np.linalg.norm(dx) < 1e-9:
+            break
+    return _matrix(x[:3], x[3:])
+
