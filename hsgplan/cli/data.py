@@ -106,6 +106,40 @@ def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir
     )
 
 
+@app.command("images")
+@refuses_bad_input
+def images(
+    count: Annotated[
+        int, typer.Option(help="Samples to render (scenes x views).", min=1, max=MAX_SAMPLES)
+    ] = 2000,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the scenes and their looks.", min=0, max=MAX_SEED)
+    ] = 0,
+    workers: Annotated[
+        int,
+        typer.Option(help="Processes (or Ray tasks in flight / 2).", min=1, max=MAX_WORKERS),
+    ] = 2,
+    ray: Annotated[
+        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
+    ] = None,
+    out_dir: Annotated[
+        Path,
+        typer.Option("--out", help="Collection folder (resumed if it exists).", parser=out_folder),
+    ] = RUNS / "collect-images",
+) -> None:
+    """Synthetic training images for f_p: random scenes from the fixed cameras, domain
+    randomised, with every object's pose and cuboid keypoints (format: perception/images.py)."""
+    from hsgplan.perception.images import ImagesConfig, collect_images
+
+    check_ray(ray)
+    config = ImagesConfig(count, seed)
+    with Progress(console=err, transient=True) as progress:
+        bar = progress.add_task("image chunks", total=config.chunks)
+        rows = collect_images(config, out_dir, workers, ray, lambda _: progress.advance(bar))
+    kept = sum(r["samples"] for r in rows)
+    out.print(f"{kept} samples ({len(rows)} chunks) in {shown(out_dir)}")
+
+
 @app.command("reach")
 @refuses_bad_input
 def reach(

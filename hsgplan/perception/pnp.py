@@ -113,4 +113,3 @@ def _refine(model: np.ndarray, views: list[ViewKeypoints], world: np.ndarray) ->
         if np.linalg.norm(dx) < 1e-9:
             break
     return _matrix(x[:3], x[3:])
-

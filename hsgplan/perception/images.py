@@ -1,0 +1,165 @@
+"""`hsgplan collect images`: synthetic samples (`perception.synthetic`) in resumable chunks.
+
+Format (version `FORMAT`), one compressed `.npz` per chunk of `CHUNK` samples in
+`RUN/chunks/chunk-NNNNN.npz`, objects padded to `MAX_OBJECTS` (n samples, V views, K = 9
+keypoints, M = `MAX_OBJECTS`):
+
+| array     | dtype   | shape              | meaning                                              |
+|-----------|---------|--------------------|------------------------------------------------------|
+| index     | int32   | [n]                | the sample's index in the `(seed)` stream            |
+| images    | uint8   | [n, V, H, W, 3]    | RGB                                                  |
+| types     | int8    | [n, M]             | index into `OBJECT_TYPES`, -1 past the last object   |
+| instance  | int8    | [n, M]             | 1 for `cherries`, 2 for `cherries_2`, ...; 0 padding |
+| poses     | float32 | [n, M, 7]          | position (m), quaternion xyzw; NaN padding           |
+| keypoints | float32 | [n, V, M, K, 2]    | pixel (u right, v down; OpenCV's centres); NaN pad   |
+| visible   | int32   | [n, V, M]          | the object's pixels in sight in that view            |
+| cameras   | float32 | [n, V, 7]          | eye xyz, target xyz, vertical field of view (deg)    |
+
+The run folder's `episodes.jsonl` logs every finished chunk with its file's SHA-256; a run
+started again runs only the chunks not logged, and `load_chunks` refuses a file that is not
+the one logged.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.objects import split_instance
+from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.perception.keypoints import KEYPOINTS
+from hsgplan.perception.synthetic import MAX_OBJECTS, VIEWS, ImageSample, render_sample
+from hsgplan.runner.items import run_items
+from hsgplan.runner.run_folder import logged_rows
+
+FORMAT = 1
+CHUNK = 16
+KIND = "collect-images"
+TYPES = tuple(OBJECT_TYPES)
+
+
+@dataclass(frozen=True)
+class ImagesConfig:
+    count: int  # samples wanted (unstaged draws are skipped, so the last chunk may hold fewer)
+    seed: int = 0
+    chunk: int = CHUNK
+
+    def __post_init__(self) -> None:
+        if self.count < 1 or self.chunk < 1:
+            raise InvalidInputError("an image collection needs at least one sample per chunk")
+
+    @property
+    def chunks(self) -> int:
+        return -(-self.count // self.chunk)
+
+
+def chunk_path(run_dir: Path, chunk: int) -> Path:
+    return run_dir / "chunks" / f"chunk-{chunk:05d}.npz"
+
+
+def render_chunk(run_dir: str, seed: int, chunk: int, size: int, count: int) -> dict:
+    """Render a chunk's samples (of the first `count`) into its file, written whole or not at
+    all; the worker's entry point. Returns what the run log keeps of it."""
+    indices = range(chunk * size, min((chunk + 1) * size, count))
+    samples = [render_sample(seed, i) for i in indices]
+    kept = [s for s in samples if s is not None]
+    path = chunk_path(Path(run_dir), chunk)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp.npz")
+    np.savez_compressed(tmp, **pack(kept))
+    digest = hashlib.sha256(tmp.read_bytes()).hexdigest()
+    os.replace(tmp, path)
+    unstaged = len(indices) - len(kept)
+    return {"chunk": chunk, "samples": len(kept), "unstaged": unstaged, "sha256": digest}
+
+
+def pack(samples: list[ImageSample]) -> dict[str, np.ndarray]:
+    n, v = len(samples), len(VIEWS)
+    h, w = VIEWS[0].height, VIEWS[0].width
+    out = {
+        "index": np.array([s.index for s in samples], dtype=np.int32),
+        "images": np.zeros((n, v, h, w, 3), dtype=np.uint8),
+        "types": np.full((n, MAX_OBJECTS), -1, dtype=np.int8),
+        "instance": np.zeros((n, MAX_OBJECTS), dtype=np.int8),
+        "poses": np.full((n, MAX_OBJECTS, 7), np.nan, dtype=np.float32),
+        "keypoints": np.full((n, v, MAX_OBJECTS, KEYPOINTS, 2), np.nan, dtype=np.float32),
+        "visible": np.zeros((n, v, MAX_OBJECTS), dtype=np.int32),
+        "cameras": np.zeros((n, v, 7), dtype=np.float32),
+    }
+    for i, s in enumerate(samples):
+        m = len(s.objects)
+        out["images"][i] = s.images
+        for j, name in enumerate(s.objects):
+            type_name, k = split_instance(name)
+            out["types"][i, j], out["instance"][i, j] = TYPES.index(type_name), k
+        out["poses"][i, :m] = s.poses
+        out["keypoints"][i, :, :m] = s.keypoints
+        out["visible"][i, :, :m] = s.visible
+        out["cameras"][i] = [[*c.eye, *c.target, c.fov] for c in s.cameras]
+    return out
+
+
+def collect_images(
+    config: ImagesConfig,
+    run_dir: Path,
+    workers: int = 2,
+    ray: str | None = None,
+    on_chunk=None,
+) -> list[dict]:
+    """Render every chunk not yet logged in `run_dir`; the log rows of all chunks."""
+    settings = asdict(config) | {
+        "format": FORMAT,
+        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in VIEWS],
+    }
+    items = [
+        (str(run_dir), config.seed, c, config.chunk, config.count) for c in range(config.chunks)
+    ]
+    rows = run_items(
+        _render,
+        items,
+        key=lambda item: item[2],
+        run_dir=run_dir,
+        kind=KIND,
+        config=settings,
+        workers=workers,
+        ray=ray,
+        on_result=on_chunk,
+    )
+    write_format(run_dir)
+    return rows
+
+
+def _render(item: tuple[str, int, int, int, int]) -> dict:
+    return render_chunk(*item)
+
+
+def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:
+    """Every logged chunk of a collection, concatenated in chunk order; a chunk file missing,
+    damaged or not the one logged is refused in one line."""
+    rows = sorted(
+        (r["result"] for r in logged_rows(run_dir) if isinstance(r, dict) and "result" in r),
+        key=lambda r: r["chunk"],
+    )
+    if not rows:
+        raise InvalidInputError(f"'{run_dir}' holds no image chunks")
+    parts = []
+    for row in rows:
+        path = chunk_path(run_dir, row["chunk"])
+        if not path.is_file() or hashlib.sha256(path.read_bytes()).hexdigest() != row["sha256"]:
+            raise InvalidInputError(f"'{path}' is missing or not the chunk logged; collect again")
+        with np.load(path, allow_pickle=False) as data:
+            parts.append({k: data[k] for k in data.files})
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def write_format(run_dir: Path) -> None:
+    """The format above, beside the chunks, for whoever reads them without this package."""
+    doc = (__doc__ or "").split("Format", 1)[1].split("The run folder", 1)[0]
+    text = json.dumps({"format": FORMAT, "types": TYPES, "description": "Format" + doc}, indent=1)
+    (run_dir / "format.json").write_text(text + "\n")
