@@ -1,0 +1,149 @@
+"""Belief maps and affinity fields: made from labelled keypoints (the training targets) and
+read back into keypoints per object instance (the network's output decoded), as DOPE does.
+
+Maps live on the network's output grid, `STRIDE` input pixels per cell; cell (i, j) covers
+input pixels [STRIDE j, STRIDE (j + 1)) across and its centre is at STRIDE j + (STRIDE - 1) / 2
+in OpenCV's pixel coordinates. A belief map holds, per (type, keypoint), a Gaussian of
+`SIGMA` cells around every instance's keypoint (the maximum where two meet). An affinity field
+holds, per (type, corner), within `FIELD_RADIUS` cells of every instance's corner, the vector
+from there to the instance's centroid, in cells.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hsgplan.perception.keypoints import KEYPOINTS
+from hsgplan.perception.model import CORNERS, STRIDE
+
+SIGMA = 1.0  # cells
+FIELD_RADIUS = 2.0  # cells
+PEAK_THRESHOLD = 0.3
+MIN_APART = 2.0  # cells between two peaks of one map
+CENTROID = KEYPOINTS - 1
+OFFSET = (STRIDE - 1) / 2
+
+
+def to_cells(pixels: np.ndarray) -> np.ndarray:
+    return (pixels - OFFSET) / STRIDE
+
+
+def to_pixels(cells: np.ndarray) -> np.ndarray:
+    return cells * STRIDE + OFFSET
+
+
+@dataclass(frozen=True)
+class Instance:
+    """One object instance found in one image.
+
+    Attributes:
+        type_index: index into `OBJECT_TYPES`.
+        pixels: [9, 2] keypoints (8 corners, then the centroid), NaN for a corner not found.
+        score: the centroid's belief.
+    """
+
+    type_index: int
+    pixels: np.ndarray
+    score: float
+
+
+def targets(
+    keypoints: np.ndarray, types: np.ndarray, types_count: int, height: int, width: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Training targets for one image.
+
+    Args:
+        keypoints: [M, 9, 2] pixel keypoints of the objects in sight.
+        types: [M] their type indices.
+        types_count: how many types the network knows.
+        height, width: the output grid.
+
+    Returns:
+        beliefs [types * 9, height, width] and fields [types * 8 * 2, height, width], float32.
+    """
+    beliefs = np.zeros((types_count * KEYPOINTS, height, width), dtype=np.float32)
+    fields = np.zeros((types_count * CORNERS * 2, height, width), dtype=np.float32)
+    ys, xs = np.mgrid[0:height, 0:width].astype(np.float32)
+    for points, t in zip(keypoints, types, strict=True):
+        cells = to_cells(points)
+        centroid = cells[CENTROID]
+        for k, (x, y) in enumerate(cells):
+            d2 = (xs - x) ** 2 + (ys - y) ** 2
+            channel = beliefs[t * KEYPOINTS + k]
+            np.maximum(channel, np.exp(-d2 / (2 * SIGMA**2)), out=channel)
+            if k < CORNERS:
+                near = d2 <= FIELD_RADIUS**2
+                base = (t * CORNERS + k) * 2
+                fields[base][near] = centroid[0] - xs[near]
+                fields[base + 1][near] = centroid[1] - ys[near]
+    return beliefs, fields
+
+
+def peaks(
+    belief: np.ndarray, threshold: float = PEAK_THRESHOLD
+) -> list[tuple[float, float, float]]:
+    """Local maxima of one map above `threshold`, strongest first, none within `MIN_APART`
+    cells of a stronger one (a keypoint half-way between cells makes two equal maxima), each
+    refined by a parabola through the log beliefs of its neighbours along x and along y (exact
+    for a Gaussian): (x, y, belief) in cells."""
+    h, w = belief.shape
+    padded = np.pad(belief, 1, constant_values=-1.0)
+    neighbours = np.stack(
+        [padded[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+    )
+    ys, xs = np.nonzero((belief >= neighbours.max(axis=0)) & (belief > threshold))
+    order = np.argsort(-belief[ys, xs], kind="stable")
+    log = np.log(np.maximum(padded, 1e-6))
+    out: list[tuple[float, float, float]] = []
+    for y, x in zip(ys[order], xs[order], strict=True):
+        if any((px - x) ** 2 + (py - y) ** 2 < MIN_APART**2 for px, py, _ in out):
+            continue
+        centre = log[y + 1, x + 1]
+        out.append(
+            (
+                x + _vertex(log[y + 1, x], centre, log[y + 1, x + 2]),
+                y + _vertex(log[y, x + 1], centre, log[y + 2, x + 1]),
+                float(belief[y, x]),
+            )
+        )
+    return out
+
+
+def _vertex(before: float, centre: float, after: float) -> float:
+    """Where the parabola through three equally spaced values peaks, from the middle one."""
+    curvature = before - 2 * centre + after
+    if curvature >= 0:  # flat or not a maximum: stay on the cell
+        return 0.0
+    return float(np.clip(0.5 * (before - after) / curvature, -0.5, 0.5))
+
+
+def decode(beliefs: np.ndarray, fields: np.ndarray, max_distance: float = 3.0) -> list[Instance]:
+    """Instances from one image's maps: a centroid peak per instance, and for each corner the
+    peak whose affinity vector points closest to that centroid (within `max_distance` cells).
+
+    Args:
+        beliefs: [types * 9, H, W]; fields: [types * 8 * 2, H, W].
+    """
+    found = []
+    for t in range(beliefs.shape[0] // KEYPOINTS):
+        centroids = peaks(beliefs[t * KEYPOINTS + CENTROID])
+        if not centroids:
+            continue
+        cells = np.full((len(centroids), KEYPOINTS, 2), np.nan)
+        best = np.full((len(centroids), CORNERS), np.inf)
+        for i, (x, y, _) in enumerate(centroids):
+            cells[i, CENTROID] = (x, y)
+        for k in range(CORNERS):
+            base = (t * CORNERS + k) * 2
+            for x, y, _ in peaks(beliefs[t * KEYPOINTS + k]):
+                iy, ix = int(round(y)), int(round(x))
+                target = np.array([x + fields[base, iy, ix], y + fields[base + 1, iy, ix]])
+                d = [np.hypot(*(target - (cx, cy))) for cx, cy, _ in centroids]
+                i = int(np.argmin(d))
+                if d[i] <= max_distance and d[i] < best[i, k]:
+                    best[i, k], cells[i, k] = d[i], (x, y)
+        for i, (_, _, score) in enumerate(centroids):
+            found.append(Instance(t, to_pixels(cells[i]), score))
+    return found

@@ -1,0 +1,122 @@
+"""The DOPE-style keypoint network: belief maps of the 9 cuboid keypoints per object type and
+affinity fields that tie each corner to its object's centroid.
+
+DOPE (Tremblay et al. 2018) trains one VGG-based network per object; here one small network,
+trained from scratch on the synthetic images, serves every type: its output has a belief map
+per (type, keypoint) and, per (type, corner), a 2-vector field pointing from the corner to the
+centroid, at a quarter of the image's resolution. Several stages refine the maps, each seeing
+the features and the previous stage's maps, as in DOPE and the convolutional pose machines it
+follows; every stage is supervised.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import torch
+from torch import nn
+
+from hsgplan.checkpoint import load_trained
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.perception.keypoints import KEYPOINTS
+
+STRIDE = 4  # input pixels per output cell
+CORNERS = KEYPOINTS - 1
+
+
+@dataclass(frozen=True)
+class PerceptionNetConfig:
+    """What builds a keypoint network; saved as `config.json` beside its weights."""
+
+    types: int = len(OBJECT_TYPES)
+    width: int = 32  # channels of the first block; doubled at each of the next two
+    stages: int = 2
+
+    def __post_init__(self) -> None:
+        for name in ("types", "width", "stages"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or value < 1:
+                raise InvalidInputError(f"{name} {value!r}: need a positive integer")
+
+    @property
+    def beliefs(self) -> int:
+        return self.types * KEYPOINTS
+
+    @property
+    def fields(self) -> int:
+        return self.types * CORNERS * 2
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+    @staticmethod
+    def from_json(d: dict) -> PerceptionNetConfig:
+        return PerceptionNetConfig(**d)
+
+
+def _block(c_in: int, c_out: int, stride: int) -> nn.Sequential:
+    return nn.Sequential(
+        nn.Conv2d(c_in, c_out, 3, stride=stride, padding=1, bias=False),
+        nn.BatchNorm2d(c_out),
+        nn.ReLU(inplace=True),
+        nn.Conv2d(c_out, c_out, 3, padding=1, bias=False),
+        nn.BatchNorm2d(c_out),
+        nn.ReLU(inplace=True),
+    )
+
+
+class KeypointNet(nn.Module):
+    """Belief maps and affinity fields from an RGB image.
+
+    Args:
+        config: the sizes (`PerceptionNetConfig`).
+
+    Shapes:
+        input: [B, 3, H, W] float in 0..1, H and W multiples of `STRIDE * 2`.
+        output: a list over stages of (beliefs [B, types * 9, H / 4, W / 4] in 0..1,
+            fields [B, types * 8 * 2, H / 4, W / 4] in metres-free pixel units / 4).
+    """
+
+    def __init__(self, config: PerceptionNetConfig) -> None:
+        super().__init__()
+        w = config.width
+        self.stem = nn.Sequential(_block(3, w, 2), _block(w, 2 * w, 2))  # 1/4
+        self.down = _block(2 * w, 4 * w, 2)  # 1/8: a wider view for telling objects apart
+        self.up = nn.ConvTranspose2d(4 * w, 2 * w, 2, stride=2)
+        features, out = 4 * w, config.beliefs + config.fields
+        self.stages = nn.ModuleList()
+        for s in range(config.stages):
+            c_in = features + (out if s else 0)
+            self.stages.append(
+                nn.Sequential(
+                    nn.Conv2d(c_in, 2 * w, 3, padding=1),
+                    nn.ReLU(inplace=True),
+                    nn.Conv2d(2 * w, 2 * w, 3, padding=2, dilation=2),
+                    nn.ReLU(inplace=True),
+                    nn.Conv2d(2 * w, out, 1),
+                )
+            )
+        self.beliefs = config.beliefs
+
+    def forward(self, image: torch.Tensor) -> list[tuple[torch.Tensor, torch.Tensor]]:
+        quarter = self.stem(image)
+        features = torch.cat([quarter, self.up(self.down(quarter))], dim=1)
+        outputs, previous = [], None
+        for stage in self.stages:
+            x = features if previous is None else torch.cat([features, previous], dim=1)
+            previous = stage(x)
+            beliefs = torch.sigmoid(previous[:, : self.beliefs])
+            outputs.append((beliefs, previous[:, self.beliefs :]))
+        return outputs
+
+
+def build(config: PerceptionNetConfig) -> KeypointNet:
+    return KeypointNet(config)
+
+
+def load_perception_net(folder: Path) -> tuple[KeypointNet, PerceptionNetConfig]:
+    """A trained keypoint network (eval mode) from its checkpoint folder; one line if not."""
+    net, config = load_trained(folder, PerceptionNetConfig.from_json, build, "perception network")
+    return net, config  # type: ignore[return-value]

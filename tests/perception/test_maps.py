@@ -1,0 +1,38 @@
+"""Belief maps and affinity fields made from keypoints decode back into those keypoints, one
+instance each, duplicates of a type apart."""
+
+import numpy as np
+
+from hsgplan.perception.keypoints import PinholeCamera, in_world
+from hsgplan.perception.maps import decode, targets
+from hsgplan.perception.model import STRIDE
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.render import Camera
+
+CAMERA = Camera(320, 240, (1.15, 0.0, 1.0), (0.42, 0.0, 0.05), 46.0)
+
+
+def _keypoints(obj: str, x: float, y: float, yaw: float) -> np.ndarray:
+    from hsgplan.domain.objects import object_type
+
+    pose = Pose.from_xyz_yaw(x, y, object_type(obj).height / 2, yaw)
+    return PinholeCamera.of(CAMERA).project(in_world(obj, pose))
+
+
+def test_maps_of_two_butters_and_a_can_decode_into_their_keypoints():
+    from hsgplan.domain.world import OBJECT_TYPES
+
+    types = list(OBJECT_TYPES)
+    objects = [("butter", 0.40, -0.10, 0.3), ("butter", 0.55, 0.12, -1.0), ("cherries", 0.5, 0, 0)]
+    keypoints = np.stack([_keypoints(o, x, y, yaw) for o, x, y, yaw in objects])
+    kinds = np.array([types.index(o) for o, *_ in objects])
+    h, w = CAMERA.height // STRIDE, CAMERA.width // STRIDE
+    beliefs, fields = targets(keypoints, kinds, len(types), h, w)
+    found = decode(beliefs, fields)
+    assert sorted(f.type_index for f in found) == sorted(kinds.tolist())
+    for points, kind in zip(keypoints, kinds, strict=True):
+        same = [f for f in found if f.type_index == kind]
+        match = min(same, key=lambda f: np.linalg.norm(f.pixels[8] - points[8]))
+        seen = ~np.isnan(match.pixels).any(axis=1)
+        assert seen.sum() >= 7  # corners on top of one another may share a peak
+        assert np.abs(match.pixels[seen] - points[seen]).max() < 1.0  # pixels
