@@ -2,7 +2,7 @@
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval, report), `data`
 (collect), `learn` (train task, eval-task, eval-reach), `motion` (train motion, eval-motion),
-`bench`.
+`perception` (train perception), `bench`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import sys
 
 import typer
 
-from hsgplan.cli import bench, data, learn, motion, symbolic, world
+from hsgplan.cli import bench, data, learn, motion, perception, symbolic, world
 from hsgplan.cli.common import OneLineErrors
 
 app = typer.Typer(
@@ -31,6 +31,7 @@ app.add_typer(learn.train_app, name="train")
 app.command("eval-task")(learn.eval_task)
 app.command("eval-reach")(learn.eval_reach)
 learn.train_app.command("motion")(motion.train_motion)
+learn.train_app.command("perception")(perception.train_perception)
 app.command("eval-motion")(motion.eval_motion)
 
 
