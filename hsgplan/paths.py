@@ -22,6 +22,7 @@ DATA = Path("data")
 TASK_CHECKPOINT = CHECKPOINTS / "task"
 PAPER_TASK_CHECKPOINT = CHECKPOINTS / "task-paper"  # the paper's recipe: 18 demonstrations alone
 MOTION_CHECKPOINTS = CHECKPOINTS / "motion"
+PERCEPTION_CHECKPOINT = CHECKPOINTS / "perception"  # f_p's keypoint network
 DEMOS = DATA / "demos" / "v1"
 MOTION_DATA = DATA / "motion"
 REACH_DATA = DATA / "reach" / "v1"  # primitives executed in the simulated world: f_reach's labels

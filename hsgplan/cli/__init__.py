@@ -2,7 +2,7 @@
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval, report), `data`
 (collect), `learn` (train task, eval-task, eval-reach), `motion` (train motion, eval-motion),
-`perception` (train perception), `bench`.
+`perception` (train perception, eval-perception), `bench`.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ app.command("eval-task")(learn.eval_task)
 app.command("eval-reach")(learn.eval_reach)
 learn.train_app.command("motion")(motion.train_motion)
 learn.train_app.command("perception")(perception.train_perception)
+app.command("eval-perception")(perception.eval_perception)
 app.command("eval-motion")(motion.eval_motion)
 
 

@@ -1,7 +1,8 @@
-"""Commands of f_p, the pose estimator: `train perception`."""
+"""Commands of f_p, the pose estimator: `train perception`, `eval-perception`."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Annotated
 
@@ -13,11 +14,13 @@ from hsgplan.cli.common import (
     input_path,
     out,
     out_folder,
+    print_table,
     read_config,
     refuses_bad_input,
     shown,
 )
-from hsgplan.paths import RUNS
+from hsgplan.domain.checks import MAX_SEED, MAX_TRIALS
+from hsgplan.paths import PERCEPTION_CHECKPOINT, RUNS
 
 
 @refuses_bad_input
@@ -50,3 +53,60 @@ def train_perception(
 
         run(cfg, out_dir, on_epoch)
     out.print(f"trained the keypoint network into {shown(out_dir)}")
+
+
+@refuses_bad_input
+def eval_perception(
+    checkpoint: Annotated[
+        Path, typer.Option(help="Keypoint network checkpoint.", parser=input_path)
+    ] = PERCEPTION_CHECKPOINT,
+    scenes: Annotated[int, typer.Option(help="Fresh scenes.", min=1, max=MAX_TRIALS)] = 100,
+    seed: Annotated[
+        int, typer.Option(help="Seed of the scenes (training's is 0).", min=0, max=MAX_SEED)
+    ] = 1,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
+    markdown: Annotated[bool, typer.Option(help="Print Markdown tables.")] = False,
+) -> None:
+    """f_p on fresh synthetic scenes: pose errors per object type, symbolic scene graph match."""
+    from hsgplan.perception.estimator import PoseEstimator
+    from hsgplan.perception.evaluate import evaluate, summary
+
+    estimator = PoseEstimator.load(checkpoint)
+    with Progress(console=err, transient=True) as progress:
+        progress.add_task("scenes", total=None)
+        report = summary(evaluate(estimator, scenes, seed))
+    if as_json:
+        print(json.dumps(report, indent=2))
+        return
+
+    def fmt(v, spec):
+        return "—" if v is None else format(v, spec)
+
+    rows = [
+        (
+            t,
+            str(m["objects"]),
+            fmt(m["translation_cm_median"], ".2f"),
+            fmt(m["rotation_deg_median"], ".1f"),
+        )
+        for t, m in report["by_type"].items()
+    ]
+    rows.append(
+        (
+            "all",
+            str(report["objects"]),
+            fmt(report["translation_cm_median"], ".2f"),
+            fmt(report["rotation_deg_median"], ".1f"),
+        )
+    )
+    title = (
+        f"f_p on {report['scenes']} fresh scenes, seed {seed}: objects found "
+        f"{report['found_rate']:.3f}, symbolic scene graph equal "
+        f"{report['symbolic_match_rate']:.3f}"
+    )
+    print_table(
+        title,
+        ("type", "objects", "translation cm (median)", "rotation deg (median)"),
+        rows,
+        markdown,
+    )

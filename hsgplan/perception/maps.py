@@ -22,6 +22,7 @@ SIGMA = 1.0  # cells
 FIELD_RADIUS = 2.0  # cells
 PEAK_THRESHOLD = 0.3
 MIN_APART = 2.0  # cells between two peaks of one map
+MAX_PEAKS = 16  # per map: more objects of one type than a scene holds
 CENTROID = KEYPOINTS - 1
 OFFSET = (STRIDE - 1) / 2
 
@@ -84,20 +85,22 @@ def targets(
 def peaks(
     belief: np.ndarray, threshold: float = PEAK_THRESHOLD
 ) -> list[tuple[float, float, float]]:
-    """Local maxima of one map above `threshold`, strongest first, none within `MIN_APART`
-    cells of a stronger one (a keypoint half-way between cells makes two equal maxima), each
-    refined by a parabola through the log beliefs of its neighbours along x and along y (exact
-    for a Gaussian): (x, y, belief) in cells."""
+    """Local maxima of one map above `threshold`, strongest first (at most `MAX_PEAKS`), none
+    within `MIN_APART` cells of a stronger one (a keypoint half-way between cells makes two
+    equal maxima), each refined by a parabola through the log beliefs of its neighbours along
+    x and along y (exact for a Gaussian): (x, y, belief) in cells."""
     h, w = belief.shape
     padded = np.pad(belief, 1, constant_values=-1.0)
     neighbours = np.stack(
         [padded[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
     )
     ys, xs = np.nonzero((belief >= neighbours.max(axis=0)) & (belief > threshold))
-    order = np.argsort(-belief[ys, xs], kind="stable")
+    order = np.argsort(-belief[ys, xs], kind="stable")[: 8 * MAX_PEAKS]
     log = np.log(np.maximum(padded, 1e-6))
     out: list[tuple[float, float, float]] = []
     for y, x in zip(ys[order], xs[order], strict=True):
+        if len(out) == MAX_PEAKS:
+            break
         if any((px - x) ** 2 + (py - y) ** 2 < MIN_APART**2 for px, py, _ in out):
             continue
         centre = log[y + 1, x + 1]

@@ -1,0 +1,110 @@
+"""f_p: object poses from the fixed cameras' images, with the trained keypoint network.
+
+Each view's image goes through the network; its last stage's maps are decoded into instances
+(`perception.maps.decode`), and each instance seen with enough keypoints gets a pose by PnP.
+Estimates of one type from different views that lie within `FUSE_DISTANCE` of one another are
+one object: its pose is refitted to the keypoints of every view that saw it
+(`perception.pnp.estimate_pose`), as the paper fuses its robot's viewpoints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.perception.keypoints import PinholeCamera
+from hsgplan.perception.maps import decode
+from hsgplan.perception.model import KeypointNet, load_perception_net
+from hsgplan.perception.pnp import ViewKeypoints, estimate_pose
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.render import Camera
+
+FUSE_DISTANCE = 0.04  # m between two views' estimates of one object
+TYPES = tuple(OBJECT_TYPES)
+
+
+@dataclass(frozen=True)
+class Detection:
+    """An object the cameras saw: its type, pose, and the views and keypoints behind it."""
+
+    type_name: str
+    pose: Pose
+    score: float
+    views: int
+    reprojection_px: float
+
+
+class PoseEstimator:
+    """Args:
+    net: a trained keypoint network (eval mode).
+    """
+
+    def __init__(self, net: KeypointNet) -> None:
+        self.net = net
+
+    @staticmethod
+    def load(folder: Path) -> PoseEstimator:
+        return PoseEstimator(load_perception_net(folder)[0])
+
+    @torch.inference_mode()
+    def detect(self, images: np.ndarray, cameras: tuple[Camera, ...]) -> list[Detection]:
+        """Objects in the views: images [V, H, W, 3] uint8, taken by `cameras`."""
+        batch = torch.from_numpy(images).permute(0, 3, 1, 2).float() / 255.0
+        beliefs, fields = self.net(batch)[-1]
+        found: list[_Seen] = []
+        for v, camera in enumerate(cameras):
+            pinhole = PinholeCamera.of(camera)
+            for inst in decode(beliefs[v].numpy(), fields[v].numpy()):
+                seen = ViewKeypoints(pinhole, inst.pixels)
+                single = estimate_pose(TYPES[inst.type_index], [seen])
+                if single is not None:
+                    found.append(_Seen(inst.type_index, inst.score, v, seen, single.pose))
+        return _fuse(found)
+
+
+@dataclass(frozen=True)
+class _Seen:
+    """One instance in one view, with its single-view pose."""
+
+    type_index: int
+    score: float
+    view: int
+    keypoints: ViewKeypoints
+    pose: Pose
+
+
+def _fuse(found: list[_Seen]) -> list[Detection]:
+    """One detection per object: the strongest estimate first, with the closest estimate of
+    that type from each other view, if within `FUSE_DISTANCE` (two of one view are two
+    objects)."""
+    order = sorted(found, key=lambda s: -s.score)
+    used: set[int] = set()
+    out = []
+    for first in order:
+        if id(first) in used:
+            continue
+        members = [first]
+        for view in sorted({s.view for s in order} - {first.view}):
+            near = [
+                (_distance(s.pose, first.pose), k)
+                for k, s in enumerate(order)
+                if s.view == view and s.type_index == first.type_index and id(s) not in used
+            ]
+            if near and min(near)[0] < FUSE_DISTANCE:
+                members.append(order[min(near)[1]])
+        used.update(id(s) for s in members)
+        name = TYPES[first.type_index]
+        fused = estimate_pose(name, [s.keypoints for s in members])
+        if fused is not None:
+            out.append(
+                Detection(name, fused.pose, first.score, len(members), fused.reprojection_px)
+            )
+    return out
+
+
+def _distance(a: Pose, b: Pose) -> float:
+    return float(np.linalg.norm(np.subtract(a.position, b.position)))

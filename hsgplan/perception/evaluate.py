@@ -1,0 +1,141 @@
+"""`hsgplan eval-perception`: f_p against the ground truth on fresh synthetic scenes.
+
+Each scene (`perception.synthetic.render_sample`, another seed than training's) is seen by the
+estimator; its detections are matched to the scene's objects type by type, nearest first
+(within `MATCH_DISTANCE`). Per matched object: the translation error, and the rotation error
+up to the cuboid's symmetries (a box looks the same turned half way about any of its axes; a
+can about its axis, and upside down). A scene's symbolic scene graph from the estimated poses
+(each matched detection named as the object it matched) must equal the one from the true
+poses, every object found, for the scene to count as a symbolic match.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from hsgplan.domain.objects import object_type, type_of
+from hsgplan.domain.world import Kind
+from hsgplan.perception.estimator import Detection, PoseEstimator
+from hsgplan.perception.synthetic import ImageSample, render_sample
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.scene_graph.symbol_mapping import map_symbols
+
+MATCH_DISTANCE = 0.10  # m: a detection further than this from every object of its type matched none
+# A box's cuboid is unchanged by half turns about its axes.
+BOX_SYMMETRIES = (
+    np.eye(3),
+    np.diag([1.0, -1.0, -1.0]),
+    np.diag([-1.0, 1.0, -1.0]),
+    np.diag([-1.0, -1.0, 1.0]),
+)
+
+
+@dataclass(frozen=True)
+class SceneResult:
+    objects: int
+    found: int
+    translation_cm: tuple[float, ...]
+    rotation_deg: tuple[float, ...]
+    types: tuple[str, ...]  # of the matched objects, in the order of the errors
+    symbolic_match: bool
+
+
+def rotation_error(obj: str, truth: Pose, estimate: Pose) -> float:
+    """Degrees between two orientations of an object, up to its cuboid's symmetries."""
+    a, b = truth.rotation, estimate.rotation
+    if object_type(obj).kind is Kind.CAN:
+        cos = abs(float(a[:, 2] @ b[:, 2]))  # the axis, either way up
+        return math.degrees(math.acos(min(1.0, cos)))
+    best = max(np.trace(a.T @ b @ s) for s in BOX_SYMMETRIES)
+    return math.degrees(math.acos(float(np.clip((best - 1) / 2, -1.0, 1.0))))
+
+
+def match(sample: ImageSample, detections: list[Detection]) -> dict[str, Detection]:
+    """Each object of the scene and the detection matched to it (type by type, nearest pair
+    first)."""
+    truth = {o: _pose(sample, i) for i, o in enumerate(sample.objects)}
+    pairs = sorted(
+        (np.linalg.norm(np.subtract(d.pose.position, truth[o].position)), o, k)
+        for o in sample.objects
+        for k, d in enumerate(detections)
+        if d.type_name == type_of(o)
+    )
+    matched: dict[str, Detection] = {}
+    taken: set[int] = set()
+    for distance, o, k in pairs:
+        if distance < MATCH_DISTANCE and o not in matched and k not in taken:
+            matched[o] = detections[k]
+            taken.add(k)
+    return matched
+
+
+def score_scene(sample: ImageSample, detections: list[Detection]) -> SceneResult:
+    matched = match(sample, detections)
+    truth = {o: _pose(sample, i) for i, o in enumerate(sample.objects)}
+    names = [o for o in sample.objects if o in matched]
+    translation = [
+        100 * float(np.linalg.norm(np.subtract(matched[o].pose.position, truth[o].position)))
+        for o in names
+    ]
+    rotation = [rotation_error(o, truth[o], matched[o].pose) for o in names]
+    same = len(names) == len(sample.objects) and (
+        map_symbols(GeometricSceneGraph.from_poses(truth)).state
+        == map_symbols(GeometricSceneGraph.from_poses({o: matched[o].pose for o in names})).state
+    )
+    return SceneResult(
+        len(sample.objects),
+        len(names),
+        tuple(translation),
+        tuple(rotation),
+        tuple(type_of(o) for o in names),
+        same,
+    )
+
+
+def evaluate(estimator: PoseEstimator, scenes: int, seed: int) -> list[SceneResult]:
+    out = []
+    for index in range(scenes):
+        sample = render_sample(seed, index)
+        if sample is not None:
+            out.append(score_scene(sample, estimator.detect(sample.images, sample.cameras)))
+    return out
+
+
+def summary(results: list[SceneResult]) -> dict:
+    """Medians over matched objects, per type and overall; rates over scenes and objects."""
+    rows = [
+        (t, tc, rd)
+        for r in results
+        for t, tc, rd in zip(r.types, r.translation_cm, r.rotation_deg, strict=True)
+    ]
+
+    def medians(selected):
+        return {
+            "objects": len(selected),
+            "translation_cm_median": float(np.median([x[1] for x in selected]))
+            if selected
+            else None,
+            "rotation_deg_median": float(np.median([x[2] for x in selected])) if selected else None,
+        }
+
+    objects = sum(r.objects for r in results)
+    return {
+        **medians(rows),
+        "scenes": len(results),
+        "found_rate": sum(r.found for r in results) / objects if objects else 0.0,
+        "symbolic_match_rate": (
+            sum(r.symbolic_match for r in results) / len(results) if results else 0.0
+        ),
+        "by_type": {
+            t: medians([x for x in rows if x[0] == t]) for t in sorted({x[0] for x in rows})
+        },
+    }
+
+
+def _pose(sample: ImageSample, i: int) -> Pose:
+    p = sample.poses[i]
+    return Pose(tuple(map(float, p[:3])), tuple(map(float, p[3:])))
