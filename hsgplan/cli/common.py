@@ -16,7 +16,7 @@ from rich.text import Text
 from typer.core import TyperGroup
 
 from hsgplan.agents.registry import AGENT_NAMES, MOTION_GENERATORS, TASK_PLANNERS
-from hsgplan.domain.checks import check_output, read_json
+from hsgplan.domain.checks import MAX_WORKERS, check_output, read_json
 from hsgplan.domain.errors import InvalidInputError
 
 out = Console()
@@ -103,6 +103,21 @@ RunFolder = Annotated[
         "--out", help="Run folder (resumed if it exists; default runs/NAME).", parser=out_folder
     ),
 ]
+
+
+# --workers and --ray of the jobs that can run on Ray (collections, eval)
+CollectWorkers = Annotated[
+    int,
+    typer.Option(help="Processes (or Ray tasks in flight / 2).", min=1, max=MAX_WORKERS),
+]
+RayAddress = Annotated[
+    str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
+]
+
+
+def dash(value, spec: str) -> str:
+    """A number formatted for a table, or a dash where there is none."""
+    return "—" if value is None else format(value, spec)
 
 
 def input_path(text) -> Path:

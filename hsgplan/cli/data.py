@@ -8,13 +8,21 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.cli.common import check_ray, err, out, out_folder, refuses_bad_input, shown
+from hsgplan.cli.common import (
+    CollectWorkers,
+    RayAddress,
+    check_ray,
+    err,
+    out,
+    out_folder,
+    refuses_bad_input,
+    shown,
+)
 from hsgplan.domain.checks import (
     MAX_SAMPLES,
     MAX_SEED,
     MAX_STATES,
     MAX_TASKS_PER_CHUNK,
-    MAX_WORKERS,
 )
 from hsgplan.paths import RUNS
 
@@ -53,16 +61,11 @@ def _collect_command(primitive: str, default_samples: int):
         samples: Annotated[
             int, typer.Option(help="Successful trials to collect.", min=1, max=MAX_SAMPLES)
         ] = default_samples,
-        workers: Annotated[
-            int,
-            typer.Option(help="Processes (or Ray tasks in flight / 2).", min=1, max=MAX_WORKERS),
-        ] = 2,
+        workers: CollectWorkers = 2,
         seed: Annotated[
             int, typer.Option(help="Seed of the scene and parameter stream.", min=0, max=MAX_SEED)
         ] = 0,
-        ray: Annotated[
-            str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
-        ] = None,
+        ray: RayAddress = None,
         out_dir: Annotated[
             Path,
             typer.Option(
@@ -115,13 +118,8 @@ def images(
     seed: Annotated[
         int, typer.Option(help="Seed of the scenes and their looks.", min=0, max=MAX_SEED)
     ] = 0,
-    workers: Annotated[
-        int,
-        typer.Option(help="Processes (or Ray tasks in flight / 2).", min=1, max=MAX_WORKERS),
-    ] = 2,
-    ray: Annotated[
-        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
-    ] = None,
+    workers: CollectWorkers = 2,
+    ray: RayAddress = None,
     out_dir: Annotated[
         Path,
         typer.Option("--out", help="Collection folder (resumed if it exists).", parser=out_folder),
@@ -150,13 +148,8 @@ def reach(
     seed: Annotated[
         int, typer.Option(help="Seed of the states and actions.", min=0, max=MAX_SEED)
     ] = 0,
-    workers: Annotated[
-        int,
-        typer.Option(help="Processes (or Ray tasks in flight / 2).", min=1, max=MAX_WORKERS),
-    ] = 2,
-    ray: Annotated[
-        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
-    ] = None,
+    workers: CollectWorkers = 2,
+    ray: RayAddress = None,
     out_dir: Annotated[
         Path,
         typer.Option("--out", help="Collection folder (resumed if it exists).", parser=out_folder),

@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     PlannerName,
     RunFolder,
+    dash,
     err,
     input_path,
     out,
@@ -122,16 +123,13 @@ def eval_task(
         print(json.dumps(report, indent=2))
         return
 
-    def fmt(v, spec):
-        return "—" if v is None else format(v, spec)
-
     rows = [
         (
             n,
-            fmt(v["success_rate"], ".3f"),
-            fmt(v["plan_length_ratio"], ".3f"),
-            fmt(v["wasted_per_episode"], ".2f"),
-            fmt(v["ms_per_decision"], ".1f"),
+            dash(v["success_rate"], ".3f"),
+            dash(v["plan_length_ratio"], ".3f"),
+            dash(v["wasted_per_episode"], ".2f"),
+            dash(v["ms_per_decision"], ".1f"),
             str(v["episodes"]),
             ", ".join(f"{k} {c}" for k, c in sorted(v["failures"].items())) or "—",
         )
@@ -179,7 +177,7 @@ def eval_reach(
         print(json.dumps(report, indent=2))
         return
 
-    def fmt(v):
+    def dash(v):
         return "—" if v is None else f"{v:.3f}"
 
     rows = [
@@ -187,10 +185,10 @@ def eval_reach(
             kind,
             str(v["questions"]),
             str(v["reachable"]),
-            fmt(v["precision"]),
-            fmt(v["recall"]),
-            fmt(v["false_yes_rate"]),
-            fmt(v["accuracy"]),
+            dash(v["precision"]),
+            dash(v["recall"]),
+            dash(v["false_yes_rate"]),
+            dash(v["accuracy"]),
         )
         for kind, v in [*report["by_kind"].items(), ("all", report["overall"])]
     ]

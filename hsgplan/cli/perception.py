@@ -10,6 +10,7 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import (
+    dash,
     err,
     input_path,
     out,
@@ -79,15 +80,12 @@ def eval_perception(
         print(json.dumps(report, indent=2))
         return
 
-    def fmt(v, spec):
-        return "—" if v is None else format(v, spec)
-
     rows = [
         (
             t,
             str(m["objects"]),
-            fmt(m["translation_cm_median"], ".2f"),
-            fmt(m["rotation_deg_median"], ".1f"),
+            dash(m["translation_cm_median"], ".2f"),
+            dash(m["rotation_deg_median"], ".1f"),
         )
         for t, m in report["by_type"].items()
     ]
@@ -95,8 +93,8 @@ def eval_perception(
         (
             "all",
             str(report["objects"]),
-            fmt(report["translation_cm_median"], ".2f"),
-            fmt(report["rotation_deg_median"], ".1f"),
+            dash(report["translation_cm_median"], ".2f"),
+            dash(report["rotation_deg_median"], ".1f"),
         )
     )
     title = (

@@ -14,6 +14,7 @@ from hsgplan.cli.common import (
     AgentName,
     MotionName,
     PlannerName,
+    RayAddress,
     RunFolder,
     check_ray,
     err,
@@ -138,9 +139,7 @@ def evaluate(
         int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
     ] = 2,
     run_dir: RunFolder = None,
-    ray: Annotated[
-        str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")
-    ] = None,
+    ray: RayAddress = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[bool, typer.Option(help="Print Markdown tables (for the README).")] = False,
 ) -> None:
