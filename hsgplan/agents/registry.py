@@ -2,7 +2,8 @@
 
 An agent is a task planner and a motion generator (`HierarchicalAgent`). The registered agents
 are named pairs; any other pair is asked for as `PLANNER+MOTION` (`regression+gnn`). The
-search-based baseline plans both levels together and is an agent of its own (`search`). Shipped
+search-based baselines plan both levels together and are agents of their own (`search`, and
+`stream`, PDDLStream's incremental algorithm). Shipped
 checkpoints are found as `hsgplan.paths` finds them, wherever the command runs.
 """
 
@@ -88,8 +89,13 @@ AGENTS: dict[str, tuple[str, str]] = {
 # agents that are not a task planner beside a motion generator: name -> what it is
 WHOLE_AGENTS: dict[str, str] = {
     "search": "Fast Downward's plan refined by sampling and simulating, backtracking",
+    "stream": "PDDLStream's incremental algorithm: Fast Downward over sampled poses and grasps",
 }
 AGENT_NAMES = [*AGENTS, *WHOLE_AGENTS]
+# The search-based baselines Table 2 may time against ours (`hsgplan bench timing --search`),
+# and the one it times unless told.
+SEARCH_BASELINES = ("search", "stream")
+DEFAULT_SEARCH = "search"
 
 
 def _known(what: str, name: str, names) -> None:
@@ -162,10 +168,14 @@ def make_agent(
     missing checkpoint is refused in one line."""
     from hsgplan.agents.hierarchical import HierarchicalAgent
 
-    if name in WHOLE_AGENTS:
+    if name == "search":
         from hsgplan.agents.search import SearchAgent
 
         return SearchAgent()
+    if name == "stream":
+        from hsgplan.agents.stream import StreamAgent
+
+        return StreamAgent()
 
     planner, motion = agent_parts(name)
     return HierarchicalAgent(

@@ -1,11 +1,16 @@
 """The paper's Table 2: seconds of task planning and of motion per episode, our agent
-(the learned regression planner and the motion GNN) against the search-based baseline
-(`agents/search.py`), in one run and on the same goals and start scenes.
+(the learned regression planner and the motion GNN) against a search-based baseline, in one
+run and on the same goals and start scenes. The baseline is one of `SEARCH_BASELINES`
+(`agents/registry.py`):
+`search` (`agents/search.py`: Fast Downward on the abstract domain, its plan refined by trials)
+or `stream` (`agents/stream.py`: PDDLStream's incremental algorithm over poses, grasps,
+configurations and pushes).
 
-Each agent's episodes go into a run folder of its own (`ours/`, `search/`), resumable as every
-evaluation is; `table2.md`, `table2.png` and `summary.json` are written beside them. Times per
-episode are sums over its steps: the task level's seconds, and the motion level's (choosing
-parameters, the search's trials of its plans included, and executing them).
+Each agent's episodes go into a run folder of its own (`ours/`, and `search/` or `stream/`),
+resumable as every evaluation is; `table2.md`, `table2.png` and `summary.json` are written
+beside them. Times per episode are sums over its steps: the task level's seconds, and the
+motion level's (choosing parameters, the baseline's stream evaluation or trials included, and
+executing them).
 """
 
 from __future__ import annotations
@@ -16,6 +21,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
 
+from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.table1 import TextTable
@@ -33,14 +40,22 @@ PAPER_TABLE2: dict[str, dict[int, tuple[float, float]]] = {
     },
     "paper": {2: (0.15, 18.1), 3: (0.13, 27.2), 4: (0.22, 36.5), 5: (0.29, 42.9), 6: (0.32, 49.4)},
 }
-# column -> registered agent
-AGENTS = {"ours": "paper", "search": "search"}
 LABELS = {
     "ours": "ours",
     "search": "search",
+    "stream": "stream (PDDLStream-style)",
     "pddlstream": "PDDLStream (paper)",
     "paper": "theirs (paper)",
 }
+
+
+def timing_agents(search: str = DEFAULT_SEARCH) -> dict[str, str]:
+    """column (and run folder) -> registered agent: ours, and the search baseline asked for."""
+    if search not in SEARCH_BASELINES:
+        raise InvalidInputError(
+            f"--search '{search}': the search baseline is one of {', '.join(SEARCH_BASELINES)}"
+        )
+    return {"ours": "paper", search: search}
 
 
 def _quartiles(values: list[float]) -> dict[str, float]:
@@ -70,14 +85,22 @@ def timing_summary(records: Sequence[EpisodeRecord]) -> dict:
 TIMING_KIND = "bench-timing"
 
 
-def check_timing_folder(sizes: Sequence[int], goals: int, seed: int, out: Path) -> tuple[dict, str]:
+def check_timing_folder(
+    sizes: Sequence[int], goals: int, seed: int, out: Path, search: str = DEFAULT_SEARCH
+) -> tuple[dict, str]:
     """Every refusal of the run folders before anything is written; what the top folder is
     claimed with and its refusal."""
+    agents = timing_agents(search)
     config = EvalConfig("", tuple(sizes), goals, seed)
     table = {"sizes": list(config.sizes), "goals": goals, "seed": seed}
-    refusal = f"'{out}' holds a timing run with other sizes, goals or seed; use another --out"
+    if search != "search":  # folders made before there was a choice timed `search`, unnamed
+        table["search"] = search
+    refusal = (
+        f"'{out}' holds a timing run with other sizes, goals, seed or search baseline; "
+        "use another --out"
+    )
     check_claim(out, TIMING_KIND, table, refusal)
-    check_runs(config, out, AGENTS)
+    check_runs(config, out, agents)
     return table, refusal
 
 
@@ -88,24 +111,28 @@ def run_timing(
     out: Path,
     workers: int = 1,
     on_episode: Callable[[EpisodeRecord], None] | None = None,
+    search: str = DEFAULT_SEARCH,
 ) -> dict:
     """Both agents' episodes into `out/AGENT/`; the summary, also written as `summary.json`,
     `table2.md` and `table2.png` in `out`.
 
-    `{"by_size": {"2": {"ours": {"task_s", "motion_s", "success_rate", ...}, "search": {...}}}}`
+    `{"by_size": {"2": {"ours": {"task_s", "motion_s", "success_rate", ...}, "search": {...}}},
+    "search": "search", ...}`: the baseline's entries are under its name (`search` or
+    `stream`), which `"search"` names.
     """
     config = EvalConfig("", tuple(sizes), goals, seed)
-    table, refusal = check_timing_folder(sizes, goals, seed, out)
+    table, refusal = check_timing_folder(sizes, goals, seed, out, search)
     claim(out, TIMING_KIND, table, refusal)
     records = {
         key: run_evaluation(replace(config, agent=agent), out / key, workers, on_episode)
-        for key, agent in AGENTS.items()
+        for key, agent in timing_agents(search).items()
     }
     report = {
         "by_size": {
             str(n): {k: timing_summary([r for r in rs if r.size == n]) for k, rs in records.items()}
             for n in sorted(set(sizes))
         },
+        "search": search,
         "goals": goals,
         "seed": seed,
         "workers": workers,
@@ -118,7 +145,7 @@ def run_timing(
 
 
 def total_episodes(sizes: Sequence[int], goals: int, seed: int) -> int:
-    return len(AGENTS) * len(episode_specs(EvalConfig("", tuple(sizes), goals, seed)))
+    return len(timing_agents()) * len(episode_specs(EvalConfig("", tuple(sizes), goals, seed)))
 
 
 def _series(report: dict) -> dict[str, dict[str, dict[int, float]]]:
@@ -142,8 +169,9 @@ def _seconds(v: dict, level: str) -> str:
 
 def tables(report: dict) -> list[TextTable]:
     rows = []
+    name = report.get("search", "search")  # summaries from before the choice hold `search`
     for n, v in report["by_size"].items():
-        ours, search = v["ours"], v["search"]
+        ours, search = v["ours"], v[name]
         paper = {k: PAPER_TABLE2[k].get(int(n)) for k in PAPER_TABLE2}
         ratio = search["task_s"] / ours["task_s"] if ours["task_s"] > 0 else float("inf")
         rows.append(
@@ -160,18 +188,18 @@ def tables(report: dict) -> list[TextTable]:
         )
     header = (
         "objects",
-        "search task s",
-        "search motion s",
+        f"{name} task s",
+        f"{name} motion s",
         "ours task s",
         "ours motion s",
         "task speed-up",
-        "success search / ours",
+        f"success {name} / ours",
         "PDDLStream task / motion (paper)",
         "theirs task / motion (paper)",
     )
     title = (
         f"Seconds per episode, median (quartiles), {report['goals']} goals per size, seed "
-        f"{report['seed']}, {report['workers']} worker(s): the search baseline against ours, "
-        "beside the paper's Table 2"
+        f"{report['seed']}, {report['workers']} worker(s): the search baseline ({LABELS[name]}) "
+        "against ours, beside the paper's Table 2"
     )
     return [TextTable(title, header, tuple(rows))]

@@ -9,8 +9,10 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
+from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
 from hsgplan.cli.common import (
     RunFolder,
+    choice,
     err,
     input_path,
     out,
@@ -25,6 +27,8 @@ from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.paths import RUNS, TASK_CHECKPOINT
 
 app = typer.Typer(no_args_is_help=True, help="Measure speed (medians over one run).")
+SearchName = choice("SearchName", SEARCH_BASELINES)
+DEFAULT_SEARCH_NAME = SearchName(DEFAULT_SEARCH)
 
 
 @app.command("sim")
@@ -170,6 +174,13 @@ def bench_timing(
             max=MAX_WORKERS,
         ),
     ] = 1,
+    search: Annotated[
+        SearchName,
+        typer.Option(
+            help="The search baseline: stream (PDDLStream's incremental algorithm over poses) "
+            "or search (Fast Downward's abstract plan, refined by trials)."
+        ),
+    ] = DEFAULT_SEARCH_NAME,
     run_dir: RunFolder = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
@@ -177,26 +188,32 @@ def bench_timing(
     ] = False,
 ) -> None:
     """The paper's Table 2: task-planning and motion seconds per episode, ours (regression +
-    GNN) against the search-based baseline, on the same goals; writes table2.md, table2.png
+    GNN) against a search-based baseline, on the same goals; writes table2.md, table2.png
     and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.benchmarks.timing import (
-        AGENTS,
         check_timing_folder,
         run_timing,
         tables,
+        timing_agents,
         total_episodes,
     )
 
     size_list = parse_sizes(sizes)
-    folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}"
-    check_timing_folder(size_list, goals, seed, folder)  # cheap refusals before the agents load
-    for agent in AGENTS.values():  # a missing checkpoint is refused before any work
+    baseline = search.value
+    agents = timing_agents(baseline)
+    # the default folder of the `search` baseline keeps the name it had before the choice
+    which = "" if baseline == "search" else f"-{baseline}"
+    folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}{which}"
+    # cheap refusals before the agents load
+    check_timing_folder(size_list, goals, seed, folder, baseline)
+    for agent in agents.values():  # a missing checkpoint is refused before any work
         make_agent(agent)
     with Progress(console=err, transient=True) as progress:
-        task = progress.add_task("ours, search", total=total_episodes(size_list, goals, seed))
+        total = total_episodes(size_list, goals, seed)
+        task = progress.add_task(f"ours, {baseline}", total=total)
         report = run_timing(
-            size_list, goals, seed, folder, workers, lambda r: progress.advance(task)
+            size_list, goals, seed, folder, workers, lambda r: progress.advance(task), baseline
         )
     if as_json:
         print(json.dumps(report, indent=2))

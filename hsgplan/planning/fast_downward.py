@@ -7,10 +7,17 @@ planner is timed against.
 from __future__ import annotations
 
 import contextlib
+import importlib.resources
+import math
+import os
+import signal
+import subprocess
+import sys
 import tempfile
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import Path
 
 import unified_planning as up
 from unified_planning.engines import PlanGenerationResultStatus as Status
@@ -119,6 +126,75 @@ class FastDownwardPlanner:
         for a in actions:
             states.append(apply(states[-1], a))
         return Plan(actions, tuple(states), seconds, "fd-optimal" if optimal else "fd-wastar")
+
+
+@dataclass(frozen=True)
+class PddlPlan:
+    """A plan Fast Downward found for PDDL text: each step's action name and arguments (lower
+    case, as Fast Downward writes them); `seconds` is the driver's wall time (translation and
+    search, the process start included)."""
+
+    steps: tuple[tuple[str, tuple[str, ...]], ...]
+    seconds: float
+
+
+# The driver's exit codes for "no plan exists" (the translator or the search proved it), "none
+# found" (an incomplete search gave up) and "out of time or memory": each means
+# the caller should try something else.
+_NO_PLAN_CODES = (10, 11, 12, 20, 21, 22, 23, 24)
+# Seconds the driver gets past its own time limit before its process group is killed.
+_KILL_GRACE_S = 5.0
+
+
+def solve_pddl(
+    domain: str, problem: str, search: str = SATISFICING_SEARCH, timeout_s: float = 60.0
+) -> PddlPlan:
+    """Fast Downward's driver on PDDL text (what unified-planning cannot express, such as
+    derived predicates), in a temporary folder of its own; `NoPlanError` when it finds none
+    within `timeout_s` (the driver's limit, on its processor time)."""
+    driver = importlib.resources.files("up_fast_downward") / "downward" / "fast-downward.py"
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="hsgplan-fd-") as tmp:
+        folder = Path(tmp)
+        (folder / "domain.pddl").write_text(domain)
+        (folder / "problem.pddl").write_text(problem)
+        cmd = [sys.executable, str(driver), "--plan-file", "plan"]
+        cmd += ["--overall-time-limit", f"{max(1, math.ceil(timeout_s))}s"]
+        cmd += ["domain.pddl", "problem.pddl", "--search", search]
+        code, tail = _run_group(cmd, folder, timeout_s + _KILL_GRACE_S)
+        plan_file = folder / "plan"
+        if code in _NO_PLAN_CODES or code is None or (code == 0 and not plan_file.exists()):
+            raise NoPlanError(f"Fast Downward found no plan (exit code {code})")
+        if code != 0:
+            raise RuntimeError(f"Fast Downward failed ({code}): {tail}")
+        lines = plan_file.read_text().splitlines()
+    steps = []
+    for line in lines:
+        if line.startswith("("):
+            name, *args = line.strip("() ").split()
+            steps.append((name, tuple(args)))
+    return PddlPlan(tuple(steps), time.perf_counter() - start)
+
+
+def _run_group(cmd: list[str], cwd: Path, timeout_s: float) -> tuple[int | None, str]:
+    """Run a command in a process group of its own: the driver starts the translator and the
+    search as children, which killing the driver alone would leave running. The exit code
+    (None when it had to be killed) and the last lines it wrote."""
+    proc = subprocess.Popen(
+        cmd,
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        out, _ = proc.communicate(timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
+        return None, ""
+    return proc.returncode, " | ".join((out or "").strip().splitlines()[-3:])
 
 
 class FastDownwardTaskPlanner:

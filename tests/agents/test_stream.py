@@ -1,0 +1,124 @@
+"""The PDDLStream-style baseline: its streams' collision test, a goal solved in the simulated
+world, its plan followed and what failed left out, and its place in Table 2."""
+
+import pytest
+from typer.testing import CliRunner
+
+from hsgplan.agents.incremental import IncrementalConfig
+from hsgplan.agents.registry import make_agent
+from hsgplan.agents.stream import StreamAgent, expected_after, scene_key
+from hsgplan.agents.streams import collides, stack_pose, surface_pose
+from hsgplan.benchmarks.timing import tables, timing_agents
+from hsgplan.cli import app
+from hsgplan.domain.actions import Pick, Place, Push
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.parameters import PickParams, PushParams
+from hsgplan.domain.predicates import in_grasp, on
+from hsgplan.evaluation.episode import run_episode
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
+from hsgplan.sim.outcome import Outcome, Status
+
+
+def test_collision_test_keeps_towers_and_flags_crowding():
+    can = surface_pose("cherries", "shelf_a", (2, 5))
+    beside = surface_pose("tomato_soup", "shelf_a", (2, 6))  # the next bin: 2.4 cm apart
+    far = surface_pose("tomato_soup", "shelf_a", (8, 0))
+    assert collides(can, beside) and collides(beside, can)
+    assert not collides(can, far)
+    on_can = stack_pose("butter", can)
+    on_butter = stack_pose("tomato_soup", on_can)
+    assert not collides(on_can, can) and not collides(on_butter, can)  # a tower stands
+    # the hand taking a flat box would sweep into a tall can standing past its narrow side
+    box = surface_pose("butter", "open_space", (5, 5))
+    tall = surface_pose("alphabet_soup", "open_space", (8, 5))  # 11 cm away along x
+    assert collides(box, tall) and not collides(box, surface_pose("cherries", "shelf_b", (0, 0)))
+    assert stack_pose("butter", surface_pose("popcorn", "shelf_a", (5, 5))) is None  # too narrow
+
+
+def test_expected_state_moves_only_the_acting_object():
+    state = SymbolicSceneGraph.from_literals(
+        ("butter", "cherries"), [on("butter", "open_space"), on("cherries", "shelf_a")]
+    )
+    held = expected_after(state, Pick("butter"))
+    assert held.holds(in_grasp("butter")) and held.holds(on("cherries", "shelf_a"))
+    stacked = expected_after(held, Place("butter", "cherries"))
+    assert stacked.holds(on("butter", "cherries"))
+
+
+def test_solves_a_three_object_goal():
+    goal = parse_goal("On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)")
+    record = run_episode(KitchenStorageEnv(), StreamAgent(), goal, seed=4)
+    assert record.success, record.steps
+    assert any(s.action.startswith("push(tomato_soup") for s in record.steps)
+    # planned once before the first step, streams and Fast Downward both timed
+    assert record.steps[0].task_seconds > 0 and record.steps[0].motion_seconds > 0
+    if all(s.status == "success" for s in record.steps):
+        assert all(s.task_seconds == 0 for s in record.steps[1:])
+
+
+def test_follows_its_plan_and_leaves_out_what_failed_in_that_scene():
+    goal = parse_goal("On(butter, shelf_b)")
+    env = KitchenStorageEnv()
+    _, info = env.reset(seed=5, options=ResetOptions(goal))
+    obs = info["observation"]
+    agent = StreamAgent(IncrementalConfig(max_levels=3))
+    agent.reset(goal, 5)
+    first = agent.decide(obs.scene_graph, obs.symbols.state, goal, env.lookahead)
+    assert first.action == Pick("butter") and first.params == PickParams("butter")
+    assert first.task_seconds > 0 and first.motion_seconds > 0
+    assert [s.action for s in agent._queue] == [Place("butter", "shelf_b")]
+    agent.observe(first.params, Outcome(Status.NO_IK, "", 0.0))
+    assert agent._queue == []
+    assert agent._failed == {scene_key(obs.scene_graph): {PickParams("butter")}}
+    # the only way to the goal starts with that pick: in this scene there is none now
+    again = agent.decide(obs.scene_graph, obs.symbols.state, goal, env.lookahead)
+    assert again.action is None and "no plan" in again.note
+    env.close()
+
+
+def test_without_the_world_offers_nothing():
+    goal = parse_goal("On(butter, shelf_b)")
+    env = KitchenStorageEnv()
+    _, info = env.reset(seed=3, options=ResetOptions(goal))
+    obs = info["observation"]
+    d = StreamAgent().decide(obs.scene_graph, obs.symbols.state, goal, env.check)
+    assert d.action is None and "scene" in d.note
+    env.close()
+
+
+def test_is_a_registered_agent_and_a_table2_baseline():
+    assert isinstance(make_agent("stream"), StreamAgent)
+    assert timing_agents("stream") == {"ours": "paper", "stream": "stream"}
+    with pytest.raises(InvalidInputError, match="search baseline"):
+        timing_agents("wizard")
+    row = {"task_s": 2.0, "task_q1": 1.0, "task_q3": 3.0, "success_rate": 1.0}
+    row |= {"motion_s": 1.0, "motion_q1": 1.0, "motion_q3": 1.0}
+    report = {"by_size": {"3": {"ours": row, "stream": row}}, "search": "stream"}
+    report |= {"goals": 1, "seed": 0, "workers": 1}
+    table = tables(report)[0]
+    assert "stream task s" in table.header and "PDDLStream-style" in table.title
+
+
+def test_timing_refuses_an_unknown_baseline_in_one_line():
+    r = CliRunner().invoke(app, ["bench", "timing", "--search", "wizard"])
+    assert r.exit_code == 2
+    lines = [line for line in r.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and "'wizard' is not one of" in lines[0]
+
+
+def test_plans_a_push_from_a_prepush_pose():
+    goal = parse_goal("In(tomato_soup, shelf_a)")
+    env = KitchenStorageEnv()
+    _, info = env.reset(seed=2, options=ResetOptions(goal))
+    obs = info["observation"]
+    agent = StreamAgent()
+    d = agent.decide(obs.scene_graph, obs.symbols.state, goal, env.lookahead)
+    assert [d.action] + [s.action for s in agent._queue] == [
+        Pick("tomato_soup"),
+        Place("tomato_soup", "prepush_a"),
+        Push("tomato_soup", "shelf_a"),
+    ]
+    assert isinstance(agent._queue[-1].params, PushParams)
+    env.close()
