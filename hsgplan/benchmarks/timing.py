@@ -67,8 +67,8 @@ def _quartiles(values: list[float]) -> dict[str, float]:
 
 def timing_summary(records: Sequence[EpisodeRecord]) -> dict:
     """Medians and quartiles of an agent's seconds per episode, and its success rate."""
-    task = [sum(s.task_seconds for s in r.steps) for r in records]
-    motion = [sum(s.motion_seconds + s.execution_seconds for s in r.steps) for r in records]
+    task = [r.task_seconds for r in records]
+    motion = [r.motion_seconds for r in records]
     t, m = _quartiles(task), _quartiles(motion)
     return {
         "task_s": t["median"],

@@ -44,6 +44,22 @@ class EpisodeRecord:
     steps: tuple[StepRecord, ...]
     seconds: float
     repeat: int = 0  # which of a goal's repeated episodes (the protocol runs each several times)
+    # The last decision's seconds when it gave nothing to execute (the agent found no subgoal
+    # or no parameters): time spent like any other, that no step records.
+    unexecuted_task_seconds: float = 0.0
+    unexecuted_motion_seconds: float = 0.0
+
+    @property
+    def task_seconds(self) -> float:
+        """The task level's seconds over the whole episode."""
+        return sum(s.task_seconds for s in self.steps) + self.unexecuted_task_seconds
+
+    @property
+    def motion_seconds(self) -> float:
+        """The motion level's seconds over the whole episode: choosing parameters, and
+        executing them."""
+        executed = sum(s.motion_seconds + s.execution_seconds for s in self.steps)
+        return executed + self.unexecuted_motion_seconds
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -77,6 +93,7 @@ def run_episode(
         on_step(None, obs)
     records: list[StepRecord] = []
     failure = None
+    unexecuted = (0.0, 0.0)
     while not goal.satisfied_by(obs.symbols.state):
         fatal = [a for a in obs.symbols.anomalies if a.kind in _FATAL]
         if fatal:
@@ -88,6 +105,7 @@ def run_episode(
         d = agent.decide(obs.scene_graph, obs.symbols.state, goal, feasible=env.lookahead)
         if d.params is None:
             failure = Failure.NO_SUBGOAL if d.action is None else Failure.NO_PARAMETERS
+            unexecuted = (d.task_seconds, d.motion_seconds)
             break
         if on_decide:
             on_decide(len(records) + 1, d)
@@ -122,4 +140,6 @@ def run_episode(
         None if failure is None else str(failure),
         tuple(records),
         time.perf_counter() - start,
+        unexecuted_task_seconds=unexecuted[0],
+        unexecuted_motion_seconds=unexecuted[1],
     )

@@ -65,11 +65,9 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         },
         "median_steps": statistics.median(len(r.steps) for r in rs),
         "median_seconds": statistics.median(r.seconds for r in rs),
-        "median_task_seconds": statistics.median(sum(s.task_seconds for s in r.steps) for r in rs),
+        "median_task_seconds": statistics.median(r.task_seconds for r in rs),
         # the motion level per episode: choosing parameters and executing them
-        "median_motion_seconds": statistics.median(
-            sum(s.motion_seconds + s.execution_seconds for s in r.steps) for r in rs
-        ),
+        "median_motion_seconds": statistics.median(r.motion_seconds for r in rs),
     }
 
 

@@ -148,3 +148,30 @@ def test_the_shipped_task_checkpoint_closes_the_loop_in_the_simulated_world():
     assert record.seed == 4 and all(s.task_seconds > 0 for s in record.steps)
     # every step names the subgoal it serves, the literal its action makes true
     assert record.steps[0].subgoal and all(s.subgoal for s in record.steps)
+
+
+def test_a_last_decision_that_gave_nothing_to_execute_still_counts_its_seconds():
+    # A search baseline that plans for minutes and finds nothing spends that time like any
+    # other; Table 2 must not read it as zero.
+    from hsgplan.agents.base import Decision
+    from hsgplan.evaluation.episode import EpisodeRecord, run_episode
+    from hsgplan.sim.env import KitchenStorageEnv
+
+    class _GivesUp:
+        name = "gives-up"
+
+        def reset(self, goal, seed):
+            pass
+
+        def decide(self, sg, state, goal, feasible=None):
+            return Decision(None, None, 2.5, 0.75, "no plan")
+
+        def observe(self, params, outcome):
+            pass
+
+    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)")
+    record = run_episode(KitchenStorageEnv(objects=2), _GivesUp(), goal, seed=0)
+    assert not record.success and record.steps == ()
+    assert record.task_seconds == 2.5 and record.motion_seconds == 0.75
+    old = {k: v for k, v in record.to_json().items() if not k.startswith("unexecuted")}
+    assert EpisodeRecord.from_json(old).task_seconds == 0.0  # rows logged before: as they were
