@@ -77,6 +77,9 @@ COMMANDS = (
     "collect reach",
     "train task",
     "train motion",
+    "collect images",
+    "train perception",
+    "eval-perception",
 )
 
 # ---------------------------------------------------------------------------------------------
@@ -233,6 +236,8 @@ BASE: dict[str, tuple[str, list[Setup]]] = {
     "train task": ("train task --config tiny.json", [TASK_TINY]),
     "train motion": ("train motion --config tiny.json", [MOTION_TINY]),
     "bench timing": ("bench timing --sizes 2 --goals 1 --workers 1", []),
+    "collect images": ("collect images --count 1 --workers 1", []),
+    "train perception": ("train perception --images imgs", [mkdir("imgs")]),
 }
 
 
@@ -275,6 +280,8 @@ bench task     | bench task --sizes 2                                 | --goals 
 bench timing   | bench timing --sizes 2 --workers 1                   | --goals     | -1 1e12
 bench collect  | bench collect --workers 1 --primitives place         | --samples   | -1 1e12
 report         | report run                                           | --failures  | -1
+collect images | collect images --workers 1 --out ds                  | --count     | ALL
+eval-perception | eval-perception                                     | --scenes    | ALL
 """
 # a small count each: a huge pool for one item would still start one process
 WORKERS = """
@@ -284,6 +291,7 @@ eval-motion    | eval-motion --trials 1 --primitives place
 collect place  | collect place --samples 1 --out ds
 collect push   | collect push --samples 1 --out ds
 collect reach  | collect reach --states 1 --out ds
+collect images | collect images --count 1 --out ds
 """
 SEEDS = """
 goals          | goals --objects 2 --count 1
@@ -294,6 +302,8 @@ collect demos  | collect demos --out ds
 collect place  | collect place --samples 1 --workers 1 --out ds
 collect reach  | collect reach --states 1 --workers 1 --out ds
 train task     | train task --config tiny.json --out ck
+collect images | collect images --count 1 --workers 1 --out ds
+eval-perception | eval-perception --scenes 1
 """
 MALFORMED = """
 goals          | goals --objects 2 --count abc
@@ -301,6 +311,7 @@ goals          | goals --objects 2 --count 1.5
 goals          | goals --objects 2 --count ''
 eval           | eval --sizes 2 --goals 1 --workers 1e3
 collect place  | collect place --samples 0x10 --out ds
+bench timing   | bench timing --sizes 2 --goals 1 --workers 1 --search pddl
 """
 # command | base command line | --sizes values (a space-separated list; '' is the empty value)
 SIZES = """
