@@ -27,6 +27,10 @@ from hsgplan.domain.checks import (
 from hsgplan.paths import RUNS
 
 app = typer.Typer(no_args_is_help=True, help="Collect datasets (resumable).")
+CollectionFolder = Annotated[
+    Path,
+    typer.Option("--out", help="Collection folder (resumed if it exists).", parser=out_folder),
+]
 
 
 @app.command("demos")
@@ -120,10 +124,7 @@ def images(
     ] = 0,
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
-    out_dir: Annotated[
-        Path,
-        typer.Option("--out", help="Collection folder (resumed if it exists).", parser=out_folder),
-    ] = RUNS / "collect-images",
+    out_dir: CollectionFolder = RUNS / "collect-images",
 ) -> None:
     """Synthetic training images for f_p: random scenes from the fixed cameras, domain
     randomised, with every object's pose and cuboid keypoints (format: perception/images.py)."""
@@ -150,10 +151,7 @@ def reach(
     ] = 0,
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
-    out_dir: Annotated[
-        Path,
-        typer.Option("--out", help="Collection folder (resumed if it exists).", parser=out_folder),
-    ] = RUNS / "collect-reach",
+    out_dir: CollectionFolder = RUNS / "collect-reach",
 ) -> None:
     """Self-supervised reachability: primitives executed in the simulated world from staged
     symbolic states, and what the world showed after each (f_reach's labels)."""
