@@ -2,7 +2,7 @@
 
 Every (sample, view) image is one example; its targets are the belief maps and affinity fields
 (`perception.maps.targets`) of the objects in sight in it (at least `MIN_VISIBLE` pixels), made
-once per image and kept in memory at the output resolution. The loss is DOPE's: the mean
+batch by batch. The loss is DOPE's: the mean
 squared error of every stage's maps, summed over stages. Labels come from the renderer: the
 poses the scene was staged in, projected through the camera that rendered it. The checkpoint
 is a folder (`train_config.json`, `config.json`, `model.safetensors`, `manifest.json`) and a
@@ -56,27 +56,35 @@ class PerceptionTrainConfig:
 
 @dataclass(frozen=True)
 class Examples:
-    """Images and their targets: images [E, 3, H, W] uint8; beliefs [E, C, h, w] float16;
-    fields [E, F, h, w] float16."""
+    """Every (sample, view) image with the keypoints and types of the objects in sight in it:
+    images [E, 3, H, W] uint8; keypoints and types, E arrays of [M, 9, 2] and [M]. Targets are
+    made per batch: kept for a whole collection they would take some 1.4 MB an image."""
 
     images: torch.Tensor
-    beliefs: torch.Tensor
-    fields: torch.Tensor
+    keypoints: list[np.ndarray]
+    types: list[np.ndarray]
+
+    def targets(self, take: list[int], types_count: int) -> tuple[torch.Tensor, torch.Tensor]:
+        """Belief maps and affinity fields of the images `take`: [B, C, h, w], [B, F, h, w]."""
+        h, w = self.images.shape[2] // STRIDE, self.images.shape[3] // STRIDE
+        maps = [targets(self.keypoints[i], self.types[i], types_count, h, w) for i in take]
+        return (
+            torch.from_numpy(np.stack([b for b, _ in maps])),
+            torch.from_numpy(np.stack([f for _, f in maps])),
+        )
 
 
-def examples(data: dict[str, np.ndarray], types_count: int) -> Examples:
-    """Every (sample, view) of a loaded collection with its targets."""
-    images, beliefs, fields = [], [], []
-    n, views, height, width = data["images"].shape[:4]
-    h, w = height // STRIDE, width // STRIDE
+def examples(data: dict[str, np.ndarray]) -> Examples:
+    """Every (sample, view) of a loaded collection."""
+    images, keypoints, types = [], [], []
+    n, views = data["images"].shape[:2]
     for i in range(n):
         for v in range(views):
             seen = (data["types"][i] >= 0) & (data["visible"][i, v] >= MIN_VISIBLE)
-            b, f = targets(data["keypoints"][i, v][seen], data["types"][i][seen], types_count, h, w)
             images.append(torch.from_numpy(data["images"][i, v]).permute(2, 0, 1))
-            beliefs.append(torch.from_numpy(b).half())
-            fields.append(torch.from_numpy(f).half())
-    return Examples(torch.stack(images), torch.stack(beliefs), torch.stack(fields))
+            keypoints.append(data["keypoints"][i, v][seen])
+            types.append(data["types"][i][seen].astype(np.int64))
+    return Examples(torch.stack(images), keypoints, types)
 
 
 def loss_of(outputs, beliefs: torch.Tensor, fields: torch.Tensor) -> torch.Tensor:
@@ -101,7 +109,7 @@ def train_perception(
     if training.finished(out):
         return
     net_config = config.net_config()
-    found = examples(data, net_config.types)
+    found = examples(data)
     if len(found.images) == 0:
         raise InvalidInputError(f"no images in '{folder}'")
     torch.set_num_threads(config.threads)
@@ -115,9 +123,10 @@ def train_perception(
         random.Random(f"{config.seed}-{epoch}").shuffle(order)
         total = 0.0
         for i in range(0, len(order), config.batch_size):
-            take = torch.tensor(order[i : i + config.batch_size])
-            image = found.images[take].float() / 255.0
-            loss = loss_of(model(image), found.beliefs[take].float(), found.fields[take].float())
+            take = order[i : i + config.batch_size]
+            image = found.images[torch.tensor(take)].float() / 255.0
+            beliefs, fields = found.targets(take, net_config.types)
+            loss = loss_of(model(image), beliefs, fields)
             optim.zero_grad()
             loss.backward()
             optim.step()
