@@ -42,6 +42,7 @@ class PerceptionTrainConfig:
     stages: int = setting(2, lo=1, hi=6)
     save_every: int = setting(1, lo=1, hi=10_000)
     threads: int = setting(2, lo=1, hi=MAX_WORKERS)
+    positive_weight: float = setting(0.0, lo=0, hi=10_000)  # see `loss_of`; 0 is DOPE's loss
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -87,10 +88,15 @@ def examples(data: dict[str, np.ndarray]) -> Examples:
     return Examples(torch.stack(images), keypoints, types)
 
 
-def loss_of(outputs, beliefs: torch.Tensor, fields: torch.Tensor) -> torch.Tensor:
-    """DOPE's loss: every stage's maps against the targets, mean squared error, summed."""
+def loss_of(
+    outputs, beliefs: torch.Tensor, fields: torch.Tensor, positive_weight: float = 0.0
+) -> torch.Tensor:
+    """DOPE's loss: every stage's maps against the targets, mean squared error, summed. With
+    `positive_weight` w, a belief cell's error weighs 1 + w x its target: the maps are almost
+    all zeros, and unweighted the network first learns to predict nothing anywhere."""
+    weight = 1.0 + positive_weight * beliefs
     return sum(
-        torch.nn.functional.mse_loss(b, beliefs) + torch.nn.functional.mse_loss(f, fields)
+        (weight * (b - beliefs) ** 2).mean() + torch.nn.functional.mse_loss(f, fields)
         for b, f in outputs
     )
 
@@ -126,7 +132,7 @@ def train_perception(
             take = order[i : i + config.batch_size]
             image = found.images[torch.tensor(take)].float() / 255.0
             beliefs, fields = found.targets(take, net_config.types)
-            loss = loss_of(model(image), beliefs, fields)
+            loss = loss_of(model(image), beliefs, fields, config.positive_weight)
             optim.zero_grad()
             loss.backward()
             optim.step()

@@ -38,3 +38,17 @@ def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_pat
             PerceptionTrainConfig(images=str(images), epochs=2, width=4, stages=1),
             tmp_path / "net",
         )
+
+
+def test_positive_weight_makes_a_missed_keypoint_cost_more_than_a_false_one():
+    from hsgplan.perception.train import loss_of
+
+    target = torch.zeros(1, 1, 4, 4)
+    target[0, 0, 1, 1] = 1.0
+    fields = torch.zeros(1, 2, 4, 4)
+    missed = [(torch.zeros_like(target), fields)]
+    false = torch.zeros_like(target)
+    false[0, 0, 2, 2] = 1.0
+    spurious = [(false + target, fields)]  # the keypoint found, and one more where none is
+    assert loss_of(missed, target, fields) == loss_of(spurious, target, fields)
+    assert loss_of(missed, target, fields, 10.0) > loss_of(spurious, target, fields, 10.0)
