@@ -22,10 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgplan.data.motion_tasks import MotionTask, draw_task
-from hsgplan.domain.parameters import BINS, MotionPrimitive, PickParams, params_for
+from hsgplan.domain.parameters import BINS, MotionPrimitive, params_for
 from hsgplan.domain.predicates import Predicate
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
+from hsgplan.sim.motion_plans import can_pick
 from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.scene import Scene
@@ -130,7 +130,7 @@ def release(scene: Scene, staged: StagedTask) -> None:
 
 def pickable(scene: Scene, objects: list[str]) -> set[str]:
     """The objects a pick could take up from the scene as it is (dry runs; the hand empty)."""
-    return {o for o in objects if isinstance(plan_primitive(scene, PickParams(o)), MotionPlan)}
+    return {o for o in objects if can_pick(scene, o)}
 
 
 def _neighbours(task: MotionTask) -> list[str]:

@@ -54,13 +54,12 @@ def rotation_error(obj: str, truth: Pose, estimate: Pose) -> float:
     return math.degrees(math.acos(float(np.clip((best - 1) / 2, -1.0, 1.0))))
 
 
-def match(sample: ImageSample, detections: list[Detection]) -> dict[str, Detection]:
-    """Each object of the scene and the detection matched to it (type by type, nearest pair
-    first)."""
-    truth = {o: _pose(sample, i) for i, o in enumerate(sample.objects)}
+def match(truth: dict[str, Pose], detections: list[Detection]) -> dict[str, Detection]:
+    """Each object of the scene (its true pose) and the detection matched to it (type by
+    type, nearest pair first)."""
     pairs = sorted(
         (np.linalg.norm(np.subtract(d.pose.position, truth[o].position)), o, k)
-        for o in sample.objects
+        for o in truth
         for k, d in enumerate(detections)
         if d.type_name == type_of(o)
     )
@@ -74,8 +73,8 @@ def match(sample: ImageSample, detections: list[Detection]) -> dict[str, Detecti
 
 
 def score_scene(sample: ImageSample, detections: list[Detection]) -> SceneResult:
-    matched = match(sample, detections)
     truth = {o: _pose(sample, i) for i, o in enumerate(sample.objects)}
+    matched = match(truth, detections)
     names = [o for o in sample.objects if o in matched]
     translation = [
         100 * float(np.linalg.norm(np.subtract(matched[o].pose.position, truth[o].position)))

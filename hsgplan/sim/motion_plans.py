@@ -96,6 +96,11 @@ def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFa
         return PlanFailure(Status.INVALID, str(e))
 
 
+def can_pick(scene: Scene, obj: str) -> bool:
+    """Whether a pick could take `obj` up from the scene as it is (a dry run)."""
+    return isinstance(plan_primitive(scene, PickParams(obj)), MotionPlan)
+
+
 def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
     """IK for a pose and for the pose APPROACH above it, with a free straight segment between.
 

@@ -15,13 +15,13 @@ import random
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import EntityKind, kind_of, object_type
-from hsgplan.domain.parameters import PickParams, place_inset
+from hsgplan.domain.parameters import place_inset
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import Kind, spot_cells, surface_rect
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
+from hsgplan.sim.motion_plans import can_pick
 from hsgplan.sim.scene import Scene
 from hsgplan.symbolic.generator import random_state
 
@@ -151,7 +151,7 @@ def _graspable(scene: Scene, state: SymbolicSceneGraph, obj: str) -> bool:
     saved = {o: scene.pose(o) for o in above}
     for i, o in enumerate(above):  # lifted off kinematically, put back exactly below
         scene.set_pose(o, Pose.from_xyz_yaw(-0.8, 0.6 - 0.2 * i, 0.5))
-    ok = isinstance(plan_primitive(scene, PickParams(obj)), MotionPlan)
+    ok = can_pick(scene, obj)
     for o, pose in saved.items():
         scene.set_pose(o, pose)
     return ok
