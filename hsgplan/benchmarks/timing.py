@@ -100,7 +100,7 @@ def check_timing_folder(
         "use another --out"
     )
     check_claim(out, TIMING_KIND, table, refusal)
-    check_runs(config, out, agents)
+    check_runs(config, out, {name: (agent, "gt") for name, agent in agents.items()})
     return table, refusal
 
 

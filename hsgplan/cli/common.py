@@ -187,3 +187,10 @@ def print_table(title: str, header: tuple[str, ...], rows: list[tuple[str, ...]]
     for row in rows:
         table.add_row(*row)
     out.print(table)
+
+
+# f_p's checkpoint, where a command can see with it (--perception rgb)
+PerceptionCheckpoint = Annotated[
+    Path | None,
+    typer.Option(help="f_p's checkpoint (default: the shipped one).", parser=input_path),
+]

@@ -48,11 +48,16 @@ def train_perception(
     cfg = PerceptionTrainConfig.from_json(settings)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("keypoint network", total=cfg.epochs)
+        batches = progress.add_task("epoch", total=None)
 
         def on_epoch(epoch: int, loss: float) -> None:
             progress.update(bar, completed=epoch, description=f"keypoint network loss {loss:.4f}")
+            err.print(f"epoch {epoch}: loss {loss:.4f}", highlight=False)
 
-        run(cfg, out_dir, on_epoch)
+        def on_batch(done: int, total: int) -> None:
+            progress.update(batches, completed=done, total=total)
+
+        run(cfg, out_dir, on_epoch, on_batch)
     out.print(f"trained the keypoint network into {shown(out_dir)}")
 
 

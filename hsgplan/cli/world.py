@@ -13,6 +13,7 @@ from hsgplan.agents.registry import AGENTS, WHOLE_AGENTS, agent_name, agent_part
 from hsgplan.cli.common import (
     AgentName,
     MotionName,
+    PerceptionCheckpoint,
     PlannerName,
     RayAddress,
     RunFolder,
@@ -61,15 +62,25 @@ def demo(
     out_dir: Annotated[
         Path, typer.Option("--out", help="Folder for the pictures.", parser=out_folder)
     ] = RUNS / "demo",
+    perception: Annotated[
+        str,
+        typer.Option(
+            help="What the agent sees with: gt (the simulator's poses) or rgb (f_p on the "
+            "fixed cameras' images; its estimate drawn on the views as cuboids)."
+        ),
+    ] = "gt",
+    perception_checkpoint: PerceptionCheckpoint = None,
 ) -> None:
     """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.domain.goals import parse_goal
     from hsgplan.evaluation.demo import demo_goal, run_demo
+    from hsgplan.evaluation.observers import make_observer
     from hsgplan.symbolic.generator import check_size
 
     agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
     make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
+    observer = make_observer(perception, perception_checkpoint and shipped(perception_checkpoint))
     if goal is None:
         check_size(objects)
     g = parse_goal(goal) if goal else demo_goal(objects, seed)
@@ -79,7 +90,7 @@ def demo(
         highlight=False,
         soft_wrap=True,
     )
-    record = run_demo(agent, g, seed, out_dir, on_step=_print_step)
+    record = run_demo(agent, g, seed, out_dir, on_step=_print_step, observer=observer)
     verdict = "[green]success[/]" if record.success else f"[red]failed: {shown(record.failure)}[/]"
     out.print(
         f"{verdict} in {len(record.steps)} steps ({record.seconds:.0f} s with the pictures); "
@@ -135,6 +146,14 @@ def evaluate(
             parser=input_path,
         ),
     ] = None,
+    perception: Annotated[
+        str,
+        typer.Option(
+            help="What the agent sees with, comma-separated: gt (the simulator's poses), rgb "
+            "(f_p on the fixed cameras' images); one column each, rgb's named METHOD-rgb."
+        ),
+    ] = "gt",
+    perception_checkpoint: PerceptionCheckpoint = None,
     workers: Annotated[
         int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
     ] = 2,
@@ -147,6 +166,7 @@ def evaluate(
     Table 1, with the failure taxonomy and the time per level; writes table1.md, table1.png
     and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
+    from hsgplan.evaluation.observers import make_observer
     from hsgplan.evaluation.protocol import EvalConfig, checkpoints, episode_specs
     from hsgplan.evaluation.table1 import Method, check_table, run_table, tables
 
@@ -165,6 +185,14 @@ def evaluate(
         methods = [
             Method(m if paper_planner else a, a) for m, a in zip(motions, agents, strict=True)
         ]
+    seeing = [p.strip() for p in perception.split(",")]
+    if len(set(seeing)) != len(seeing) or "" in seeing:
+        raise InvalidInputError(f"--perception '{perception}': name each observer once")
+    methods = [
+        Method(m.name if p == "gt" else f"{m.name}-{p}", m.agent, p)
+        for m in methods
+        for p in seeing
+    ]
     config = EvalConfig(
         "",
         tuple(parse_sizes(sizes)),
@@ -174,7 +202,10 @@ def evaluate(
         repeats,
         checkpoint and str(shipped(checkpoint)),
         motion_checkpoints and str(shipped(motion_checkpoints)),
+        perception_checkpoint=perception_checkpoint and str(shipped(perception_checkpoint)),
     )
+    for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
+        make_observer(p, config.perception_checkpoint)
     total = len(episode_specs(config)) * len(methods)
     folder = run_dir or RUNS / _run_name(methods, config)
     check_ray(ray)
@@ -197,7 +228,9 @@ def evaluate(
 def _run_name(methods, config) -> str:
     source = Path(config.goals_file).stem if config.goals_file else f"g{config.goals}"
     sizes = "-".join(map(str, config.sizes))
-    agents = "_".join(m.agent for m in methods)
+    agents = "_".join(
+        m.agent + ("" if m.perception == "gt" else f"-{m.perception}") for m in methods
+    )
     return f"eval-{agents}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}"
 
 

@@ -19,6 +19,7 @@ from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord, params_text, run_episode
 from hsgplan.runner.engines import one_core
 from hsgplan.sim.env import KitchenStorageEnv
+from hsgplan.sim.observer import SceneObserver
 from hsgplan.sim.render import DEMO_VIEWS
 from hsgplan.symbolic.generator import random_goal
 from hsgplan.viz.frames import compose
@@ -40,6 +41,7 @@ def run_demo(
     on_step: Callable[[StepRecord], None] | None = None,
     scale: float = 1.0,
     frame_every: int = FRAME_EVERY,
+    observer: SceneObserver | None = None,
 ) -> EpisodeRecord:
     """Run the episode and write its pictures and record into `out`; `on_step` sees every
     step as soon as it has been executed.
@@ -48,12 +50,16 @@ def run_demo(
         agent: a registered agent's name (its shipped checkpoints), or the agent itself.
         scale: the GIF's frames at this fraction of their size (a report keeps them small).
         frame_every: arm waypoints between two frames.
+        observer: what the agent sees with (default: the ground truth). Another observer's
+            estimate, as of its last observation, is drawn on the views as cuboids.
     """
     one_core()  # beside other busy processes, two threads make each planner call 20x slower
     out.mkdir(parents=True, exist_ok=True)
     graphs = out / "graphs"
     graphs.mkdir(exist_ok=True)
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(observer=observer)
+    seeing = observer is not None and observer.name != "gt"
+    believed: dict = {}
     frames = []
     waypoints = 0
     caption = ["start", "", f"goal: {goal}"]
@@ -65,6 +71,10 @@ def run_demo(
 
     def snapshot():
         views = [env.render(camera) for camera in cameras]
+        if seeing:
+            from hsgplan.perception.draw import draw_cuboids
+
+            views = [draw_cuboids(v, c, believed) for v, c in zip(views, cameras, strict=True)]
         return compose(views, [name for name, _ in DEMO_VIEWS], caption, scale)
 
     def on_frame() -> None:
@@ -81,6 +91,9 @@ def run_demo(
         ]
 
     def on_step_done(record, obs) -> None:
+        believed.clear()
+        held = obs.scene_graph.held
+        believed.update({n.name: n.pose for n in obs.scene_graph.nodes if n.name != held})
         if record is not None:
             caption[0] += f"  ->  {record.status}"
         if goal.satisfied_by(obs.symbols.state):

@@ -1,5 +1,11 @@
 """One closed-loop episode: observe, decide, execute, until the goal holds or it cannot go on.
 
+The agent acts on what the env's observer makes of the scene, and stops when the goal holds
+there; the episode is judged on the truth (the simulator's poses): a goal the agent believes
+reached that does not truly hold is a failure (`MISPERCEIVED`), and a toppled or fallen object
+ends the episode whether the observer saw it or not. With the ground truth as observer the two
+are one.
+
 Every episode records its seed; the same seed, goal and agent give the same record (timings
 aside).
 """
@@ -48,6 +54,9 @@ class EpisodeRecord:
     # or no parameters): time spent like any other, that no step records.
     unexecuted_task_seconds: float = 0.0
     unexecuted_motion_seconds: float = 0.0
+    observer: str = "gt"
+    # Over every observation, objects the observer did not see (their poses carried over).
+    unseen_objects: int = 0
 
     @property
     def task_seconds(self) -> float:
@@ -94,8 +103,9 @@ def run_episode(
     records: list[StepRecord] = []
     failure = None
     unexecuted = (0.0, 0.0)
+    unseen = len(obs.unseen)
     while not goal.satisfied_by(obs.symbols.state):
-        fatal = [a for a in obs.symbols.anomalies if a.kind in _FATAL]
+        fatal = [a for a in obs.true_symbols.anomalies if a.kind in _FATAL]
         if fatal:
             failure = _FATAL[fatal[0].kind]
             break
@@ -111,6 +121,7 @@ def run_episode(
             on_decide(len(records) + 1, d)
         _, _, _, _, info = env.step(d.params, on_frame)
         obs = info["observation"]
+        unseen += len(obs.unseen)
         outcome = info["outcome"]
         agent.observe(d.params, outcome)
         record = StepRecord(
@@ -127,7 +138,9 @@ def run_episode(
         records.append(record)
         if on_step:
             on_step(record, obs)
-    state = obs.symbols.state
+    state = obs.true_symbols.state
+    if failure is None and not goal.satisfied_by(state):
+        failure = Failure.MISPERCEIVED
     done = sum(state.holds(lit) for lit in goal.literals)
     env.close()
     return EpisodeRecord(
@@ -142,4 +155,6 @@ def run_episode(
         time.perf_counter() - start,
         unexecuted_task_seconds=unexecuted[0],
         unexecuted_motion_seconds=unexecuted[1],
+        observer=env.observer.name,
+        unseen_objects=unseen,
     )

@@ -11,3 +11,4 @@ class Failure(StrEnum):
     NO_PARAMETERS = "no_parameters"  # every parameter choice for the next action had failed
     KNOCKED_OVER = "knocked_over"  # simulated world: an object toppled
     OFF_TABLE = "off_table"  # simulated world: an object fell off the table
+    MISPERCEIVED = "misperceived"  # the agent saw the goal reached where it truly was not

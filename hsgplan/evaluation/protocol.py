@@ -21,6 +21,7 @@ from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.evaluation.episode import EpisodeRecord
+from hsgplan.evaluation.observers import check_observer, make_observer, perception_folder
 from hsgplan.runner.items import run_items
 from hsgplan.runner.run_folder import CONFIG, add_wall_seconds, check_claim
 from hsgplan.symbolic.generator import random_goals
@@ -36,6 +37,11 @@ class EvalConfig:
     repeats: int = 1
     checkpoint: str | None = None  # the task planner's folder (None: the shipped one)
     motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
+    perception: str = "gt"  # what the agent sees: "gt" (the simulator's poses) or "rgb" (f_p)
+    perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
+
+    def __post_init__(self) -> None:
+        check_observer(self.perception)
 
 
 @dataclass(frozen=True)
@@ -87,6 +93,11 @@ def _worker_agent(config: EvalConfig):
     return make_agent(config.agent, *checkpoints(config))
 
 
+@lru_cache(maxsize=2)
+def _worker_observer(config: EvalConfig):
+    return make_observer(config.perception, config.perception_checkpoint)
+
+
 EVAL_KIND = "eval"
 
 
@@ -98,8 +109,13 @@ def run_config(config: EvalConfig) -> dict:
     from hsgplan.checkpoint import fingerprint
 
     folders = agent_checkpoints(config.agent, *checkpoints(config))
+    settings = asdict(config)
+    if config.perception == "gt":  # as runs were claimed before f_p could see
+        del settings["perception"], settings["perception_checkpoint"]
+    else:
+        folders = [*folders, perception_folder(config.perception_checkpoint)]
     files = [Path(config.goals_file)] if config.goals_file else []
-    return asdict(config) | {
+    return settings | {
         "sizes": list(config.sizes),
         "fingerprint": fingerprint([*folders, *files]),
     }
@@ -118,16 +134,18 @@ def read_eval_config(run_dir: Path) -> EvalConfig:
         ) from None
 
 
-def check_runs(config: EvalConfig, out: Path, agents: dict[str, str]) -> None:
-    """Refuse, before anything is written, a folder `out/NAME` (one per agent) that is no
-    evaluation's or holds episodes of another configuration, checkpoint or goal file."""
-    for name, agent in agents.items():
+def check_runs(config: EvalConfig, out: Path, agents: dict[str, tuple[str, str]]) -> None:
+    """Refuse, before anything is written, a folder `out/NAME` (one per agent and perception)
+    that is no evaluation's or holds episodes of another configuration, checkpoint or goal
+    file."""
+    for name, (agent, perception) in agents.items():
         run_dir = out / name
         refusal = (
             f"'{run_dir}' holds episodes of another configuration, checkpoint or goal file; "
             "use another --out"
         )
-        check_claim(run_dir, EVAL_KIND, run_config(replace(config, agent=agent)), refusal)
+        run = run_config(replace(config, agent=agent, perception=perception))
+        check_claim(run_dir, EVAL_KIND, run, refusal)
 
 
 def checkpoints(config: EvalConfig) -> tuple[Path, Path]:
@@ -146,7 +164,8 @@ def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
     from hsgplan.sim.env import KitchenStorageEnv
 
     agent = _worker_agent(config)
-    record = run_episode(KitchenStorageEnv(), agent, parse_goal(spec.goal), spec.seed)
+    env = KitchenStorageEnv(observer=_worker_observer(config))
+    record = run_episode(env, agent, parse_goal(spec.goal), spec.seed)
     return replace(record, repeat=spec.repeat).to_json()
 
 

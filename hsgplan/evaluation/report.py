@@ -19,6 +19,7 @@ from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.episode import EpisodeRecord
+from hsgplan.evaluation.observers import make_observer
 from hsgplan.evaluation.protocol import checkpoints, read_eval_config
 from hsgplan.evaluation.summary import FAILED_EXECUTION, failure_class
 from hsgplan.evaluation.table1 import label, tables
@@ -122,6 +123,7 @@ def rollout(run_dir: Path, method: str, agent: str, record: EpisodeRecord) -> Ro
             partial,
             scale=GIF_SCALE,
             frame_every=FRAME_EVERY,
+            observer=make_observer(config.perception, config.perception_checkpoint),
         )
         partial.rename(folder)
     rerun = EpisodeRecord.from_json(json.loads(done.read_text()))

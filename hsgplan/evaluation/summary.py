@@ -21,6 +21,7 @@ from hsgplan.sim.outcome import Status
 
 EXECUTION = "execution"
 OVERSTEP = "overstep"
+PERCEPTION = "perception"  # the agent saw the goal reached where it truly was not
 # statuses of a primitive that failed in execution (an inapplicable one is the task level's)
 FAILED_EXECUTION = frozenset(s.value for s in Status) - {Status.SUCCESS, Status.INVALID}
 _ENDED_BY_EXECUTION = {Failure.KNOCKED_OVER, Failure.OFF_TABLE, Failure.NO_PARAMETERS}
@@ -30,6 +31,8 @@ def failure_class(record: EpisodeRecord) -> tuple[str, str] | None:
     """(class, kind) of a failed episode, None for a success."""
     if record.success:
         return None
+    if record.failure == Failure.MISPERCEIVED:
+        return PERCEPTION, str(record.failure)
     if record.failure in _ENDED_BY_EXECUTION:
         return EXECUTION, str(record.failure)
     failed = [s.status for s in record.steps if s.status in FAILED_EXECUTION]
@@ -61,7 +64,7 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "failures": dict(Counter(r.failure for r in rs if r.failure)),
         "failure_classes": {
             cls: dict(Counter(kind for c, kind in classes if c == cls))
-            for cls in (EXECUTION, OVERSTEP)
+            for cls in (EXECUTION, OVERSTEP, PERCEPTION)
         },
         "median_steps": statistics.median(len(r.steps) for r in rs),
         "median_seconds": statistics.median(r.seconds for r in rs),

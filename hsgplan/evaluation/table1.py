@@ -16,7 +16,7 @@ from pathlib import Path
 
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
-from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, summarize
+from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
 from hsgplan.runner.run_folder import check_claim, claim, read_timing
 
 # Table 1 of the paper (success rate, subgoal completion), by motion generator and size.
@@ -30,10 +30,12 @@ LABELS = {"gnn": "GNN", "mlp": "MLP", "random": "Random"}
 
 @dataclass(frozen=True)
 class Method:
-    """One column of the table: its name there and the agent that runs it."""
+    """One column of the table: its name there, the agent that runs it and what it sees with
+    (`EvalConfig.perception`)."""
 
     name: str
     agent: str
+    perception: str = "gt"
 
 
 TABLE_KIND = "eval-table"
@@ -46,12 +48,15 @@ def label(method: str) -> str:
 def check_table(methods: list[Method], config: EvalConfig, out: Path) -> tuple[dict, str]:
     """Every refusal of a table's run folders before anything is written (the table's own,
     then each method's); what the table folder is claimed with and its refusal."""
-    table = {k: v for k, v in asdict(config).items() if k != "agent"} | {
-        "sizes": list(config.sizes)
-    }
+    per_method = ("agent", "perception")
+    table = {
+        k: v
+        for k, v in asdict(config).items()
+        if k not in per_method and not (k == "perception_checkpoint" and v is None)
+    } | {"sizes": list(config.sizes)}
     refusal = f"'{out}' holds a table of another configuration or goal file; use another --out"
     check_claim(out, TABLE_KIND, table, refusal)
-    check_runs(config, out, {m.name: m.agent for m in methods})
+    check_runs(config, out, {m.name: (m.agent, m.perception) for m in methods})
     return table, refusal
 
 
@@ -70,11 +75,17 @@ def run_table(
     records = {}
     for m in methods:
         records[m.name] = run_evaluation(
-            replace(config, agent=m.agent), out / m.name, workers, on_episode, ray
+            replace(config, agent=m.agent, perception=m.perception),
+            out / m.name,
+            workers,
+            on_episode,
+            ray,
         )
     report = {
         "methods": {
-            m.name: {"agent": m.agent} | read_timing(out / m.name) | summarize(records[m.name])
+            m.name: {"agent": m.agent, "perception": m.perception}
+            | read_timing(out / m.name)
+            | summarize(records[m.name])
             for m in methods
         },
         "goals": config.goals,
@@ -178,6 +189,11 @@ def _results(report: dict) -> TextTable:
 
 
 def _failures(report: dict) -> TextTable:
+    seen = any(  # a column for what the observer got wrong, when one did
+        v["failure_classes"].get(PERCEPTION)
+        for s in report["methods"].values()
+        for v in s["by_size"].values()
+    )
     rows = []
     for m, s in report["methods"].items():
         for n in _sizes(report["methods"]):
@@ -187,6 +203,7 @@ def _failures(report: dict) -> TextTable:
                 rows.append(
                     (label(m), str(n), str(v["episodes"]), str(failed))
                     + (_kinds(fc[EXECUTION]), _kinds(fc[OVERSTEP]))
+                    + ((_kinds(fc.get(PERCEPTION, {})),) if seen else ())
                 )
     title = (
         "Failures: execution (a primitive failed; by the fatal anomaly or the last failed "
@@ -194,6 +211,7 @@ def _failures(report: dict) -> TextTable:
         "primitive having done what it was asked)"
     )
     header = ("method", "objects", "episodes", "failed", "execution", "overstep")
+    header += (PERCEPTION,) if seen else ()
     return TextTable(title, header, tuple(rows))
 
 

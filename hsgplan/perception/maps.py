@@ -5,8 +5,8 @@ Maps live on the network's output grid, `STRIDE` input pixels per cell; cell (i,
 input pixels [STRIDE j, STRIDE (j + 1)) across and its centre is at STRIDE j + (STRIDE - 1) / 2
 in OpenCV's pixel coordinates. A belief map holds, per (type, keypoint), a Gaussian of
 `SIGMA` cells around every instance's keypoint (the maximum where two meet). An affinity field
-holds, per (type, corner), within `FIELD_RADIUS` cells of every instance's corner, the vector
-from there to the instance's centroid, in cells.
+holds, per corner (whatever the type), within `FIELD_RADIUS` cells of every instance's corner, the
+vector from there to the instance's centroid, in cells; elsewhere zero, and not trained.
 """
 
 from __future__ import annotations
@@ -62,10 +62,10 @@ def targets(
         height, width: the output grid.
 
     Returns:
-        beliefs [types * 9, height, width] and fields [types * 8 * 2, height, width], float32.
+        beliefs [types * 9, height, width] and fields [8 * 2, height, width], float32.
     """
     beliefs = np.zeros((types_count * KEYPOINTS, height, width), dtype=np.float32)
-    fields = np.zeros((types_count * CORNERS * 2, height, width), dtype=np.float32)
+    fields = np.zeros((CORNERS * 2, height, width), dtype=np.float32)
     ys, xs = np.mgrid[0:height, 0:width].astype(np.float32)
     for points, t in zip(keypoints, types, strict=True):
         cells = to_cells(points)
@@ -76,7 +76,7 @@ def targets(
             np.maximum(channel, np.exp(-d2 / (2 * SIGMA**2)), out=channel)
             if k < CORNERS:
                 near = d2 <= FIELD_RADIUS**2
-                base = (t * CORNERS + k) * 2
+                base = k * 2
                 fields[base][near] = centroid[0] - xs[near]
                 fields[base + 1][near] = centroid[1] - ys[near]
     return beliefs, fields
@@ -127,7 +127,7 @@ def decode(beliefs: np.ndarray, fields: np.ndarray, max_distance: float = 3.0) -
     peak whose affinity vector points closest to that centroid (within `max_distance` cells).
 
     Args:
-        beliefs: [types * 9, H, W]; fields: [types * 8 * 2, H, W].
+        beliefs: [types * 9, H, W]; fields: [8 * 2, H, W].
     """
     found = []
     for t in range(beliefs.shape[0] // KEYPOINTS):
@@ -139,7 +139,7 @@ def decode(beliefs: np.ndarray, fields: np.ndarray, max_distance: float = 3.0) -
         for i, (x, y, _) in enumerate(centroids):
             cells[i, CENTROID] = (x, y)
         for k in range(CORNERS):
-            base = (t * CORNERS + k) * 2
+            base = k * 2
             for x, y, _ in peaks(beliefs[t * KEYPOINTS + k]):
                 iy, ix = int(round(y)), int(round(x))
                 target = np.array([x + fields[base, iy, ix], y + fields[base + 1, iy, ix]])

@@ -3,8 +3,9 @@ affinity fields that tie each corner to its object's centroid.
 
 DOPE (Tremblay et al. 2018) trains one VGG-based network per object; here one small network,
 trained from scratch on the synthetic images, serves every type: its output has a belief map
-per (type, keypoint) and, per (type, corner), a 2-vector field pointing from the corner to the
-centroid, at a quarter of the image's resolution. Several stages refine the maps, each seeing
+per (type, keypoint) and, per corner, a 2-vector field pointing from the corner to the
+centroid (shared by the types: which type a corner belongs to is its belief map's business), at a
+quarter of the image's resolution. Several stages refine the maps, each seeing
 the features and the previous stage's maps, as in DOPE and the convolutional pose machines it
 follows; every stage is supervised.
 """
@@ -46,7 +47,7 @@ class PerceptionNetConfig:
 
     @property
     def fields(self) -> int:
-        return self.types * CORNERS * 2
+        return CORNERS * 2
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -76,7 +77,7 @@ class KeypointNet(nn.Module):
     Shapes:
         input: [B, 3, H, W] float in 0..1, H and W multiples of `STRIDE * 2`.
         output: a list over stages of (beliefs [B, types * 9, H / 4, W / 4] in 0..1,
-            fields [B, types * 8 * 2, H / 4, W / 4] in metres-free pixel units / 4).
+            fields [B, 8 * 2, H / 4, W / 4], corner-to-centroid vectors in output cells).
     """
 
     def __init__(self, config: PerceptionNetConfig) -> None:

@@ -3,8 +3,9 @@
 Actions are parametrised primitives: the `Dict` of `Discrete`s in `gym_spaces`, or the typed
 `PickParams`, `PlaceParams`, `PushParams` the agents use. Observations are numeric for
 Gymnasium; the typed one (the geometric scene graph, its symbols and, when rendering is on, an
-RGB image from the fixed camera) is in `info["observation"]`. The reward is 1 on the step where
-the goal holds.
+RGB image from the fixed camera) is in `info["observation"]`: what the env's observer
+(`sim.observer`, the ground truth by default) makes of the scene, with the true symbols beside
+it to judge by. The reward is 1 on the step where the goal truly holds.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
 from hsgplan.sim.gym_spaces import action_space, decode, encode, observation_space
 from hsgplan.sim.lookahead import Lookahead
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
+from hsgplan.sim.observer import GroundTruth, SceneObserver
 from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.render import Camera
@@ -36,9 +38,19 @@ ENV_ID = "hsgplan/KitchenStorage-v0"
 
 @dataclass(frozen=True)
 class Observation:
+    """What the agent gets (`scene_graph`, `symbols`: the observer's), and the truth.
+
+    Attributes:
+        true_symbols: f_m of the simulator's poses; the same object as `symbols` when the
+            observer is the ground truth.
+        unseen: objects the observer did not see this time (their poses carried over).
+    """
+
     scene_graph: GeometricSceneGraph
     symbols: SymbolMapping
     rgb: np.ndarray | None
+    true_symbols: SymbolMapping
+    unseen: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -62,6 +74,7 @@ class KitchenStorageEnv(gymnasium.Env):
         max_steps: after this many primitives an episode is truncated.
         objects: the size of the random goal drawn when `reset` is given none.
         render_mode: "rgb_array" (what `render()` returns) or None.
+        observer: what the agent sees of the scene (default: the ground truth).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
@@ -73,6 +86,7 @@ class KitchenStorageEnv(gymnasium.Env):
         max_steps: int = MAX_STEPS,
         objects: int = 3,
         render_mode: str | None = None,
+        observer: SceneObserver | None = None,
     ):
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
@@ -84,6 +98,7 @@ class KitchenStorageEnv(gymnasium.Env):
         self.camera = camera or Camera()
         self.max_steps = max_steps
         self.objects = objects
+        self.observer = observer or GroundTruth()
         self.scene: Scene | None = None
         self.goal: Goal | None = None
         self.steps = 0
@@ -106,6 +121,7 @@ class KitchenStorageEnv(gymnasium.Env):
         self.scene, _ = sample_scene(options.goal.objects, scene_seed, options.p_elsewhere)
         self.steps = 0
         self._checked.clear()
+        self.observer.reset(self.scene)
         typed = self._observe()
         return self._encode(typed), {"seed": scene_seed, "observation": typed}
 
@@ -127,7 +143,7 @@ class KitchenStorageEnv(gymnasium.Env):
         self._checked.clear()
         self.steps += 1
         typed = self._observe()
-        done = self.goal.satisfied_by(typed.symbols.state)
+        done = self.goal.satisfied_by(typed.true_symbols.state)
         truncated = not done and self.steps >= self.max_steps
         info = {"outcome": outcome, "observation": typed}
         return self._encode(typed), float(done), done, truncated, info
@@ -154,8 +170,12 @@ class KitchenStorageEnv(gymnasium.Env):
             self.scene = None
 
     def _observe(self) -> Observation:
-        sg = self.scene.scene_graph()
-        return Observation(sg, map_symbols(sg), self.render() if self.render_images else None)
+        seen = self.observer.observe(self.scene)
+        rgb = self.render() if self.render_images else None
+        symbols = map_symbols(seen.scene_graph)
+        truth = self.scene.scene_graph()
+        true_symbols = symbols if truth == seen.scene_graph else map_symbols(truth)
+        return Observation(seen.scene_graph, symbols, rgb, true_symbols, seen.unseen)
 
     def _encode(self, typed: Observation) -> dict:
         return encode(self.goal.objects, typed.scene_graph, typed.symbols.state)

@@ -12,7 +12,7 @@ import pytest
 
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord
 from hsgplan.evaluation.protocol import EvalConfig, episode_specs
-from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, failure_class, summarize
+from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, failure_class, summarize
 from hsgplan.evaluation.table1 import PAPER_TABLE1, markdown
 
 
@@ -55,6 +55,8 @@ def test_failures_are_classed_as_the_paper_classes_them():
         "step limit",
     )
     assert failure_class(_record(False, "no_subgoal", ("success",))) == (OVERSTEP, "no_subgoal")
+    seen_done = _record(False, "misperceived", ("success",))
+    assert failure_class(seen_done) == (PERCEPTION, "misperceived")
 
 
 def test_summary_spreads_success_over_repeats_and_counts_failure_classes():
@@ -67,7 +69,7 @@ def test_summary_spreads_success_over_repeats_and_counts_failure_classes():
     entry = summarize(records)["by_size"]["2"]
     assert entry["success_rate"] == 0.75 and entry["episodes"] == 4 and entry["repeats"] == 2
     assert entry["success_std"] == pytest.approx(0.25)  # repeat means 1.0 and 0.5
-    assert entry["failure_classes"] == {EXECUTION: {"no_ik": 1}, OVERSTEP: {}}
+    assert entry["failure_classes"] == {EXECUTION: {"no_ik": 1}, OVERSTEP: {}, PERCEPTION: {}}
     assert entry["median_task_seconds"] == pytest.approx(0.01)
     assert entry["median_motion_seconds"] == pytest.approx(0.502)
     assert summarize([_record(True)])["by_size"]["2"]["success_std"] is None

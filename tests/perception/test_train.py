@@ -40,15 +40,36 @@ def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_pat
         )
 
 
-def test_positive_weight_makes_a_missed_keypoint_cost_more_than_a_false_one():
-    from hsgplan.perception.train import loss_of
-
+def _one_keypoint():
     target = torch.zeros(1, 1, 4, 4)
     target[0, 0, 1, 1] = 1.0
-    fields = torch.zeros(1, 2, 4, 4)
+    target[0, 0, 1, 2] = 0.5
+    return target, torch.zeros(1, 2, 4, 4)
+
+
+def test_the_belief_loss_is_least_at_the_target_and_positive_weight_makes_a_miss_cost_more():
+    from hsgplan.perception.train import loss_of
+
+    target, fields = _one_keypoint()
+    exact = loss_of([(target, fields)], target, fields, 20.0)
+    for wrong in (torch.zeros_like(target), target.roll(1, dims=3), target * 0.8):
+        assert loss_of([(wrong, fields)], target, fields, 20.0) > exact
     missed = [(torch.zeros_like(target), fields)]
-    false = torch.zeros_like(target)
-    false[0, 0, 2, 2] = 1.0
-    spurious = [(false + target, fields)]  # the keypoint found, and one more where none is
-    assert loss_of(missed, target, fields) == loss_of(spurious, target, fields)
-    assert loss_of(missed, target, fields, 10.0) > loss_of(spurious, target, fields, 10.0)
+    false = target.clone()
+    false[0, 0, 3, 3] = 1.0  # the keypoint found, and one more where none is
+    spurious = [(false, fields)]
+    assert loss_of(missed, target, fields, 20.0) > loss_of(spurious, target, fields, 20.0)
+
+
+def test_fields_are_trained_only_near_a_corner():
+    from hsgplan.perception.train import loss_of
+
+    target, fields = _one_keypoint()
+    fields[0, :, 1, 1] = torch.tensor([2.0, -1.0])
+    right = fields.clone()
+    right[0, :, 3, 3] = 5.0  # anything, far from every corner
+    wrong = fields.clone()
+    wrong[0, 0, 1, 1] = 0.0
+    base = loss_of([(target, fields)], target, fields)
+    assert loss_of([(target, right)], target, fields) == base
+    assert loss_of([(target, wrong)], target, fields) > base

@@ -1,0 +1,115 @@
+"""f_p behind the observer interface: naming detections after the objects they are (tracks by
+type and last pose), and the whole loop run on what a camera observer makes of the scene. The
+network is replaced by one that outputs the scene's true maps, so that the loop's plumbing,
+decoding, PnP and fusion are checked without a trained checkpoint."""
+
+import numpy as np
+import torch
+
+from hsgplan.agents.registry import make_agent
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.objects import type_of
+from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.evaluation.episode import run_episode
+from hsgplan.evaluation.failures import Failure
+from hsgplan.perception.estimator import Detection, PoseEstimator
+from hsgplan.perception.keypoints import PinholeCamera, in_world
+from hsgplan.perception.maps import targets
+from hsgplan.perception.model import STRIDE
+from hsgplan.perception.observer import RgbObserver, assign
+from hsgplan.perception.synthetic import VIEWS
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.env import KitchenStorageEnv
+from hsgplan.sim.observer import Seen
+
+TYPES = list(OBJECT_TYPES)
+
+
+def _at(type_name: str, x: float, y: float, score: float = 0.9) -> Detection:
+    return Detection(type_name, Pose.from_xyz_yaw(x, y, 0.05), score, 2, 1.0)
+
+
+def test_a_lone_object_takes_its_types_strongest_detection_wherever_it_is():
+    last = {"butter": Pose.from_xyz_yaw(0.5, 0.0, 0.05)}
+    found = assign([_at("butter", 0.2, 0.3, 0.5), _at("butter", 0.9, -0.3, 0.8)], last)
+    assert found["butter"].position[:2] == (0.9, -0.3)
+
+
+def test_duplicates_keep_their_names_and_one_put_down_elsewhere_is_found_by_elimination():
+    last = {
+        "cherries": Pose.from_xyz_yaw(0.5, 0.0, 0.05),
+        "cherries_2": Pose.from_xyz_yaw(0.5, 0.2, 0.05),
+        "cherries_3": Pose.from_xyz_yaw(0.3, -0.2, 0.05),
+    }
+    detections = [_at("cherries", 0.51, 0.2), _at("cherries", 0.49, 0.0), _at("cherries", 0.9, 0.6)]
+    found = assign(detections, last)
+    assert found["cherries"].position[:2] == (0.49, 0.0)
+    assert found["cherries_2"].position[:2] == (0.51, 0.2)
+    assert found["cherries_3"].position[:2] == (0.9, 0.6)  # moved far: the one left over
+    # a false detection among them: only near ones count, and the moved one is left unseen
+    found = assign([*detections[:2], _at("cherries", 0.3, 0.5), _at("cherries", 0.95, 0.6)], last)
+    assert set(found) == {"cherries", "cherries_2"}
+
+
+class _SceneMaps(torch.nn.Module):
+    """Outputs the true maps of the scene it is given (every object, hidden or not)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.scene = None
+
+    def forward(self, images):
+        poses = self.scene.poses()
+        kinds = np.array([TYPES.index(type_of(o)) for o in poses])
+        height, width = images.shape[2] // STRIDE, images.shape[3] // STRIDE
+        maps = []
+        for camera in VIEWS:
+            pinhole = PinholeCamera.of(camera)
+            points = np.stack([pinhole.project(in_world(o, p)) for o, p in poses.items()])
+            maps.append(targets(points, kinds, len(TYPES), height, width))
+        return [
+            (
+                torch.from_numpy(np.stack([b for b, _ in maps])),
+                torch.from_numpy(np.stack([f for _, f in maps])),
+            )
+        ]
+
+
+class _Watching(RgbObserver):
+    def observe(self, scene) -> Seen:
+        self.estimator.net.scene = scene
+        return super().observe(scene)
+
+
+def test_the_loop_runs_on_what_the_cameras_make_of_the_scene_and_is_judged_on_the_truth():
+    observer = _Watching(PoseEstimator(_SceneMaps()))
+    env = KitchenStorageEnv(observer=observer)
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, butter)")
+    record = run_episode(env, make_agent("oracle"), goal, seed=4)
+    assert record.observer == "rgb"
+    assert record.success and record.failure is None, record.steps
+    assert record.unseen_objects == 0
+
+
+def test_a_goal_only_seen_reached_is_a_failure_of_perception():
+    class Fooled:  # sees the cherries on the butter, wherever they are
+        name = "fooled"
+
+        def reset(self, scene) -> None:
+            pass
+
+        def observe(self, scene) -> Seen:
+            sg = scene.scene_graph()
+            butter, cherries = sg.node("butter"), sg.node("cherries")
+            lift = cherries.pose.position[2] - cherries.bottom_z
+            x, y, _ = butter.pose.position
+            poses = {n.name: n.pose for n in sg.nodes}
+            poses["cherries"] = Pose((x, y, butter.top_z + lift), cherries.pose.orientation)
+            return Seen(GeometricSceneGraph.from_poses(poses, held=sg.held))
+
+    env = KitchenStorageEnv(observer=Fooled())
+    record = run_episode(env, make_agent("oracle"), parse_goal("On(cherries, butter)"), seed=4)
+    assert record.observer == "fooled" and record.steps == ()
+    assert not record.success and record.failure == Failure.MISPERCEIVED
+    assert record.subgoal_completion == 0.0
