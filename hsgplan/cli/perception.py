@@ -70,6 +70,9 @@ def eval_perception(
     seed: Annotated[
         int, typer.Option(help="Seed of the scenes (training's is 0).", min=0, max=MAX_SEED)
     ] = 1,
+    raw: Annotated[
+        bool, typer.Option(help="The fused PnP poses, not made to rest on their supports.")
+    ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
     markdown: Annotated[bool, typer.Option(help="Print Markdown tables.")] = False,
 ) -> None:
@@ -77,10 +80,10 @@ def eval_perception(
     from hsgplan.perception.estimator import PoseEstimator
     from hsgplan.perception.evaluate import evaluate, summary
 
-    estimator = PoseEstimator.load(checkpoint)
+    estimator = PoseEstimator.load(checkpoint, settled=not raw)
     with Progress(console=err, transient=True) as progress:
-        progress.add_task("scenes", total=None)
-        report = summary(evaluate(estimator, scenes, seed))
+        task = progress.add_task("scenes", total=scenes)
+        report = summary(evaluate(estimator, scenes, seed, lambda: progress.advance(task)))
     if as_json:
         print(json.dumps(report, indent=2))
         return

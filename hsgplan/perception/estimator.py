@@ -4,12 +4,13 @@ Each view's image goes through the network; its last stage's maps are decoded in
 (`perception.maps.decode`), and each instance seen with enough keypoints gets a pose by PnP.
 Estimates of one type from different views that lie within `FUSE_DISTANCE` of one another are
 one object: its pose is refitted to the keypoints of every view that saw it
-(`perception.pnp.estimate_pose`), as the paper fuses its robot's viewpoints.
+(`perception.pnp.estimate_pose`), as the paper fuses its robot's viewpoints. Last, the poses are
+made to rest on what is under them (`perception.settle`), unless asked for raw.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,7 @@ from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
 from hsgplan.perception.pnp import ViewKeypoints, estimate_pose
+from hsgplan.perception.settle import settle
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 
@@ -41,14 +43,16 @@ class Detection:
 class PoseEstimator:
     """Args:
     net: a trained keypoint network (eval mode).
+    settled: make the fused poses rest on their supports (`perception.settle`).
     """
 
-    def __init__(self, net: KeypointNet) -> None:
+    def __init__(self, net: KeypointNet, settled: bool = True) -> None:
         self.net = net
+        self.settled = settled
 
     @staticmethod
-    def load(folder: Path) -> PoseEstimator:
-        return PoseEstimator(load_perception_net(folder)[0])
+    def load(folder: Path, settled: bool = True) -> PoseEstimator:
+        return PoseEstimator(load_perception_net(folder)[0], settled)
 
     @torch.inference_mode()
     def detect(self, images: np.ndarray, cameras: tuple[Camera, ...]) -> list[Detection]:
@@ -63,7 +67,11 @@ class PoseEstimator:
                 single = estimate_pose(TYPES[inst.type_index], [seen])
                 if single is not None:
                     found.append(_Seen(inst.type_index, inst.score, v, seen, single.pose))
-        return _fuse(found)
+        fused = _fuse(found)
+        if not self.settled:
+            return fused
+        poses = settle([d.type_name for d in fused], [d.pose for d in fused])
+        return [replace(d, pose=p) for d, p in zip(fused, poses, strict=True)]
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ poses, every object found, for the scene to count as a symbolic match.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,12 +96,20 @@ def score_scene(sample: ImageSample, detections: list[Detection]) -> SceneResult
     )
 
 
-def evaluate(estimator: PoseEstimator, scenes: int, seed: int) -> list[SceneResult]:
+def evaluate(
+    estimator: PoseEstimator,
+    scenes: int,
+    seed: int,
+    on_scene: Callable[[], None] | None = None,
+) -> list[SceneResult]:
+    """The scenes `(seed, 0 .. scenes - 1)` that could be staged, each scored."""
     out = []
     for index in range(scenes):
         sample = render_sample(seed, index)
         if sample is not None:
             out.append(score_scene(sample, estimator.detect(sample.images, sample.cameras)))
+        if on_scene:
+            on_scene()
     return out
 
 
