@@ -113,3 +113,15 @@ def test_a_goal_only_seen_reached_is_a_failure_of_perception():
     assert record.observer == "fooled" and record.steps == ()
     assert not record.success and record.failure == Failure.MISPERCEIVED
     assert record.subgoal_completion == 0.0
+
+
+def test_the_estimate_is_drawn_where_the_camera_sees_it():
+    from hsgplan.perception.draw import COLOR, draw_cuboids
+
+    camera = VIEWS[0]
+    image = np.zeros((camera.height, camera.width, 3), dtype=np.uint8)
+    pose = Pose.from_xyz_yaw(0.5, 0.0, 0.05, 0.3)
+    drawn = draw_cuboids(image, camera, {"popcorn": pose})
+    u, v = np.round(PinholeCamera.of(camera).project(in_world("popcorn", pose))[-1]).astype(int)
+    assert tuple(drawn[v, u]) == COLOR  # the centroid's dot
+    assert (drawn.any(axis=2)).sum() > 100 and not image.any()  # edges drawn, on a copy
