@@ -20,19 +20,13 @@ import numpy as np
 from hsgplan.domain.objects import object_type, type_of
 from hsgplan.domain.world import Kind
 from hsgplan.perception.estimator import Detection, PoseEstimator
+from hsgplan.perception.keypoints import BOX_SYMMETRIES
 from hsgplan.perception.synthetic import ImageSample, render_sample
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 
 MATCH_DISTANCE = 0.10  # m: a detection further than this from every object of its type matched none
-# A box's cuboid is unchanged by half turns about its axes.
-BOX_SYMMETRIES = (
-    np.eye(3),
-    np.diag([1.0, -1.0, -1.0]),
-    np.diag([-1.0, 1.0, -1.0]),
-    np.diag([-1.0, -1.0, 1.0]),
-)
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,14 @@ object's frame, as the simulated bodies are built). The camera is the renderer's
 (`hsgplan.sim.render.Camera`: a PyBullet view and vertical field of view), written in OpenCV's
 convention (x right, y down, z forward; pixel centres at integer coordinates) so that
 `cv2.solvePnP` can invert it.
+
+The objects are plain coloured cuboids and cylinders: a box looks the same turned half way
+about any of its axes, a can turned any way about its axis or upside down. A keypoint named by
+the pose alone ("the corner at -x, -y, -z") is then not something an image can show, and a
+network taught it learns a blur of the look-alike corners. So each view names the keypoints by
+the pose's look-alike that is canonical for that camera (`canonical_rotation`): upright, and
+its x axis towards the camera (a box: the one of its two upright look-alikes; a can: exactly,
+in the horizontal plane). The centroid is the same point in every look-alike.
 """
 
 from __future__ import annotations
@@ -16,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgplan.domain.objects import object_type
+from hsgplan.domain.world import Kind
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 
@@ -23,6 +32,15 @@ KEYPOINTS = 9  # 8 corners, then the centroid
 # Corner order: x, y, z signs, x slowest; fixed so that a network's maps name the same corner.
 CORNER_SIGNS = np.array(
     [(sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64
+)
+
+
+# The rotations that leave a box's cuboid where it was: half turns about its axes.
+BOX_SYMMETRIES = (
+    np.eye(3),
+    np.diag([1.0, -1.0, -1.0]),
+    np.diag([-1.0, 1.0, -1.0]),
+    np.diag([-1.0, -1.0, 1.0]),
 )
 
 
@@ -36,6 +54,33 @@ def in_world(obj: str, pose: Pose) -> np.ndarray:
     """The object's 9 keypoints where `pose` puts it: [9, 3]."""
     m = pose.matrix()
     return cuboid(obj) @ m[:3, :3].T + m[:3, 3]
+
+
+def canonical_rotation(
+    obj: str, rotation: np.ndarray, position: np.ndarray, eye: np.ndarray
+) -> np.ndarray:
+    """The look-alike of the object's rotation that a camera at `eye` names keypoints by
+    (see the module): [3, 3]."""
+    r = np.asarray(rotation, dtype=np.float64)
+    if r[2, 2] < 0:  # upside down: the same look turned half way about x
+        r = r @ BOX_SYMMETRIES[1]
+    toward = np.asarray(eye, dtype=np.float64) - np.asarray(position, dtype=np.float64)
+    if object_type(obj).kind is Kind.CAN:
+        local = r.T @ toward
+        phi = math.atan2(local[1], local[0])
+        c, s = math.cos(phi), math.sin(phi)
+        return r @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    if r[:, 0] @ toward < 0:
+        r = r @ BOX_SYMMETRIES[3]
+    return r
+
+
+def view_keypoints(obj: str, pose: Pose, camera: PinholeCamera) -> np.ndarray:
+    """The object's 9 keypoints as `camera` names them (its canonical look-alike), in pixels:
+    [9, 2]."""
+    m = pose.matrix()
+    r = canonical_rotation(obj, m[:3, :3], m[:3, 3], camera.eye)
+    return camera.project(cuboid(obj) @ r.T + m[:3, 3])
 
 
 @dataclass(frozen=True)
@@ -84,3 +129,9 @@ class PinholeCamera:
     def camera_to_world(self) -> np.ndarray:
         """The inverse extrinsic transform: [4, 4]."""
         return np.linalg.inv(self.world_to_camera)
+
+    @property
+    def eye(self) -> np.ndarray:
+        """The camera's position in the world: [3]."""
+        r, t = self.world_to_camera[:3, :3], self.world_to_camera[:3, 3]
+        return -r.T @ t

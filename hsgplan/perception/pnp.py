@@ -4,7 +4,9 @@ DOPE's last step: with the cuboid known (the object type's size), the pose that 
 onto the detected keypoints is the solution of a perspective-n-point problem. Views are fused
 as the paper fuses its real robot's viewpoints: each view's estimate is refined by minimising
 the reprojection error over the keypoints of every view at once, starting from the view whose
-own fit is best.
+own fit is best. Each view names the keypoints by its own canonical look-alike of the pose
+(`perception.keypoints.canonical_rotation`), so the refit projects, for each view, the cuboid of
+that view's look-alike of the pose being fitted.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from hsgplan.perception.keypoints import PinholeCamera, cuboid
+from hsgplan.perception.keypoints import PinholeCamera, canonical_rotation, cuboid
 from hsgplan.scene_graph.geometry import Pose
 
 MIN_POINTS = 5  # solvePnP's iterative solver needs 4; one more guards against a bad peak
@@ -66,13 +68,13 @@ def estimate_pose(obj: str, views: list[ViewKeypoints]) -> PoseEstimate | None:
         )
         if ok:
             world = view.camera.camera_to_world() @ _matrix(rvec, tvec)
-            fits.append((_error(model, views, world), world))
+            fits.append((_error(obj, views, world), world))
     if not fits:
         return None
     best = min(fits, key=lambda f: f[0][0])[1]
-    fused = _refine(model, views, best)
-    world = min((best, fused), key=lambda m: _error(model, views, m)[0])
-    rms, used = _error(model, views, world)
+    fused = _refine(obj, views, best)
+    world = min((best, fused), key=lambda m: _error(obj, views, m)[0])
+    rms, used = _error(obj, views, world)
     return PoseEstimate(Pose.from_matrix(world), rms, used)
 
 
@@ -83,31 +85,33 @@ def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
     return m
 
 
-def _residuals(model: np.ndarray, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
-    points = model @ world[:3, :3].T + world[:3, 3]
+def _residuals(obj: str, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
+    model, position = cuboid(obj), world[:3, 3]
     out = []
     for view in views:
         found = ~np.isnan(view.pixels).any(axis=1)
-        out.append((view.camera.project(points[found]) - view.pixels[found]).ravel())
+        rotation = canonical_rotation(obj, world[:3, :3], position, view.camera.eye)
+        points = model[found] @ rotation.T + position
+        out.append((view.camera.project(points) - view.pixels[found]).ravel())
     return np.concatenate(out) if out else np.zeros(0)
 
 
-def _error(model, views, world) -> tuple[float, int]:
-    r = _residuals(model, views, world)
+def _error(obj: str, views: list[ViewKeypoints], world: np.ndarray) -> tuple[float, int]:
+    r = _residuals(obj, views, world)
     return (float(np.sqrt(np.mean(r**2))) if r.size else float("inf")), r.size // 2
 
 
-def _refine(model: np.ndarray, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
+def _refine(obj: str, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
     """Gauss-Newton on the pose (rotation vector, translation) over every view's keypoints."""
     rvec, tvec = cv2.Rodrigues(world[:3, :3])[0].ravel(), world[:3, 3].copy()
     x = np.concatenate([rvec, tvec])
     for _ in range(10):
-        r = _residuals(model, views, _matrix(x[:3], x[3:]))
+        r = _residuals(obj, views, _matrix(x[:3], x[3:]))
         jac = np.empty((r.size, 6))
         for i in range(6):
             step = np.zeros(6)
             step[i] = 1e-6
-            jac[:, i] = (_residuals(model, views, _matrix(*np.split(x + step, 2))) - r) / 1e-6
+            jac[:, i] = (_residuals(obj, views, _matrix(*np.split(x + step, 2))) - r) / 1e-6
         dx = np.linalg.lstsq(jac, -r, rcond=None)[0]
         x = x + dx
         if np.linalg.norm(dx) < 1e-9:

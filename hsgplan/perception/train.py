@@ -1,7 +1,8 @@
 """Training the keypoint network on a synthetic image collection: `hsgplan train perception`.
 
 Every (sample, view) image is one example; its targets are the belief maps and affinity fields
-(`perception.maps.targets`) of the objects in sight in it (at least `MIN_VISIBLE` pixels), made
+(`perception.maps.targets`) of the objects in sight in it (at least `MIN_VISIBLE` pixels), their
+keypoints named as that view names them (the pose's canonical look-alike for the camera), made
 batch by batch. Every stage is supervised, as in DOPE, though not with its squared error
 (`loss_of` says why). Labels come from the renderer: the
 poses the scene was staged in, projected through the camera that rendered it. The checkpoint
@@ -24,10 +25,13 @@ from hsgplan import training
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.checks import MAX_SEED, MAX_WORKERS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.perception.images import chunk_path, load_chunks
+from hsgplan.perception.images import TYPES, chunk_path, load_chunks
+from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE, PerceptionNetConfig, build
 from hsgplan.runner.run_folder import logged_rows
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.render import Camera
 
 MIN_VISIBLE = 30  # pixels of an object in sight for its keypoints to be a target
 
@@ -81,16 +85,34 @@ class Examples:
 
 
 def examples(data: dict[str, np.ndarray]) -> Examples:
-    """Every (sample, view) of a loaded collection."""
+    """Every (sample, view) of a loaded collection, its keypoints named as that view names
+    them (`perception.keypoints.view_keypoints`, from the stored poses and cameras)."""
     images, keypoints, types = [], [], []
-    n, views = data["images"].shape[:2]
+    n, views, height, width = data["images"].shape[:4]
     for i in range(n):
         for v in range(views):
             seen = (data["types"][i] >= 0) & (data["visible"][i, v] >= MIN_VISIBLE)
+            eye, target, fov = (
+                data["cameras"][i, v, :3],
+                data["cameras"][i, v, 3:6],
+                data["cameras"][i, v, 6],
+            )
+            camera = PinholeCamera.of(
+                Camera(width, height, tuple(map(float, eye)), tuple(map(float, target)), float(fov))
+            )
+            kinds = data["types"][i][seen].astype(np.int64)
+            points = [
+                view_keypoints(TYPES[t], _pose(p), camera)
+                for t, p in zip(kinds, data["poses"][i][seen], strict=True)
+            ]
             images.append(torch.from_numpy(data["images"][i, v]).permute(2, 0, 1))
-            keypoints.append(data["keypoints"][i, v][seen])
-            types.append(data["types"][i][seen].astype(np.int64))
+            keypoints.append(np.asarray(points, dtype=np.float32).reshape(-1, KEYPOINTS, 2))
+            types.append(kinds)
     return Examples(torch.stack(images), keypoints, types)
+
+
+def _pose(p: np.ndarray) -> Pose:
+    return Pose(tuple(map(float, p[:3])), tuple(map(float, p[3:])))
 
 
 def loss_of(

@@ -11,6 +11,7 @@ from hsgplan.domain.objects import type_of
 from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.evaluate import rotation_error, score_scene, summary
+from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE
 from hsgplan.perception.synthetic import render_sample
@@ -30,9 +31,16 @@ class _TrueMaps(torch.nn.Module):
         maps = []
         for v in range(views):
             seen = sample.visible[v] >= MIN_VISIBLE
+            pinhole = PinholeCamera.of(sample.cameras[v])
+            named = np.stack(  # as this view names them
+                [
+                    view_keypoints(o, Pose(tuple(p[:3]), tuple(p[3:])), pinhole)
+                    for o, p in zip(sample.objects, sample.poses.astype(float), strict=True)
+                ]
+            )
             maps.append(
                 targets(
-                    sample.keypoints[v][seen],
+                    named[seen],
                     kinds[seen],
                     len(TYPES),
                     height // STRIDE,

@@ -13,7 +13,7 @@ from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.failures import Failure
 from hsgplan.perception.estimator import Detection, PoseEstimator
-from hsgplan.perception.keypoints import PinholeCamera, in_world
+from hsgplan.perception.keypoints import PinholeCamera, in_world, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE
 from hsgplan.perception.observer import RgbObserver, assign
@@ -66,7 +66,7 @@ class _SceneMaps(torch.nn.Module):
         maps = []
         for camera in VIEWS:
             pinhole = PinholeCamera.of(camera)
-            points = np.stack([pinhole.project(in_world(o, p)) for o, p in poses.items()])
+            points = np.stack([view_keypoints(o, p, pinhole) for o, p in poses.items()])
             maps.append(targets(points, kinds, len(TYPES), height, width))
         return [
             (
