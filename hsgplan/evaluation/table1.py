@@ -42,6 +42,9 @@ TABLE_KIND = "eval-table"
 
 
 def label(method: str) -> str:
+    base, seen, observer = method.rpartition("-")
+    if seen and observer == "rgb":  # a column seeing with f_p (`--perception rgb`)
+        return f"{label(base)} (rgb)"
     return LABELS.get(method, method)
 
 

@@ -173,3 +173,10 @@ def test_eval_runs_every_motion_model_and_resumes_after_a_kill(tmp_path):
     assert (
         json.loads((out / "summary.json").read_text())["methods"].keys() == report["methods"].keys()
     )
+
+
+def test_a_column_seeing_with_f_p_is_labelled_so():
+    from hsgplan.evaluation.table1 import label
+
+    assert label("gnn-rgb") == "GNN (rgb)" and label("gnn") == "GNN"
+    assert label("forward_gnn") == "forward_gnn"
