@@ -2,10 +2,12 @@
 
 Each view's image goes through the network; its last stage's maps are decoded into instances
 (`perception.maps.decode`), and each instance seen with enough keypoints gets a pose by PnP.
-Estimates of one type from different views that lie within `FUSE_DISTANCE` of one another are
-one object: its pose is refitted to the keypoints of every view that saw it
-(`perception.pnp.estimate_pose`), as the paper fuses its robot's viewpoints. Last, the poses are
-made to rest on what is under them (`perception.settle`), unless asked for raw.
+Estimates of one type from different views whose centroids' lines of sight pass within
+`RAY_GAP` of one another, near where each view alone put the object, are one object (a single
+view's depth is its weak axis, so views are matched by their rays, not their poses): its pose
+is refitted to the keypoints of every view that saw it (`perception.pnp.estimate_pose`), as the
+paper fuses its robot's viewpoints. Last, the poses are made to rest on what is under them
+(`perception.settle`), unless asked for raw.
 """
 
 from __future__ import annotations
@@ -25,7 +27,8 @@ from hsgplan.perception.settle import settle
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 
-FUSE_DISTANCE = 0.04  # m between two views' estimates of one object
+RAY_GAP = 0.02  # m between two views' lines of sight to one object's centroid
+DEPTH_SLACK = 0.15  # m between where two rays meet and where each view alone put the object
 TYPES = tuple(OBJECT_TYPES)
 
 
@@ -86,9 +89,9 @@ class _Seen:
 
 
 def _fuse(found: list[_Seen]) -> list[Detection]:
-    """One detection per object: the strongest estimate first, with the closest estimate of
-    that type from each other view, if within `FUSE_DISTANCE` (two of one view are two
-    objects)."""
+    """One detection per object: the strongest estimate first, with the estimate of that type
+    from each other view whose centroid's ray passes closest to its own, if within `RAY_GAP`
+    (two of one view are two objects)."""
     order = sorted(found, key=lambda s: -s.score)
     used: set[int] = set()
     out = []
@@ -98,11 +101,11 @@ def _fuse(found: list[_Seen]) -> list[Detection]:
         members = [first]
         for view in sorted({s.view for s in order} - {first.view}):
             near = [
-                (_distance(s.pose, first.pose), k)
+                (_gap(s, first), k)
                 for k, s in enumerate(order)
                 if s.view == view and s.type_index == first.type_index and id(s) not in used
             ]
-            if near and min(near)[0] < FUSE_DISTANCE:
+            if near and min(near)[0] < RAY_GAP:
                 members.append(order[min(near)[1]])
         used.update(id(s) for s in members)
         name = TYPES[first.type_index]
@@ -114,5 +117,30 @@ def _fuse(found: list[_Seen]) -> list[Detection]:
     return out
 
 
-def _distance(a: Pose, b: Pose) -> float:
-    return float(np.linalg.norm(np.subtract(a.position, b.position)))
+def _ray(s: _Seen) -> tuple[np.ndarray, np.ndarray]:
+    """The line of sight through the instance's centroid: origin and unit direction."""
+    camera = s.keypoints.camera
+    u, v = s.keypoints.pixels[-1]
+    local = np.linalg.solve(camera.matrix, np.array([u, v, 1.0]))
+    direction = camera.world_to_camera[:3, :3].T @ local
+    return camera.eye, direction / np.linalg.norm(direction)
+
+
+def _gap(a: _Seen, b: _Seen) -> float:
+    """How far apart two instances' centroid rays pass (m); infinite when they meet behind a
+    camera or far from where either view alone put its object."""
+    (pa, da), (pb, db) = _ray(a), _ray(b)
+    w = pa - pb
+    cross = da @ db
+    denom = 1.0 - cross**2
+    if denom < 1e-9:  # parallel lines of sight
+        return float("inf")
+    ta = (cross * (db @ w) - (da @ w)) / denom
+    tb = ((db @ w) - cross * (da @ w)) / denom
+    qa, qb = pa + ta * da, pb + tb * db
+    meet = (qa + qb) / 2
+    if ta <= 0 or tb <= 0 or any(
+        np.linalg.norm(meet - np.asarray(s.pose.position)) > DEPTH_SLACK for s in (a, b)
+    ):
+        return float("inf")
+    return float(np.linalg.norm(qa - qb))
