@@ -3,8 +3,8 @@
 Each view's image goes through the network; its last stage's maps are decoded into instances
 (`perception.maps.decode`), and each instance seen with enough keypoints gets a pose by PnP.
 Estimates of one type from different views whose centroids' lines of sight pass within
-`RAY_GAP` of one another, near where each view alone put the object, are one object (a single
-view's depth is its weak axis, so views are matched by their rays, not their poses): its pose
+`RAY_GAP` of one another, at a point on the table, are one object (a single view's depth is its
+weak axis, so views are matched by their rays, not by their poses): its pose
 is refitted to the keypoints of every view that saw it (`perception.pnp.estimate_pose`), as the
 paper fuses its robot's viewpoints. Last, the poses are made to rest on what is under them
 (`perception.settle`), unless asked for raw.
@@ -18,29 +18,37 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.world import OBJECT_TYPES, TABLE
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
-from hsgplan.perception.pnp import ViewKeypoints, estimate_pose
-from hsgplan.perception.settle import settle
+from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost, upright_fit
+from hsgplan.perception.settle import Ray, meeting_point, settle
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 
 RAY_GAP = 0.02  # m between two views' lines of sight to one object's centroid
-DEPTH_SLACK = 0.15  # m between where two rays meet and where each view alone put the object
+# Where two rays meet must be over the table and below this height to be an object's centroid.
+TOP_Z = 0.6  # m
 TYPES = tuple(OBJECT_TYPES)
 
 
 @dataclass(frozen=True)
 class Detection:
-    """An object the cameras saw: its type, pose, and the views and keypoints behind it."""
+    """An object the cameras saw: its type, pose, and the views and keypoints behind it.
+
+    Attributes:
+        rays: each view's line of sight through the object's centroid, (origin, unit
+            direction) in the world; where two or more views saw it, `pose` sits where they
+            meet.
+    """
 
     type_name: str
     pose: Pose
     score: float
     views: int
     reprojection_px: float
+    rays: tuple[Ray, ...] = ()
 
 
 class PoseEstimator:
@@ -73,7 +81,9 @@ class PoseEstimator:
         fused = _fuse(found)
         if not self.settled:
             return fused
-        poses = settle([d.type_name for d in fused], [d.pose for d in fused])
+        poses = settle(
+            [d.type_name for d in fused], [d.pose for d in fused], [d.rays for d in fused]
+        )
         return [replace(d, pose=p) for d, p in zip(fused, poses, strict=True)]
 
 
@@ -110,14 +120,23 @@ def _fuse(found: list[_Seen]) -> list[Detection]:
         used.update(id(s) for s in members)
         name = TYPES[first.type_index]
         fused = estimate_pose(name, [s.keypoints for s in members])
-        if fused is not None:
-            out.append(
-                Detection(name, fused.pose, first.score, len(members), fused.reprojection_px)
-            )
+        if fused is None:
+            continue
+        rays = tuple(_ray(s) for s in members)
+        views = [s.keypoints for s in members]
+        pose = fused.pose
+        if len(rays) > 1:  # the centroid where the views' lines of sight meet
+            pose = Pose(tuple(map(float, meeting_point(rays))), pose.orientation)
+        # Objects here rest upright: the best upright yaw, unless a free pose explains the
+        # keypoints better (a toppled object).
+        level = upright_fit(name, views, pose.position)
+        if robust_cost(name, views, level) <= robust_cost(name, views, pose):
+            pose = level
+        out.append(Detection(name, pose, first.score, len(members), fused.reprojection_px, rays))
     return out
 
 
-def _ray(s: _Seen) -> tuple[np.ndarray, np.ndarray]:
+def _ray(s: _Seen) -> Ray:
     """The line of sight through the instance's centroid: origin and unit direction."""
     camera = s.keypoints.camera
     u, v = s.keypoints.pixels[-1]
@@ -128,7 +147,7 @@ def _ray(s: _Seen) -> tuple[np.ndarray, np.ndarray]:
 
 def _gap(a: _Seen, b: _Seen) -> float:
     """How far apart two instances' centroid rays pass (m); infinite when they meet behind a
-    camera or far from where either view alone put its object."""
+    camera or where no object can be (off the table, under it, high above it)."""
     (pa, da), (pb, db) = _ray(a), _ray(b)
     w = pa - pb
     cross = da @ db
@@ -139,8 +158,7 @@ def _gap(a: _Seen, b: _Seen) -> float:
     tb = ((db @ w) - cross * (da @ w)) / denom
     qa, qb = pa + ta * da, pb + tb * db
     meet = (qa + qb) / 2
-    if ta <= 0 or tb <= 0 or any(
-        np.linalg.norm(meet - np.asarray(s.pose.position)) > DEPTH_SLACK for s in (a, b)
-    ):
+    plausible = TABLE.contains(meet[0], meet[1]) and TABLE.z - 0.05 < meet[2] < TOP_Z
+    if ta <= 0 or tb <= 0 or not plausible:
         return float("inf")
     return float(np.linalg.norm(qa - qb))

@@ -20,6 +20,10 @@ from hsgplan.perception.keypoints import PinholeCamera, canonical_rotation, cubo
 from hsgplan.scene_graph.geometry import Pose
 
 MIN_POINTS = 5  # solvePnP's iterative solver needs 4; one more guards against a bad peak
+# A keypoint further than this from where a pose projects it counts as this far: one wrong
+# peak should not outweigh the keypoints that agree.
+OUTLIER_PX = 8.0
+YAWS = 90  # upright yaws tried, over the half turn a box looks the same after
 
 
 @dataclass(frozen=True)
@@ -76,6 +80,22 @@ def estimate_pose(obj: str, views: list[ViewKeypoints]) -> PoseEstimate | None:
     world = min((best, fused), key=lambda m: _error(obj, views, m)[0])
     rms, used = _error(obj, views, world)
     return PoseEstimate(Pose.from_matrix(world), rms, used)
+
+
+def robust_cost(obj: str, views: list[ViewKeypoints], pose: Pose) -> float:
+    """Squared reprojection error over every view's keypoints, each capped at `OUTLIER_PX`."""
+    r = _residuals(obj, views, pose.matrix()).reshape(-1, 2)
+    return float(np.minimum((r**2).sum(axis=1), OUTLIER_PX**2).sum())
+
+
+def upright_fit(obj: str, views: list[ViewKeypoints], position: tuple[float, ...]) -> Pose:
+    """The upright pose at `position` whose yaw best explains every view's keypoints
+    (`robust_cost`), over `YAWS` yaws (a can's cuboid is named by the view: any yaw will do)."""
+    yaws = np.linspace(0.0, np.pi, YAWS, endpoint=False)
+    return min(
+        (Pose.from_xyz_yaw(*position, float(y)) for y in yaws),
+        key=lambda p: robust_cost(obj, views, p),
+    )
 
 
 def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:

@@ -6,7 +6,10 @@ or sunk by a centimetre or two, which f_m's tolerances (1.5 cm of contact, 14 de
 can read as another support or a toppled object. So each estimate within `UPRIGHT_TILT` of
 upright is turned upright about its own yaw, and then moved onto the support under its centre
 whose top is nearest its bottom, if within `SNAP_Z`: the table, a shelf's top board, or an
-object settled before it (lowest first). An estimate that fits none is left as it is: what f_p
+object settled before it (lowest first). An object one view alone saw moves along that view's
+line of sight through its centroid: the centroid's pixel is what the network finds best, and the
+depth along the ray is what PnP gets worst. One that several views saw sits where their rays
+meet, and only moves straight up or down. An estimate that fits none is left as it is: what f_p
 saw, for f_m to report.
 """
 
@@ -20,9 +23,12 @@ from hsgplan.domain.objects import object_type
 from hsgplan.domain.world import SHELVES, TABLE
 from hsgplan.scene_graph.geometry import Pose
 
+Ray = tuple[np.ndarray, np.ndarray]  # a line of sight: origin, unit direction (world)
+
 UPRIGHT_TILT = math.radians(25)
 SNAP_Z = 0.025  # m between an estimate's bottom and a support's top
 EDGE = 0.01  # m past a support's top face that a centre may lie
+GRAZING = 0.2  # a ray flatter than this (the sine of its angle to the ground) meets a plane badly
 
 
 def upright(pose: Pose) -> Pose:
@@ -37,8 +43,31 @@ def upright(pose: Pose) -> Pose:
     return Pose.from_xyz_yaw(*pose.position, yaw)
 
 
-def settle(types: list[str], poses: list[Pose]) -> list[Pose]:
-    """Each pose (of an object of `types[i]`) made to rest, lowest first (see the module)."""
+def meeting_point(rays: tuple[Ray, ...] | list[Ray]) -> np.ndarray:
+    """The point nearest every ray, least squares: [3]."""
+    a, b = np.zeros((3, 3)), np.zeros(3)
+    for origin, direction in rays:
+        away = np.eye(3) - np.outer(direction, direction)
+        a += away
+        b += away @ origin
+    return np.linalg.lstsq(a, b, rcond=None)[0]
+
+
+def _at_height(position: np.ndarray, rays: tuple[Ray, ...], z: float) -> np.ndarray:
+    """Where a lone ray crosses height `z`; straight up or down from `position` with several
+    rays (they have fixed it already) or none steep enough."""
+    if len(rays) == 1 and abs(rays[0][1][2]) > GRAZING:
+        origin, direction = rays[0]
+        return origin + direction * (z - origin[2]) / direction[2]
+    return np.array([position[0], position[1], z])
+
+
+def settle(
+    types: list[str], poses: list[Pose], rays: list[tuple[Ray, ...]] | None = None
+) -> list[Pose]:
+    """Each pose (of an object of `types[i]`, seen along `rays[i]` if given) made to rest,
+    lowest first (see the module)."""
+    rays = rays or [()] * len(poses)
     out = [upright(p) for p in poses]
     heights = [object_type(t).size[2] for t in types]
     order = sorted(range(len(out)), key=lambda i: out[i].position[2] - heights[i] / 2)
@@ -56,7 +85,8 @@ def settle(types: list[str], poses: list[Pose]) -> list[Pose]:
         near = [t for t in tops if abs(t - bottom) <= SNAP_Z]
         if near:
             top = min(near, key=lambda t: abs(t - bottom))
-            out[i] = Pose((x, y, top + heights[i] / 2), out[i].orientation)
+            centre = _at_height(np.array([x, y, z]), rays[i], top + heights[i] / 2)
+            out[i] = Pose(tuple(map(float, centre)), out[i].orientation)
         settled.append(i)
     return out
 
