@@ -48,3 +48,26 @@ def test_a_stack_lands_bottom_first_and_a_shelf_top_holds_what_is_near_it():
     assert out[0].position[2] == pytest.approx(2 * _half("butter") + _half("cherries"))
     assert out[2].position[2] == pytest.approx(SHELF_TOP_Z + _half("tomato_soup"))
     assert out[3].position == poses[3].position
+
+
+def test_a_lone_views_estimate_slides_along_its_line_of_sight_onto_the_table():
+    eye = np.array([1.15, 0.0, 1.0])
+    truth = np.array([0.5, 0.1, _half("butter")])
+    direction = (truth - eye) / np.linalg.norm(truth - eye)
+    too_near = eye + direction * (np.linalg.norm(truth - eye) - 0.02)  # 2 cm short in depth
+    (out,) = settle(["butter"], [Pose.from_xyz_yaw(*too_near, 0.2)], [((eye, direction),)])
+    assert np.allclose(out.position, truth, atol=1e-9)
+    # seen by two views, it sits where they put it and only drops onto the table
+    (both,) = settle(["butter"], [Pose.from_xyz_yaw(*too_near, 0.2)], [((eye, direction),) * 2])
+    assert np.allclose(both.position[:2], too_near[:2]) and both.position[2] == truth[2]
+
+
+def test_where_rays_meet():
+    from hsgplan.perception.settle import meeting_point
+
+    point = np.array([0.4, -0.1, 0.05])
+    rays = []
+    for eye in ([1.0, 0.0, 1.0], [-0.2, 0.7, 0.5], [-0.2, -0.7, 0.5]):
+        d = point - np.array(eye)
+        rays.append((np.array(eye), d / np.linalg.norm(d)))
+    assert np.allclose(meeting_point(rays), point)
