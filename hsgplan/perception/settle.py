@@ -6,10 +6,11 @@ or sunk by a centimetre or two, which f_m's tolerances (1.5 cm of contact, 14 de
 can read as another support or a toppled object. So each estimate within `UPRIGHT_TILT` of
 upright is turned upright about its own yaw, and then moved onto the support under its centre
 whose top is nearest its bottom, if within `SNAP_Z`: the table, a shelf's top board, or an
-object settled before it (lowest first). An object one view alone saw moves along that view's
-line of sight through its centroid: the centroid's pixel is what the network finds best, and the
-depth along the ray is what PnP gets worst. One that several views saw sits where their rays
-meet, and only moves straight up or down. An estimate that fits none is left as it is: what f_p
+object settled before it (lowest first). One that several views saw sits where their rays meet
+and only moves straight up or down. One that a single view saw moves along that view's line of
+sight through its centroid, to the resting place on it nearest the estimate, however far: the
+centroid's pixel is what the network finds best, and the depth along the ray is what PnP gets
+worst. An estimate that fits none is left as it is: what f_p
 saw, for f_m to report.
 """
 
@@ -53,15 +54,6 @@ def meeting_point(rays: tuple[Ray, ...] | list[Ray]) -> np.ndarray:
     return np.linalg.lstsq(a, b, rcond=None)[0]
 
 
-def _at_height(position: np.ndarray, rays: tuple[Ray, ...], z: float) -> np.ndarray:
-    """Where a lone ray crosses height `z`; straight up or down from `position` with several
-    rays (they have fixed it already) or none steep enough."""
-    if len(rays) == 1 and abs(rays[0][1][2]) > GRAZING:
-        origin, direction = rays[0]
-        return origin + direction * (z - origin[2]) / direction[2]
-    return np.array([position[0], position[1], z])
-
-
 def settle(
     types: list[str], poses: list[Pose], rays: list[tuple[Ray, ...]] | None = None
 ) -> list[Pose]:
@@ -76,19 +68,56 @@ def settle(
         x, y, z = out[i].position
         if out[i].rotation[2, 2] < math.cos(UPRIGHT_TILT):
             continue  # not upright: nothing to rest on
-        bottom = z - heights[i] / 2
-        tops = _surfaces(x, y) + [
-            out[k].position[2] + heights[k] / 2
-            for k in settled
-            if _on_top_face(x, y, types[k], out[k])
-        ]
-        near = [t for t in tops if abs(t - bottom) <= SNAP_Z]
-        if near:
-            top = min(near, key=lambda t: abs(t - bottom))
-            centre = _at_height(np.array([x, y, z]), rays[i], top + heights[i] / 2)
+        carriers = [(types[k], out[k]) for k in settled]
+        if len(rays[i]) == 1 and abs(rays[i][0][1][2]) > GRAZING:
+            centre = _along_ray(np.array([x, y, z]), rays[i][0], heights[i], carriers)
+        else:
+            centre = _straight_down(np.array([x, y, z]), heights[i], carriers)
+        if centre is not None:
             out[i] = Pose(tuple(map(float, centre)), out[i].orientation)
         settled.append(i)
     return out
+
+
+def _tops(x: float, y: float, carriers: list[tuple[str, Pose]]) -> list[float]:
+    """The heights of the surfaces and carriers' top faces under (x, y)."""
+    return _surfaces(x, y) + [
+        p.position[2] + object_type(t).size[2] / 2 for t, p in carriers if _on_top_face(x, y, t, p)
+    ]
+
+
+def _straight_down(
+    centre: np.ndarray, height: float, carriers: list[tuple[str, Pose]]
+) -> np.ndarray | None:
+    """The centre moved up or down onto the top under it nearest its bottom, within `SNAP_Z`."""
+    bottom = centre[2] - height / 2
+    near = [t for t in _tops(centre[0], centre[1], carriers) if abs(t - bottom) <= SNAP_Z]
+    if not near:
+        return None
+    top = min(near, key=lambda t: abs(t - bottom))
+    return np.array([centre[0], centre[1], top + height / 2])
+
+
+def _along_ray(
+    centre: np.ndarray, ray: Ray, height: float, carriers: list[tuple[str, Pose]]
+) -> np.ndarray | None:
+    """Where the ray meets a resting place: for each surface or carrier top, the point on the
+    ray at the height the object's centre would have on it, if that point is over it; of
+    those, the one nearest the estimate."""
+    origin, direction = ray
+    candidates = []
+    for level in {round(t, 6) for t in [TABLE.z] + [s.top.z for s in SHELVES.values()]} | {
+        round(p.position[2] + object_type(t).size[2] / 2, 6) for t, p in carriers
+    }:
+        z = level + height / 2
+        point = origin + direction * (z - origin[2]) / direction[2]
+        if (z - origin[2]) / direction[2] > 0 and any(
+            abs(t - level) < 1e-6 for t in _tops(point[0], point[1], carriers)
+        ):
+            candidates.append(point)
+    if not candidates:
+        return None
+    return min(candidates, key=lambda p: float(np.linalg.norm(p - centre)))
 
 
 def _surfaces(x: float, y: float) -> list[float]:
