@@ -4,14 +4,17 @@ Objects here stand upright where they were set down, on the table, a shelf's top
 another object. PnP on a few pixels of keypoints leaves the pose a little tilted and floating
 or sunk by a centimetre or two, which f_m's tolerances (1.5 cm of contact, 14 degrees of tilt)
 can read as another support or a toppled object. So each estimate within `UPRIGHT_TILT` of
-upright is turned upright about its own yaw, and then moved onto the support under its centre
-whose top is nearest its bottom, if within `SNAP_Z`: the table, a shelf's top board, or an
-object settled before it (lowest first). One that several views saw sits where their rays meet
-and only moves straight up or down. One that a single view saw moves along that view's line of
-sight through its centroid, to the resting place on it nearest the estimate, however far: the
-centroid's pixel is what the network finds best, and the depth along the ray is what PnP gets
-worst. An estimate that fits none is left as it is: what f_p
-saw, for f_m to report.
+upright is turned upright about its own yaw, then made to rest (lowest first, so that carriers
+rest before what they carry):
+
+- one that several views saw sits where their rays meet, and moves straight up or down onto
+  the highest support under its centre that lies below its centre (the table, a shelf's top
+  board, or an object): nothing floats, and nothing sinks into another;
+- one that a single view saw moves along that view's line of sight through its centroid, to
+  the resting place on it nearest the estimate, however far: the centroid's pixel is what the
+  network finds best, and the depth along the ray is what PnP gets worst.
+
+An estimate that fits none is left as it is: what f_p saw, for f_m to report.
 """
 
 from __future__ import annotations
@@ -27,8 +30,8 @@ from hsgplan.scene_graph.geometry import Pose
 Ray = tuple[np.ndarray, np.ndarray]  # a line of sight: origin, unit direction (world)
 
 UPRIGHT_TILT = math.radians(25)
-SNAP_Z = 0.025  # m between an estimate's bottom and a support's top
-EDGE = 0.01  # m past a support's top face that a centre may lie
+EDGE = 0.01  # m past a surface's top face that a centre may lie
+CARRIER_EDGE = 0.015  # m past a carrier's: both estimates are off by half a centimetre or so
 GRAZING = 0.2  # a ray flatter than this (the sine of its angle to the ground) meets a plane badly
 
 
@@ -89,13 +92,14 @@ def _tops(x: float, y: float, carriers: list[tuple[str, Pose]]) -> list[float]:
 def _straight_down(
     centre: np.ndarray, height: float, carriers: list[tuple[str, Pose]]
 ) -> np.ndarray | None:
-    """The centre moved up or down onto the top under it nearest its bottom, within `SNAP_Z`."""
-    bottom = centre[2] - height / 2
-    near = [t for t in _tops(centre[0], centre[1], carriers) if abs(t - bottom) <= SNAP_Z]
-    if not near:
+    """The centre moved up or down onto the highest top under it that is below the centre:
+    nothing here floats, and two objects cannot overlap, so one whose centre is over a carrier
+    rests on it, not on the table beneath (a stacked object's centroid tends to be found a
+    little low or high, where it would be on its own)."""
+    tops = [t for t in _tops(centre[0], centre[1], carriers) if t < centre[2]]
+    if not tops:
         return None
-    top = min(near, key=lambda t: abs(t - bottom))
-    return np.array([centre[0], centre[1], top + height / 2])
+    return np.array([centre[0], centre[1], max(tops) + height / 2])
 
 
 def _along_ray(
@@ -131,4 +135,4 @@ def _on_top_face(x: float, y: float, carrier: str, pose: Pose) -> bool:
     r = pose.rotation
     dx, dy = x - cx, y - cy
     u, v = r[0, 0] * dx + r[1, 0] * dy, r[0, 1] * dx + r[1, 1] * dy
-    return abs(u) <= sx / 2 + EDGE and abs(v) <= sy / 2 + EDGE
+    return abs(u) <= sx / 2 + CARRIER_EDGE and abs(v) <= sy / 2 + CARRIER_EDGE
