@@ -12,13 +12,19 @@ paper fuses its robot's viewpoints. Last, the poses are made to rest on what is 
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from hsgplan.domain.objects import object_type
 from hsgplan.domain.world import OBJECT_TYPES, TABLE
+from hsgplan.paths import shipped
+from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
+from hsgplan.perception.colour import ColourNet, features, load_colour
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
@@ -30,6 +36,7 @@ from hsgplan.sim.render import Camera
 RAY_GAP = 0.02  # m between two views' lines of sight to one object's centroid
 # Where two rays meet must be over the table and below this height to be an object's centroid.
 TOP_Z = 0.6  # m
+OVERLAP_XY = 0.03  # m between two detections' centres across for them to fill one space
 TYPES = tuple(OBJECT_TYPES)
 
 
@@ -49,21 +56,41 @@ class Detection:
     views: int
     reprojection_px: float
     rays: tuple[Ray, ...] = ()
+    type_confidence: float = 1.0  # the colour network's probability of the type (1: no colour)
 
 
 class PoseEstimator:
     """Args:
     net: a trained keypoint network (eval mode).
     settled: make the fused poses rest on their supports (`perception.settle`).
+    colour: the colour network that names each object's type (`perception.colour`); without
+        it, the keypoint network's type is kept.
     """
 
-    def __init__(self, net: KeypointNet, settled: bool = True) -> None:
+    def __init__(
+        self, net: KeypointNet, settled: bool = True, colour: ColourNet | None = None
+    ) -> None:
         self.net = net
         self.settled = settled
+        self.colour = colour
 
     @staticmethod
     def load(folder: Path, settled: bool = True) -> PoseEstimator:
-        return PoseEstimator(load_perception_net(folder)[0], settled)
+        """The estimator of a checkpoint folder (the keypoint network, and the colour network
+        in its `colour/`)."""
+        net = load_perception_net(folder)[0]
+        return PoseEstimator(net, settled, load_colour(shipped(folder) / COLOUR_FOLDER))
+
+    def _typed(self, images: np.ndarray, members: list[_Seen]) -> tuple[int, float]:
+        """The type of an object its members saw, and its probability: by the colour network
+        over the members' views, else the keypoint network's."""
+        rows = [features(images[s.view], s.keypoints.pixels[-1]) for s in members]
+        rows = [r for r in rows if r is not None]
+        if self.colour is None or not rows:
+            return members[0].type_index, 1.0
+        probs = torch.softmax(self.colour(torch.from_numpy(np.stack(rows))), dim=1).mean(dim=0)
+        best = int(probs.argmax())
+        return best, float(probs[best])
 
     @torch.inference_mode()
     def detect(self, images: np.ndarray, cameras: tuple[Camera, ...]) -> list[Detection]:
@@ -78,7 +105,7 @@ class PoseEstimator:
                 single = estimate_pose(TYPES[inst.type_index], [seen])
                 if single is not None:
                     found.append(_Seen(inst.type_index, inst.score, v, seen, single.pose))
-        fused = _fuse(found)
+        fused = _apart(_fuse(found, lambda members: self._typed(images, members)))
         if not self.settled:
             return fused
         poses = settle(
@@ -98,7 +125,7 @@ class _Seen:
     pose: Pose
 
 
-def _fuse(found: list[_Seen]) -> list[Detection]:
+def _fuse(found: list[_Seen], typed: Callable[[list[_Seen]], tuple[int, float]]) -> list[Detection]:
     """One detection per object: the strongest estimate first, with the estimate of that type
     from each other view whose centroid's ray passes closest to its own, if within `RAY_GAP`
     (two of one view are two objects)."""
@@ -118,7 +145,8 @@ def _fuse(found: list[_Seen]) -> list[Detection]:
             if near and min(near)[0] < RAY_GAP:
                 members.append(order[min(near)[1]])
         used.update(id(s) for s in members)
-        name = TYPES[first.type_index]
+        kind, confidence = typed(members)
+        name = TYPES[kind]
         fused = estimate_pose(name, [s.keypoints for s in members])
         if fused is None:
             continue
@@ -132,8 +160,28 @@ def _fuse(found: list[_Seen]) -> list[Detection]:
         level = upright_fit(name, views, pose.position)
         if robust_cost(name, views, level) <= robust_cost(name, views, pose):
             pose = level
-        out.append(Detection(name, pose, first.score, len(members), fused.reprojection_px, rays))
+        points = sum(int((~np.isnan(v.pixels).any(axis=1)).sum()) for v in views)
+        error = math.sqrt(robust_cost(name, views, pose) / max(points, 1))
+        out.append(Detection(name, pose, first.score, len(members), error, rays, confidence))
     return out
+
+
+def _apart(detections: list[Detection]) -> list[Detection]:
+    """Two objects cannot fill one space. Detections whose centres lie within `OVERLAP_XY`
+    across and under a quarter of their heights apart up and down are one object found twice,
+    mostly once in each look-alike type's maps; the one whose type the colour network is surest
+    of is kept (then the stronger)."""
+    kept: list[Detection] = []
+    for d in sorted(detections, key=lambda d: (-d.type_confidence, -d.score)):
+        h = object_type(d.type_name).size[2]
+        if not any(
+            math.dist(d.pose.position[:2], k.pose.position[:2]) < OVERLAP_XY
+            and abs(d.pose.position[2] - k.pose.position[2])
+            < (h + object_type(k.type_name).size[2]) / 4
+            for k in kept
+        ):
+            kept.append(d)
+    return kept
 
 
 def _ray(s: _Seen) -> Ray:

@@ -31,6 +31,7 @@ Ray = tuple[np.ndarray, np.ndarray]  # a line of sight: origin, unit direction (
 
 UPRIGHT_TILT = math.radians(25)
 EDGE = 0.01  # m past a surface's top face that a centre may lie
+OVERLAP_XY = 0.03  # m across between two estimates of one space (see `_same_place`)
 CARRIER_EDGE = 0.015  # m past a carrier's: both estimates are off by half a centimetre or so
 GRAZING = 0.2  # a ray flatter than this (the sine of its angle to the ground) meets a plane badly
 
@@ -71,7 +72,11 @@ def settle(
         x, y, z = out[i].position
         if out[i].rotation[2, 2] < math.cos(UPRIGHT_TILT):
             continue  # not upright: nothing to rest on
-        carriers = [(types[k], out[k]) for k in settled]
+        carriers = [
+            (types[k], out[k])
+            for k in settled
+            if not _same_place(types[i], out[i], types[k], out[k])
+        ]
         if len(rays[i]) == 1 and abs(rays[i][0][1][2]) > GRAZING:
             centre = _along_ray(np.array([x, y, z]), rays[i][0], heights[i], carriers)
         else:
@@ -80,6 +85,15 @@ def settle(
             out[i] = Pose(tuple(map(float, centre)), out[i].orientation)
         settled.append(i)
     return out
+
+
+def _same_place(a: str, pa: Pose, b: str, pb: Pose) -> bool:
+    """Whether two estimates fill one space (an object found twice, once as a look-alike
+    type): centres within `OVERLAP_XY` across and under a quarter of their heights apart up and
+    down. Such a one is no support for the other."""
+    ha, hb = object_type(a).size[2], object_type(b).size[2]
+    across = math.dist(pa.position[:2], pb.position[:2])
+    return across < OVERLAP_XY and abs(pa.position[2] - pb.position[2]) < (ha + hb) / 4
 
 
 def _tops(x: float, y: float, carriers: list[tuple[str, Pose]]) -> list[float]:

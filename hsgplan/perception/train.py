@@ -25,6 +25,8 @@ from hsgplan import training
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.checks import MAX_SEED, MAX_WORKERS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
+from hsgplan.perception.colour import ColourConfig, features, train_colour
 from hsgplan.perception.images import TYPES, chunk_path, load_chunks
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
@@ -162,19 +164,42 @@ def train_perception(
     on_epoch: Callable[[int, float], None] | None = None,
     on_batch: Callable[[int, int], None] | None = None,
 ) -> None:
-    """Train (or go on training) the keypoint network into the checkpoint folder `out`;
+    """Train (or go on training) the keypoint network into the checkpoint folder `out`, then
+    the colour network that names types (`perception.colour`) into `out/colour/` (seconds);
     `on_batch` sees (images done this epoch, images in an epoch) after every batch."""
     folder = Path(config.images)
     data = load_chunks(folder)  # a missing or damaged collection: refused before any write
     chunks = [chunk_path(folder, r["result"]["chunk"]) for r in logged_rows(folder)]
     data_print = fingerprint(chunks)
     training.claim(out, asdict(config))
-    if training.finished(out):
-        return
-    net_config = config.net_config()
     found = examples(data)
     if len(found.images) == 0:
         raise InvalidInputError(f"no images in '{folder}'")
+    if not training.finished(out):
+        _train_keypoints(config, found, out, data_print, on_epoch, on_batch)
+    train_colour(colour_samples(found), out / COLOUR_FOLDER, ColourConfig(seed=config.seed))
+
+
+def colour_samples(found: Examples) -> list[tuple[np.ndarray, int]]:
+    """(colour features at the centroid, type) of every in-sight object of every image."""
+    out = []
+    for image, points, kinds in zip(found.images, found.keypoints, found.types, strict=True):
+        pixels = image.permute(1, 2, 0).numpy()
+        for p, t in zip(points, kinds, strict=True):
+            if (row := features(pixels, p[-1])) is not None:
+                out.append((row, int(t)))
+    return out
+
+
+def _train_keypoints(
+    config: PerceptionTrainConfig,
+    found: Examples,
+    out: Path,
+    data_print: str,
+    on_epoch: Callable[[int, float], None] | None,
+    on_batch: Callable[[int, int], None] | None,
+) -> None:
+    net_config = config.net_config()
     torch.set_num_threads(config.threads)
     torch.manual_seed(config.seed)
     model = build(net_config)

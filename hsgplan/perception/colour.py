@@ -1,0 +1,114 @@
+"""Which type a detection is, from the colour where its centroid is seen.
+
+The keypoint network finds objects and their keypoints well, but tells apart poorly the types
+that share a shape: the three cans, and butter and cream cheese (same box). Trained with
+belief maps per type, it finds a can at every can-shaped place in every can type's maps with
+about the same belief. What does tell them apart is their colour, which the maps' loss never
+makes the network weigh against another type's. So a second, small network is trained to do
+only that: from the mean chromaticity and brightness of the pixels around the centroid's
+projection in a view, the type, as a softmax over every type (a cross-entropy, so the types
+compete). The estimator averages its probabilities over the views that saw an object.
+
+Labels come from the renderer: each in-sight object's type and its centroid projected
+through the camera that rendered the image. Saved in the keypoint network's checkpoint folder,
+in `colour/` (its own `config.json`, weights and manifest).
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import nn
+
+from hsgplan import training
+from hsgplan.checkpoint import load_trained
+from hsgplan.domain.world import OBJECT_TYPES
+
+PATCH = 3  # pixels each side of the centroid's pixel
+FEATURES = 4  # chromaticity r, g, b and brightness
+FOLDER = "colour"
+
+
+@dataclass(frozen=True)
+class ColourConfig:
+    types: int = len(OBJECT_TYPES)
+    hidden: int = 32
+    steps: int = 400
+    lr: float = 0.01
+    seed: int = 0
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+    @staticmethod
+    def from_json(d: dict) -> ColourConfig:
+        return ColourConfig(**d)
+
+
+class ColourNet(nn.Module):
+    """Type logits from a patch's colour features.
+
+    Args:
+        config: the sizes (`ColourConfig`).
+
+    Shapes:
+        input: [N, FEATURES]; output: [N, types].
+    """
+
+    def __init__(self, config: ColourConfig) -> None:
+        super().__init__()
+        self.mlp = nn.Sequential(
+            nn.Linear(FEATURES, config.hidden), nn.ReLU(), nn.Linear(config.hidden, config.types)
+        )
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return self.mlp(x)
+
+
+def features(image: np.ndarray, pixel: np.ndarray) -> np.ndarray | None:
+    """Mean chromaticity (r, g, b over their sum) and brightness of the pixels within `PATCH`
+    of `pixel` in an [H, W, 3] uint8 image; None when it is not in the image."""
+    if not np.isfinite(pixel).all():
+        return None
+    u, v = int(round(float(pixel[0]))), int(round(float(pixel[1])))
+    h, w = image.shape[:2]
+    if not (0 <= u < w and 0 <= v < h):
+        return None
+    patch = image[max(0, v - PATCH) : v + PATCH + 1, max(0, u - PATCH) : u + PATCH + 1]
+    mean = patch.reshape(-1, 3).astype(np.float64).mean(axis=0) / 255.0
+    total = max(mean.sum(), 1e-6)
+    return np.array([*(mean / total), total / 3], dtype=np.float32)
+
+
+def train_colour(
+    samples: list[tuple[np.ndarray, int]], out: Path, config: ColourConfig = ColourConfig()
+) -> ColourNet:
+    """Fit the colour network to (features, type index) pairs into the folder `out` (a
+    finished one is loaded, not redone)."""
+    training.claim(out, config.to_json())
+    if training.finished(out):
+        return load_colour(out)
+    torch.manual_seed(config.seed)
+    order = list(range(len(samples)))
+    random.Random(config.seed).shuffle(order)
+    x = torch.from_numpy(np.stack([samples[i][0] for i in order]))
+    y = torch.tensor([samples[i][1] for i in order])
+    model = ColourNet(config)
+    optim = torch.optim.Adam(model.parameters(), lr=config.lr)
+    for _ in range(config.steps):  # full batch: a few thousand rows of four numbers
+        loss = nn.functional.cross_entropy(model(x), y)
+        optim.zero_grad()
+        loss.backward()
+        optim.step()
+    training.check_loss(float(loss.detach()), "the colour network", config.steps)
+    training.finish(out, model.eval(), config.to_json())
+    return model
+
+
+def load_colour(folder: Path) -> ColourNet:
+    model, _ = load_trained(folder, ColourConfig.from_json, ColourNet, "colour network")
+    return model  # type: ignore[return-value]
