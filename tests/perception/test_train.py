@@ -6,6 +6,7 @@ import pytest
 import torch
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.images import ImagesConfig, collect_images
 from hsgplan.perception.model import STRIDE, load_perception_net
 from hsgplan.perception.synthetic import VIEWS
@@ -30,6 +31,8 @@ def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_pat
         VIEWS[0].width // STRIDE,
     )
     assert fields.shape[1] == net_config.fields
+    estimator = PoseEstimator.load(tmp_path / "net")  # the colour network beside it
+    assert estimator.colour is not None
     again = []
     train_perception(config, tmp_path / "net", lambda e, loss: again.append(loss))
     assert again == []
@@ -73,3 +76,16 @@ def test_fields_are_trained_only_near_a_corner():
     base = loss_of([(target, fields)], target, fields)
     assert loss_of([(target, right)], target, fields) == base
     assert loss_of([(target, wrong)], target, fields) > base
+
+
+def test_colour_features_read_the_patch_around_a_pixel_and_nothing_outside_the_image():
+    import numpy as np
+
+    from hsgplan.perception.colour import features
+
+    image = np.zeros((20, 30, 3), dtype=np.uint8)
+    image[5:15, 10:20] = (200, 40, 40)
+    row = features(image, np.array([14.6, 9.8]))
+    assert row is not None and row[0] > 0.7 and abs(row[3] - 280 / 3 / 255) < 1e-6
+    assert features(image, np.array([35.0, 5.0])) is None
+    assert features(image, np.array([np.nan, 5.0])) is None
