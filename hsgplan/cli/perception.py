@@ -58,7 +58,7 @@ def train_perception(
             progress.update(batches, completed=done, total=total)
 
         run(cfg, out_dir, on_epoch, on_batch)
-    out.print(f"trained the keypoint network into {shown(out_dir)}")
+    out.print(f"trained the keypoint and colour networks into {shown(out_dir)}")
 
 
 @refuses_bad_input

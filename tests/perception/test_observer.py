@@ -125,3 +125,23 @@ def test_the_estimate_is_drawn_where_the_camera_sees_it():
     u, v = np.round(PinholeCamera.of(camera).project(in_world("popcorn", pose))[-1]).astype(int)
     assert tuple(drawn[v, u]) == COLOR  # the centroid's dot
     assert (drawn.any(axis=2)).sum() > 100 and not image.any()  # edges drawn, on a copy
+
+
+def test_eval_sees_through_the_shipped_f_p_beside_the_ground_truth(tmp_path):
+    import json
+
+    from typer.testing import CliRunner
+
+    from hsgplan.cli import app
+
+    r = CliRunner().invoke(
+        app,
+        ["eval", "--agent", "paper", "--sizes", "2", "--goals", "1", "--workers", "1"]
+        + ["--perception", "gt,rgb", "--json", "--out", str(tmp_path / "run")],
+    )
+    assert r.exit_code == 0, r.output
+    methods = json.loads(r.stdout)["methods"]
+    assert methods["paper"]["perception"] == "gt" and methods["paper-rgb"]["perception"] == "rgb"
+    assert methods["paper-rgb"]["by_size"]["2"]["episodes"] == 1
+    (line,) = (tmp_path / "run" / "paper-rgb" / "episodes.jsonl").read_text().splitlines()
+    assert json.loads(line)["result"]["observer"] == "rgb"
