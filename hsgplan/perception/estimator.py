@@ -83,12 +83,18 @@ class PoseEstimator:
 
     def _typed(self, images: np.ndarray, members: list[_Seen]) -> tuple[int, float]:
         """The type of an object its members saw, and its probability: by the colour network
-        over the members' views, else the keypoint network's."""
+        over the members' views, among the types of the kind (can or box) the keypoint network
+        saw, which it tells apart well; else the keypoint network's. (A thin box under a can
+        shows the can's colour at its centroid's pixel: it stays a box.)"""
         rows = [features(images[s.view], s.keypoints.pixels[-1]) for s in members]
         rows = [r for r in rows if r is not None]
         if self.colour is None or not rows:
             return members[0].type_index, 1.0
         probs = torch.softmax(self.colour(torch.from_numpy(np.stack(rows))), dim=1).mean(dim=0)
+        kind = OBJECT_TYPES[TYPES[members[0].type_index]].kind
+        same = torch.tensor([OBJECT_TYPES[t].kind is kind for t in TYPES])
+        probs = torch.where(same, probs, torch.zeros_like(probs))
+        probs = probs / probs.sum().clamp(min=1e-12)
         best = int(probs.argmax())
         return best, float(probs[best])
 
