@@ -2,8 +2,9 @@
 
 Every observation renders the three views (`perception.synthetic.VIEWS`, the scene's own look),
 runs the pose estimator and names what it found. The goal names object instances, so the
-observer keeps a track of each: a detection of a type is given to that type's objects by an
-optimal assignment on the distance to where each was last seen. Tracks start where the scene
+observer keeps a track of each: detections of a kind (cans, boxes) are given to that kind's
+objects by an optimal assignment on the type f_p named and the distance to where each object
+was last seen (`assign`). Tracks start where the scene
 was staged (the goal's names must refer to something; only look-alike duplicates need it), and
 an object no view found this time keeps its last pose and is reported unseen. The object in the
 hand is the robot's own knowledge: its pose is the gripper's (the arm's kinematics and the
@@ -17,7 +18,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from hsgplan.domain.objects import type_of
+from hsgplan.domain.objects import object_type, type_of
+from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.perception.estimator import Detection, PoseEstimator
 from hsgplan.perception.synthetic import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -26,10 +28,11 @@ from hsgplan.sim.observer import Seen
 from hsgplan.sim.render import Camera
 from hsgplan.sim.scene import Scene
 
-# With more detections of a type than objects (a false one among them), a detection further
-# than this from an object's last pose is not that object. Otherwise every detection is some
-# object's: a duplicate just put down elsewhere is found by elimination.
+# A detection f_p named another type is only an object's if it is within this of where the
+# object was last seen.
 TRACK_DISTANCE = 0.3  # m
+MISMATCH = 0.03  # cost (in metres of distance) of a detection f_p named another type
+FORBIDDEN = 1e6
 # Beyond this a detection is as far from an object's last pose as any other: most objects stay
 # where they were, so the assignment keeps as many as it can within it, and a far-moved one
 # does not drag the others to its detection to shorten its own distance.
@@ -71,28 +74,30 @@ class RgbObserver:
 
 
 def assign(detections: list[Detection], last: dict[str, Pose]) -> dict[str, Pose]:
-    """Each object (by its last pose) and the pose of the detection it gets, type by type: the
-    assignment with the least total distance, each distance counted up to `STILL` (and a
-    thousandth beyond, to break ties); a lone object of its type takes its type's
-    strongest detection wherever it is."""
+    """Each object (by its last pose) and the pose of the detection it gets, kind by kind (cans,
+    boxes): the assignment of least total cost, a detection's cost for an object being its
+    distance from the object's last pose counted up to `STILL`, plus `MISMATCH` when f_p named
+    it another type (look-alikes stacked can show one another's colour: an object that did not
+    move is known by where it is), less a hundredth of its score and plus a thousandth of the
+    distance to break ties. A detection of another type further than `TRACK_DISTANCE` from an
+    object's last pose is never that object."""
     out: dict[str, Pose] = {}
-    for t in sorted({type_of(o) for o in last}):
-        objects = [o for o in last if type_of(o) == t]
-        found = sorted((d for d in detections if d.type_name == t), key=lambda d: -d.score)
+    for kind in sorted({object_type(o).kind for o in last}):
+        objects = [o for o in last if object_type(o).kind is kind]
+        found = [d for d in detections if OBJECT_TYPES[d.type_name].kind is kind]
         if not found:
             continue
-        if len(objects) == 1:
-            out[objects[0]] = found[0].pose
-            continue
-        cost = np.array(
-            [
-                [np.linalg.norm(np.subtract(d.pose.position, last[o].position)) for d in found]
-                for o in objects
-            ]
-        )
-        gate = TRACK_DISTANCE if len(found) > len(objects) else np.inf
-        saturated = np.minimum(cost, STILL) + 1e-3 * cost
-        for i, j in zip(*linear_sum_assignment(saturated), strict=True):
-            if cost[i, j] < gate:
+        cost = np.empty((len(objects), len(found)))
+        allowed = np.empty_like(cost, dtype=bool)
+        for i, o in enumerate(objects):
+            for j, d in enumerate(found):
+                far = float(np.linalg.norm(np.subtract(d.pose.position, last[o].position)))
+                same = d.type_name == type_of(o)
+                allowed[i, j] = same or far < TRACK_DISTANCE
+                cost[i, j] = min(far, STILL) + (0.0 if same else MISMATCH)
+                cost[i, j] += 1e-3 * far - 1e-2 * d.score
+        cost[~allowed] = FORBIDDEN
+        for i, j in zip(*linear_sum_assignment(cost), strict=True):
+            if allowed[i, j]:
                 out[objects[i]] = found[j].pose
     return out

@@ -47,9 +47,29 @@ def test_duplicates_keep_their_names_and_one_put_down_elsewhere_is_found_by_elim
     assert found["cherries"].position[:2] == (0.49, 0.0)
     assert found["cherries_2"].position[:2] == (0.51, 0.2)
     assert found["cherries_3"].position[:2] == (0.9, 0.6)  # moved far: the one left over
-    # a false detection among them: only near ones count, and the moved one is left unseen
+    # with one detection too many, the one put down elsewhere takes the nearer far one
     found = assign([*detections[:2], _at("cherries", 0.3, 0.5), _at("cherries", 0.95, 0.6)], last)
-    assert set(found) == {"cherries", "cherries_2"}
+    assert found["cherries_3"].position[:2] == (0.3, 0.5)
+
+
+def test_an_object_that_stayed_is_known_by_where_it_is_whatever_type_f_p_named():
+    last = {
+        "butter": Pose.from_xyz_yaw(0.5, 0.0, 0.012),
+        "cream_cheese": Pose.from_xyz_yaw(0.6, 0.3, 0.012),  # in the hand, then put down
+        "cherries": Pose.from_xyz_yaw(0.4, -0.2, 0.03),
+    }
+    # the cream cheese now on the butter; the butter's centroid shows cream cheese's colour
+    detections = [
+        _at("cream_cheese", 0.501, 0.0),
+        _at("cream_cheese", 0.5, 0.01, 0.8),
+        _at("tomato_soup", 0.4, -0.2),
+    ]
+    found = assign(detections, last)
+    assert found["butter"].position[:2] == (0.501, 0.0)
+    assert found["cream_cheese"].position[:2] == (0.5, 0.01)
+    assert found["cherries"].position[:2] == (0.4, -0.2)  # still where it was
+    far = assign([_at("popcorn", 0.9, 0.5)], {"butter": last["butter"]})
+    assert far == {}  # another type, far from where the butter was: not the butter
 
 
 class _SceneMaps(torch.nn.Module):
