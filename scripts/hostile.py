@@ -637,7 +637,7 @@ eval           | eval --sizes 2 --goals 1 --workers 1 --out run --planner ''
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception ''
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception rgb,,gt
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception '[red]x'
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception rgb --perception-checkpoint .
+eval           | eval --sizes 2 --goals 1 --out run --perception rgb --perception-checkpoint .
 demo           | demo --perception ''
 demo           | demo --perception rgb --perception-checkpoint .
 eval-motion    | eval-motion --trials 1 --workers 1 --primitives ''
