@@ -8,7 +8,8 @@ was last seen (`assign`). Tracks start where the scene
 was staged (the goal's names must refer to something; only look-alike duplicates need it), and
 an object no view found this time keeps its last pose and is reported unseen. The object in the
 hand is the robot's own knowledge: its pose is the gripper's (the arm's kinematics and the
-grasp), not an estimate.
+grasp), not an estimate; and one let go since the last look was last seen where the hand let
+it go (`Panda.released`), not where it was carried.
 """
 
 from __future__ import annotations
@@ -51,6 +52,7 @@ class RgbObserver:
         self.estimator = estimator
         self.cameras = cameras
         self._last: dict[str, Pose] = {}
+        self._held: str | None = None
 
     @staticmethod
     def load(folder: Path) -> RgbObserver:
@@ -58,11 +60,18 @@ class RgbObserver:
 
     def reset(self, scene: Scene) -> None:
         self._last = scene.poses()
+        self._held = scene.held()
 
     def observe(self, scene: Scene) -> Seen:
         images = np.stack([camera.capture(scene.bc) for camera in self.cameras])
         detections = self.estimator.detect(images, self.cameras)
         held = scene.held()
+        let_go = self._held if self._held not in (None, held) else None
+        released = scene.robot.released
+        if let_go is not None and released and released[0] == scene.bodies[let_go]:
+            # last seen in the hand: it is where the hand let it go, which the robot knows
+            self._last[let_go] = released[1]
+        self._held = held
         poses = assign(detections, {o: p for o, p in self._last.items() if o != held})
         unseen = tuple(o for o in self._last if o != held and o not in poses)
         for o in unseen:

@@ -60,6 +60,9 @@ class Panda:
         self.grasp_constraint: int | None = None
         self.held_body: int | None = None
         self.held_offset: Pose | None = None
+        # The last object let go and its pose as the hand let it go (the arm's kinematics and
+        # the grasp): what the robot itself knows of where it put something.
+        self.released: tuple[int, Pose] | None = None
         self.set_q(REST)
         self.set_fingers(GRIPPER_MAX_OPENING)
         self.hold_position()
@@ -215,6 +218,8 @@ class Panda:
         self.bc.changeConstraint(self.grasp_constraint, maxForce=200.0)
 
     def detach(self) -> None:
+        if self.held_body is not None and self.held_offset is not None:
+            self.released = (self.held_body, self.tcp().compose(self.held_offset))
         if self.grasp_constraint is not None:
             self.bc.removeConstraint(self.grasp_constraint)
         self.grasp_constraint = self.held_body = self.held_offset = None
