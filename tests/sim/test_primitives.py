@@ -25,6 +25,11 @@ def test_pick_then_place_on_a_shelf_top(scene):
     s = state(scene)
     assert s.holds(on("cherries", "shelf_a")) and s.held() is None
     assert out.seconds > 0
+    # the robot knows where it let go: within a centimetre of where the can came to rest
+    body, let_go = scene.robot.released
+    assert body == scene.bodies["cherries"]
+    rest = scene.pose("cherries").position
+    assert max(abs(a - b) for a, b in zip(let_go.position, rest, strict=True)) < 0.01
 
 
 def test_stack_a_box_on_a_can(scene):
