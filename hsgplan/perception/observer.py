@@ -32,7 +32,11 @@ from hsgplan.sim.scene import Scene
 # A detection f_p named another type is only an object's if it is within this of where the
 # object was last seen.
 TRACK_DISTANCE = 0.3  # m
-MISMATCH = 0.03  # cost (in metres of distance) of a detection f_p named another type
+# The cost, in metres of distance, of a detection f_p named another type. Small: within a
+# couple of centimetres where an object was is a surer sign of which it is than the colour at
+# its centroid, which a look-alike stacked on it lends it (at 3 cm, a box put down on its
+# look-alike took the one detection of the pair and the one beneath kept its place: both in one).
+MISMATCH = 0.01
 FORBIDDEN = 1e6
 # Beyond this a detection is as far from an object's last pose as any other: most objects stay
 # where they were, so the assignment keeps as many as it can within it, and a far-moved one
