@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from hsgplan.domain.objects import object_type
 from hsgplan.domain.world import OBJECT_TYPES, TABLE
 from hsgplan.paths import shipped
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
@@ -29,14 +28,13 @@ from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
 from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost, upright_fit
-from hsgplan.perception.settle import Ray, meeting_point, settle
+from hsgplan.perception.settle import Ray, meeting_point, same_place, settle
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 
 RAY_GAP = 0.02  # m between two views' lines of sight to one object's centroid
 # Where two rays meet must be over the table and below this height to be an object's centroid.
 TOP_Z = 0.6  # m
-OVERLAP_XY = 0.03  # m between two detections' centres across for them to fill one space
 TYPES = tuple(OBJECT_TYPES)
 
 
@@ -173,19 +171,13 @@ def _fuse(found: list[_Seen], typed: Callable[[list[_Seen]], tuple[int, float]])
 
 
 def _apart(detections: list[Detection]) -> list[Detection]:
-    """Two objects cannot fill one space. Detections whose centres lie within `OVERLAP_XY`
-    across and under a quarter of their heights apart up and down are one object found twice,
+    """Two objects cannot fill one space. Detections that fill one (`settle.same_place`) are
+    one object found twice,
     mostly once in each look-alike type's maps; the one whose type the colour network is surest
     of is kept (then the stronger)."""
     kept: list[Detection] = []
     for d in sorted(detections, key=lambda d: (-d.type_confidence, -d.score)):
-        h = object_type(d.type_name).size[2]
-        if not any(
-            math.dist(d.pose.position[:2], k.pose.position[:2]) < OVERLAP_XY
-            and abs(d.pose.position[2] - k.pose.position[2])
-            < (h + object_type(k.type_name).size[2]) / 4
-            for k in kept
-        ):
+        if not any(same_place(d.type_name, d.pose, k.type_name, k.pose) for k in kept):
             kept.append(d)
     return kept
 

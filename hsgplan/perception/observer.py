@@ -4,9 +4,9 @@ Every observation renders the three views (`perception.synthetic.VIEWS`, the sce
 runs the pose estimator and names what it found. The goal names object instances, so the
 observer keeps a track of each: detections of a kind (cans, boxes) are given to that kind's
 objects by an optimal assignment on the type f_p named and the distance to where each object
-was last seen (`assign`). Tracks start where the scene
-was staged (the goal's names must refer to something; only look-alike duplicates need it), and
-an object no view found this time keeps its last pose and is reported unseen. The object in the
+was last seen (`assign`). Tracks start where the scene was staged (the goal's names must refer
+to something; only look-alike duplicates need it), and an object no view found this time keeps
+its last pose and is reported unseen. The object in the
 hand is the robot's own knowledge: its pose is the gripper's (the arm's kinematics and the
 grasp), not an estimate; and one let go since the last look was last seen where the hand let
 it go (`Panda.released`), not where it was carried.

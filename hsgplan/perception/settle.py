@@ -31,7 +31,7 @@ Ray = tuple[np.ndarray, np.ndarray]  # a line of sight: origin, unit direction (
 
 UPRIGHT_TILT = math.radians(25)
 EDGE = 0.01  # m past a surface's top face that a centre may lie
-OVERLAP_XY = 0.03  # m across between two estimates of one space (see `_same_place`)
+OVERLAP_XY = 0.03  # m across between two estimates of one space (see `same_place`)
 CARRIER_EDGE = 0.015  # m past a carrier's: both estimates are off by half a centimetre or so
 GRAZING = 0.2  # a ray flatter than this (the sine of its angle to the ground) meets a plane badly
 
@@ -75,7 +75,7 @@ def settle(
         carriers = [
             (types[k], out[k])
             for k in settled
-            if not _same_place(types[i], out[i], types[k], out[k])
+            if not same_place(types[i], out[i], types[k], out[k])
         ]
         if len(rays[i]) == 1 and abs(rays[i][0][1][2]) > GRAZING:
             centre = _along_ray(np.array([x, y, z]), rays[i][0], heights[i], carriers)
@@ -87,7 +87,7 @@ def settle(
     return out
 
 
-def _same_place(a: str, pa: Pose, b: str, pb: Pose) -> bool:
+def same_place(a: str, pa: Pose, b: str, pb: Pose) -> bool:
     """Whether two estimates fill one space (an object found twice, once as a look-alike
     type): centres within `OVERLAP_XY` across and under a quarter of their heights apart up and
     down. Such a one is no support for the other."""

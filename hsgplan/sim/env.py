@@ -173,8 +173,10 @@ class KitchenStorageEnv(gymnasium.Env):
         seen = self.observer.observe(self.scene)
         rgb = self.render() if self.render_images else None
         symbols = map_symbols(seen.scene_graph)
-        truth = self.scene.scene_graph()
-        true_symbols = symbols if truth == seen.scene_graph else map_symbols(truth)
+        if isinstance(self.observer, GroundTruth):  # what it sees is the truth: mapped once
+            true_symbols = symbols
+        else:
+            true_symbols = map_symbols(self.scene.scene_graph())
         return Observation(seen.scene_graph, symbols, rgb, true_symbols, seen.unseen)
 
     def _encode(self, typed: Observation) -> dict:
