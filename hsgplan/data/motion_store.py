@@ -40,7 +40,9 @@ from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.outcome import Status
 
-SCHEMA_VERSION = 2  # 2: a place that leaves an object unpickable is labelled `blocks_pick`
+# 2: a place that leaves an object unpickable is labelled `blocks_pick`; 3: a push task may
+# start where a short push left the can (`MotionTask.front_gap`), place rows as in 2.
+SCHEMA_VERSION = 3
 CHUNK_FORMAT = 2  # 2: a chunk carries its index and seed, checked on load
 STATUSES: tuple[Status, ...] = tuple(Status)
 TYPES: tuple[str, ...] = tuple(OBJECT_TYPES)

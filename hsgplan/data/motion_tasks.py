@@ -12,6 +12,11 @@ The draws, for `n` objects (2-6 distinct types, as in the simulated evaluation):
 - push: the pushed object is a can on shelf A's prepush region (the only pushes the task
   domain makes); `crowding` other cans (uniform in 0..interior capacity-1) are already inside
   shelf A; the rest go anywhere there is room, the prepush region's other cell included.
+  With `P_FELL_SHORT` the can starts where a push that fell short leaves it: at the shelf's
+  open front, `front_gap` (uniform in `FRONT_GAPS`) short of its interior. Places never put it
+  there, but in the loop a short push does, and from there only short pushes keep the hand
+  out of the shelf: data without such starts taught the networks to push 10 cm or more from
+  there, again and again (README, Table 1).
 """
 
 from __future__ import annotations
@@ -39,6 +44,10 @@ from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 MIN_OBJECTS, MAX_SCENE_OBJECTS = 2, len(OBJECT_TYPES)
 PUSH_SHELF = GOAL_INTERIOR  # the task domain pushes only to fill the goals' interior
 P_STACK = 0.25  # chance that an object left to place goes on top of a bare one
+P_FELL_SHORT = 0.3  # chance that a pushed can starts where a short push left it
+# m the can's centre stands short of the interior's front: from just short of where f_m calls
+# it inside, back to where the farthest place bin puts a can.
+FRONT_GAPS = (0.005, 0.05)
 
 
 @dataclass(frozen=True)
@@ -52,6 +61,8 @@ class MotionTask:
         target: the surface to place on, or the shelf to push into.
         crowding: how many other objects rest on the target surface or are inside the shelf.
         state: the symbolic arrangement the scene is staged in.
+        front_gap: for a push, how far short of the shelf's interior the can's centre starts
+            (None: wherever the stager puts it on the prepush region).
     """
 
     primitive: MotionPrimitive
@@ -61,6 +72,7 @@ class MotionTask:
     target: str
     crowding: int
     state: SymbolicSceneGraph
+    front_gap: float | None = None
 
     @property
     def subgoal(self) -> Literal:
@@ -109,7 +121,8 @@ def _draw_push(rng: random.Random, seed: int, index: int) -> MotionTask:
     left = [o for o in others if o not in inside_now]
     literals += _arrange([], left, prepush, rng, taken={prepush: 1})
     state = SymbolicSceneGraph.from_literals(objects, literals)
-    return MotionTask(MotionPrimitive.PUSH, seed, index, obj, PUSH_SHELF, crowding, state)
+    gap = rng.uniform(*FRONT_GAPS) if rng.random() < P_FELL_SHORT else None
+    return MotionTask(MotionPrimitive.PUSH, seed, index, obj, PUSH_SHELF, crowding, state, gap)
 
 
 def _objects(rng: random.Random) -> list[str]:

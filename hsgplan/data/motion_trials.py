@@ -29,7 +29,7 @@ from hsgplan.sim.motion_plans import can_pick
 from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.scene import Scene
-from hsgplan.sim.staging import stage
+from hsgplan.sim.staging import move_short_of, stage
 
 TASKS_PER_CHUNK = 32
 # Staging a scene costs about one push trial (a cProfile of 3 chunks: 19 ms against 23 ms).
@@ -111,6 +111,10 @@ def stage_task(scene: Scene, task: MotionTask) -> StagedTask | None:
     rng = random.Random(f"trials-{task.primitive.value}-{task.seed}-{task.index}")
     scene.rng = np.random.default_rng(rng.getrandbits(64))
     if not stage(scene, task.state, rng):
+        return None
+    if task.front_gap is not None and not move_short_of(
+        scene, task.state, task.obj, task.target, task.front_gap
+    ):
         return None
     return StagedTask(task, scene.snapshot(), scene.robot.held_body, scene.scene_graph(), rng)
 

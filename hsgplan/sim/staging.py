@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 import random
 
+import numpy as np
+
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import GRIPPER_MAX_OPENING, SHELVES, Kind, interior_slots
@@ -29,6 +31,7 @@ HOLD_X, HOLD_Y, HOLD_Z = (0.30, 0.55), (-0.25, 0.25), (0.28, 0.38)
 # their half width): where pushes leave them, and somewhat deeper.
 INSIDE_DEPTH = (0.01, 0.06)
 INSIDE_JITTER = 0.01
+SHORT_OF_TOLERANCE = 0.005  # m an object moved short of a shelf may settle from where it was put
 
 
 def stage(scene: Scene, state: SymbolicSceneGraph, rng: random.Random) -> bool:
@@ -72,6 +75,25 @@ def _put_inside(
             placed.append(o)
     return all(
         state.location(o).predicate is not Predicate.IN or o in placed for o in state.objects
+    )
+
+
+def move_short_of(
+    scene: Scene, state: SymbolicSceneGraph, obj: str, shelf: str, gap: float
+) -> bool:
+    """Slide a staged object straight towards a shelf until its centre is `gap` short of the
+    interior, where a push that fell short leaves it. False when it would not rest there as
+    `state` says (it met a neighbour, or f_m reads it otherwise)."""
+    before = scene.pose(obj)
+    x = SHELVES[shelf].interior.x_min - gap
+    scene.set_pose(obj, Pose((x, *before.position[1:]), before.orientation))
+    scene.settle()
+    moved = np.subtract(scene.pose(obj).position[:2], (x, before.position[1]))
+    mapping = map_symbols(scene.scene_graph())
+    return (
+        float(np.hypot(*moved)) < SHORT_OF_TOLERANCE
+        and not mapping.anomalies
+        and mapping.state == state
     )
 
 

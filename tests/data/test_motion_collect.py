@@ -209,3 +209,28 @@ def test_a_place_that_leaves_an_object_unable_to_be_taken_up_is_no_sample():
             if seen == {Status.SUCCESS, Status.BLOCKS_PICK}:
                 break
     assert seen == {Status.SUCCESS, Status.BLOCKS_PICK}
+
+
+def test_some_push_tasks_start_where_a_short_push_leaves_the_can():
+    # The dead end of Table 1: a push that fell short leaves the can at the shelf's front,
+    # where no place bin puts it. Such tasks stage the can there, still on the prepush region.
+    from hsgplan.data.motion_tasks import FRONT_GAPS
+    from hsgplan.data.motion_trials import release, stage_task
+    from hsgplan.domain.parameters import place_xy
+    from hsgplan.domain.world import PLACE_BINS, SHELVES
+    from hsgplan.sim.scene import Scene
+
+    tasks = [draw_task(PUSH, 0, i) for i in range(30)]
+    short = [t for t in tasks if t.front_gap is not None]
+    assert 0 < len(short) < len(tasks)
+    assert all(FRONT_GAPS[0] <= t.front_gap <= FRONT_GAPS[1] for t in short)
+    front = SHELVES["shelf_a"].interior.x_min
+    with Scene((), seed=0) as scene:
+        for task in short[:3]:
+            staged = stage_task(scene, task)
+            assert staged is not None
+            x = staged.before.node(task.obj).pose.position[0]
+            assert x == pytest.approx(front - task.front_gap, abs=0.005)
+            farthest_place = place_xy(task.obj, "prepush_a", PLACE_BINS - 1, 0)[0]
+            assert x > farthest_place
+            release(scene, staged)
