@@ -10,17 +10,36 @@ project's actions and their parameters; no plan means one level deeper, with mor
 the last level's outputs as new inputs. The streams (`agents/streams.py`):
 
 - grasp(o) -> g: the top-down grasp (one per object);
-- place-pose(o, surface) -> p: the next place bins, `place_samples` a level;
+- place-pose(o, surface) -> p: the next place bins, `place_samples` a level (`goal_place_samples`
+  on the surface the goal puts o on);
 - stack-pose(o, b, pb) -> p: o on b's top at b's pose pb;
 - kin(o, p, g) -> q: inverse kinematics and a path for the grasp at p (not for poses inside a
   shelf, from which nothing is taken up);
 - push(o, p, shelf) -> (u, p2, q): pushes from a prepush pose into the shelf's slots.
 
-The problem grows with every level, the stack poses fastest (one per object on every pose of
-every other object): the third level of the 6-object goals measured held some 2,000 poses
-and 200,000 to 290,000 facts. Each Fast Downward call is bounded (`fd_timeout_s`, as
-PDDLStream bounds its planner's time; a level whose problem has no plan may take that long to
-tell), and so is the problem's size (`max_facts`).
+Evaluated on every input (`stream`, the default), the streams make the problem explode with
+the levels, the stack poses fastest (one per object on every pose of every other object): the
+third level of a 6-object goal held some 2,000 poses and 240,000 facts, and 8- and 10-object
+goals found no plan within the limits. As PDDLStream's users write streams with what they know
+of the domain, `GOAL_DIRECTED` (the `stream-goal` baseline) takes two streams' inputs from the
+goal (`goal_stacks`, `goal_places`):
+
+- stack-pose(o, b, pb) only where the goal has On(o, b), and only on poses pb where b's own
+  On goal (if it has one) would have it. A tower the goal does not name is never needed: the
+  open space alone holds every object a goal may name (12 cells, `SURFACE_CAPACITY`, and
+  `MAX_OBJECTS` 12), nothing starts held or in an interior (`symbolic/generator.py`), so any
+  object can wait there; an observed tower stays at its observed poses (level 0).
+- place-pose(o, s) only on the open space (where anything waits) and on o's goal surface, or
+  the prepush region of the shelf its In goal names; every surface for an object the goal
+  does not place.
+
+Measured on 6- to 10-object goals with those streams, a level with a plan had it from Fast
+Downward within 1.2 s; a level without one (no collision-free arrangement of the goal's poses
+among its samples, checked by enumeration) ran until `fd_timeout_s`, the search unable to prove
+there is none (the FF heuristic does not see collisions). So `GOAL_DIRECTED` bounds a call at
+10 s and allows more levels, and samples more poses on the goal's surface a level (the shelf
+tops are where arrangements are tight), which makes the levels without a plan fewer. The
+problem's size is bounded too (`max_facts`).
 
 Times: the task level is Fast Downward's (writing the problem, translation and search), the
 motion level the streams' (sampling, inverse kinematics, push planning, collision tests) and
@@ -69,6 +88,8 @@ STREAM_SEARCH = "let(hff,ff(axioms=approximate_negative),lazy_wastar([hff],prefe
 class IncrementalConfig:
     """Args:
     place_samples: new poses per object and surface at each level.
+    goal_place_samples: new poses per object on the surface its goal names, or the prepush
+        region of the shelf its In goal names (`goal_places`).
     push_samples: new pushes per prepush pose and shelf at each level.
     max_levels: levels before the planner gives up.
     max_facts: facts a problem may hold; past them the planner gives up rather than write it
@@ -76,6 +97,9 @@ class IncrementalConfig:
         Downward's translator did not read within a minute).
     time_limit_s: seconds (streams and Fast Downward together) before it gives up.
     fd_timeout_s: seconds one Fast Downward call may take.
+    goal_stacks: stack-pose(o, b, pb) only for the goal's On(o, b), on b's poses where b's
+        own goal has it (the module docstring says why nothing is lost).
+    goal_places: place-pose(o, s) only on the open space and o's goal surface.
     """
 
     place_samples: int = 2
@@ -84,6 +108,15 @@ class IncrementalConfig:
     max_facts: int = 1_000_000
     time_limit_s: float = 900.0
     fd_timeout_s: float = 60.0
+    goal_stacks: bool = False
+    goal_places: bool = False
+    goal_place_samples: int = 4
+
+
+# The `stream-goal` baseline's settings (the module docstring says why).
+GOAL_DIRECTED = IncrementalConfig(
+    max_levels=12, fd_timeout_s=10.0, goal_stacks=True, goal_places=True
+)
 
 
 @dataclass(frozen=True)
@@ -123,6 +156,10 @@ class _Problem:
     push_streams: dict[tuple[str, str], Iterator] = field(default_factory=dict)
     done: set[tuple[str, ...]] = field(default_factory=set)  # stream instances evaluated
     below: dict[str, str] = field(default_factory=dict)  # stacked pose -> the pose under it
+    stacks: dict[str, set[str]] | None = None  # b -> what stack-pose puts on b; None: anything
+    sites: dict[str, str] = field(default_factory=dict)  # o -> what o's On goal puts it on
+    shelves: dict[str, str] = field(default_factory=dict)  # o -> the shelf o's In goal names
+    goal_places: bool = False
 
     def add(self, *fact: str) -> None:
         self.facts[fact] = None
@@ -175,6 +212,7 @@ class IncrementalPlanner:
         task = motion = 0.0
         t0 = time.perf_counter()
         prob = _initial(sg, state, np.random.default_rng(seed))
+        _aim(prob, goal, cfg)
         motion += time.perf_counter() - t0
         for level in range(1, cfg.max_levels + 1):
             if time.perf_counter() - start > cfg.time_limit_s:
@@ -210,12 +248,12 @@ class IncrementalPlanner:
             if o not in prob.grasps:
                 _grasp(prob, o, level)
         for o in objects:
-            for s in SURFACES:
+            for s, samples in _surfaces(prob, o, cfg):
                 order = prob.bins.setdefault((o, s), bin_order(o, s, prob.rng))
-                for _ in range(min(cfg.place_samples, len(order))):
+                for _ in range(min(samples, len(order))):
                     prob.new_pose(surface_pose(o, s, order.pop(0)), level)
         for pb in poses:
-            for o in objects:
+            for o in _stackable(prob, pb, objects):
                 if ("stack", o, pb) in prob.done:
                     continue
                 prob.done.add(("stack", o, pb))
@@ -247,6 +285,49 @@ class IncrementalPlanner:
                 taken += 1
                 if taken >= cfg.push_samples:
                     break
+
+
+def _aim(prob: _Problem, goal: Goal, cfg: IncrementalConfig) -> None:
+    """What the goal-restricted streams (`goal_stacks`, `goal_places`) take from the goal:
+    where its On and In literals put each object, and what it stacks on what."""
+    for lit in goal.literals:
+        if lit.positive and lit.predicate is Predicate.ON:
+            prob.sites[lit.subject] = lit.args[1]
+        elif lit.positive and lit.predicate is Predicate.IN:
+            prob.shelves[lit.subject] = lit.args[1]
+    prob.goal_places = cfg.goal_places
+    if cfg.goal_stacks:
+        prob.stacks = {}
+        for o, x in prob.sites.items():
+            if kind_of(x) is EntityKind.OBJECT:
+                prob.stacks.setdefault(x, set()).add(o)
+
+
+def _surfaces(prob: _Problem, obj: str, cfg: IncrementalConfig) -> list[tuple[str, int]]:
+    """The surfaces place-pose samples for an object, and how many poses on each a level:
+    with `goal_places`, the open space (where anything may wait) and the surface the goal
+    puts it on, or the prepush region of the shelf its In goal names."""
+    goal = prob.sites.get(obj)
+    if obj in prob.shelves:
+        goal = SHELVES[prob.shelves[obj]].prepush
+    if not prob.goal_places or goal is None:
+        return [(s, cfg.place_samples) for s in SURFACES]
+    wanted = [("open_space", cfg.place_samples)]
+    if goal in SURFACES and goal != "open_space":
+        wanted.append((goal, cfg.goal_place_samples))
+    return wanted
+
+
+def _stackable(prob: _Problem, pb: str, objects: list[str]) -> list[str]:
+    """The objects stack-pose puts on the pose pb: with `goal_stacks`, those the goal puts on
+    its object, and only where that object's own On goal (if any) would have it."""
+    if prob.stacks is None:
+        return objects
+    below = prob.poses[pb]
+    site = prob.sites.get(below.obj)
+    if site is not None and below.support != site:
+        return []
+    return sorted(prob.stacks.get(below.obj, ()))
 
 
 def _grasp(prob: _Problem, obj: str, level: int) -> str:

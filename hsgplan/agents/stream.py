@@ -43,12 +43,12 @@ class Step:
 
 class StreamAgent:
     """Args:
-    config: the incremental algorithm's samples and limits (`IncrementalConfig`).
+    config: the incremental algorithm's samples, streams and limits (`IncrementalConfig`).
+    name: the agent's name in records (`stream`, or `stream-goal` with `GOAL_DIRECTED`).
     """
 
-    name = "stream"
-
-    def __init__(self, config: IncrementalConfig | None = None) -> None:
+    def __init__(self, config: IncrementalConfig | None = None, name: str = "stream") -> None:
+        self.name = name
         self.planner = IncrementalPlanner(config)
         self.reset(None, 0)
 

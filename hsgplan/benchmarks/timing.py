@@ -44,6 +44,7 @@ LABELS = {
     "ours": "ours",
     "search": "search",
     "stream": "stream (PDDLStream-style)",
+    "stream-goal": "stream-goal (PDDLStream-style, goal-directed streams)",
     "pddlstream": "PDDLStream (paper)",
     "paper": "theirs (paper)",
 }

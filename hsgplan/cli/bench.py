@@ -177,8 +177,9 @@ def bench_timing(
     search: Annotated[
         SearchName,
         typer.Option(
-            help="The search baseline: stream (PDDLStream's incremental algorithm over poses) "
-            "or search (Fast Downward's abstract plan, refined by trials)."
+            help="The search baseline: stream (PDDLStream's incremental algorithm over poses), "
+            "stream-goal (the same with goal-directed streams) or search (Fast Downward's "
+            "abstract plan, refined by trials)."
         ),
     ] = DEFAULT_SEARCH_NAME,
     run_dir: RunFolder = None,

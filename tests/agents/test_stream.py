@@ -1,10 +1,17 @@
 """The PDDLStream-style baseline: its streams' collision test, a goal solved in the simulated
 world, its plan followed and what failed left out, and its place in Table 2."""
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from hsgplan.agents.incremental import IncrementalConfig
+from hsgplan.agents.incremental import (
+    GOAL_DIRECTED,
+    IncrementalConfig,
+    IncrementalPlanner,
+    _aim,
+    _initial,
+)
 from hsgplan.agents.registry import make_agent
 from hsgplan.agents.stream import StreamAgent, expected_after, scene_key
 from hsgplan.agents.streams import collides, stack_pose, surface_pose
@@ -122,3 +129,45 @@ def test_plans_a_push_from_a_prepush_pose():
     ]
     assert isinstance(agent._queue[-1].params, PushParams)
     env.close()
+
+
+class _NoRobot:
+    """A world whose kinematics and pushes certify nothing: only the poses are looked at."""
+
+    def kin(self, pose):
+        return None
+
+    def pushes(self, start, shelf):
+        return iter(())
+
+
+def test_goal_restricted_streams_stack_and_place_only_where_the_goal_leads():
+    goal = parse_goal("On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)")
+    env = KitchenStorageEnv()
+    _, info = env.reset(seed=4, options=ResetOptions(goal))
+    obs = info["observation"]
+    env.close()
+
+    def sampled(config):
+        prob = _initial(obs.scene_graph, obs.symbols.state, np.random.default_rng(0))
+        _aim(prob, goal, config)
+        for level in (1, 2, 3):
+            IncrementalPlanner(config)._evaluate(prob, level, _NoRobot(), frozenset())
+        new = [p for p in prob.poses if prob.level[p] > 0]
+        values = [prob.poses[p] for p in new]
+        places = {(v.obj, v.support) for v in values if v.relation == "supported"}
+        under = [(prob.poses[p], prob.poses[prob.below[p]]) for p in new if p in prob.below]
+        return {(v.obj, b.obj, b.support) for v, b in under}, places
+
+    stacks, places = sampled(GOAL_DIRECTED)
+    assert stacks == {("butter", "cherries", "shelf_a")}  # only on cherries where its goal is
+    assert places == {
+        ("cherries", "open_space"),
+        ("cherries", "shelf_a"),
+        ("butter", "open_space"),
+        ("tomato_soup", "open_space"),
+        ("tomato_soup", "prepush_a"),
+    }
+    stacks, places = sampled(IncrementalConfig())  # the general streams
+    assert {("cherries", "butter"), ("tomato_soup", "butter")} <= {(o, b) for o, b, _ in stacks}
+    assert ("butter", "shelf_b") in places and ("butter", "cherries", "open_space") in stacks
