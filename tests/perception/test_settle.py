@@ -59,9 +59,19 @@ def test_a_stack_lands_bottom_first_and_a_shelf_top_holds_what_is_near_it():
 
 def test_a_stacked_object_found_low_rests_on_its_carrier_not_inside_it():
     butter = Pose.from_xyz_yaw(0.5, 0.0, _half("butter"), 0.0)
-    low = Pose.from_xyz_yaw(0.5, 0.01, _half("cherries") + 0.004, 0.0)  # 2 cm into the butter
+    top = 2 * _half("butter")
+    low = Pose.from_xyz_yaw(0.5, 0.01, top + _half("cherries") - 0.011, 0.0)  # 1.1 cm into it
     _, cherries = settle(["butter", "cherries"], [butter, low])
-    assert cherries.position[2] == pytest.approx(2 * _half("butter") + _half("cherries"))
+    assert cherries.position[2] == pytest.approx(top + _half("cherries"))
+    # a thin box found low enough that its centre is below its carrier's top (a can) still
+    # rests on the can, not on the table inside it; one found down at the can's middle fills
+    # one space with it (`same_place`), and the can is no carrier of it
+    can = Pose.from_xyz_yaw(0.5, 0.0, _half("alphabet_soup"), 0.0)
+    can_top = 2 * _half("alphabet_soup")
+    for drop, expected in ((0.014, can_top), (0.06, 0.0)):
+        box = Pose.from_xyz_yaw(0.5, 0.005, can_top + _half("cream_cheese") - drop, 0.0)
+        _, rests = settle(["alphabet_soup", "cream_cheese"], [can, box])
+        assert rests.position[2] == pytest.approx(expected + _half("cream_cheese")), drop
 
 
 def test_a_lone_views_estimate_slides_along_its_line_of_sight_onto_the_table():
