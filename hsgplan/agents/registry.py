@@ -2,9 +2,10 @@
 
 An agent is a task planner and a motion generator (`HierarchicalAgent`). The registered agents
 are named pairs; any other pair is asked for as `PLANNER+MOTION` (`regression+gnn`). The
-search-based baselines plan both levels together and are agents of their own (`search`, and
-`stream`, PDDLStream's incremental algorithm). Shipped
-checkpoints are found as `hsgplan.paths` finds them, wherever the command runs.
+search-based baselines plan both levels together and are agents of their own (`search`;
+`stream`, PDDLStream's incremental algorithm; `stream-goal`, the same with goal-directed
+streams). Shipped checkpoints are found as `hsgplan.paths` finds them, wherever the command
+runs.
 """
 
 from __future__ import annotations
