@@ -82,8 +82,8 @@ def move_short_of(
     scene: Scene, state: SymbolicSceneGraph, obj: str, shelf: str, gap: float
 ) -> bool:
     """Set a staged object down again nearer a shelf, moved along x only, its centre `gap`
-    short of the interior: where a push that fell short leaves it. False when it would not rest there as
-    `state` says (it met a neighbour, or f_m reads it otherwise)."""
+    short of the interior: where a push that fell short leaves it. False when it would not
+    rest there as `state` says (it met a neighbour, or f_m reads it otherwise)."""
     before = scene.pose(obj)
     x = SHELVES[shelf].interior.x_min - gap
     scene.set_pose(obj, Pose((x, *before.position[1:]), before.orientation))
