@@ -159,7 +159,6 @@ class _Problem:
     stacks: dict[str, set[str]] | None = None  # b -> what stack-pose puts on b; None: anything
     sites: dict[str, str] = field(default_factory=dict)  # o -> what o's On goal puts it on
     shelves: dict[str, str] = field(default_factory=dict)  # o -> the shelf o's In goal names
-    goal_places: bool = False
 
     def add(self, *fact: str) -> None:
         self.facts[fact] = None
@@ -295,7 +294,6 @@ def _aim(prob: _Problem, goal: Goal, cfg: IncrementalConfig) -> None:
             prob.sites[lit.subject] = lit.args[1]
         elif lit.positive and lit.predicate is Predicate.IN:
             prob.shelves[lit.subject] = lit.args[1]
-    prob.goal_places = cfg.goal_places
     if cfg.goal_stacks:
         prob.stacks = {}
         for o, x in prob.sites.items():
@@ -310,7 +308,7 @@ def _surfaces(prob: _Problem, obj: str, cfg: IncrementalConfig) -> list[tuple[st
     goal = prob.sites.get(obj)
     if obj in prob.shelves:
         goal = SHELVES[prob.shelves[obj]].prepush
-    if not prob.goal_places or goal is None:
+    if not cfg.goal_places or goal is None:
         return [(s, cfg.place_samples) for s in SURFACES]
     wanted = [("open_space", cfg.place_samples)]
     if goal in SURFACES and goal != "open_space":
