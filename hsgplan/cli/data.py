@@ -125,13 +125,21 @@ def images(
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     out_dir: CollectionFolder = RUNS / "collect-images",
+    p_elsewhere: Annotated[
+        float,
+        typer.Option(
+            help="Chance that an object starts off the open space (more: more stacks).",
+            min=0.0,
+            max=1.0,
+        ),
+    ] = 0.5,
 ) -> None:
     """Synthetic training images for f_p: random scenes from the fixed cameras, domain
     randomised, with every object's pose and cuboid keypoints (format: perception/images.py)."""
     from hsgplan.perception.images import ImagesConfig, collect_images
 
     check_ray(ray)
-    config = ImagesConfig(count, seed)
+    config = ImagesConfig(count, seed, p_elsewhere=p_elsewhere)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("image chunks", total=config.chunks)
         rows = collect_images(config, out_dir, workers, ray, lambda _: progress.advance(bar))

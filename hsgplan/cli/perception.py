@@ -30,8 +30,11 @@ def train_perception(
         Path | None, typer.Option(help="Training configuration (JSON).", parser=input_path)
     ] = None,
     images: Annotated[
-        Path | None,
-        typer.Option(help="Image collection folder (overrides the config).", parser=input_path),
+        list[Path] | None,
+        typer.Option(
+            help="Image collection folder, repeated for several (overrides the config).",
+            parser=input_path,
+        ),
     ] = None,
     out_dir: Annotated[
         Path,
@@ -43,8 +46,8 @@ def train_perception(
     from hsgplan.perception.train import train_perception as run
 
     settings = read_config(config)
-    if images is not None:
-        settings["images"] = str(images)
+    if images:
+        settings["images"] = ",".join(str(p) for p in images)
     cfg = PerceptionTrainConfig.from_json(settings)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("keypoint network", total=cfg.epochs)

@@ -104,7 +104,7 @@ class PoseEstimator:
         found: list[_Seen] = []
         for v, camera in enumerate(cameras):
             pinhole = PinholeCamera.of(camera)
-            for inst in decode(beliefs[v].numpy(), fields[v].numpy()):
+            for inst in decode(beliefs[v].numpy(), fields[v].numpy(), self.net.stride):
                 seen = ViewKeypoints(pinhole, inst.pixels)
                 single = estimate_pose(TYPES[inst.type_index], [seen])
                 if single is not None:

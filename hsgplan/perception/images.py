@@ -34,7 +34,13 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import split_instance
 from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.perception.keypoints import KEYPOINTS
-from hsgplan.perception.synthetic import MAX_OBJECTS, VIEWS, ImageSample, render_sample
+from hsgplan.perception.synthetic import (
+    MAX_OBJECTS,
+    P_ELSEWHERE,
+    VIEWS,
+    ImageSample,
+    render_sample,
+)
 from hsgplan.runner.items import run_items
 from hsgplan.runner.run_folder import logged_rows
 
@@ -49,10 +55,13 @@ class ImagesConfig:
     count: int  # samples wanted (unstaged draws are skipped, so the last chunk may hold fewer)
     seed: int = 0
     chunk: int = CHUNK
+    p_elsewhere: float = P_ELSEWHERE  # see `synthetic.P_ELSEWHERE`
 
     def __post_init__(self) -> None:
         if self.count < 1 or self.chunk < 1:
             raise InvalidInputError("an image collection needs at least one sample per chunk")
+        if not 0.0 <= self.p_elsewhere <= 1.0:
+            raise InvalidInputError(f"p_elsewhere {self.p_elsewhere}: need a chance in 0..1")
 
     @property
     def chunks(self) -> int:
@@ -63,11 +72,13 @@ def chunk_path(run_dir: Path, chunk: int) -> Path:
     return run_dir / "chunks" / f"chunk-{chunk:05d}.npz"
 
 
-def render_chunk(run_dir: str, seed: int, chunk: int, size: int, count: int) -> dict:
+def render_chunk(
+    run_dir: str, seed: int, chunk: int, size: int, count: int, p_elsewhere: float = P_ELSEWHERE
+) -> dict:
     """Render a chunk's samples (of the first `count`) into its file, written whole or not at
     all; the worker's entry point. Returns what the run log keeps of it."""
     indices = range(chunk * size, min((chunk + 1) * size, count))
-    samples = [render_sample(seed, i) for i in indices]
+    samples = [render_sample(seed, i, p_elsewhere) for i in indices]
     kept = [s for s in samples if s is not None]
     path = chunk_path(Path(run_dir), chunk)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -118,7 +129,8 @@ def collect_images(
         "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in VIEWS],
     }
     items = [
-        (str(run_dir), config.seed, c, config.chunk, config.count) for c in range(config.chunks)
+        (str(run_dir), config.seed, c, config.chunk, config.count, config.p_elsewhere)
+        for c in range(config.chunks)
     ]
     rows = run_items(
         _render,
@@ -135,7 +147,7 @@ def collect_images(
     return rows
 
 
-def _render(item: tuple[str, int, int, int, int]) -> dict:
+def _render(item: tuple[str, int, int, int, int, float]) -> dict:
     return render_chunk(*item)
 
 

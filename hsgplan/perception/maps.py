@@ -1,12 +1,13 @@
 """Belief maps and affinity fields: made from labelled keypoints (the training targets) and
 read back into keypoints per object instance (the network's output decoded), as DOPE does.
 
-Maps live on the network's output grid, `STRIDE` input pixels per cell; cell (i, j) covers
-input pixels [STRIDE j, STRIDE (j + 1)) across and its centre is at STRIDE j + (STRIDE - 1) / 2
-in OpenCV's pixel coordinates. A belief map holds, per (type, keypoint), a Gaussian of
-`SIGMA` cells around every instance's keypoint (the maximum where two meet). An affinity field
-holds, per corner (whatever the type), within `FIELD_RADIUS` cells of every instance's corner, the
-vector from there to the instance's centroid, in cells; elsewhere zero, and not trained.
+Maps live on the network's output grid, S input pixels per cell (the network's stride, 4 or
+2); cell (i, j) covers input pixels [S j, S (j + 1)) across and its centre is at
+S j + (S - 1) / 2 in OpenCV's pixel coordinates. A belief map holds, per (type, keypoint), a
+Gaussian of `SIGMA` cells around every instance's keypoint (the maximum where two meet). An
+affinity field holds, per corner (whatever the type), within `FIELD_RADIUS` cells of every
+instance's corner, the vector from there to the instance's centroid, in cells; elsewhere zero,
+and not trained.
 """
 
 from __future__ import annotations
@@ -24,15 +25,15 @@ PEAK_THRESHOLD = 0.3
 MIN_APART = 2.0  # cells between two peaks of one map
 MAX_PEAKS = 16  # per map: more objects of one type than a scene holds
 CENTROID = KEYPOINTS - 1
-OFFSET = (STRIDE - 1) / 2
+MAX_DISTANCE_PX = 12.0  # between where a corner's field points and its centroid
 
 
-def to_cells(pixels: np.ndarray) -> np.ndarray:
-    return (pixels - OFFSET) / STRIDE
+def to_cells(pixels: np.ndarray, stride: int = STRIDE) -> np.ndarray:
+    return (pixels - (stride - 1) / 2) / stride
 
 
-def to_pixels(cells: np.ndarray) -> np.ndarray:
-    return cells * STRIDE + OFFSET
+def to_pixels(cells: np.ndarray, stride: int = STRIDE) -> np.ndarray:
+    return cells * stride + (stride - 1) / 2
 
 
 @dataclass(frozen=True)
@@ -51,7 +52,12 @@ class Instance:
 
 
 def targets(
-    keypoints: np.ndarray, types: np.ndarray, types_count: int, height: int, width: int
+    keypoints: np.ndarray,
+    types: np.ndarray,
+    types_count: int,
+    height: int,
+    width: int,
+    stride: int = STRIDE,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Training targets for one image.
 
@@ -60,6 +66,7 @@ def targets(
         types: [M] their type indices.
         types_count: how many types the network knows.
         height, width: the output grid.
+        stride: input pixels per output cell.
 
     Returns:
         beliefs [types * 9, height, width] and fields [8 * 2, height, width], float32.
@@ -68,7 +75,7 @@ def targets(
     fields = np.zeros((CORNERS * 2, height, width), dtype=np.float32)
     ys, xs = np.mgrid[0:height, 0:width].astype(np.float32)
     for points, t in zip(keypoints, types, strict=True):
-        cells = to_cells(points)
+        cells = to_cells(points, stride)
         centroid = cells[CENTROID]
         for k, (x, y) in enumerate(cells):
             d2 = (xs - x) ** 2 + (ys - y) ** 2
@@ -122,13 +129,14 @@ def _vertex(before: float, centre: float, after: float) -> float:
     return float(np.clip(0.5 * (before - after) / curvature, -0.5, 0.5))
 
 
-def decode(beliefs: np.ndarray, fields: np.ndarray, max_distance: float = 3.0) -> list[Instance]:
+def decode(beliefs: np.ndarray, fields: np.ndarray, stride: int = STRIDE) -> list[Instance]:
     """Instances from one image's maps: a centroid peak per instance, and for each corner the
-    peak whose affinity vector points closest to that centroid (within `max_distance` cells).
+    peak whose affinity vector points closest to that centroid (within `MAX_DISTANCE_PX`).
 
     Args:
-        beliefs: [types * 9, H, W]; fields: [8 * 2, H, W].
+        beliefs: [types * 9, H, W]; fields: [8 * 2, H, W]; stride: input pixels per cell.
     """
+    max_distance = MAX_DISTANCE_PX / stride
     found = []
     for t in range(beliefs.shape[0] // KEYPOINTS):
         centroids = peaks(beliefs[t * KEYPOINTS + CENTROID])
@@ -148,5 +156,5 @@ def decode(beliefs: np.ndarray, fields: np.ndarray, max_distance: float = 3.0) -
                 if d[i] <= max_distance and d[i] < best[i, k]:
                     best[i, k], cells[i, k] = d[i], (x, y)
         for i, (_, _, score) in enumerate(centroids):
-            found.append(Instance(t, to_pixels(cells[i]), score))
+            found.append(Instance(t, to_pixels(cells[i], stride), score))
     return found

@@ -8,6 +8,13 @@ centroid (shared by the types: which type a corner belongs to is its belief map'
 quarter of the image's resolution. Several stages refine the maps, each seeing
 the features and the previous stage's maps, as in DOPE and the convolutional pose machines it
 follows; every stage is supervised.
+
+The stages work at a quarter of the image's resolution (`stride` 4). Two thin boxes stacked
+(2.4 cm each) have centroids 4 to 7 pixels apart in these views: one cell at that stride, one
+blob in the maps, so the lower box was never found. With `stride` 2 a light head
+(`_Refine`) brings the last stage's maps to half resolution, with the first block's
+half-resolution features for where edges are; earlier stages' maps are scaled up to be
+supervised there too.
 """
 
 from __future__ import annotations
@@ -23,7 +30,8 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.perception.keypoints import KEYPOINTS
 
-STRIDE = 4  # input pixels per output cell
+STRIDE = 4  # input pixels per output cell, unless a config says 2
+STRIDES = (2, 4)
 CORNERS = KEYPOINTS - 1
 
 
@@ -34,12 +42,15 @@ class PerceptionNetConfig:
     types: int = len(OBJECT_TYPES)
     width: int = 32  # channels of the first block; doubled at each of the next two
     stages: int = 2
+    stride: int = STRIDE  # input pixels per output cell: 4, or 2 through `_Refine`
 
     def __post_init__(self) -> None:
         for name in ("types", "width", "stages"):
             value = getattr(self, name)
             if not isinstance(value, int) or value < 1:
                 raise InvalidInputError(f"{name} {value!r}: need a positive integer")
+        if self.stride not in STRIDES:
+            raise InvalidInputError(f"stride {self.stride!r}: need one of {STRIDES}")
 
     @property
     def beliefs(self) -> int:
@@ -68,6 +79,40 @@ def _block(c_in: int, c_out: int, stride: int) -> nn.Sequential:
     )
 
 
+class _Refine(nn.Module):
+    """The last stage's maps at twice their resolution: scaled up, then corrected from the
+    half-resolution features.
+
+    Args:
+        maps: channels of the maps (beliefs and fields, before the sigmoid).
+        features: channels of the half-resolution features.
+        width: channels of the correction's hidden layers.
+
+    Shapes:
+        maps: [B, maps, h, w]; features: [B, features, 2h, 2w]; output: [B, maps, 2h, 2w].
+    """
+
+    def __init__(self, maps: int, features: int, width: int) -> None:
+        super().__init__()
+        self.correct = nn.Sequential(
+            nn.Conv2d(maps + features, width, 1),
+            nn.ReLU(inplace=True),
+            nn.Conv2d(width, width, 3, padding=1),
+            nn.ReLU(inplace=True),
+            nn.Conv2d(width, width, 3, padding=1),
+            nn.ReLU(inplace=True),
+            nn.Conv2d(width, maps, 1),
+        )
+
+    def forward(self, maps: torch.Tensor, features: torch.Tensor) -> torch.Tensor:
+        up = _doubled(maps)
+        return up + self.correct(torch.cat([up, features], dim=1))
+
+
+def _doubled(maps: torch.Tensor) -> torch.Tensor:
+    return nn.functional.interpolate(maps, scale_factor=2, mode="bilinear", align_corners=False)
+
+
 class KeypointNet(nn.Module):
     """Belief maps and affinity fields from an RGB image.
 
@@ -75,14 +120,16 @@ class KeypointNet(nn.Module):
         config: the sizes (`PerceptionNetConfig`).
 
     Shapes:
-        input: [B, 3, H, W] float in 0..1, H and W multiples of `STRIDE * 2`.
-        output: a list over stages of (beliefs [B, types * 9, H / 4, W / 4] in 0..1,
-            fields [B, 8 * 2, H / 4, W / 4], corner-to-centroid vectors in output cells).
+        input: [B, 3, H, W] float in 0..1, H and W multiples of 8.
+        output: a list over stages (and the refinement, at stride 2) of
+            (beliefs [B, types * 9, H / s, W / s] in 0..1, fields [B, 8 * 2, H / s, W / s],
+            corner-to-centroid vectors in output cells), s = `config.stride`.
     """
 
     def __init__(self, config: PerceptionNetConfig) -> None:
         super().__init__()
         w = config.width
+        self.stride = config.stride
         self.stem = nn.Sequential(_block(3, w, 2), _block(w, 2 * w, 2))  # 1/4
         self.down = _block(2 * w, 4 * w, 2)  # 1/8: a wider view for telling objects apart
         self.up = nn.ConvTranspose2d(4 * w, 2 * w, 2, stride=2)
@@ -99,18 +146,21 @@ class KeypointNet(nn.Module):
                     nn.Conv2d(2 * w, out, 1),
                 )
             )
+        self.refine = _Refine(out, w, w) if config.stride == 2 else None
         self.beliefs = config.beliefs
 
     def forward(self, image: torch.Tensor) -> list[tuple[torch.Tensor, torch.Tensor]]:
-        quarter = self.stem(image)
+        half = self.stem[0](image)
+        quarter = self.stem[1](half)
         features = torch.cat([quarter, self.up(self.down(quarter))], dim=1)
-        outputs, previous = [], None
+        maps, previous = [], None
         for stage in self.stages:
             x = features if previous is None else torch.cat([features, previous], dim=1)
             previous = stage(x)
-            beliefs = torch.sigmoid(previous[:, : self.beliefs])
-            outputs.append((beliefs, previous[:, self.beliefs :]))
-        return outputs
+            maps.append(previous)
+        if self.refine is not None:
+            maps = [_doubled(m) for m in maps] + [self.refine(previous, half)]
+        return [(torch.sigmoid(m[:, : self.beliefs]), m[:, self.beliefs :]) for m in maps]
 
 
 def build(config: PerceptionNetConfig) -> KeypointNet:

@@ -32,6 +32,9 @@ MAX_OBJECTS = 12
 CAMERA_JITTER = 0.02  # m, on the eye and on the point looked at, per axis
 DISTRACTORS = 3
 P_INSIDE = 0.3  # a clear can on the open space goes into a shelf with this chance
+# Each object leaves the open space (for a shelf top or another object) with this chance, as
+# the scene sampler's starts do; a collection may ask for more, for more stacks to learn from.
+P_ELSEWHERE = 0.5
 MAX_NOISE = 6.0  # pixel noise standard deviation, at most (0..255 scale)
 NEAR, FAR = 0.05, 4.0
 
@@ -69,10 +72,10 @@ class ImageSample:
     visible: np.ndarray
 
 
-def draw_state(rng: random.Random) -> SymbolicSceneGraph:
+def draw_state(rng: random.Random, p_elsewhere: float = P_ELSEWHERE) -> SymbolicSceneGraph:
     """A random arrangement of 2 to `MAX_OBJECTS` objects, some cans inside the shelves."""
     objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng)
-    state = random_state(objects, rng, p_elsewhere=0.5)
+    state = random_state(objects, rng, p_elsewhere=p_elsewhere)
     inside_count = dict.fromkeys(INTERIOR_CAPACITY, 0)
     literals = []
     for o in state.objects:
@@ -92,10 +95,12 @@ def draw_state(rng: random.Random) -> SymbolicSceneGraph:
     return SymbolicSceneGraph.from_literals(objects, literals)
 
 
-def render_sample(seed: int, index: int) -> ImageSample | None:
+def render_sample(
+    seed: int, index: int, p_elsewhere: float = P_ELSEWHERE
+) -> ImageSample | None:
     """The sample `(seed, index)`; None when its arrangement could not be staged."""
     rng = random.Random(f"images-{seed}-{index}")
-    state = draw_state(rng)
+    state = draw_state(rng, p_elsewhere)
     with Scene(state.objects, seed=rng.getrandbits(32)) as scene:
         if not stage(scene, state, rng):
             return None

@@ -30,7 +30,7 @@ from hsgplan.perception.colour import ColourConfig, features, train_colour
 from hsgplan.perception.images import TYPES, chunk_path, load_chunks
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
-from hsgplan.perception.model import STRIDE, PerceptionNetConfig, build
+from hsgplan.perception.model import STRIDE, PerceptionNetConfig, build, load_perception_net
 from hsgplan.runner.run_folder import logged_rows
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -50,8 +50,12 @@ class PerceptionTrainConfig:
     batch_size: int = setting(16, lo=1, hi=4096)
     width: int = setting(24, lo=1, hi=512)
     stages: int = setting(2, lo=1, hi=6)
+    stride: int = setting(2, lo=2, hi=4)  # see `perception.model`: 2 or 4
     save_every: int = setting(1, lo=1, hi=10_000)
     threads: int = setting(2, lo=1, hi=MAX_WORKERS)
+    # A trained checkpoint folder whose weights start the network (a stride-2 network from a
+    # stride-4 one of the same sizes, its refinement head fresh); "": from scratch.
+    init: str = ""
     positive_weight: float = setting(20.0, lo=0, hi=10_000)  # see `loss_of`
     field_weight: float = setting(0.1, lo=0, hi=10_000)  # see `loss_of`
 
@@ -59,7 +63,12 @@ class PerceptionTrainConfig:
         check_fields(self)
 
     def net_config(self) -> PerceptionNetConfig:
-        return PerceptionNetConfig(width=self.width, stages=self.stages)
+        return PerceptionNetConfig(width=self.width, stages=self.stages, stride=self.stride)
+
+    @property
+    def folders(self) -> list[Path]:
+        """The image collections trained on: `images` names one, or several joined by commas."""
+        return [Path(p.strip()) for p in self.images.split(",") if p.strip()]
 
     @staticmethod
     def from_json(d: dict) -> PerceptionTrainConfig:
@@ -76,10 +85,14 @@ class Examples:
     keypoints: list[np.ndarray]
     types: list[np.ndarray]
 
-    def targets(self, take: list[int], types_count: int) -> tuple[torch.Tensor, torch.Tensor]:
+    def targets(
+        self, take: list[int], types_count: int, stride: int = STRIDE
+    ) -> tuple[torch.Tensor, torch.Tensor]:
         """Belief maps and affinity fields of the images `take`: [B, C, h, w], [B, F, h, w]."""
-        h, w = self.images.shape[2] // STRIDE, self.images.shape[3] // STRIDE
-        maps = [targets(self.keypoints[i], self.types[i], types_count, h, w) for i in take]
+        h, w = self.images.shape[2] // stride, self.images.shape[3] // stride
+        maps = [
+            targets(self.keypoints[i], self.types[i], types_count, h, w, stride) for i in take
+        ]
         return (
             torch.from_numpy(np.stack([b for b, _ in maps])),
             torch.from_numpy(np.stack([f for _, f in maps])),
@@ -167,16 +180,22 @@ def train_perception(
     """Train (or go on training) the keypoint network into the checkpoint folder `out`, then
     the colour network that names types (`perception.colour`) into `out/colour/` (seconds);
     `on_batch` sees (images done this epoch, images in an epoch) after every batch."""
-    folder = Path(config.images)
-    data = load_chunks(folder)  # a missing or damaged collection: refused before any write
-    chunks = [chunk_path(folder, r["result"]["chunk"]) for r in logged_rows(folder)]
-    data_print = fingerprint(chunks)
+    config.net_config()  # a stride the network does not have: refused before any write
+    parts = [load_chunks(f) for f in config.folders]  # missing or damaged: refused, too
+    if not parts:
+        raise InvalidInputError("no image collection named")
+    data = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+    chunks = [
+        chunk_path(f, r["result"]["chunk"]) for f in config.folders for r in logged_rows(f)
+    ]
+    start = load_perception_net(Path(config.init))[0] if config.init else None
+    data_print = fingerprint(chunks + ([Path(config.init)] if config.init else []))
     training.claim(out, asdict(config))
     found = examples(data)
     if len(found.images) == 0:
-        raise InvalidInputError(f"no images in '{folder}'")
+        raise InvalidInputError(f"no images in '{config.images}'")
     if not training.finished(out):
-        _train_keypoints(config, found, out, data_print, on_epoch, on_batch)
+        _train_keypoints(config, found, out, data_print, start, on_epoch, on_batch)
     train_colour(colour_samples(found), out / COLOUR_FOLDER, ColourConfig(seed=config.seed))
 
 
@@ -191,11 +210,23 @@ def colour_samples(found: Examples) -> list[tuple[np.ndarray, int]]:
     return out
 
 
+def _start_from(model: torch.nn.Module, trained: torch.nn.Module) -> None:
+    """Copy every weight of `trained` into `model`, whose other weights (a refinement head)
+    keep their start; refused in one line unless each has its place, of its shape, there."""
+    own, weights = model.state_dict(), trained.state_dict()
+    if any(k not in own or own[k].shape != v.shape for k, v in weights.items()):
+        raise InvalidInputError(
+            "the init checkpoint's network differs from this one in more than its stride"
+        )
+    model.load_state_dict(weights, strict=False)
+
+
 def _train_keypoints(
     config: PerceptionTrainConfig,
     found: Examples,
     out: Path,
     data_print: str,
+    start_from: torch.nn.Module | None,
     on_epoch: Callable[[int, float], None] | None,
     on_batch: Callable[[int, int], None] | None,
 ) -> None:
@@ -203,6 +234,8 @@ def _train_keypoints(
     torch.set_num_threads(config.threads)
     torch.manual_seed(config.seed)
     model = build(net_config)
+    if start_from is not None:
+        _start_from(model, start_from)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start = training.resume(out, model, optim, data_print)
     for epoch in range(start, config.epochs):
@@ -215,7 +248,7 @@ def _train_keypoints(
         for i in range(0, len(order), config.batch_size):
             take = order[i : i + config.batch_size]
             image = found.images[torch.tensor(take)].float() / 255.0
-            beliefs, fields = found.targets(take, net_config.types)
+            beliefs, fields = found.targets(take, net_config.types, net_config.stride)
             loss = loss_of(
                 model(image), beliefs, fields, config.positive_weight, config.field_weight
             )

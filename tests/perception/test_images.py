@@ -42,3 +42,17 @@ def test_a_collection_resumes_without_rendering_again_and_refuses_a_damaged_chun
     chunk_path(tmp_path, 1).write_bytes(b"not a chunk")
     with pytest.raises(InvalidInputError, match="not the chunk logged"):
         load_chunks(tmp_path)
+
+
+def test_a_collection_may_ask_for_more_stacks_and_refuses_a_chance_outside_0_to_1():
+    import random
+
+    from hsgplan.perception.synthetic import draw_state
+
+    def stacked(p: float) -> int:
+        states = [draw_state(random.Random(f"stacks-{i}"), p) for i in range(40)]
+        return sum(len(s.resting_on(o)) > 0 for s in states for o in s.objects)
+
+    assert stacked(0.85) > stacked(0.5) > stacked(0.0) == 0
+    with pytest.raises(InvalidInputError, match="p_elsewhere"):
+        ImagesConfig(count=1, p_elsewhere=1.5)

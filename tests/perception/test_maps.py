@@ -36,3 +36,25 @@ def test_maps_of_two_butters_and_a_can_decode_into_their_keypoints():
         seen = ~np.isnan(match.pixels).any(axis=1)
         assert seen.sum() >= 7  # corners on top of one another may share a peak
         assert np.abs(match.pixels[seen] - points[seen]).max() < 1.0  # pixels
+
+
+def test_two_thin_boxes_stacked_are_two_peaks_at_stride_2_and_one_blob_at_stride_4():
+    """Butter on cream cheese: their centroids are 2.4 cm apart, a few pixels in the view; a
+    quarter-resolution grid holds one peak of them, a half-resolution grid two."""
+    from hsgplan.domain.world import OBJECT_TYPES
+
+    types = list(OBJECT_TYPES)
+    low = _keypoints("cream_cheese", 0.45, 0.0, 0.2)
+    high = low.copy()
+    high[:, 1] -= 6.0  # pixels: the upper box, seen just above the lower one
+    kinds = np.array([types.index("butter")] * 2)
+    counts = {}
+    for stride in (4, 2):
+        h, w = CAMERA.height // stride, CAMERA.width // stride
+        beliefs, fields = targets(np.stack([low, high]), kinds, len(types), h, w, stride)
+        found = decode(beliefs, fields, stride)
+        counts[stride] = len(found)
+        if stride == 2:
+            centroids = sorted(f.pixels[8][1] for f in found)
+            assert np.allclose(centroids, sorted([low[8][1], high[8][1]]), atol=0.5)
+    assert counts == {4: 1, 2: 2}

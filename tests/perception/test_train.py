@@ -8,7 +8,7 @@ import torch
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.images import ImagesConfig, collect_images
-from hsgplan.perception.model import STRIDE, load_perception_net
+from hsgplan.perception.model import PerceptionNetConfig, build, load_perception_net
 from hsgplan.perception.synthetic import VIEWS
 from hsgplan.perception.train import PerceptionTrainConfig, train_perception
 
@@ -23,14 +23,11 @@ def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_pat
     train_perception(config, tmp_path / "net", lambda e, loss: losses.append(loss))
     assert len(losses) == 1 and losses[0] > 0
     net, net_config = load_perception_net(tmp_path / "net")
-    ((beliefs, fields),) = net(torch.zeros(1, 3, VIEWS[0].height, VIEWS[0].width))
-    assert beliefs.shape == (
-        1,
-        net_config.beliefs,
-        VIEWS[0].height // STRIDE,
-        VIEWS[0].width // STRIDE,
-    )
-    assert fields.shape[1] == net_config.fields
+    outputs = net(torch.zeros(1, 3, VIEWS[0].height, VIEWS[0].width))
+    assert net_config.stride == 2 and len(outputs) == 2  # the stage, and its refinement
+    for beliefs, fields in outputs:
+        assert beliefs.shape == (1, net_config.beliefs, VIEWS[0].height // 2, VIEWS[0].width // 2)
+        assert fields.shape[1] == net_config.fields
     estimator = PoseEstimator.load(tmp_path / "net")  # the colour network beside it
     assert estimator.colour is not None
     again = []
@@ -41,6 +38,30 @@ def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_pat
             PerceptionTrainConfig(images=str(images), epochs=2, width=4, stages=1),
             tmp_path / "net",
         )
+
+
+def test_a_stride_2_network_starts_from_a_stride_4_one_and_a_bad_stride_is_refused(tmp_path):
+    images = tmp_path / "images"
+    collect_images(ImagesConfig(count=1, chunk=1), images, workers=1)
+    base = PerceptionTrainConfig(
+        images=str(images), epochs=1, batch_size=3, width=4, stages=1, threads=1, stride=4
+    )
+    train_perception(base, tmp_path / "s4")
+    coarse = load_perception_net(tmp_path / "s4")[0]
+    from hsgplan.perception.train import _start_from
+
+    fine = build(PerceptionNetConfig(width=4, stages=1, stride=2))
+    _start_from(fine, coarse)
+    for name, value in coarse.state_dict().items():
+        assert torch.equal(fine.state_dict()[name], value)
+    assert fine.refine is not None
+    wider = build(PerceptionNetConfig(width=8, stages=1, stride=2))
+    with pytest.raises(InvalidInputError, match="more than its stride"):
+        _start_from(wider, coarse)
+    with pytest.raises(InvalidInputError, match="stride 3"):
+        PerceptionNetConfig(stride=3)
+    two = PerceptionTrainConfig(images=f"{images}, {images}", epochs=1, width=4, stages=1)
+    assert two.folders == [images, images]
 
 
 def _one_keypoint():
