@@ -95,9 +95,7 @@ def draw_state(rng: random.Random, p_elsewhere: float = P_ELSEWHERE) -> Symbolic
     return SymbolicSceneGraph.from_literals(objects, literals)
 
 
-def render_sample(
-    seed: int, index: int, p_elsewhere: float = P_ELSEWHERE
-) -> ImageSample | None:
+def render_sample(seed: int, index: int, p_elsewhere: float = P_ELSEWHERE) -> ImageSample | None:
     """The sample `(seed, index)`; None when its arrangement could not be staged."""
     rng = random.Random(f"images-{seed}-{index}")
     state = draw_state(rng, p_elsewhere)

@@ -90,9 +90,7 @@ class Examples:
     ) -> tuple[torch.Tensor, torch.Tensor]:
         """Belief maps and affinity fields of the images `take`: [B, C, h, w], [B, F, h, w]."""
         h, w = self.images.shape[2] // stride, self.images.shape[3] // stride
-        maps = [
-            targets(self.keypoints[i], self.types[i], types_count, h, w, stride) for i in take
-        ]
+        maps = [targets(self.keypoints[i], self.types[i], types_count, h, w, stride) for i in take]
         return (
             torch.from_numpy(np.stack([b for b, _ in maps])),
             torch.from_numpy(np.stack([f for _, f in maps])),
@@ -185,9 +183,7 @@ def train_perception(
     if not parts:
         raise InvalidInputError("no image collection named")
     data = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
-    chunks = [
-        chunk_path(f, r["result"]["chunk"]) for f in config.folders for r in logged_rows(f)
-    ]
+    chunks = [chunk_path(f, r["result"]["chunk"]) for f in config.folders for r in logged_rows(f)]
     start = load_perception_net(Path(config.init))[0] if config.init else None
     data_print = fingerprint(chunks + ([Path(config.init)] if config.init else []))
     training.claim(out, asdict(config))
