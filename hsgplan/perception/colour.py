@@ -30,6 +30,7 @@ from hsgplan.domain.world import OBJECT_TYPES
 
 PATCH = 3  # pixels each side of the centroid's pixel
 FEATURES = 4  # chromaticity r, g, b and brightness
+MIN_REGION = 12  # pixels of an object in sight for their colour to name it
 FOLDER = "colour"
 
 
@@ -79,7 +80,19 @@ def features(image: np.ndarray, pixel: np.ndarray) -> np.ndarray | None:
     if not (0 <= u < w and 0 <= v < h):
         return None
     patch = image[max(0, v - PATCH) : v + PATCH + 1, max(0, u - PATCH) : u + PATCH + 1]
-    mean = patch.reshape(-1, 3).astype(np.float64).mean(axis=0) / 255.0
+    return _described(patch.reshape(-1, 3))
+
+
+def region_features(image: np.ndarray, mask: np.ndarray) -> np.ndarray | None:
+    """The same features over the pixels of `mask` [H, W] (bool) of the image; None when it
+    holds fewer than `MIN_REGION` pixels."""
+    if int(mask.sum()) < MIN_REGION:
+        return None
+    return _described(image[mask])
+
+
+def _described(pixels: np.ndarray) -> np.ndarray:
+    mean = pixels.astype(np.float64).mean(axis=0) / 255.0
     total = max(mean.sum(), 1e-6)
     return np.array([*(mean / total), total / 3], dtype=np.float32)
 

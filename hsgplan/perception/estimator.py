@@ -23,12 +23,13 @@ import torch
 from hsgplan.domain.world import OBJECT_TYPES, TABLE
 from hsgplan.paths import shipped
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
-from hsgplan.perception.colour import ColourNet, features, load_colour
+from hsgplan.perception.colour import ColourNet, features, load_colour, region_features
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
 from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost, upright_fit
 from hsgplan.perception.settle import Ray, meeting_point, same_place, settle
+from hsgplan.perception.visible import painted, visible_masks
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 
@@ -55,6 +56,7 @@ class Detection:
     reprojection_px: float
     rays: tuple[Ray, ...] = ()
     type_confidence: float = 1.0  # the colour network's probability of the type (1: no colour)
+    keypoints: tuple[ViewKeypoints, ...] = ()  # each view's keypoints behind it
 
 
 class PoseEstimator:
@@ -89,12 +91,43 @@ class PoseEstimator:
         if self.colour is None or not rows:
             return members[0].type_index, 1.0
         probs = torch.softmax(self.colour(torch.from_numpy(np.stack(rows))), dim=1).mean(dim=0)
-        kind = OBJECT_TYPES[TYPES[members[0].type_index]].kind
-        same = torch.tensor([OBJECT_TYPES[t].kind is kind for t in TYPES])
-        probs = torch.where(same, probs, torch.zeros_like(probs))
-        probs = probs / probs.sum().clamp(min=1e-12)
-        best = int(probs.argmax())
-        return best, float(probs[best])
+        return _of_kind(probs, TYPES[members[0].type_index])
+
+    def _retyped(
+        self, images: np.ndarray, cameras: tuple[Camera, ...], found: list[Detection]
+    ) -> list[Detection]:
+        """Each detection named again by the colour of the pixels it keeps in sight once every
+        detection is painted where it was found (`perception.visible`), not of its centroid's
+        pixel, which an object on or before it may show; among the types of its kind, and
+        refitted if renamed. One in sight nowhere keeps its name."""
+        assert self.colour is not None
+        types, poses = [d.type_name for d in found], [d.pose for d in found]
+        rows: list[list[np.ndarray]] = [[] for _ in found]
+        for image, camera in zip(images, cameras, strict=True):
+            pinhole = PinholeCamera.of(camera)
+            label = painted(types, poses, pinhole)
+            masks = visible_masks(label, len(found))
+            for i, (mask, pose) in enumerate(zip(masks, poses, strict=True)):
+                u, v = np.round(pinhole.project(np.array([pose.position]))[0]).astype(int)
+                own = 0 <= v < label.shape[0] and 0 <= u < label.shape[1] and label[v, u] == i
+                row = features(image, np.array([u, v])) if own else None
+                if (row := row if own else region_features(image, mask)) is not None:
+                    rows[i].append(row)
+        out = []
+        for d, seen in zip(found, rows, strict=True):
+            if not seen:
+                out.append(d)
+                continue
+            probs = torch.softmax(self.colour(torch.from_numpy(np.stack(seen))), dim=1).mean(0)
+            best, confidence = _of_kind(probs, d.type_name)
+            if TYPES[best] == d.type_name:
+                out.append(replace(d, type_confidence=confidence))
+                continue
+            pose, error = _fitted(TYPES[best], list(d.keypoints), list(d.rays))
+            if pose is not None:
+                d = replace(d, type_name=TYPES[best], pose=pose, reprojection_px=error)
+            out.append(replace(d, type_confidence=confidence))
+        return out
 
     @torch.inference_mode()
     def detect(self, images: np.ndarray, cameras: tuple[Camera, ...]) -> list[Detection]:
@@ -110,12 +143,25 @@ class PoseEstimator:
                 if single is not None:
                     found.append(_Seen(inst.type_index, inst.score, v, seen, single.pose))
         fused = _apart(_fuse(found, lambda members: self._typed(images, members)))
+        if self.colour is not None:
+            fused = _apart(self._retyped(images, cameras, fused))
         if not self.settled:
             return fused
         poses = settle(
             [d.type_name for d in fused], [d.pose for d in fused], [d.rays for d in fused]
         )
         return [replace(d, pose=p) for d, p in zip(fused, poses, strict=True)]
+
+
+def _of_kind(probs: torch.Tensor, type_name: str) -> tuple[int, float]:
+    """The likeliest type of `type_name`'s kind (can or box) by the colour network's
+    probabilities [types], and its probability among that kind's."""
+    kind = OBJECT_TYPES[type_name].kind
+    same = torch.tensor([OBJECT_TYPES[t].kind is kind for t in TYPES])
+    probs = torch.where(same, probs, torch.zeros_like(probs))
+    probs = probs / probs.sum().clamp(min=1e-12)
+    best = int(probs.argmax())
+    return best, float(probs[best])
 
 
 @dataclass(frozen=True)
@@ -151,23 +197,35 @@ def _fuse(found: list[_Seen], typed: Callable[[list[_Seen]], tuple[int, float]])
         used.update(id(s) for s in members)
         kind, confidence = typed(members)
         name = TYPES[kind]
-        fused = estimate_pose(name, [s.keypoints for s in members])
-        if fused is None:
-            continue
-        rays = tuple(_ray(s) for s in members)
+        rays = [_ray(s) for s in members]
         views = [s.keypoints for s in members]
-        pose = fused.pose
-        if len(rays) > 1:  # the centroid where the views' lines of sight meet
-            pose = Pose(tuple(map(float, meeting_point(rays))), pose.orientation)
-        # Objects here rest upright: the best upright yaw, unless a free pose explains the
-        # keypoints better (a toppled object).
-        level = upright_fit(name, views, pose.position)
-        if robust_cost(name, views, level) <= robust_cost(name, views, pose):
-            pose = level
-        points = sum(int((~np.isnan(v.pixels).any(axis=1)).sum()) for v in views)
-        error = math.sqrt(robust_cost(name, views, pose) / max(points, 1))
-        out.append(Detection(name, pose, first.score, len(members), error, rays, confidence))
+        pose, error = _fitted(name, views, rays)
+        if pose is None:
+            continue
+        out.append(
+            Detection(
+                name, pose, first.score, len(members), error, tuple(rays), confidence, tuple(views)
+            )
+        )
     return out
+
+
+def _fitted(name: str, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[Pose | None, float]:
+    """The pose of an object of type `name` from the keypoints of the views that saw it, and
+    its RMS reprojection error (pixels); None if PnP finds none."""
+    fused = estimate_pose(name, views)
+    if fused is None:
+        return None, math.inf
+    pose = fused.pose
+    if len(rays) > 1:  # the centroid where the views' lines of sight meet
+        pose = Pose(tuple(map(float, meeting_point(rays))), pose.orientation)
+    # Objects here rest upright: the best upright yaw, unless a free pose explains the
+    # keypoints better (a toppled object).
+    level = upright_fit(name, views, pose.position)
+    if robust_cost(name, views, level) <= robust_cost(name, views, pose):
+        pose = level
+    points = sum(int((~np.isnan(v.pixels).any(axis=1)).sum()) for v in views)
+    return pose, math.sqrt(robust_cost(name, views, pose) / max(points, 1))
 
 
 def _apart(detections: list[Detection]) -> list[Detection]:

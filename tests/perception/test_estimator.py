@@ -24,6 +24,8 @@ TYPES = list(OBJECT_TYPES)
 class _TrueMaps(torch.nn.Module):
     """Outputs the true maps of a sample's views, whatever the images."""
 
+    stride = STRIDE
+
     def __init__(self, sample) -> None:
         super().__init__()
         views, height, width = sample.images.shape[:3]

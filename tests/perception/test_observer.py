@@ -75,6 +75,8 @@ def test_an_object_that_stayed_is_known_by_where_it_is_whatever_type_f_p_named()
 class _SceneMaps(torch.nn.Module):
     """Outputs the true maps of the scene it is given (every object, hidden or not)."""
 
+    stride = STRIDE
+
     def __init__(self) -> None:
         super().__init__()
         self.scene = None

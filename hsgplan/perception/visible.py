@@ -1,0 +1,59 @@
+"""Which pixels of a view show which detected object: the detections' cuboids painted far to
+near (the painter's algorithm), face by face.
+
+The colour network names a type from the colour around the centroid's pixel. Where another
+object stands on or in front of the detected one, that pixel shows the other object: a cream
+cheese under a butter shows the butter's yellow there, and was named butter (7 of the 28
+objects missing from the scene graphs of 100 tuning scenes, seed 2, were named so; 3 with
+this module). Painted from the estimated poses, the pixels each detection keeps in sight are
+where its own colour is; where its centroid's pixel is its own, that pixel's patch, which is
+what the colour network was trained on, still names it (the region's mean named a few soups
+cherries).
+
+Cuboids are shrunk across (`SHRINK`) before painting: a can fills only the middle of its
+cuboid, and an estimate is off by a few millimetres; what is left is eroded by a pixel.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import cv2
+import numpy as np
+
+from hsgplan.domain.objects import object_type
+from hsgplan.perception.keypoints import PinholeCamera
+from hsgplan.scene_graph.geometry import Pose
+
+SHRINK = 0.8  # of a cuboid's footprint painted
+
+
+def painted(types: list[str], poses: list[Pose], camera: PinholeCamera) -> np.ndarray:
+    """Which object (its index; -1 for none) each pixel shows, as painted: [H, W] int32."""
+    label = np.full((camera.height, camera.width), -1, dtype=np.int32)
+    faces = []
+    for i, (t, pose) in enumerate(zip(types, poses, strict=True)):
+        sx, sy, sz = object_type(t).size
+        half = np.array([SHRINK * sx / 2, SHRINK * sy / 2, sz / 2])
+        local = np.array(list(itertools.product((-1, 1), repeat=3)), dtype=np.float64) * half
+        m = pose.matrix()
+        corners = local @ m[:3, :3].T + m[:3, 3]
+        for axis, sign in itertools.product(range(3), (-1, 1)):
+            quad = corners[local[:, axis] * sign > 0]
+            centre = quad.mean(axis=0)
+            if (centre - m[:3, 3]) @ (camera.eye - centre) <= 0:
+                continue  # faces away from the camera
+            faces.append((float(np.linalg.norm(camera.eye - centre)), i, quad))
+    for _, i, quad in sorted(faces, key=lambda f: -f[0]):
+        if (camera.to_camera(quad)[:, 2] <= 0).any():
+            continue  # behind the camera
+        hull = cv2.convexHull(np.round(camera.project(quad)).astype(np.int32))
+        cv2.fillConvexPoly(label, hull, i)
+    return label
+
+
+def visible_masks(label: np.ndarray, count: int) -> list[np.ndarray]:
+    """Each of `count` objects' pixels in sight in a painted view, less a pixel around: N bool
+    masks [H, W]."""
+    kernel = np.ones((3, 3), np.uint8)
+    return [cv2.erode((label == i).astype(np.uint8), kernel).astype(bool) for i in range(count)]

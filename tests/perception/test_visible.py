@@ -1,0 +1,70 @@
+"""Detections painted where they were found: an object on another hides the lower one's
+centroid from a camera above, not the lower one's side; and a detection is named by the colour
+of what it keeps in sight, not of what hides its centroid."""
+
+import numpy as np
+import torch
+
+from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.perception.colour import MIN_REGION
+from hsgplan.perception.estimator import Detection, PoseEstimator
+from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
+from hsgplan.perception.pnp import ViewKeypoints
+from hsgplan.perception.synthetic import VIEWS
+from hsgplan.perception.visible import painted, visible_masks
+from hsgplan.scene_graph.geometry import Pose
+
+TYPES = list(OBJECT_TYPES)
+LOWER = Pose.from_xyz_yaw(0.45, 0.1, 0.012, 0.3)  # a thin box on the table
+UPPER = Pose.from_xyz_yaw(0.45, 0.1, 0.036, 0.3)  # another on it
+
+
+def _pixel(camera: PinholeCamera, pose: Pose) -> tuple[int, int]:
+    u, v = np.round(camera.project(np.array([pose.position]))[0]).astype(int)
+    return int(u), int(v)
+
+
+def test_the_upper_box_hides_the_lower_ones_centroid_but_not_its_side():
+    camera = PinholeCamera.of(VIEWS[0])
+    label = painted(["cream_cheese", "butter"], [LOWER, UPPER], camera)
+    u, v = _pixel(camera, LOWER)
+    assert label[v, u] == 1  # the butter is what that pixel shows
+    lower, upper = visible_masks(label, 2)
+    assert lower.sum() >= MIN_REGION and upper.sum() > lower.sum()
+    assert not (lower & upper).any()
+    alone = painted(["cream_cheese"], [LOWER], camera)
+    assert alone[v, u] == 0
+
+
+class _NearestColour(torch.nn.Module):
+    """Type logits: how near the chromaticity is to each type's own colour."""
+
+    def forward(self, x):
+        rgb = torch.tensor([OBJECT_TYPES[t].color[:3] for t in TYPES])
+        chroma = rgb / rgb.sum(dim=1, keepdim=True)
+        return -100 * torch.cdist(x[:, :3], chroma)
+
+
+def _detection(name: str, pose: Pose) -> Detection:
+    seen = tuple(
+        ViewKeypoints(PinholeCamera.of(c), view_keypoints(name, pose, PinholeCamera.of(c)))
+        for c in VIEWS
+    )
+    return Detection(name, pose, 1.0, len(VIEWS), 0.0, (), 0.5, seen)
+
+
+def test_a_box_under_another_is_named_by_the_colour_of_its_side_in_sight():
+    types, poses = ["cream_cheese", "butter"], [LOWER, UPPER]
+    images = []
+    for camera in VIEWS:  # each painted pixel in its object's colour, the rest grey
+        label = painted(types, poses, PinholeCamera.of(camera))
+        image = np.full((camera.height, camera.width, 3), 128, dtype=np.uint8)
+        for i, t in enumerate(types):
+            image[label == i] = np.array(OBJECT_TYPES[t].color[:3]) * 255
+        images.append(image)
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    # both named butter, as the colour at the lower one's centroid says
+    found = [_detection("butter", LOWER), _detection("butter", UPPER)]
+    named = estimator._retyped(np.stack(images), VIEWS, found)
+    assert [d.type_name for d in named] == types
+    assert np.allclose(named[0].pose.position, LOWER.position, atol=0.005)
