@@ -96,10 +96,11 @@ class PoseEstimator:
     def _retyped(
         self, images: np.ndarray, cameras: tuple[Camera, ...], found: list[Detection]
     ) -> list[Detection]:
-        """Each detection named again by the colour of the pixels it keeps in sight once every
-        detection is painted where it was found (`perception.visible`), not of its centroid's
-        pixel, which an object on or before it may show; among the types of its kind, and
-        refitted if renamed. One in sight nowhere keeps its name."""
+        """Each detection named again, in the views that found it, by the colour of the pixels
+        it keeps in sight once every detection is painted where it was found
+        (`perception.visible`) where an object on or before it hides its centroid's pixel (else
+        by that pixel's patch, as before); among the types of its kind, and refitted if
+        renamed. One in sight nowhere keeps its name."""
         assert self.colour is not None
         types, poses = [d.type_name for d in found], [d.pose for d in found]
         rows: list[list[np.ndarray]] = [[] for _ in found]
@@ -107,11 +108,13 @@ class PoseEstimator:
             pinhole = PinholeCamera.of(camera)
             label = painted(types, poses, pinhole)
             masks = visible_masks(label, len(found))
-            for i, (mask, pose) in enumerate(zip(masks, poses, strict=True)):
-                u, v = np.round(pinhole.project(np.array([pose.position]))[0]).astype(int)
+            for i, (d, mask) in enumerate(zip(found, masks, strict=True)):
+                if not any(np.allclose(k.camera.eye, pinhole.eye) for k in d.keypoints):
+                    continue  # a view that did not find it: a phantom's pixels there are not its
+                u, v = np.round(pinhole.project(np.array([d.pose.position]))[0]).astype(int)
                 own = 0 <= v < label.shape[0] and 0 <= u < label.shape[1] and label[v, u] == i
-                row = features(image, np.array([u, v])) if own else None
-                if (row := row if own else region_features(image, mask)) is not None:
+                row = features(image, np.array([u, v])) if own else region_features(image, mask)
+                if row is not None:
                     rows[i].append(row)
         out = []
         for d, seen in zip(found, rows, strict=True):
