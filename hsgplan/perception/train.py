@@ -50,7 +50,7 @@ class PerceptionTrainConfig:
     batch_size: int = setting(16, lo=1, hi=4096)
     width: int = setting(24, lo=1, hi=512)
     stages: int = setting(2, lo=1, hi=6)
-    stride: int = setting(2, lo=2, hi=4)  # see `perception.model`: 2 or 4
+    stride: int = setting(4, lo=2, hi=4)  # see `perception.model`: 4, or 2 (not trained yet)
     save_every: int = setting(1, lo=1, hi=10_000)
     threads: int = setting(2, lo=1, hi=MAX_WORKERS)
     # A trained checkpoint folder whose weights start the network (a stride-2 network from a

@@ -17,7 +17,7 @@ def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_pat
     images = tmp_path / "images"
     collect_images(ImagesConfig(count=2, chunk=2), images, workers=1)
     config = PerceptionTrainConfig(
-        images=str(images), epochs=1, batch_size=3, width=4, stages=1, threads=1
+        images=str(images), epochs=1, batch_size=3, width=4, stages=1, threads=1, stride=2
     )
     losses = []
     train_perception(config, tmp_path / "net", lambda e, loss: losses.append(loss))
@@ -35,7 +35,7 @@ def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_pat
     assert again == []
     with pytest.raises(InvalidInputError, match="another configuration"):
         train_perception(
-            PerceptionTrainConfig(images=str(images), epochs=2, width=4, stages=1),
+            PerceptionTrainConfig(images=str(images), epochs=2, width=4, stages=1, stride=2),
             tmp_path / "net",
         )
 
