@@ -179,12 +179,12 @@ def train_perception(
     the colour network that names types (`perception.colour`) into `out/colour/` (seconds);
     `on_batch` sees (images done this epoch, images in an epoch) after every batch."""
     config.net_config()  # a stride the network does not have: refused before any write
+    start = load_perception_net(Path(config.init))[0] if config.init else None
     parts = [load_chunks(f) for f in config.folders]  # missing or damaged: refused, too
     if not parts:
         raise InvalidInputError("no image collection named")
     data = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     chunks = [chunk_path(f, r["result"]["chunk"]) for f in config.folders for r in logged_rows(f)]
-    start = load_perception_net(Path(config.init))[0] if config.init else None
     data_print = fingerprint(chunks + ([Path(config.init)] if config.init else []))
     training.claim(out, asdict(config))
     found = examples(data)
