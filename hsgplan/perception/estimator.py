@@ -6,7 +6,9 @@ Estimates of one type from different views whose centroids' lines of sight pass 
 `RAY_GAP` of one another, at a point on the table, are one object (a single view's depth is its
 weak axis, so views are matched by their rays, not by their poses): its pose
 is refitted to the keypoints of every view that saw it (`perception.pnp.estimate_pose`), as the
-paper fuses its robot's viewpoints. Last, the poses are made to rest on what is under them
+paper fuses its robot's viewpoints. The colour network names each object's type; one whose
+centroid's pixel another detection hides is named again by the pixels it keeps in sight
+(`perception.visible`). Last, the poses are made to rest on what is under them
 (`perception.settle`), unless asked for raw.
 """
 
