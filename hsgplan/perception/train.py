@@ -179,7 +179,10 @@ def train_perception(
     the colour network that names types (`perception.colour`) into `out/colour/` (seconds);
     `on_batch` sees (images done this epoch, images in an epoch) after every batch."""
     config.net_config()  # a stride the network does not have: refused before any write
-    start = load_perception_net(Path(config.init))[0] if config.init else None
+    torch.manual_seed(config.seed)
+    model = build(config.net_config())
+    if config.init:  # one that does not fit: refused before any write
+        _start_from(model, load_perception_net(Path(config.init))[0])
     parts = [load_chunks(f) for f in config.folders]  # missing or damaged: refused, too
     if not parts:
         raise InvalidInputError("no image collection named")
@@ -191,7 +194,7 @@ def train_perception(
     if len(found.images) == 0:
         raise InvalidInputError(f"no images in '{config.images}'")
     if not training.finished(out):
-        _train_keypoints(config, found, out, data_print, start, on_epoch, on_batch)
+        _train_keypoints(config, model, found, out, data_print, on_epoch, on_batch)
     train_colour(colour_samples(found), out / COLOUR_FOLDER, ColourConfig(seed=config.seed))
 
 
@@ -219,19 +222,15 @@ def _start_from(model: torch.nn.Module, trained: torch.nn.Module) -> None:
 
 def _train_keypoints(
     config: PerceptionTrainConfig,
+    model: torch.nn.Module,
     found: Examples,
     out: Path,
     data_print: str,
-    start_from: torch.nn.Module | None,
     on_epoch: Callable[[int, float], None] | None,
     on_batch: Callable[[int, int], None] | None,
 ) -> None:
     net_config = config.net_config()
     torch.set_num_threads(config.threads)
-    torch.manual_seed(config.seed)
-    model = build(net_config)
-    if start_from is not None:
-        _start_from(model, start_from)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start = training.resume(out, model, optim, data_print)
     for epoch in range(start, config.epochs):
