@@ -31,6 +31,7 @@ from hsgplan.domain.world import OBJECT_TYPES
 PATCH = 3  # pixels each side of the centroid's pixel
 FEATURES = 4  # chromaticity r, g, b and brightness
 MIN_REGION = 12  # pixels of an object in sight for their colour to name it
+MIN_VOTES = 6  # of them named a type of the object's kind, for `pixel_vote` to say
 FOLDER = "colour"
 
 
@@ -83,12 +84,28 @@ def features(image: np.ndarray, pixel: np.ndarray) -> np.ndarray | None:
     return _described(patch.reshape(-1, 3))
 
 
-def region_features(image: np.ndarray, mask: np.ndarray) -> np.ndarray | None:
-    """The same features over the pixels of `mask` [H, W] (bool) of the image; None when it
-    holds fewer than `MIN_REGION` pixels."""
+def pixel_vote(
+    colour: ColourNet, image: np.ndarray, mask: np.ndarray, allowed: torch.Tensor
+) -> torch.Tensor | None:
+    """The colour network's mean probabilities [types] over the pixels of `mask` [H, W] (bool)
+    that it names one of the `allowed` types [types] (bool), each pixel on its own; None when
+    the mask holds fewer than `MIN_REGION` pixels, or fewer than `MIN_VOTES` are so named.
+
+    A region painted from estimated poses holds pixels of what hides it too, and a mean of two
+    colours can be a third type's: the orange of a soup and the green of a cream cheese under it
+    average to a butter's yellow. Each pixel named on its own, those of another kind left out,
+    names the cream cheese (3 of 8 such misnamed objects on 100 tuning scenes, seed 2)."""
     if int(mask.sum()) < MIN_REGION:
         return None
-    return _described(image[mask])
+    pixels = image[mask].astype(np.float64) / 255.0
+    total = np.maximum(pixels.sum(axis=1, keepdims=True), 1e-6)
+    rows = np.concatenate([pixels / total, total / 3], axis=1).astype(np.float32)
+    with torch.no_grad():
+        probs = torch.softmax(colour(torch.from_numpy(rows)), dim=1)
+    votes = allowed[probs.argmax(dim=1)]
+    if int(votes.sum()) < MIN_VOTES:
+        return None
+    return probs[votes].mean(dim=0)
 
 
 def _described(pixels: np.ndarray) -> np.ndarray:
