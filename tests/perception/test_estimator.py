@@ -5,18 +5,21 @@ scores it. (The trained network's quality is measured by `hsgplan eval-perceptio
 import math
 
 import numpy as np
+import pytest
 import torch
+from scipy.spatial.transform import Rotation
 
 from hsgplan.domain.objects import type_of
 from hsgplan.domain.world import OBJECT_TYPES
-from hsgplan.perception.estimator import PoseEstimator
+from hsgplan.perception.estimator import PoseEstimator, _fitted, _of_kind
 from hsgplan.perception.evaluate import rotation_error, score_scene, summary
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
+from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.model import STRIDE
-from hsgplan.perception.synthetic import render_sample
+from hsgplan.perception.synthetic import VIEWS, render_sample
 from hsgplan.perception.train import MIN_VISIBLE
-from hsgplan.scene_graph.geometry import Pose
+from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
 
 TYPES = list(OBJECT_TYPES)
 
@@ -76,3 +79,31 @@ def test_rotation_error_counts_a_cuboid_symmetry_as_no_error():
         abs(rotation_error("butter", upright, Pose.from_xyz_yaw(0.5, 0, 0.02, 0.5)) - 11.46) < 0.1
     )
     assert rotation_error("cherries", upright, Pose.from_xyz_yaw(0.5, 0, 0.02, 2.0)) < 1e-4
+
+
+def test_a_box_whose_rays_meet_a_centimetre_over_the_table_is_named_a_thin_one():
+    probs = torch.tensor([0.0, 0.0, 0.0, 0.5, 0.3, 0.2])  # the colour says popcorn
+    assert TYPES[_of_kind(probs, "popcorn")[0]] == "popcorn"
+    low = np.array([0.5, 0.0, 0.012])
+    best, confidence = _of_kind(probs, "popcorn", low)
+    assert TYPES[best] == "cream_cheese" and confidence == pytest.approx(0.6)
+    assert TYPES[_of_kind(probs, "popcorn", np.array([0.5, 0.0, 0.063]))[0]] == "popcorn"
+
+
+def _views_of(name: str, pose: Pose) -> list[ViewKeypoints]:
+    cameras = [PinholeCamera.of(c) for c in VIEWS]
+    return [ViewKeypoints(c, view_keypoints(name, pose, c)) for c in cameras]
+
+
+def test_an_object_on_its_side_stays_toppled_and_a_noisy_upright_one_stands():
+    on_side = Pose(
+        (0.5, 0.1, 0.0355), matrix_to_quat(Rotation.from_euler("x", 90, degrees=True).as_matrix())
+    )
+    pose, error = _fitted("alphabet_soup", _views_of("alphabet_soup", on_side), [])
+    assert pose is not None and abs(pose.rotation[2, 2]) < 0.1 and error < 1.0
+    upright = Pose.from_xyz_yaw(0.45, -0.1, 0.012, 0.4)
+    views = _views_of("butter", upright)
+    noise = np.random.default_rng(0).normal(0, 1.5, size=(len(views), 9, 2))
+    noisy = [ViewKeypoints(v.camera, v.pixels + n) for v, n in zip(views, noise, strict=True)]
+    pose, _ = _fitted("butter", noisy, [])
+    assert pose is not None and pose.rotation[2, 2] == pytest.approx(1.0)

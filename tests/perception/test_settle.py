@@ -8,7 +8,7 @@ import pytest
 
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.world import SHELF_TOP_Z
-from hsgplan.perception.settle import settle, upright
+from hsgplan.perception.settle import NEAR_TOPS, fits_height, settle, upright
 from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
 
 
@@ -95,3 +95,33 @@ def test_where_rays_meet():
         d = point - np.array(eye)
         rays.append((np.array(eye), d / np.linalg.norm(d)))
     assert np.allclose(meeting_point(rays), point)
+
+
+def test_between_two_near_tops_the_keypoints_choose():
+    butter = Pose.from_xyz_yaw(0.5, 0.0, _half("butter"), 0.0)
+    top = 2 * _half("butter")
+    # a soup found 1.3 cm low on the butter: its bottom is nearer the table than the butter's top
+    low = Pose.from_xyz_yaw(0.5, 0.0, top + _half("alphabet_soup") - 0.013, 0.0)
+    types = ["butter", "alphabet_soup"]
+    assert settle(types, [butter, low])[1].position[2] == pytest.approx(_half("alphabet_soup"))
+    on_butter = top + _half("alphabet_soup")
+
+    def cost(centre):  # the views saw it on the butter
+        return abs(centre[2] - on_butter)
+
+    rests = settle(types, [butter, low], None, [lambda c: 0.0, cost])[1]
+    assert rests.position[2] == pytest.approx(on_butter)
+    # a top farther than `NEAR_TOPS` from its bottom is not a candidate, whatever the cost
+    far = Pose.from_xyz_yaw(0.5, 0.0, _half("alphabet_soup") - NEAR_TOPS / 2, 0.0)
+    rests = settle(types, [butter, far], None, [lambda c: 0.0, cost])[1]
+    assert rests.position[2] == pytest.approx(_half("alphabet_soup"))
+
+
+def test_a_centre_a_centimetre_over_the_table_is_no_popcorn():
+    thin = np.array([0.5, 0.0, _half("butter")])
+    assert fits_height("butter", thin) and fits_height("cream_cheese", thin)
+    assert not fits_height("popcorn", thin) and not fits_height("alphabet_soup", thin)
+    assert fits_height("popcorn", np.array([0.5, 0.0, 2 * _half("butter") + _half("popcorn")]))
+    on_shelf = np.array([0.49, 0.38, SHELF_TOP_Z + _half("butter")])
+    assert fits_height("butter", on_shelf) and not fits_height("popcorn", on_shelf)
+    assert fits_height("popcorn", np.array([1.4, 0.0, 0.01]))  # over no surface: no say

@@ -6,7 +6,7 @@ import numpy as np
 import torch
 
 from hsgplan.domain.world import OBJECT_TYPES
-from hsgplan.perception.colour import MIN_REGION
+from hsgplan.perception.colour import MIN_REGION, features, pixel_vote
 from hsgplan.perception.estimator import Detection, PoseEstimator
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.pnp import ViewKeypoints
@@ -68,3 +68,19 @@ def test_a_box_under_another_is_named_by_the_colour_of_its_side_in_sight():
     named = estimator._retyped(np.stack(images), VIEWS, found)
     assert [d.type_name for d in named] == types
     assert np.allclose(named[0].pose.position, LOWER.position, atol=0.005)
+
+
+def test_a_region_half_hidden_by_a_soup_is_named_by_its_own_pixels_not_their_mean():
+    soup, cheese = OBJECT_TYPES["tomato_soup"].color[:3], OBJECT_TYPES["cream_cheese"].color[:3]
+    image = np.zeros((4, 10, 3), dtype=np.uint8)
+    image[:, :5] = np.array(soup) * 255
+    image[:, 5:] = np.array(cheese) * 255
+    mask = np.ones((4, 10), dtype=bool)
+    boxes = torch.tensor([OBJECT_TYPES[t].kind is OBJECT_TYPES["butter"].kind for t in TYPES])
+    colour = _NearestColour()
+    mean = colour(torch.from_numpy(features(image, np.array([5, 2]))[None]))[0]
+    assert TYPES[int(torch.where(boxes, mean, -torch.inf).argmax())] == "butter"  # the mixture
+    vote = pixel_vote(colour, image, mask, boxes)
+    assert vote is not None and TYPES[int(vote.argmax())] == "cream_cheese"
+    assert pixel_vote(colour, image, mask & (np.arange(10) < 5), boxes) is None  # no box pixels
+    assert pixel_vote(colour, image[:1, :6], mask[:1, :6], boxes) is None  # too few pixels

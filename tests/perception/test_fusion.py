@@ -1,0 +1,53 @@
+"""Instances from several views grouped into objects by their lines of sight: each object
+once with one instance per view, and a strong instance whose ray passes near another object's
+does not take that object's instance from it."""
+
+import numpy as np
+
+from hsgplan.perception.fusion import RAY_GAP, Seen, grouped, line_of_sight, ray_gap
+from hsgplan.perception.keypoints import PinholeCamera
+from hsgplan.perception.pnp import ViewKeypoints
+from hsgplan.perception.synthetic import VIEWS
+from hsgplan.scene_graph.geometry import Pose
+
+CAMERAS = [PinholeCamera.of(c) for c in VIEWS]
+
+
+def _seen(point, view: int, score: float, type_index: int = 0) -> Seen:
+    camera = CAMERAS[view]
+    pixels = np.full((9, 2), np.nan)
+    pixels[-1] = camera.project(np.array([point]))[0]
+    return Seen(type_index, score, view, ViewKeypoints(camera, pixels), Pose(tuple(point)))
+
+
+def test_two_objects_seen_by_three_views_are_two_groups_of_three():
+    a, b = (0.45, 0.10, 0.03), (0.60, -0.15, 0.03)
+    found = [_seen(p, v, 0.5 + 0.1 * v) for p in (a, b) for v in range(3)]
+    groups = grouped(found)
+    assert len(groups) == 2
+    for g in groups:
+        assert sorted(s.view for s in g) == [0, 1, 2]
+        assert len({tuple(s.pose.position) for s in g}) == 1  # one object's instances
+        assert [s.score for s in g] == sorted((s.score for s in g), reverse=True)
+
+
+def test_a_strong_phantom_near_an_objects_line_of_sight_does_not_take_its_instance():
+    real = np.array([0.50, 0.05, 0.03])
+    origin, direction = line_of_sight(_seen(real, 1, 0.5))
+    # a point on view 1's ray to the object, 8 cm farther along it and 1 cm to the side
+    side = np.cross(direction, [0.0, 0.0, 1.0])
+    ghost = origin + direction * (np.linalg.norm(real - origin) + 0.08)
+    ghost = ghost + 0.01 * side / np.linalg.norm(side)
+    phantom = _seen(ghost, 0, 0.9)  # stronger than anything else
+    found = [phantom, _seen(real, 0, 0.6), _seen(real, 1, 0.5)]
+    assert ray_gap(phantom, found[2]) < RAY_GAP  # the greedy rule would have paired them
+    groups = grouped(found)
+    assert [len(g) for g in groups] == [1, 2]
+    assert groups[0][0] is phantom
+    assert {s.view for s in groups[1]} == {0, 1}
+
+
+def test_instances_of_different_types_or_of_one_view_are_never_one_object():
+    p = (0.45, 0.0, 0.03)
+    assert [len(g) for g in grouped([_seen(p, 0, 0.9, 0), _seen(p, 1, 0.8, 1)])] == [1, 1]
+    assert [len(g) for g in grouped([_seen(p, 0, 0.9), _seen(p, 0, 0.8)])] == [1, 1]
