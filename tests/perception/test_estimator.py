@@ -15,8 +15,8 @@ from hsgplan.perception.estimator import PoseEstimator, _fitted, _of_kind
 from hsgplan.perception.evaluate import rotation_error, score_scene, summary
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
-from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.model import STRIDE
+from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.synthetic import VIEWS, render_sample
 from hsgplan.perception.train import MIN_VISIBLE
 from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
