@@ -74,7 +74,7 @@ def settle(
     types: list[str],
     poses: list[Pose],
     rays: list[tuple[Ray, ...]] | None = None,
-    costs: list[Callable[[np.ndarray], float]] | None = None,
+    costs: list[Callable[[np.ndarray], float] | None] | None = None,
 ) -> list[Pose]:
     """Each pose (of an object of `types[i]`, seen along `rays[i]` if given) made to rest,
     lowest first (see the module); `costs[i]`, if given, says how badly the estimate's pose
@@ -115,7 +115,7 @@ def same_place(a: str, pa: Pose, b: str, pb: Pose) -> bool:
 
 def _tops(x: float, y: float, carriers: list[tuple[str, Pose]]) -> list[float]:
     """The heights of the surfaces and carriers' top faces under (x, y)."""
-    return _surfaces(x, y) + [
+    return surfaces_under(x, y) + [
         p.position[2] + object_type(t).size[2] / 2 for t, p in carriers if _on_top_face(x, y, t, p)
     ]
 
@@ -124,7 +124,7 @@ def fits_height(type_name: str, centre: np.ndarray) -> bool:
     """Whether an object of `type_name` could have its centre at `centre` [3] (where several
     views' rays meet), standing on the highest surface under it: no more than `SINK` lower
     than half its height over that surface. True over no surface."""
-    tops = [t for t in _surfaces(centre[0], centre[1]) if t <= centre[2]]
+    tops = [t for t in surfaces_under(centre[0], centre[1]) if t <= centre[2]]
     if not tops:
         return True
     return bool(centre[2] >= max(tops) + object_type(type_name).size[2] / 2 - SINK)
@@ -175,7 +175,8 @@ def _along_ray(
     return min(candidates, key=lambda p: float(np.linalg.norm(p - centre)))
 
 
-def _surfaces(x: float, y: float) -> list[float]:
+def surfaces_under(x: float, y: float) -> list[float]:
+    """The heights of the table's and the shelves' top faces under (x, y)."""
     tops = [TABLE.z] if TABLE.contains(x, y, EDGE) else []
     return tops + [s.top.z for s in SHELVES.values() if s.top.contains(x, y, EDGE)]
 

@@ -2,7 +2,10 @@
 centroid from a camera above, not the lower one's side; and a detection is named by the colour
 of what it keeps in sight, not of what hides its centroid."""
 
+from dataclasses import replace
+
 import numpy as np
+import pytest
 import torch
 
 from hsgplan.domain.world import OBJECT_TYPES
@@ -84,3 +87,37 @@ def test_a_region_half_hidden_by_a_soup_is_named_by_its_own_pixels_not_their_mea
     assert vote is not None and TYPES[int(vote.argmax())] == "cream_cheese"
     assert pixel_vote(colour, image, mask & (np.arange(10) < 5), boxes) is None  # no box pixels
     assert pixel_vote(colour, image[:1, :6], mask[:1, :6], boxes) is None  # too few pixels
+
+
+def _blob(name: str, z: float) -> Detection:
+    """A detection where several views' rays meet at (LOWER's x, y, z)."""
+    centre = np.array([*LOWER.position[:2], z])
+    rays = tuple(
+        (np.array(c.eye), (centre - c.eye) / np.linalg.norm(centre - c.eye)) for c in VIEWS
+    )
+    at = Pose(tuple(centre), LOWER.orientation)
+    return replace(_detection(name, at), rays=rays)
+
+
+def test_two_thin_boxes_seen_as_one_are_split_and_each_named_by_its_colour():
+    types, poses = ["cream_cheese", "butter"], [LOWER, UPPER]
+    images = []
+    for camera in VIEWS:
+        label = painted(types, poses, PinholeCamera.of(camera))
+        image = np.full((camera.height, camera.width, 3), 128, dtype=np.uint8)
+        for i, t in enumerate(types):
+            image[label == i] = np.array(OBJECT_TYPES[t].color[:3]) * 255
+        images.append(image)
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    height = OBJECT_TYPES["butter"].size[2]
+    blob = _blob("butter", height)  # half-way up the stack: a box's height over the table
+    split = estimator._unstacked(np.stack(images), VIEWS, [blob])
+    assert [d.type_name for d in split] == types and all(d.stacked for d in split)
+    assert [d.pose.position[2] for d in split] == pytest.approx([height / 2, 3 * height / 2])
+    # a lone box's height, a popcorn, or a box with something found under it: no stack
+    alone = _blob("butter", height / 2)
+    assert estimator._unstacked(np.stack(images), VIEWS, [alone]) == [alone]
+    tall = _blob("popcorn", height)
+    assert estimator._unstacked(np.stack(images), VIEWS, [tall]) == [tall]
+    under = _blob("cream_cheese", height / 2)
+    assert estimator._unstacked(np.stack(images), VIEWS, [under, blob]) == [under, blob]
