@@ -6,9 +6,9 @@ object stands on or in front of the detected one, that pixel shows the other obj
 cheese under a butter shows the butter's yellow there, and was named butter (7 of the 28
 objects missing from the scene graphs of 100 tuning scenes, seed 2, were named so; 3 with
 this module). Painted from the estimated poses, the pixels each detection keeps in sight are
-where its own colour is; where its centroid's pixel is its own, that pixel's patch, which is
-what the colour network was trained on, still names it (the region's mean named a few soups
-cherries).
+where its own colour is, and a vote of them names it (`colour.pixel_vote`); where its
+centroid's pixel is its own, that pixel's patch, which is what the colour network was trained
+on, still names it (the region's colour everywhere named a few soups cherries).
 
 Cuboids are shrunk across (`SHRINK`) before painting: a can fills only the middle of its
 cuboid, and an estimate is off by a few millimetres; what is left is eroded by a pixel.

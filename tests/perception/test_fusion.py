@@ -51,3 +51,28 @@ def test_instances_of_different_types_or_of_one_view_are_never_one_object():
     p = (0.45, 0.0, 0.03)
     assert [len(g) for g in grouped([_seen(p, 0, 0.9, 0), _seen(p, 1, 0.8, 1)])] == [1, 1]
     assert [len(g) for g in grouped([_seen(p, 0, 0.9), _seen(p, 0, 0.8)])] == [1, 1]
+
+
+def test_a_pair_of_rays_to_two_objects_does_not_break_up_an_object_every_view_saw():
+    top = np.array([0.45, 0.25, 0.18])  # seen by all three views
+    eye0, eye1 = CAMERAS[0].eye, CAMERAS[1].eye
+    ghost = top + 0.1 * (eye0 - top) / np.linalg.norm(eye0 - top)  # on view 0's ray to it
+    ray = (ghost - eye1) / np.linalg.norm(ghost - eye1)
+    below = ghost + ray * 0.12  # another object, 12 cm on along view 1's ray through it
+
+    def nudged(s: Seen, du: float) -> Seen:  # a pixel off: the object's own rays miss a little
+        pixels = s.keypoints.pixels.copy()
+        pixels[-1, 0] += du
+        return Seen(
+            s.type_index, s.score, s.view, ViewKeypoints(s.keypoints.camera, pixels), s.pose
+        )
+
+    t0, t1, t2 = (
+        _seen(top, 0, 0.9),
+        nudged(_seen(top, 1, 0.8), 1.0),
+        nudged(_seen(top, 2, 0.7), -1.0),
+    )
+    b1, b2 = _seen(below, 1, 0.6), _seen(below, 2, 0.5)
+    assert ray_gap(t0, b1) < ray_gap(t0, t1) < RAY_GAP  # the closest pair is a ghost
+    groups = grouped([t0, t1, t2, b1, b2])
+    assert [{id(s) for s in g} for g in groups] == [{id(t0), id(t1), id(t2)}, {id(b1), id(b2)}]
