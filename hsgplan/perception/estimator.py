@@ -15,7 +15,7 @@ keeps in sight (`perception.visible`). Last, the poses are made to rest on what 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -24,7 +24,7 @@ import numpy as np
 import torch
 
 from hsgplan.domain.objects import object_type
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.world import OBJECT_TYPES, TABLE
 from hsgplan.paths import shipped
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
 from hsgplan.perception.colour import ColourNet, features, load_colour, pixel_vote
@@ -83,6 +83,7 @@ class Detection:
     type_confidence: float = 1.0  # the colour network's probability of the type (1: no colour)
     keypoints: tuple[ViewKeypoints, ...] = ()  # each view's keypoints behind it
     stacked: bool = False  # one of two thin boxes that the views saw as one (`STACK_BAND`)
+    measured: Pose | None = None  # the pose before it was made to rest (`PoseEstimator.rest`)
 
 
 class PoseEstimator:
@@ -225,11 +226,25 @@ class PoseEstimator:
         if not self.settled:
             return fused
         fused = self._unstacked(images, cameras, fused)
-        costs = [None if d.stacked else partial(_cost_at, d) for d in fused]
-        poses = settle(
-            [d.type_name for d in fused], [d.pose for d in fused], [d.rays for d in fused], costs
-        )
-        return [replace(d, pose=p) for d, p in zip(fused, poses, strict=True)]
+        return self.rest([replace(d, measured=d.pose) for d in fused])
+
+    @staticmethod
+    def rest(found: list[Detection], fixed: Sequence[tuple[str, Pose]] = ()) -> list[Detection]:
+        """Detections (as `detect` found them) made to rest from their measured poses
+        (`perception.settle`), `fixed` objects (type and pose: believed there, unseen) carrying
+        them too; one left with its centre inside the table is dropped (a lone view's phantom
+        that nothing could hold: no object can be there)."""
+        costs = [None if d.stacked else partial(_cost_at, d) for d in found]
+        measured = [d.measured or d.pose for d in found]
+        types, rays = [d.type_name for d in found], [d.rays for d in found]
+        poses = settle(types, measured, rays, costs, fixed)
+        out = [replace(d, pose=p) for d, p in zip(found, poses, strict=True)]
+        return [d for d in out if not _inside_table(d.pose)]
+
+
+def _inside_table(pose: Pose) -> bool:
+    x, y, z = pose.position
+    return TABLE.contains(x, y) and z < TABLE.z
 
 
 def _stack_of_two(d: Detection, found: list[Detection]) -> bool:

@@ -6,7 +6,9 @@ observer keeps a track of each: detections of a kind (cans, boxes) are given to 
 objects by an optimal assignment on the type f_p named and the distance to where each object
 was last seen (`assign`). Tracks start where the scene was staged (the goal's names must refer
 to something; only look-alike duplicates need it), and an object no view found this time keeps
-its last pose and is reported unseen. The object in the
+its last pose and is reported unseen; what was found is then made to rest again with the unseen
+objects where they are believed as supports too (a can put down on a butter hides it from
+every view, and would otherwise be seen sunk onto the shelf under it). The object in the
 hand is the robot's own knowledge: its pose is the gripper's (the arm's kinematics and the
 grasp), not an estimate; and one let go since the last look was last seen where the hand let
 it go (`Panda.released`), not where it was carried.
@@ -76,8 +78,14 @@ class RgbObserver:
             # last seen in the hand: it is where the hand let it go, which the robot knows
             self._last[let_go] = released[1]
         self._held = held
-        poses = assign(detections, {o: p for o, p in self._last.items() if o != held})
-        unseen = tuple(o for o in self._last if o != held and o not in poses)
+        last = {o: p for o, p in self._last.items() if o != held}
+        found = assigned(detections, last)
+        unseen = tuple(o for o in last if o not in found)
+        if unseen and self.estimator.settled:
+            fixed = [(type_of(o), last[o]) for o in unseen]
+            found = assigned(self.estimator.rest(detections, fixed), last)
+            unseen = tuple(o for o in last if o not in found)
+        poses = {o: d.pose for o, d in found.items()}
         for o in unseen:
             poses[o] = self._last[o]
         if held is not None:
@@ -87,14 +95,20 @@ class RgbObserver:
 
 
 def assign(detections: list[Detection], last: dict[str, Pose]) -> dict[str, Pose]:
-    """Each object (by its last pose) and the pose of the detection it gets, kind by kind (cans,
+    """Each object (by its last pose) and the pose of the detection it gets (`assigned`)."""
+    return {o: d.pose for o, d in assigned(detections, last).items()}
+
+
+def assigned(detections: list[Detection], last: dict[str, Pose]) -> dict[str, Detection]:
+    """Each object (by its last pose) and the detection it gets, kind by kind (cans,
     boxes): the assignment of least total cost, a detection's cost for an object being its
     distance from the object's last pose counted up to `STILL`, plus `MISMATCH` when f_p named
     it another type (look-alikes stacked can show one another's colour: an object that did not
     move is known by where it is), less a hundredth of its score and plus a thousandth of the
     distance to break ties. A detection of another type further than `TRACK_DISTANCE` from an
-    object's last pose is never that object."""
-    out: dict[str, Pose] = {}
+    object's last pose is never that object, nor is one that a single view saw further than
+    `STILL`: two weak signs, where a look-alike phantom is likelier than a moved object."""
+    out: dict[str, Detection] = {}
     for kind in sorted({object_type(o).kind for o in last}):
         objects = [o for o in last if object_type(o).kind is kind]
         found = [d for d in detections if OBJECT_TYPES[d.type_name].kind is kind]
@@ -106,11 +120,11 @@ def assign(detections: list[Detection], last: dict[str, Pose]) -> dict[str, Pose
             for j, d in enumerate(found):
                 far = float(np.linalg.norm(np.subtract(d.pose.position, last[o].position)))
                 same = d.type_name == type_of(o)
-                allowed[i, j] = same or far < TRACK_DISTANCE
+                allowed[i, j] = same or far < (TRACK_DISTANCE if d.views > 1 else STILL)
                 cost[i, j] = min(far, STILL) + (0.0 if same else MISMATCH)
                 cost[i, j] += 1e-3 * far - 1e-2 * d.score
         cost[~allowed] = FORBIDDEN
         for i, j in zip(*linear_sum_assignment(cost), strict=True):
             if allowed[i, j]:
-                out[objects[i]] = found[j].pose
+                out[objects[i]] = found[j]
     return out

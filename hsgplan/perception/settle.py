@@ -23,7 +23,7 @@ An estimate that fits none is left as it is: what f_p saw, for f_m to report.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -75,10 +75,12 @@ def settle(
     poses: list[Pose],
     rays: list[tuple[Ray, ...]] | None = None,
     costs: list[Callable[[np.ndarray], float] | None] | None = None,
+    fixed: Sequence[tuple[str, Pose]] = (),
 ) -> list[Pose]:
     """Each pose (of an object of `types[i]`, seen along `rays[i]` if given) made to rest,
     lowest first (see the module); `costs[i]`, if given, says how badly the estimate's pose
-    with its centre moved to a point explains what the views saw."""
+    with its centre moved to a point explains what the views saw. `fixed` objects (type and
+    pose) stay where they are and carry the others too: objects believed there, unseen."""
     rays = rays or [()] * len(poses)
     out = [upright(p) for p in poses]
     heights = [object_type(t).size[2] for t in types]
@@ -89,9 +91,9 @@ def settle(
         if out[i].rotation[2, 2] < math.cos(UPRIGHT_TILT):
             continue  # not upright: nothing to rest on
         carriers = [
-            (types[k], out[k])
-            for k in settled
-            if not same_place(types[i], out[i], types[k], out[k])
+            (t, p)
+            for t, p in [*fixed, *((types[k], out[k]) for k in settled)]
+            if not same_place(types[i], out[i], t, p)
         ]
         if len(rays[i]) == 1 and abs(rays[i][0][1][2]) > GRAZING:
             centre = _along_ray(np.array([x, y, z]), rays[i][0], heights[i], carriers)
