@@ -234,7 +234,8 @@ class PoseEstimator:
         (`perception.settle`), `fixed` objects (type and pose: believed there, unseen) carrying
         them too; one left with its centre inside the table is dropped (a lone view's phantom
         that nothing could hold: no object can be there)."""
-        costs = [None if d.stacked else partial(_cost_at, d) for d in found]
+        # a split stack's keypoints are its blob's: they say nothing of either box's height
+        costs = [None if d.stacked or not d.keypoints else partial(_cost_at, d) for d in found]
         measured = [d.measured or d.pose for d in found]
         types, rays = [d.type_name for d in found], [d.rays for d in found]
         poses = settle(types, measured, rays, costs, fixed)

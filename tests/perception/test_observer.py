@@ -3,7 +3,11 @@ type and last pose), and the whole loop run on what a camera observer makes of t
 network is replaced by one that outputs the scene's true maps, so that the loop's plumbing,
 decoding, PnP and fusion are checked without a trained checkpoint."""
 
+import math
+from dataclasses import replace
+
 import numpy as np
+import pytest
 import torch
 
 from hsgplan.agents.registry import make_agent
@@ -167,3 +171,29 @@ def test_eval_sees_through_the_shipped_f_p_beside_the_ground_truth(tmp_path):
     assert methods["paper-rgb"]["by_size"]["2"]["episodes"] == 1
     (line,) = (tmp_path / "run" / "paper-rgb" / "episodes.jsonl").read_text().splitlines()
     assert json.loads(line)["result"]["observer"] == "rgb"
+
+
+def test_a_lone_views_detection_of_another_type_far_from_where_an_object_was_is_not_it():
+    last = {"butter": Pose.from_xyz_yaw(0.5, 0.0, 0.012)}
+    lone = Detection("cream_cheese", Pose.from_xyz_yaw(0.6, 0.0, 0.012), 0.9, 1, 1.0)
+    assert assign([lone], last) == {}  # 10 cm off, one view, another type: a phantom
+    both = replace(lone, views=2)
+    assert assign([both], last)["butter"] == both.pose
+    near = replace(lone, pose=Pose.from_xyz_yaw(0.52, 0.0, 0.012))
+    assert assign([near], last)["butter"] == near.pose  # where it was: its colour misled
+
+
+def test_an_object_unseen_under_a_can_still_holds_the_can_up():
+    butter = Pose.from_xyz_yaw(0.5, 0.0, OBJECT_TYPES["butter"].size[2] / 2)
+    top = OBJECT_TYPES["butter"].size[2]
+    can_half = OBJECT_TYPES["tomato_soup"].size[2] / 2
+    measured = Pose.from_xyz_yaw(0.5, 0.005, top + can_half - 0.003)  # seen on it, nearly
+    can = Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)
+    (alone,) = PoseEstimator.rest([can])
+    assert alone.pose.position[2] == pytest.approx(can_half)  # nothing found under it
+    (held_up,) = PoseEstimator.rest([can], [("butter", butter)])
+    assert held_up.pose.position[2] == pytest.approx(top + can_half)
+    # on its side, so nothing to rest on: left where it was seen, inside the table
+    lying = Pose((0.5, 0.0, -0.15), (math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5)))
+    assert PoseEstimator.rest([replace(can, measured=lying)]) == []  # nothing can be there
+    assert PoseEstimator.rest([replace(can, measured=replace(lying, position=(0.5, 0, 0.05)))])
