@@ -183,7 +183,8 @@ class PoseEstimator:
     ) -> list[Detection]:
         """Each detection that is two thin boxes stacked (`STACK_BAND`) as the two, one on the
         other on the surface under it, each named by the colour it keeps in sight once both
-        are painted (the upper one by its top face, the lower one by its sides)."""
+        are painted (the upper one by its top face, the lower one by its sides). Without a
+        colour network (which names the two) nothing is split."""
         split = [k for k, d in enumerate(found) if _stack_of_two(d, found)]
         if not split or self.colour is None:
             return found
@@ -289,10 +290,9 @@ def _of_kind(
     if centre is not None:
         fits = same & torch.tensor([fits_height(t, centre) for t in TYPES])
         same = fits if bool(fits.any()) else same
+    best = int(torch.where(same, probs, torch.full_like(probs, -1.0)).argmax())  # of the kind
     probs = torch.where(same, probs, torch.zeros_like(probs))
-    probs = probs / probs.sum().clamp(min=1e-12)
-    best = int(probs.argmax())
-    return best, float(probs[best])
+    return best, float(probs[best] / probs.sum().clamp(min=1e-12))
 
 
 def _fuse(found: list[Seen], typed: Callable[[list[Seen]], tuple[int, float]]) -> list[Detection]:

@@ -3,7 +3,8 @@
 A single view's depth is its weak axis, so views are matched by the rays through the
 instances' centroids, not by their single-view poses: two instances of one type from different
 views are one object when their rays pass within `RAY_GAP` of one another at a point where an
-object can be (over the table, below `TOP_Z`).
+object can be (over the table's footprint, from 5 cm under its top, an estimate's slack, up to
+`TOP_Z`).
 
 Instances are grouped as cliques: sets of instances of one type, at most one per view, every
 two of whose rays pass within `RAY_GAP`. Cliques of more views are taken first, and among those

@@ -16,6 +16,7 @@ it go (`Panda.released`), not where it was carried.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +33,7 @@ from hsgplan.sim.render import Camera
 from hsgplan.sim.scene import Scene
 
 # A detection f_p named another type is only an object's if it is within this of where the
-# object was last seen.
+# object was last seen (within `STILL` if a single view saw it).
 TRACK_DISTANCE = 0.3  # m
 # The cost, in metres of distance, of a detection f_p named another type. Small: within a
 # couple of centimetres where an object was is a surer sign of which it is than the colour at
@@ -79,19 +80,29 @@ class RgbObserver:
             self._last[let_go] = released[1]
         self._held = held
         last = {o: p for o, p in self._last.items() if o != held}
-        found = assigned(detections, last)
-        unseen = tuple(o for o in last if o not in found)
-        if unseen and self.estimator.settled:
-            fixed = [(type_of(o), last[o]) for o in unseen]
-            found = assigned(self.estimator.rest(detections, fixed), last)
-            unseen = tuple(o for o in last if o not in found)
-        poses = {o: d.pose for o, d in found.items()}
-        for o in unseen:
-            poses[o] = self._last[o]
+        rest = self.estimator.rest if self.estimator.settled else None
+        poses, unseen = tracked(detections, last, rest)
         if held is not None:
             poses[held] = scene.pose(held)
         self._last = {o: poses[o] for o in self._last}
         return Seen(GeometricSceneGraph.from_poses(self._last, held=held), unseen)
+
+
+def tracked(
+    detections: list[Detection],
+    last: dict[str, Pose],
+    rest: Callable[[list[Detection], list[tuple[str, Pose]]], list[Detection]] | None = None,
+) -> tuple[dict[str, Pose], tuple[str, ...]]:
+    """Every object's pose (by its last pose `last`) and those no detection was given
+    (`assigned`), which keep their last poses; with `rest` (`PoseEstimator.rest`), the
+    detections are made to rest again with the unseen objects as supports, and given again."""
+    found = assigned(detections, last)
+    unseen = tuple(o for o in last if o not in found)
+    if unseen and rest is not None:
+        found = assigned(rest(detections, [(type_of(o), last[o]) for o in unseen]), last)
+        unseen = tuple(o for o in last if o not in found)
+    poses = {o: d.pose for o, d in found.items()}
+    return poses | {o: last[o] for o in unseen}, unseen
 
 
 def assign(detections: list[Detection], last: dict[str, Pose]) -> dict[str, Pose]:
@@ -106,8 +117,9 @@ def assigned(detections: list[Detection], last: dict[str, Pose]) -> dict[str, De
     it another type (look-alikes stacked can show one another's colour: an object that did not
     move is known by where it is), less a hundredth of its score and plus a thousandth of the
     distance to break ties. A detection of another type further than `TRACK_DISTANCE` from an
-    object's last pose is never that object, nor is one that a single view saw further than
-    `STILL`: two weak signs, where a look-alike phantom is likelier than a moved object."""
+    object's last pose is never that object, nor is one of another type that a single view saw
+    further than `STILL`: two weak signs, where a look-alike phantom is likelier than a moved
+    object."""
     out: dict[str, Detection] = {}
     for kind in sorted({object_type(o).kind for o in last}):
         objects = [o for o in last if object_type(o).kind is kind]

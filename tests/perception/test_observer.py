@@ -20,7 +20,7 @@ from hsgplan.perception.estimator import Detection, PoseEstimator
 from hsgplan.perception.keypoints import PinholeCamera, in_world, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE
-from hsgplan.perception.observer import RgbObserver, assign
+from hsgplan.perception.observer import RgbObserver, assign, tracked
 from hsgplan.perception.synthetic import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -196,4 +196,21 @@ def test_an_object_unseen_under_a_can_still_holds_the_can_up():
     # on its side, so nothing to rest on: left where it was seen, inside the table
     lying = Pose((0.5, 0.0, -0.15), (math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5)))
     assert PoseEstimator.rest([replace(can, measured=lying)]) == []  # nothing can be there
-    assert PoseEstimator.rest([replace(can, measured=replace(lying, position=(0.5, 0, 0.05)))])
+    (above,) = PoseEstimator.rest([replace(can, measured=replace(lying, position=(0.5, 0, 0.05)))])
+    assert above.pose.position[2] == 0.05  # over the table, left as it was seen
+
+
+def test_the_tracker_keeps_a_hidden_butter_where_it_was_and_the_can_on_it_up():
+    butter = Pose.from_xyz_yaw(0.5, 0.0, OBJECT_TYPES["butter"].size[2] / 2)
+    top, can_half = OBJECT_TYPES["butter"].size[2], OBJECT_TYPES["tomato_soup"].size[2] / 2
+    measured = Pose.from_xyz_yaw(0.5, 0.005, top + can_half - 0.003)
+    (seen,) = PoseEstimator.rest(
+        [Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)]
+    )
+    last = {"butter": butter, "tomato_soup": Pose.from_xyz_yaw(0.5, 0.0, top + can_half)}
+    poses, unseen = tracked([seen], last)
+    assert unseen == ("butter",) and poses["butter"] == butter
+    assert poses["tomato_soup"].position[2] == pytest.approx(can_half)  # sunk onto the table
+    poses, unseen = tracked([seen], last, PoseEstimator.rest)
+    assert unseen == ("butter",) and poses["butter"] == butter
+    assert poses["tomato_soup"].position[2] == pytest.approx(top + can_half)  # on the butter
