@@ -97,9 +97,7 @@ def pixel_vote(
     names the cream cheese (3 of 8 such misnamed objects on 100 tuning scenes, seed 2)."""
     if int(mask.sum()) < MIN_REGION:
         return None
-    pixels = image[mask].astype(np.float64) / 255.0
-    total = np.maximum(pixels.sum(axis=1, keepdims=True), 1e-6)
-    rows = np.concatenate([pixels / total, total / 3], axis=1).astype(np.float32)
+    rows = _chromaticity(image[mask].astype(np.float64) / 255.0)
     with torch.no_grad():
         probs = torch.softmax(colour(torch.from_numpy(rows)), dim=1)
     votes = allowed[probs.argmax(dim=1)]
@@ -109,9 +107,15 @@ def pixel_vote(
 
 
 def _described(pixels: np.ndarray) -> np.ndarray:
-    mean = pixels.astype(np.float64).mean(axis=0) / 255.0
-    total = max(mean.sum(), 1e-6)
-    return np.array([*(mean / total), total / 3], dtype=np.float32)
+    """The features of the mean of [N, 3] uint8 pixels: [FEATURES]."""
+    return _chromaticity(pixels.astype(np.float64).mean(axis=0, keepdims=True) / 255.0)[0]
+
+
+def _chromaticity(rgb: np.ndarray) -> np.ndarray:
+    """Chromaticity (r, g, b over their sum) and brightness of [N, 3] colours in 0..1:
+    [N, FEATURES] float32."""
+    total = np.maximum(rgb.sum(axis=1, keepdims=True), 1e-6)
+    return np.concatenate([rgb / total, total / 3], axis=1).astype(np.float32)
 
 
 def train_colour(

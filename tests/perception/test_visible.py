@@ -56,19 +56,25 @@ def _detection(name: str, pose: Pose) -> Detection:
     return Detection(name, pose, 1.0, len(VIEWS), 0.0, (), 0.5, seen)
 
 
-def test_a_box_under_another_is_named_by_the_colour_of_its_side_in_sight():
-    types, poses = ["cream_cheese", "butter"], [LOWER, UPPER]
+def _painted_images(types: list[str], poses: list[Pose]) -> np.ndarray:
+    """The views with each painted pixel in its object's colour, the rest grey: [V, H, W, 3]."""
     images = []
-    for camera in VIEWS:  # each painted pixel in its object's colour, the rest grey
+    for camera in VIEWS:
         label = painted(types, poses, PinholeCamera.of(camera))
         image = np.full((camera.height, camera.width, 3), 128, dtype=np.uint8)
         for i, t in enumerate(types):
             image[label == i] = np.array(OBJECT_TYPES[t].color[:3]) * 255
         images.append(image)
+    return np.stack(images)
+
+
+def test_a_box_under_another_is_named_by_the_colour_of_its_side_in_sight():
+    types, poses = ["cream_cheese", "butter"], [LOWER, UPPER]
+    images = _painted_images(types, poses)
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
     # both named butter, as the colour at the lower one's centroid says
     found = [_detection("butter", LOWER), _detection("butter", UPPER)]
-    named = estimator._retyped(np.stack(images), VIEWS, found)
+    named = estimator._retyped(images, VIEWS, found)
     assert [d.type_name for d in named] == types
     assert np.allclose(named[0].pose.position, LOWER.position, atol=0.005)
 
@@ -100,24 +106,18 @@ def _blob(name: str, z: float) -> Detection:
 
 
 def test_two_thin_boxes_seen_as_one_are_split_and_each_named_by_its_colour():
-    types, poses = ["cream_cheese", "butter"], [LOWER, UPPER]
-    images = []
-    for camera in VIEWS:
-        label = painted(types, poses, PinholeCamera.of(camera))
-        image = np.full((camera.height, camera.width, 3), 128, dtype=np.uint8)
-        for i, t in enumerate(types):
-            image[label == i] = np.array(OBJECT_TYPES[t].color[:3]) * 255
-        images.append(image)
+    types = ["cream_cheese", "butter"]
+    images = _painted_images(types, [LOWER, UPPER])
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
     height = OBJECT_TYPES["butter"].size[2]
     blob = _blob("butter", height)  # half-way up the stack: a box's height over the table
-    split = estimator._unstacked(np.stack(images), VIEWS, [blob])
+    split = estimator._unstacked(images, VIEWS, [blob])
     assert [d.type_name for d in split] == types and all(d.stacked for d in split)
     assert [d.pose.position[2] for d in split] == pytest.approx([height / 2, 3 * height / 2])
     # a lone box's height, a popcorn, or a box with something found under it: no stack
     alone = _blob("butter", height / 2)
-    assert estimator._unstacked(np.stack(images), VIEWS, [alone]) == [alone]
+    assert estimator._unstacked(images, VIEWS, [alone]) == [alone]
     tall = _blob("popcorn", height)
-    assert estimator._unstacked(np.stack(images), VIEWS, [tall]) == [tall]
+    assert estimator._unstacked(images, VIEWS, [tall]) == [tall]
     under = _blob("cream_cheese", height / 2)
-    assert estimator._unstacked(np.stack(images), VIEWS, [under, blob]) == [under, blob]
+    assert estimator._unstacked(images, VIEWS, [under, blob]) == [under, blob]
