@@ -121,3 +121,16 @@ def test_two_thin_boxes_seen_as_one_are_split_and_each_named_by_its_colour():
     assert estimator._unstacked(images, VIEWS, [tall]) == [tall]
     under = _blob("cream_cheese", height / 2)
     assert estimator._unstacked(images, VIEWS, [under, blob]) == [under, blob]
+
+
+def test_a_thin_box_carrying_what_rests_on_one_box_is_not_split():
+    images = _painted_images(["butter"], [LOWER])
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    height = OBJECT_TYPES["butter"].size[2]
+    can = OBJECT_TYPES["tomato_soup"].size[2]
+    blob = _blob("butter", height)  # found a box's height up, as two stacked would be
+    on_one = _blob("tomato_soup", height + can / 2)
+    assert estimator._unstacked(images, VIEWS, [blob, on_one]) == [blob, on_one]
+    on_two = _blob("tomato_soup", 2 * height + can / 2)
+    split = estimator._unstacked(images, VIEWS, [blob, on_two])
+    assert sum(d.stacked for d in split) == 2 and on_two in split
