@@ -20,17 +20,18 @@ PROGRESS = "progress.pt"
 TRAIN_CONFIG = "train_config.json"
 
 
-def claim(out: Path, config: dict) -> None:
+def claim(out: Path, config: dict, defaults: dict | None = None) -> None:
     """Make `out` the checkpoint folder of a training with `config` (its `train_config.json`).
     Refused in one line, before anything is written: a file, a folder holding other things
     (a dataset, a run, another kind of checkpoint), and a checkpoint trained or in training
     with another configuration. A folder whose training never got as far as saving anything
-    (it was refused or diverged) takes the new configuration."""
+    (it was refused or diverged) takes the new configuration. A saved configuration lacking a
+    setting of `defaults` was trained before the setting existed, with its default."""
     saved = out / TRAIN_CONFIG
     if out.exists() and not out.is_dir():
         raise InvalidInputError(f"'{out}' is a file, not a checkpoint folder")
     if saved.exists() or saved.is_symlink():
-        other = read_json(saved, "training configuration")
+        other = {**(defaults or {}), **read_json(saved, "training configuration")}
         # anything trained or in training anywhere below (a task checkpoint keeps its networks
         # in subfolders): another kind of checkpoint is never trained over
         started = any(next(out.rglob(f), None) for f in (MANIFEST, WEIGHTS, PROGRESS))

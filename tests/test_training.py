@@ -64,3 +64,12 @@ def test_a_damaged_or_replaced_checkpoint_file_is_not_finished(tmp_path):
     training.finish(tmp_path, model, {"a": 1})
     (tmp_path / "config.json").unlink()
     assert not training.finished(tmp_path)
+
+
+def test_a_configuration_saved_before_a_setting_existed_counts_as_its_default(tmp_path):
+    model, optim = _model_and_optim()
+    training.claim(tmp_path, {"lr": 0.1})
+    training.save_progress(tmp_path, model, optim, 1, "data-a")
+    training.claim(tmp_path, {"lr": 0.1, "stride": 4}, {"lr": 0.2, "stride": 4})
+    with pytest.raises(InvalidInputError, match="another configuration"):
+        training.claim(tmp_path, {"lr": 0.1, "stride": 2}, {"lr": 0.1, "stride": 4})

@@ -9,9 +9,15 @@ only that: from the mean chromaticity and brightness of the pixels around the ce
 projection in a view, the type, as a softmax over every type (a cross-entropy, so the types
 compete). The estimator averages its probabilities over the views that saw an object.
 
+A last class is the background: patches wholly outside every object's projected cuboid. A
+hidden object is named by a vote of the pixels it keeps in sight (`pixel_vote`), and some of
+them are the table's or a shelf's; without it, a pale table's pixels voted butter, and a cream
+cheese under another was named butter from its strip of sides and table.
+
 Labels come from the renderer: each in-sight object's type and its centroid projected
-through the camera that rendered the image. Saved in the keypoint network's checkpoint folder,
-in `colour/` (its own `config.json`, weights and manifest).
+through the camera that rendered the image; the background, by the objects' cuboids projected
+through it. Saved in the keypoint network's checkpoint folder, in `colour/` (its own
+`config.json`, weights and manifest).
 """
 
 from __future__ import annotations
@@ -33,11 +39,13 @@ FEATURES = 4  # chromaticity r, g, b and brightness
 MIN_REGION = 12  # pixels of an object in sight for their colour to name it
 MIN_VOTES = 6  # of them named a type of the object's kind, for `pixel_vote` to say
 FOLDER = "colour"
+TYPES = len(OBJECT_TYPES)
+BACKGROUND = TYPES  # the class index of the background (in a network with `TYPES + 1` classes)
 
 
 @dataclass(frozen=True)
 class ColourConfig:
-    types: int = len(OBJECT_TYPES)
+    types: int = TYPES + 1  # the object types, then the background
     hidden: int = 32
     steps: int = 400
     lr: float = 0.01
@@ -71,6 +79,13 @@ class ColourNet(nn.Module):
         return self.mlp(x)
 
 
+def type_probs(colour: ColourNet, rows: np.ndarray) -> torch.Tensor:
+    """The colour network's probabilities of the object types, against one another (the
+    background left out): [N, FEATURES] features -> [N, TYPES]."""
+    with torch.no_grad():
+        return torch.softmax(colour(torch.from_numpy(rows))[:, :TYPES], dim=1)
+
+
 def features(image: np.ndarray, pixel: np.ndarray) -> np.ndarray | None:
     """Mean chromaticity (r, g, b over their sum) and brightness of the pixels within `PATCH`
     of `pixel` in an [H, W, 3] uint8 image; None when it is not in the image."""
@@ -88,8 +103,9 @@ def pixel_vote(
     colour: ColourNet, image: np.ndarray, mask: np.ndarray, allowed: torch.Tensor
 ) -> torch.Tensor | None:
     """The colour network's mean probabilities [types] over the pixels of `mask` [H, W] (bool)
-    that it names one of the `allowed` types [types] (bool), each pixel on its own; None when
-    the mask holds fewer than `MIN_REGION` pixels, or fewer than `MIN_VOTES` are so named.
+    that it names one of the `allowed` types [types] (bool), each pixel on its own (one it
+    names the background is no vote); None when the mask holds fewer than `MIN_REGION` pixels,
+    or fewer than `MIN_VOTES` are so named.
 
     A region painted from estimated poses holds pixels of what hides it too, and a mean of two
     colours can be a third type's: the orange of a soup and the green of a cream cheese under it
@@ -99,11 +115,12 @@ def pixel_vote(
         return None
     rows = _chromaticity(image[mask].astype(np.float64) / 255.0)
     with torch.no_grad():
-        probs = torch.softmax(colour(torch.from_numpy(rows)), dim=1)
-    votes = allowed[probs.argmax(dim=1)]
+        logits = colour(torch.from_numpy(rows))
+    named = logits.argmax(dim=1)
+    votes = (named < TYPES) & allowed[named.clamp(max=TYPES - 1)]
     if int(votes.sum()) < MIN_VOTES:
         return None
-    return probs[votes].mean(dim=0)
+    return torch.softmax(logits[votes, :TYPES], dim=1).mean(dim=0)
 
 
 def _described(pixels: np.ndarray) -> np.ndarray:

@@ -27,7 +27,7 @@ from hsgplan.domain.objects import object_type
 from hsgplan.domain.world import OBJECT_TYPES, TABLE
 from hsgplan.paths import shipped
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
-from hsgplan.perception.colour import ColourNet, features, load_colour, pixel_vote
+from hsgplan.perception.colour import ColourNet, features, load_colour, pixel_vote, type_probs
 from hsgplan.perception.fusion import Seen, grouped, line_of_sight
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
@@ -121,7 +121,7 @@ class PoseEstimator:
         rows = [r for r in rows if r is not None]
         if self.colour is None or not rows:
             return members[0].type_index, 1.0
-        probs = torch.softmax(self.colour(torch.from_numpy(np.stack(rows))), dim=1).mean(dim=0)
+        probs = type_probs(self.colour, np.stack(rows)).mean(dim=0)
         rays = [line_of_sight(s) for s in members]
         centre = meeting_point(rays) if len(rays) > 1 else None
         return _of_kind(probs, TYPES[members[0].type_index], centre)
@@ -174,7 +174,7 @@ class PoseEstimator:
                 if not own:
                     vote = pixel_vote(self.colour, image, mask, kinds[i])
                 elif (row := features(image, np.array([u, v]))) is not None:
-                    vote = torch.softmax(self.colour(torch.from_numpy(row[None])), dim=1)[0]
+                    vote = type_probs(self.colour, row[None])[0]
                 else:
                     vote = None
                 if vote is not None:

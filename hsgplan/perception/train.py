@@ -18,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+import cv2
 import numpy as np
 import torch
 
@@ -25,8 +26,8 @@ from hsgplan import training
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.checks import MAX_SEED, MAX_WORKERS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.perception.colour import BACKGROUND, PATCH, ColourConfig, features, train_colour
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
-from hsgplan.perception.colour import ColourConfig, features, train_colour
 from hsgplan.perception.images import TYPES, chunk_path, load_chunks
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
@@ -36,6 +37,7 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 
 MIN_VISIBLE = 30  # pixels of an object in sight for its keypoints to be a target
+BACKGROUND_PATCHES = 3  # patches of background an image, for the colour network (`colour`)
 
 
 @dataclass(frozen=True)
@@ -84,6 +86,7 @@ class Examples:
     images: torch.Tensor
     keypoints: list[np.ndarray]
     types: list[np.ndarray]
+    cuboids: list[np.ndarray] | None = None  # every object's keypoints, in sight or not
 
     def targets(
         self, take: list[int], types_count: int, stride: int = STRIDE
@@ -100,7 +103,7 @@ class Examples:
 def examples(data: dict[str, np.ndarray]) -> Examples:
     """Every (sample, view) of a loaded collection, its keypoints named as that view names
     them (`perception.keypoints.view_keypoints`, from the stored poses and cameras)."""
-    images, keypoints, types = [], [], []
+    images, keypoints, types, cuboids = [], [], [], []
     n, views, height, width = data["images"].shape[:4]
     for i in range(n):
         for v in range(views):
@@ -113,15 +116,21 @@ def examples(data: dict[str, np.ndarray]) -> Examples:
             camera = PinholeCamera.of(
                 Camera(width, height, tuple(map(float, eye)), tuple(map(float, target)), float(fov))
             )
-            kinds = data["types"][i][seen].astype(np.int64)
-            points = [
-                view_keypoints(TYPES[t], _pose(p), camera)
-                for t, p in zip(kinds, data["poses"][i][seen], strict=True)
-            ]
+            present = data["types"][i] >= 0
+            every = np.asarray(
+                [
+                    view_keypoints(TYPES[t], _pose(p), camera)
+                    for t, p in zip(
+                        data["types"][i][present], data["poses"][i][present], strict=True
+                    )
+                ],
+                dtype=np.float32,
+            ).reshape(-1, KEYPOINTS, 2)
             images.append(torch.from_numpy(data["images"][i, v]).permute(2, 0, 1))
-            keypoints.append(np.asarray(points, dtype=np.float32).reshape(-1, KEYPOINTS, 2))
-            types.append(kinds)
-    return Examples(torch.stack(images), keypoints, types)
+            keypoints.append(every[seen[present]])
+            types.append(data["types"][i][seen].astype(np.int64))
+            cuboids.append(every)
+    return Examples(torch.stack(images), keypoints, types, cuboids)
 
 
 def _pose(p: np.ndarray) -> Pose:
@@ -189,7 +198,7 @@ def train_perception(
     data = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     chunks = [chunk_path(f, r["result"]["chunk"]) for f in config.folders for r in logged_rows(f)]
     data_print = fingerprint(chunks + ([Path(config.init)] if config.init else []))
-    training.claim(out, asdict(config))
+    training.claim(out, asdict(config), asdict(PerceptionTrainConfig()))
     found = examples(data)
     if len(found.images) == 0:
         raise InvalidInputError(f"no images in '{config.images}'")
@@ -199,14 +208,34 @@ def train_perception(
 
 
 def colour_samples(found: Examples) -> list[tuple[np.ndarray, int]]:
-    """(colour features at the centroid, type) of every in-sight object of every image."""
+    """(colour features at the centroid, type) of every in-sight object of every image, and
+    (those of `BACKGROUND_PATCHES` patches outside every object, the background class)."""
     out = []
-    for image, points, kinds in zip(found.images, found.keypoints, found.types, strict=True):
+    cuboids = found.cuboids or found.keypoints
+    for e, (image, points, kinds, every) in enumerate(
+        zip(found.images, found.keypoints, found.types, cuboids, strict=True)
+    ):
         pixels = image.permute(1, 2, 0).numpy()
         for p, t in zip(points, kinds, strict=True):
             if (row := features(pixels, p[-1])) is not None:
                 out.append((row, int(t)))
+        out += [(row, BACKGROUND) for row in _background(pixels, every, np.random.default_rng(e))]
     return out
+
+
+def _background(pixels: np.ndarray, cuboids: np.ndarray, rng: np.random.Generator) -> list:
+    """The features of up to `BACKGROUND_PATCHES` random patches of an [H, W, 3] image lying
+    wholly outside every object's projected cuboid (`cuboids`: [M, 9, 2] keypoints)."""
+    inside = np.zeros(pixels.shape[:2], np.uint8)
+    for corners in cuboids[:, :8]:
+        if np.isfinite(corners).all():
+            cv2.fillConvexPoly(inside, cv2.convexHull(np.round(corners).astype(np.int32)), 1)
+    inside = cv2.dilate(inside, np.ones((2 * PATCH + 1, 2 * PATCH + 1), np.uint8))
+    v, u = np.nonzero(inside == 0)
+    if not len(u):
+        return []
+    take = rng.choice(len(u), size=min(BACKGROUND_PATCHES, len(u)), replace=False)
+    return [features(pixels, np.array([u[k], v[k]])) for k in take]
 
 
 def _start_from(model: torch.nn.Module, trained: torch.nn.Module) -> None:

@@ -110,3 +110,23 @@ def test_colour_features_read_the_patch_around_a_pixel_and_nothing_outside_the_i
     assert row is not None and row[0] > 0.7 and abs(row[3] - 280 / 3 / 255) < 1e-6
     assert features(image, np.array([35.0, 5.0])) is None
     assert features(image, np.array([np.nan, 5.0])) is None
+
+
+def test_background_patches_lie_outside_every_objects_cuboid():
+    import numpy as np
+
+    from hsgplan.perception.colour import BACKGROUND
+    from hsgplan.perception.train import BACKGROUND_PATCHES, Examples, colour_samples
+
+    image = np.zeros((40, 60, 3), dtype=np.uint8)
+    image[:, :30] = (200, 40, 40)  # the object's side of the image; the rest is black
+    corners = np.array([[u, v] for u in (0, 29) for v in (0, 39)] * 2 + [[15, 20]], float)
+    found = Examples(
+        torch.from_numpy(image).permute(2, 0, 1)[None],
+        [corners[None]],
+        [np.array([3])],
+        [corners[None]],
+    )
+    rows = colour_samples(found)
+    assert [t for _, t in rows] == [3] + [BACKGROUND] * BACKGROUND_PATCHES
+    assert all(r[3] < 1e-3 for r, _ in rows[1:])  # black: no pixel of their patches is red

@@ -134,3 +134,24 @@ def test_a_thin_box_carrying_what_rests_on_one_box_is_not_split():
     on_two = _blob("tomato_soup", 2 * height + can / 2)
     split = estimator._unstacked(images, VIEWS, [blob, on_two])
     assert sum(d.stacked for d in split) == 2 and on_two in split
+
+
+class _WithBackground(_NearestColour):
+    """`_NearestColour`, and a last class, the background, for grey."""
+
+    def forward(self, x):
+        grey = -100 * torch.cdist(x[:, :3], torch.full((1, 3), 1 / 3))
+        return torch.cat([super().forward(x), grey], dim=1)
+
+
+def test_pixels_named_background_are_no_votes():
+    grey, cheese = (0.5, 0.5, 0.5), OBJECT_TYPES["cream_cheese"].color[:3]
+    image = np.zeros((4, 10, 3), dtype=np.uint8)
+    image[:, :8] = np.array(grey) * 255  # mostly table: the mean would be no box's
+    image[:, 8:] = np.array(cheese) * 255
+    mask = np.ones((4, 10), dtype=bool)
+    boxes = torch.tensor([OBJECT_TYPES[t].kind is OBJECT_TYPES["butter"].kind for t in TYPES])
+    vote = pixel_vote(_WithBackground(), image, mask, boxes)
+    assert vote is not None and vote.shape == (len(TYPES),)
+    assert TYPES[int(vote.argmax())] == "cream_cheese" and float(vote.sum()) == pytest.approx(1)
+    assert pixel_vote(_WithBackground(), image, mask & (np.arange(10) < 8), boxes) is None
