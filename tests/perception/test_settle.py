@@ -125,3 +125,21 @@ def test_a_centre_a_centimetre_over_the_table_is_no_popcorn():
     on_shelf = np.array([0.49, 0.38, SHELF_TOP_Z + _half("butter")])
     assert fits_height("butter", on_shelf) and not fits_height("popcorn", on_shelf)
     assert fits_height("popcorn", np.array([1.4, 0.0, 0.01]))  # over no surface: no say
+
+
+def test_nothing_rests_through_an_object_several_views_saw_but_a_lone_views_may_be_a_phantom():
+    cheese = Pose.from_xyz_yaw(0.5, 0.0, _half("cream_cheese"), 0.0)
+    top = 2 * _half("cream_cheese")
+    # a popcorn found 1.1 cm low on the cheese, its keypoints a little surer of the table
+    low = Pose.from_xyz_yaw(0.5, 0.0, top + _half("popcorn") - 0.011, 0.0)
+    types = ["cream_cheese", "popcorn"]
+    costs = [None, lambda centre: centre[2]]
+    ray = (np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0]))
+    seen_twice = settle(types, [cheese, low], [(ray, ray), (ray, ray)], costs)[1]
+    assert seen_twice.position[2] == pytest.approx(top + _half("popcorn"))
+    seen_once = settle(types, [cheese, low], [(ray,), (ray, ray)], costs)[1]
+    assert seen_once.position[2] == pytest.approx(_half("popcorn"))
+    # a neighbour's edge under the centre is no carrier to pass through
+    beside = Pose.from_xyz_yaw(0.5 + 0.053 / 2 + 0.005, 0.0, _half("cream_cheese"), 0.0)
+    next_to = settle(types, [beside, low], [(ray, ray), (ray, ray)], costs)[1]
+    assert next_to.position[2] == pytest.approx(_half("popcorn"))
