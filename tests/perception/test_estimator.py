@@ -101,6 +101,9 @@ def test_an_object_on_its_side_stays_toppled_and_a_noisy_upright_one_stands():
     )
     pose, error = _fitted("alphabet_soup", _views_of("alphabet_soup", on_side), [])
     assert pose is not None and abs(pose.rotation[2, 2]) < 0.1 and error < 1.0
+    # one view alone never says toppled
+    lone, _ = _fitted("alphabet_soup", _views_of("alphabet_soup", on_side)[:1], [])
+    assert lone is not None and lone.rotation[2, 2] == pytest.approx(1.0)
     upright = Pose.from_xyz_yaw(0.45, -0.1, 0.012, 0.4)
     views = _views_of("butter", upright)
     noise = np.random.default_rng(0).normal(0, 1.5, size=(len(views), 9, 2))
