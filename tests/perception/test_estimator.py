@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from hsgplan.domain.objects import type_of
 from hsgplan.domain.world import OBJECT_TYPES
-from hsgplan.perception.estimator import PoseEstimator, _fitted, _of_kind
+from hsgplan.perception.estimator import Detection, PoseEstimator, _apart, _fitted, _of_kind
 from hsgplan.perception.evaluate import rotation_error, score_scene, summary
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
@@ -86,8 +86,19 @@ def test_a_box_whose_rays_meet_a_centimetre_over_the_table_is_named_a_thin_one()
     assert TYPES[_of_kind(probs, "popcorn")[0]] == "popcorn"
     low = np.array([0.5, 0.0, 0.012])
     best, confidence = _of_kind(probs, "popcorn", low)
-    assert TYPES[best] == "cream_cheese" and confidence == pytest.approx(0.6)
+    assert TYPES[best] == "cream_cheese" and confidence == pytest.approx(0.3)
     assert TYPES[_of_kind(probs, "popcorn", np.array([0.5, 0.0, 0.063]))[0]] == "popcorn"
+
+
+def test_of_a_soup_and_a_box_found_in_one_place_the_colour_keeps_the_soup():
+    probs = torch.tensor([0.1, 0.6, 0.2, 0.09, 0.005, 0.005])  # an alphabet soup's colour
+    at = Pose.from_xyz_yaw(0.5, 0.0, 0.042, 0.0)
+    found = []
+    for kind in ("popcorn", "alphabet_soup"):
+        best, confidence = _of_kind(probs, kind)
+        found.append(Detection(TYPES[best], at, 1.0, 2, 0.0, (), confidence))
+    assert found[0].type_name == "popcorn"  # the likeliest box, though no box is likely
+    assert [d.type_name for d in _apart(found)] == ["alphabet_soup"]
 
 
 def _views_of(name: str, pose: Pose) -> list[ViewKeypoints]:
