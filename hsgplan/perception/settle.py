@@ -10,10 +10,10 @@ rest before what they carry):
 - one that several views saw sits where their rays meet, and moves straight up or down onto
   the support under its centre (the table, a shelf's top board, or an object) whose top is
   nearest its bottom and would not put it through an object several views saw: nothing
-  floats, and nothing sinks into another. Where several tops lie
-  within `NEAR_TOPS` of its bottom, the one where its pose best explains its keypoints wins,
-  if the caller can say (`costs`): a can on a thin box found a centimetre low is as near the
-  table as the box's top by height alone;
+  floats, and nothing sinks into another. Where several tops lie within `NEAR_TOPS` of its
+  bottom, the one where its pose best explains its keypoints wins, if the caller can say
+  (`costs`): a can on a thin box found a centimetre low is as near the table as the box's top
+  by height alone;
 - one that a single view saw moves along that view's line of sight through its centroid, to
   the resting place on it nearest the estimate, however far: the centroid's pixel is what the
   network finds best, and the depth along the ray is what PnP gets worst.
