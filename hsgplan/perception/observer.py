@@ -91,15 +91,21 @@ class RgbObserver:
 def tracked(
     detections: list[Detection],
     last: dict[str, Pose],
-    rest: Callable[[list[Detection], list[tuple[str, Pose]]], list[Detection]] | None = None,
+    rest: Callable[[list[Detection], list[tuple[str, Pose]], dict[int, Pose]], list[Detection]]
+    | None = None,
 ) -> tuple[dict[str, Pose], tuple[str, ...]]:
     """Every object's pose (by its last pose `last`) and those no detection was given
     (`assigned`), which keep their last poses; with `rest` (`PoseEstimator.rest`), the
-    detections are made to rest again with the unseen objects as supports, and given again."""
+    detections are made to rest again with the unseen objects as supports, a lone view's at
+    the place on its line of sight nearest where its object was (`along_ray_near`), and given
+    again."""
     found = assigned(detections, last)
     unseen = tuple(o for o in last if o not in found)
-    if unseen and rest is not None:
-        found = assigned(rest(detections, [(type_of(o), last[o]) for o in unseen]), last)
+    index = {id(d): k for k, d in enumerate(detections)}
+    near = {index[id(d)]: last[o] for o, d in found.items() if len(d.rays) == 1}
+    if (unseen or near) and rest is not None:
+        fixed = [(type_of(o), last[o]) for o in unseen]
+        found = assigned(rest(detections, fixed, near), last)
         unseen = tuple(o for o in last if o not in found)
     poses = {o: d.pose for o, d in found.items()}
     return poses | {o: last[o] for o in unseen}, unseen

@@ -214,3 +214,28 @@ def test_the_tracker_keeps_a_hidden_butter_where_it_was_and_the_can_on_it_up():
     poses, unseen = tracked([seen], last, PoseEstimator.rest)
     assert unseen == ("butter",) and poses["butter"] == butter
     assert poses["tomato_soup"].position[2] == pytest.approx(top + can_half)  # on the butter
+
+
+def test_a_lone_views_butter_is_put_where_its_ray_passes_its_last_pose_and_holds_its_can_up():
+    from hsgplan.domain.world import SHELF_TOP_Z
+
+    half, can_half = OBJECT_TYPES["butter"].size[2] / 2, OBJECT_TYPES["tomato_soup"].size[2] / 2
+    butter = Pose.from_xyz_yaw(0.45, 0.35, SHELF_TOP_Z + half, 0.0)  # on shelf A's top
+    eye = np.array(VIEWS[1].eye)
+    ray = (eye, (np.array(butter.position) - eye) / np.linalg.norm(butter.position - eye))
+    # one view saw a strip of it; PnP put it far along that view's line of sight, on the table
+    table = eye + ray[1] * (half - eye[2]) / ray[1][2]
+    wrong = Pose.from_xyz_yaw(*table, 0.0)
+    lone = Detection("butter", wrong, 0.9, 1, 1.0, rays=(ray,), measured=wrong)
+    measured = Pose.from_xyz_yaw(0.45, 0.35, SHELF_TOP_Z + 2 * half + can_half - 0.004)
+    can = Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)
+    found = PoseEstimator.rest([lone, can])
+    assert found[0].pose.position[2] == pytest.approx(half)  # on the table, far off
+    last = {"butter": butter, "tomato_soup": replace(measured, position=(0.45, 0.35, 0.3))}
+    poses, unseen = tracked(found, last, PoseEstimator.rest)
+    assert unseen == () and np.allclose(poses["butter"].position, butter.position, atol=1e-6)
+    assert poses["tomato_soup"].position[2] == pytest.approx(SHELF_TOP_Z + 2 * half + can_half)
+    # a lone view's ray far from where the object was leaves its estimate as it was measured
+    moved = {**last, "butter": Pose.from_xyz_yaw(0.45, 0.0, half, 0.0)}
+    poses, _ = tracked(found, moved, PoseEstimator.rest)
+    assert poses["butter"].position == pytest.approx(found[0].pose.position)
