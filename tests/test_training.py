@@ -71,5 +71,6 @@ def test_a_configuration_saved_before_a_setting_existed_counts_as_its_default(tm
     training.claim(tmp_path, {"lr": 0.1})
     training.save_progress(tmp_path, model, optim, 1, "data-a")
     training.claim(tmp_path, {"lr": 0.1, "stride": 4}, {"lr": 0.2, "stride": 4})
+    (tmp_path / training.TRAIN_CONFIG).write_text('{"lr": 0.1}')  # saved before stride existed
     with pytest.raises(InvalidInputError, match="another configuration"):
         training.claim(tmp_path, {"lr": 0.1, "stride": 2}, {"lr": 0.1, "stride": 4})

@@ -39,13 +39,13 @@ FEATURES = 4  # chromaticity r, g, b and brightness
 MIN_REGION = 12  # pixels of an object in sight for their colour to name it
 MIN_VOTES = 6  # of them named a type of the object's kind, for `pixel_vote` to say
 FOLDER = "colour"
-TYPES = len(OBJECT_TYPES)
-BACKGROUND = TYPES  # the class index of the background (in a network with `TYPES + 1` classes)
+TYPE_COUNT = len(OBJECT_TYPES)
+BACKGROUND = TYPE_COUNT  # the background's class index (a network of `TYPE_COUNT + 1` classes)
 
 
 @dataclass(frozen=True)
 class ColourConfig:
-    types: int = TYPES + 1  # the object types, then the background
+    types: int = TYPE_COUNT + 1  # the object types, then the background
     hidden: int = 32
     steps: int = 400
     lr: float = 0.01
@@ -81,9 +81,9 @@ class ColourNet(nn.Module):
 
 def type_probs(colour: ColourNet, rows: np.ndarray) -> torch.Tensor:
     """The colour network's probabilities of the object types, against one another (the
-    background left out): [N, FEATURES] features -> [N, TYPES]."""
+    background left out): [N, FEATURES] features -> [N, TYPE_COUNT]."""
     with torch.no_grad():
-        return torch.softmax(colour(torch.from_numpy(rows))[:, :TYPES], dim=1)
+        return torch.softmax(colour(torch.from_numpy(rows))[:, :TYPE_COUNT], dim=1)
 
 
 def features(image: np.ndarray, pixel: np.ndarray) -> np.ndarray | None:
@@ -117,10 +117,10 @@ def pixel_vote(
     with torch.no_grad():
         logits = colour(torch.from_numpy(rows))
     named = logits.argmax(dim=1)
-    votes = (named < TYPES) & allowed[named.clamp(max=TYPES - 1)]
+    votes = (named < TYPE_COUNT) & allowed[named.clamp(max=TYPE_COUNT - 1)]
     if int(votes.sum()) < MIN_VOTES:
         return None
-    return torch.softmax(logits[votes, :TYPES], dim=1).mean(dim=0)
+    return torch.softmax(logits[votes, :TYPE_COUNT], dim=1).mean(dim=0)
 
 
 def _described(pixels: np.ndarray) -> np.ndarray:

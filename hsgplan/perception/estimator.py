@@ -86,7 +86,8 @@ class Detection:
     views: int
     reprojection_px: float
     rays: tuple[Ray, ...] = ()
-    # the colour network's probability of the type, among every type (1: no colour network)
+    # the colour network's probability of the type, among every type (1: no colour network, or
+    # no member view's centroid patch in its image: then it wins `_apart` over measured ones)
     type_confidence: float = 1.0
     keypoints: tuple[ViewKeypoints, ...] = ()  # each view's keypoints behind it
     stacked: bool = False  # one of two thin boxes that the views saw as one (`STACK_BAND`)
@@ -361,11 +362,13 @@ def _fitted(name: str, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[Pos
     # Objects here rest upright: the best upright yaw, unless a free pose explains several
     # views' keypoints much better (a toppled object; see `TOPPLED_COST`).
     level = upright_fit(name, views, pose.position)
-    cost, upright_cost = robust_cost(name, views, pose), robust_cost(name, views, level)
-    if len(views) < 2 or cost >= TOPPLED_COST * upright_cost:
+    cost = upright_cost = robust_cost(name, views, level)
+    if len(views) > 1 and (free := robust_cost(name, views, pose)) < TOPPLED_COST * upright_cost:
+        cost = free
+    else:
         pose = level
     points = sum(int((~np.isnan(v.pixels).any(axis=1)).sum()) for v in views)
-    return pose, math.sqrt(robust_cost(name, views, pose) / max(points, 1))
+    return pose, math.sqrt(cost / max(points, 1))
 
 
 def _apart(detections: list[Detection]) -> list[Detection]:

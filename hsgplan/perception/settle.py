@@ -9,7 +9,8 @@ rest before what they carry):
 
 - one that several views saw sits where their rays meet, and moves straight up or down onto
   the support under its centre (the table, a shelf's top board, or an object) whose top is
-  nearest its bottom and would not put it through an object several views saw: nothing
+  nearest its bottom and would not put it through an object several views saw (or believed
+  there, unseen: `fixed`): nothing
   floats, and nothing sinks into another. Where several tops lie within `NEAR_TOPS` of its
   bottom, the one where its pose best explains its keypoints wins, if the caller can say
   (`costs`): a can on a thin box found a centimetre low is as near the table as the box's top
@@ -150,12 +151,13 @@ def _straight_down(
     table beneath, inside its carrier (symbolic match on the tuning scenes, seed 2: 0.60 then,
     0.65 with this rule).
 
-    No top is taken that would put it through a `solid` carrier (one several views saw; a lone
-    view's may be a phantom) under its centre, by more than `PASS`, while another is left: a
-    popcorn on a cream cheese found a centimetre low is as near the table as the cheese's top,
-    and its keypoints could not tell them apart (the evaluation's seed 1, scene 54; nothing
-    else changed on the 300 scenes of seeds 1 to 3). Through any carrier, a lone view's
-    phantom beside a stack kept the object on it off its true carrier (5 scenes of seed 1)."""
+    No top is taken that would put it through a `solid` carrier (one several views saw, or one
+    believed there, unseen; a lone view's may be a phantom) under its centre, by more than
+    `PASS`, while another is left: a popcorn on a cream cheese found a centimetre low is as
+    near the table as the cheese's top, and its keypoints could not tell them apart (the
+    evaluation's seed 1, scene 54; nothing else changed on the 300 scenes of seeds 1 to 3).
+    Through any carrier, a lone view's phantom beside a stack kept the object on it off its
+    true carrier (5 scenes of seed 1)."""
     tops = _tops(centre[0], centre[1], carriers)
     if not tops:
         return None

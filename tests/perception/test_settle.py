@@ -134,7 +134,7 @@ def test_nothing_rests_through_an_object_several_views_saw_but_a_lone_views_may_
     low = Pose.from_xyz_yaw(0.5, 0.0, top + _half("popcorn") - 0.011, 0.0)
     types = ["cream_cheese", "popcorn"]
     costs = [None, lambda centre: centre[2]]
-    ray = (np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0]))
+    ray = (np.array([0.5, 0.0, 1.0]), np.array([0.0, 0.0, -1.0]))  # straight down on both
     seen_twice = settle(types, [cheese, low], [(ray, ray), (ray, ray)], costs)[1]
     assert seen_twice.position[2] == pytest.approx(top + _half("popcorn"))
     seen_once = settle(types, [cheese, low], [(ray,), (ray, ray)], costs)[1]

@@ -130,3 +130,32 @@ def test_background_patches_lie_outside_every_objects_cuboid():
     rows = colour_samples(found)
     assert [t for _, t in rows] == [3] + [BACKGROUND] * BACKGROUND_PATCHES
     assert all(r[3] < 1e-3 for r, _ in rows[1:])  # black: no pixel of their patches is red
+
+
+def test_examples_keep_the_keypoints_of_objects_in_sight_and_the_cuboids_of_all():
+    import numpy as np
+
+    from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
+    from hsgplan.perception.train import MIN_VISIBLE, examples
+    from hsgplan.scene_graph.geometry import Pose
+
+    c = VIEWS[0]
+    poses = [Pose.from_xyz_yaw(0.45, y, 0.05, 0.0) for y in (-0.1, 0.0, 0.1)]
+    data = {
+        "images": np.zeros((1, 1, c.height, c.width, 3), np.uint8),
+        "types": np.array([[3, -1, 5]], np.int8),  # a gap in the slots
+        "poses": np.array([[[*p.position, *p.orientation] for p in poses]], np.float32),
+        "visible": np.array([[[MIN_VISIBLE - 1, 0, MIN_VISIBLE]]], np.int32),
+        "cameras": np.array([[[*c.eye, *c.target, c.fov]]], np.float32),
+    }
+    found = examples(data)
+    from hsgplan.domain.world import OBJECT_TYPES
+
+    names = list(OBJECT_TYPES)
+    camera = PinholeCamera.of(c)
+    assert [list(t) for t in found.types] == [[5]]  # the popcorn is barely in sight
+    expected = view_keypoints(names[5], poses[2], camera)
+    assert np.allclose(found.keypoints[0][0], expected, atol=1e-3)
+    assert found.cuboids is not None and found.cuboids[0].shape == (2, 9, 2)
+    assert np.allclose(found.cuboids[0][1], expected, atol=1e-3)
+    assert np.allclose(found.cuboids[0][0], view_keypoints(names[3], poses[0], camera), atol=1e-3)
