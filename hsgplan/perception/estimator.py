@@ -362,8 +362,8 @@ def _fitted(name: str, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[Pos
     # Objects here rest upright: the best upright yaw, unless a free pose explains several
     # views' keypoints much better (a toppled object; see `TOPPLED_COST`).
     level = upright_fit(name, views, pose.position)
-    cost = upright_cost = robust_cost(name, views, level)
-    if len(views) > 1 and (free := robust_cost(name, views, pose)) < TOPPLED_COST * upright_cost:
+    cost = robust_cost(name, views, level)
+    if len(views) > 1 and (free := robust_cost(name, views, pose)) < TOPPLED_COST * cost:
         cost = free
     else:
         pose = level

@@ -80,13 +80,15 @@ class PerceptionTrainConfig:
 @dataclass(frozen=True)
 class Examples:
     """Every (sample, view) image with the keypoints and types of the objects in sight in it:
-    images [E, 3, H, W] uint8; keypoints and types, E arrays of [M, 9, 2] and [M]. Targets are
-    made per batch: kept for a whole collection they would take some 1.4 MB an image."""
+    images [E, 3, H, W] uint8; keypoints and types, E arrays of [M, 9, 2] and [M]; and the
+    keypoints of every object in the scene, in sight or not (cuboids, E arrays of [N, 9, 2]:
+    what is not background). Targets are made per batch: kept for a whole collection they
+    would take some 1.4 MB an image."""
 
     images: torch.Tensor
     keypoints: list[np.ndarray]
     types: list[np.ndarray]
-    cuboids: list[np.ndarray] | None = None  # every object's keypoints, in sight or not
+    cuboids: list[np.ndarray]
 
     def targets(
         self, take: list[int], types_count: int, stride: int = STRIDE
@@ -211,9 +213,8 @@ def colour_samples(found: Examples) -> list[tuple[np.ndarray, int]]:
     """(colour features at the centroid, type) of every in-sight object of every image, and
     (those of `BACKGROUND_PATCHES` patches outside every object, the background class)."""
     out = []
-    cuboids = found.cuboids or found.keypoints
     for e, (image, points, kinds, every) in enumerate(
-        zip(found.images, found.keypoints, found.types, cuboids, strict=True)
+        zip(found.images, found.keypoints, found.types, found.cuboids, strict=True)
     ):
         pixels = image.permute(1, 2, 0).numpy()
         for p, t in zip(points, kinds, strict=True):
