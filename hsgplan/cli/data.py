@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -133,6 +134,12 @@ def images(
             max=1.0,
         ),
     ] = 0.5,
+    views: Annotated[
+        int | None,
+        typer.Option(
+            help="The first this many fixed views (3: those before stop 30). [all]", min=1
+        ),
+    ] = None,
 ) -> None:
     """Synthetic training images for f_p: random scenes from the fixed cameras, domain
     randomised, with every object's pose and cuboid keypoints (format: perception/images.py)."""
@@ -140,6 +147,8 @@ def images(
 
     check_ray(ray)
     config = ImagesConfig(count, seed, p_elsewhere=p_elsewhere)
+    if views is not None:
+        config = replace(config, views=views)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("image chunks", total=config.chunks)
         rows = collect_images(config, out_dir, workers, ray, lambda _: progress.advance(bar))

@@ -56,10 +56,13 @@ class ImagesConfig:
     seed: int = 0
     chunk: int = CHUNK
     p_elsewhere: float = P_ELSEWHERE  # see `synthetic.P_ELSEWHERE`
+    views: int = len(VIEWS)  # the first this many fixed views (3: those before stop 30)
 
     def __post_init__(self) -> None:
         if self.count < 1 or self.chunk < 1:
             raise InvalidInputError("an image collection needs at least one sample per chunk")
+        if not 1 <= self.views <= len(VIEWS):
+            raise InvalidInputError(f"views {self.views}: there are 1 to {len(VIEWS)} fixed views")
         if not 0.0 <= self.p_elsewhere <= 1.0:
             raise InvalidInputError(f"p_elsewhere {self.p_elsewhere}: need a chance in 0..1")
 
@@ -73,12 +76,18 @@ def chunk_path(run_dir: Path, chunk: int) -> Path:
 
 
 def render_chunk(
-    run_dir: str, seed: int, chunk: int, size: int, count: int, p_elsewhere: float = P_ELSEWHERE
+    run_dir: str,
+    seed: int,
+    chunk: int,
+    size: int,
+    count: int,
+    p_elsewhere: float = P_ELSEWHERE,
+    views: int = len(VIEWS),
 ) -> dict:
     """Render a chunk's samples (of the first `count`) into its file, written whole or not at
     all; the worker's entry point. Returns what the run log keeps of it."""
     indices = range(chunk * size, min((chunk + 1) * size, count))
-    samples = [render_sample(seed, i, p_elsewhere) for i in indices]
+    samples = [render_sample(seed, i, p_elsewhere, views) for i in indices]
     kept = [s for s in samples if s is not None]
     path = chunk_path(Path(run_dir), chunk)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -91,7 +100,7 @@ def render_chunk(
 
 
 def pack(samples: list[ImageSample]) -> dict[str, np.ndarray]:
-    n, v = len(samples), len(VIEWS)
+    n, v = len(samples), len(samples[0].cameras)
     h, w = VIEWS[0].height, VIEWS[0].width
     out = {
         "index": np.array([s.index for s in samples], dtype=np.int32),
@@ -124,12 +133,14 @@ def collect_images(
     on_chunk=None,
 ) -> list[dict]:
     """Render every chunk not yet logged in `run_dir`; the log rows of all chunks."""
-    settings = asdict(config) | {
+    # The views are recorded as cameras (a collection from before the count was a setting
+    # holds the first three), not as the count.
+    settings = {k: v for k, v in asdict(config).items() if k != "views"} | {
         "format": FORMAT,
-        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in VIEWS],
+        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in VIEWS[: config.views]],
     }
     items = [
-        (str(run_dir), config.seed, c, config.chunk, config.count, config.p_elsewhere)
+        (str(run_dir), config.seed, c, config.chunk, config.count, config.p_elsewhere, config.views)
         for c in range(config.chunks)
     ]
     rows = run_items(
@@ -147,7 +158,7 @@ def collect_images(
     return rows
 
 
-def _render(item: tuple[str, int, int, int, int, float]) -> dict:
+def _render(item: tuple[str, int, int, int, int, float, int]) -> dict:
     return render_chunk(*item)
 
 

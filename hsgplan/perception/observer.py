@@ -1,6 +1,6 @@
 """f_p in the loop: the scene graph the agent plans on, from the fixed cameras' images.
 
-Every observation renders the three views (`perception.synthetic.VIEWS`, the scene's own look),
+Every observation renders the fixed views (`perception.synthetic.VIEWS`, the scene's own look),
 runs the pose estimator and names what it found. The goal names object instances, so the
 observer keeps a track of each: detections of a kind (cans, boxes) are given to that kind's
 objects by an optimal assignment on the type f_p named and the distance to where each object

@@ -38,14 +38,24 @@ P_ELSEWHERE = 0.5
 MAX_NOISE = 6.0  # pixel noise standard deviation, at most (0..255 scale)
 NEAR, FAR = 0.05, 4.0
 
-# Three fixed views at 320 x 240: facing the robot over the table (shelf tops, open space), and
+# Five fixed views at 320 x 240: facing the robot over the table (shelf tops, open space);
 # from behind the robot's shoulders on either side, low enough to look into the shelves and
-# over the prepush regions past the arm (which hides the middle from straight behind).
+# over the prepush regions past the arm (which hides the middle from straight behind); and,
+# since stop 30, from the table's far corners as low, which see the sides of the stacks on the
+# open space and the shelf tops that the first three see from one side only (a box under a can
+# or another box was often seen by one view alone). The first three were the only views until
+# then, and the keypoint network was trained on them (see `ORIGINAL_VIEWS`).
 VIEWS: tuple[Camera, ...] = (
     Camera(320, 240, (1.15, 0.0, 1.0), (0.42, 0.0, 0.05), 46.0),
     Camera(320, 240, (-0.25, 0.7, 0.55), (0.45, 0.2, 0.06), 50.0),
     Camera(320, 240, (-0.25, -0.7, 0.55), (0.45, -0.2, 0.06), 50.0),
+    Camera(320, 240, (1.1, 0.7, 0.55), (0.45, 0.1, 0.06), 50.0),
+    Camera(320, 240, (1.1, -0.7, 0.55), (0.45, -0.1, 0.06), 50.0),
 )
+# Views past these draw their jitter from a stream of their own, so that a sample rendered from
+# the first three is the same with or without the others (`collect images --views 3` renders
+# the collection the shipped network was first trained on, byte for byte).
+ORIGINAL_VIEWS = 3
 
 
 @dataclass(frozen=True)
@@ -95,8 +105,11 @@ def draw_state(rng: random.Random, p_elsewhere: float = P_ELSEWHERE) -> Symbolic
     return SymbolicSceneGraph.from_literals(objects, literals)
 
 
-def render_sample(seed: int, index: int, p_elsewhere: float = P_ELSEWHERE) -> ImageSample | None:
-    """The sample `(seed, index)`; None when its arrangement could not be staged."""
+def render_sample(
+    seed: int, index: int, p_elsewhere: float = P_ELSEWHERE, views: int = len(VIEWS)
+) -> ImageSample | None:
+    """The sample `(seed, index)` from the first `views` fixed views; None when its arrangement
+    could not be staged."""
     rng = random.Random(f"images-{seed}-{index}")
     state = draw_state(rng, p_elsewhere)
     with Scene(state.objects, seed=rng.getrandbits(32)) as scene:
@@ -105,8 +118,12 @@ def render_sample(seed: int, index: int, p_elsewhere: float = P_ELSEWHERE) -> Im
         _randomise_fixtures(scene, rng)
         for _ in range(rng.randint(0, DISTRACTORS)):
             _add_distractor(scene, rng)
-        cameras = tuple(_jittered(c, rng) for c in VIEWS)
+        cameras = tuple(_jittered(c, rng) for c in VIEWS[: min(views, ORIGINAL_VIEWS)])
         light = _light(rng)
+        cameras += tuple(
+            _jittered(VIEWS[k], random.Random(f"images-{seed}-{index}-view-{k}"))
+            for k in range(ORIGINAL_VIEWS, views)
+        )
         objects = scene.objects
         poses = [scene.pose(o) for o in objects]
         images, keypoints, visible = [], [], []

@@ -135,6 +135,16 @@ def examples(data: dict[str, np.ndarray]) -> Examples:
     return Examples(torch.stack(images), keypoints, types, cuboids)
 
 
+def joined(parts: list[Examples]) -> Examples:
+    """The examples of several collections, in order."""
+    return Examples(
+        torch.cat([p.images for p in parts]),
+        [k for p in parts for k in p.keypoints],
+        [t for p in parts for t in p.types],
+        [c for p in parts for c in p.cuboids],
+    )
+
+
 def _pose(p: np.ndarray) -> Pose:
     return Pose(tuple(map(float, p[:3])), tuple(map(float, p[3:])))
 
@@ -197,11 +207,10 @@ def train_perception(
     parts = [load_chunks(f) for f in config.folders]  # missing or damaged: refused, too
     if not parts:
         raise InvalidInputError("no image collection named")
-    data = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     chunks = [chunk_path(f, r["result"]["chunk"]) for f in config.folders for r in logged_rows(f)]
     data_print = fingerprint(chunks + ([Path(config.init)] if config.init else []))
     training.claim(out, asdict(config), asdict(PerceptionTrainConfig()))
-    found = examples(data)
+    found = joined([examples(p) for p in parts])  # collections of different view counts too
     if len(found.images) == 0:
         raise InvalidInputError(f"no images in '{config.images}'")
     if not training.finished(out):

@@ -56,3 +56,26 @@ def test_a_collection_may_ask_for_more_stacks_and_refuses_a_chance_outside_0_to_
     assert stacked(0.85) > stacked(0.5) > stacked(0.0) == 0
     with pytest.raises(InvalidInputError, match="p_elsewhere"):
         ImagesConfig(count=1, p_elsewhere=1.5)
+
+
+def test_the_first_views_of_a_sample_do_not_change_when_views_are_added():
+    three, every = render_sample(0, 3, views=3), render_sample(0, 3)
+    assert three is not None and every is not None
+    assert len(three.cameras) == 3 and len(every.cameras) == len(VIEWS) > 3
+    assert np.array_equal(three.images, every.images[:3])
+    assert three.cameras == every.cameras[:3]
+
+
+def test_a_collection_of_fewer_views_records_them_and_a_count_past_the_views_is_refused(
+    tmp_path,
+):
+    import json
+
+    collect_images(ImagesConfig(count=1, chunk=1, views=3), tmp_path, workers=1)
+    assert load_chunks(tmp_path)["images"].shape[1] == 3
+    saved = json.loads((tmp_path / "config.json").read_text())
+    assert len(saved["views"]) == 3 and "count" in saved
+    with pytest.raises(InvalidInputError, match="views"):
+        ImagesConfig(count=1, views=len(VIEWS) + 1)
+    with pytest.raises(InvalidInputError, match="views"):
+        ImagesConfig(count=1, views=0)

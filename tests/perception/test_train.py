@@ -159,3 +159,22 @@ def test_examples_keep_the_keypoints_of_objects_in_sight_and_the_cuboids_of_all(
     assert found.cuboids[0].shape == (2, 9, 2)
     assert np.allclose(found.cuboids[0][1], expected, atol=1e-3)
     assert np.allclose(found.cuboids[0][0], view_keypoints(names[3], poses[0], camera), atol=1e-3)
+
+
+def test_collections_of_different_view_counts_train_together(tmp_path):
+    three, every = tmp_path / "three", tmp_path / "every"
+    collect_images(ImagesConfig(count=1, chunk=1, views=3), three, workers=1)
+    collect_images(ImagesConfig(count=1, chunk=1), every, workers=1)
+    from hsgplan.perception.images import load_chunks
+    from hsgplan.perception.train import examples, joined
+
+    parts = [examples(load_chunks(f)) for f in (three, every)]
+    both = joined(parts)
+    assert len(both.images) == 3 + len(VIEWS) == len(both.keypoints) == len(both.cuboids)
+    assert torch.equal(both.images[3:], parts[1].images)
+    config = PerceptionTrainConfig(
+        images=f"{three},{every}", epochs=1, batch_size=4, width=4, stages=1, threads=1
+    )
+    losses = []
+    train_perception(config, tmp_path / "net", lambda e, loss: losses.append(loss))
+    assert len(losses) == 1 and losses[0] > 0
