@@ -122,6 +122,9 @@ BAD = [
     (["eval", "--agent", "search", "--motion", "gnn"], "no task planner or motion generator"),
     (["report", "/nonexistent/run"], "is not a folder"),
     (["report", "/nonexistent/run", "--failures", "-1"], "greater than or equal to 0"),
+    (["collect", "images", "--count", "1", "--views", "9"], "views 9: there are 1 to 5"),
+    (["collect", "images", "--count", "1", "--views", "0"], "greater than or equal to 1"),
+    (["eval-perception", "--scenes", "1", "--views", "6"], "views 6: there are 1 to 5"),
 ]
 
 

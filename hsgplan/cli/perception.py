@@ -21,6 +21,7 @@ from hsgplan.cli.common import (
     shown,
 )
 from hsgplan.domain.checks import MAX_SEED, MAX_TRIALS
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import PERCEPTION_CHECKPOINT, RUNS
 
 
@@ -78,15 +79,26 @@ def eval_perception(
     ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
     markdown: Annotated[bool, typer.Option(help="Print Markdown tables.")] = False,
+    views: Annotated[
+        int | None,
+        typer.Option(
+            help="See from the first this many fixed views (3: those before stop 30).", min=1
+        ),
+    ] = None,
 ) -> None:
     """f_p on fresh synthetic scenes: pose errors per object type, symbolic scene graph match."""
     from hsgplan.perception.estimator import PoseEstimator
     from hsgplan.perception.evaluate import evaluate, summary
 
+    from hsgplan.perception.synthetic import VIEWS
+
+    if views is not None and views > len(VIEWS):
+        raise InvalidInputError(f"views {views}: there are 1 to {len(VIEWS)} fixed views")
     estimator = PoseEstimator.load(checkpoint, settled=not raw)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
-        report = summary(evaluate(estimator, scenes, seed, lambda: progress.advance(task)))
+        shown = views or len(VIEWS)
+        report = summary(evaluate(estimator, scenes, seed, lambda: progress.advance(task), shown))
     if as_json:
         print(json.dumps(report, indent=2))
         return
@@ -109,7 +121,8 @@ def eval_perception(
         )
     )
     title = (
-        f"f_p on {report['scenes']} fresh scenes, seed {seed}: objects found "
+        f"f_p on {report['scenes']} fresh scenes, seed {seed}"
+        f"{f' (the first {views} views)' if views else ''}: objects found "
         f"{report['found_rate']:.3f}, symbolic scene graph equal "
         f"{report['symbolic_match_rate']:.3f}"
     )

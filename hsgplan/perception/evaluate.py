@@ -21,7 +21,7 @@ from hsgplan.domain.objects import object_type, type_of
 from hsgplan.domain.world import Kind
 from hsgplan.perception.estimator import Detection, PoseEstimator
 from hsgplan.perception.keypoints import BOX_SYMMETRIES
-from hsgplan.perception.synthetic import ImageSample, render_sample
+from hsgplan.perception.synthetic import VIEWS, ImageSample, render_sample
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -95,11 +95,13 @@ def evaluate(
     scenes: int,
     seed: int,
     on_scene: Callable[[], None] | None = None,
+    views: int = len(VIEWS),
 ) -> list[SceneResult]:
-    """The scenes `(seed, 0 .. scenes - 1)` that could be staged, each scored."""
+    """The scenes `(seed, 0 .. scenes - 1)` that could be staged, each scored, seen from the
+    first `views` fixed views."""
     out = []
     for index in range(scenes):
-        sample = render_sample(seed, index)
+        sample = render_sample(seed, index, views=views)
         if sample is not None:
             out.append(score_scene(sample, estimator.detect(sample.images, sample.cameras)))
         if on_scene:

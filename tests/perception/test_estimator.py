@@ -121,3 +121,22 @@ def test_an_object_on_its_side_stays_toppled_and_a_noisy_upright_one_stands():
     noisy = [ViewKeypoints(v.camera, v.pixels + n) for v, n in zip(views, noise, strict=True)]
     pose, _ = _fitted("butter", noisy, [])
     assert pose is not None and pose.rotation[2, 2] == pytest.approx(1.0)
+
+
+def test_the_evaluation_sees_from_the_first_views_asked_for():
+    from hsgplan.perception.evaluate import evaluate
+
+    class Counting:
+        def __init__(self):
+            self.views = []
+
+        def detect(self, images, cameras):
+            assert len(images) == len(cameras)
+            self.views.append(len(cameras))
+            return []
+
+    for views in (3, len(VIEWS)):
+        estimator = Counting()
+        results = evaluate(estimator, 2, 1, views=views)
+        assert estimator.views == [views] * len(results) and results
+        assert all(r.found == 0 and not r.symbolic_match for r in results)
