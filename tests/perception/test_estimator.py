@@ -101,6 +101,20 @@ def test_of_a_soup_and_a_box_found_in_one_place_the_colour_keeps_the_soup():
     assert [d.type_name for d in _apart(found)] == ["alphabet_soup"]
 
 
+def test_a_lone_views_can_where_several_views_saw_one_of_its_type_is_that_can_again():
+    lower = Pose.from_xyz_yaw(0.43, -0.37, 0.176, 0.0)  # under a cherries can at 0.251
+    lone = Pose.from_xyz_yaw(0.425, -0.38, 0.169, 0.0)
+    several = Detection("alphabet_soup", lower, 0.8, 5, 0.0, (), 0.830)
+    again = Detection("alphabet_soup", lone, 0.46, 1, 0.0, (), 0.835)  # surer, by a hair
+    on_it = Detection("cherries", Pose.from_xyz_yaw(0.43, -0.37, 0.251, 0.0), 0.86, 5, 0.0, (), 0.9)
+    assert _apart([on_it, again, several]) == [on_it, several]
+    # a lone view's box is kept as before: it may be the lower of a stack seen as one blob
+    box = Pose.from_xyz_yaw(0.5, 0.0, 0.036, 0.0)
+    blob = Detection("butter", box, 0.8, 3, 0.0, (), 0.6)
+    lone_box = Detection("butter", Pose.from_xyz_yaw(0.5, 0.005, 0.03, 0.0), 0.5, 1, 0.0, (), 0.7)
+    assert _apart([blob, lone_box]) == [lone_box]
+
+
 def _views_of(name: str, pose: Pose) -> list[ViewKeypoints]:
     cameras = [PinholeCamera.of(c) for c in VIEWS]
     return [ViewKeypoints(c, view_keypoints(name, pose, c)) for c in cameras]
