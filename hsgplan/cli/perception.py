@@ -89,7 +89,6 @@ def eval_perception(
     """f_p on fresh synthetic scenes: pose errors per object type, symbolic scene graph match."""
     from hsgplan.perception.estimator import PoseEstimator
     from hsgplan.perception.evaluate import evaluate, summary
-
     from hsgplan.perception.synthetic import VIEWS
 
     if views is not None and views > len(VIEWS):
