@@ -92,15 +92,16 @@ def render_chunk(
     path = chunk_path(Path(run_dir), chunk)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp.npz")
-    np.savez_compressed(tmp, **pack(kept))
+    np.savez_compressed(tmp, **pack(kept, views))
     digest = hashlib.sha256(tmp.read_bytes()).hexdigest()
     os.replace(tmp, path)
     unstaged = len(indices) - len(kept)
     return {"chunk": chunk, "samples": len(kept), "unstaged": unstaged, "sha256": digest}
 
 
-def pack(samples: list[ImageSample]) -> dict[str, np.ndarray]:
-    n, v = len(samples), len(samples[0].cameras)
+def pack(samples: list[ImageSample], views: int = len(VIEWS)) -> dict[str, np.ndarray]:
+    """The arrays of a chunk (`views` each; a chunk whose draws were all unstaged holds none)."""
+    n, v = len(samples), views
     h, w = VIEWS[0].height, VIEWS[0].width
     out = {
         "index": np.array([s.index for s in samples], dtype=np.int32),

@@ -79,3 +79,11 @@ def test_a_collection_of_fewer_views_records_them_and_a_count_past_the_views_is_
         ImagesConfig(count=1, views=len(VIEWS) + 1)
     with pytest.raises(InvalidInputError, match="views"):
         ImagesConfig(count=1, views=0)
+
+
+def test_a_chunk_whose_draws_were_all_unstaged_packs_empty_arrays_of_its_views():
+    from hsgplan.perception.images import pack
+
+    empty = pack([], views=3)
+    assert empty["images"].shape == (0, 3, VIEWS[0].height, VIEWS[0].width, 3)
+    assert empty["keypoints"].shape[:2] == (0, 3)
