@@ -21,7 +21,6 @@ from hsgplan.cli.common import (
     shown,
 )
 from hsgplan.domain.checks import MAX_SEED, MAX_TRIALS
-from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import PERCEPTION_CHECKPOINT, RUNS
 
 
@@ -89,14 +88,12 @@ def eval_perception(
     """f_p on fresh synthetic scenes: pose errors per object type, symbolic scene graph match."""
     from hsgplan.perception.estimator import PoseEstimator
     from hsgplan.perception.evaluate import evaluate, summary
-    from hsgplan.perception.synthetic import VIEWS
+    from hsgplan.perception.synthetic import VIEWS, first_views
 
-    if views is not None and views > len(VIEWS):
-        raise InvalidInputError(f"views {views}: there are 1 to {len(VIEWS)} fixed views")
+    shown = len(first_views(views)) if views is not None else len(VIEWS)  # before loading
     estimator = PoseEstimator.load(checkpoint, settled=not raw)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
-        shown = views or len(VIEWS)
         report = summary(evaluate(estimator, scenes, seed, lambda: progress.advance(task), shown))
     if as_json:
         print(json.dumps(report, indent=2))

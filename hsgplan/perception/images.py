@@ -39,6 +39,7 @@ from hsgplan.perception.synthetic import (
     P_ELSEWHERE,
     VIEWS,
     ImageSample,
+    first_views,
     render_sample,
 )
 from hsgplan.runner.items import run_items
@@ -61,8 +62,7 @@ class ImagesConfig:
     def __post_init__(self) -> None:
         if self.count < 1 or self.chunk < 1:
             raise InvalidInputError("an image collection needs at least one sample per chunk")
-        if not 1 <= self.views <= len(VIEWS):
-            raise InvalidInputError(f"views {self.views}: there are 1 to {len(VIEWS)} fixed views")
+        first_views(self.views)
         if not 0.0 <= self.p_elsewhere <= 1.0:
             raise InvalidInputError(f"p_elsewhere {self.p_elsewhere}: need a chance in 0..1")
 
@@ -138,7 +138,7 @@ def collect_images(
     # holds the first three), not as the count.
     settings = {k: v for k, v in asdict(config).items() if k != "views"} | {
         "format": FORMAT,
-        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in VIEWS[: config.views]],
+        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in first_views(config.views)],
     }
     items = [
         (str(run_dir), config.seed, c, config.chunk, config.count, config.p_elsewhere, config.views)

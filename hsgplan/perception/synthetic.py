@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import draw_objects, object_type
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.world import INTERIOR_CAPACITY, Kind
@@ -105,6 +106,13 @@ def draw_state(rng: random.Random, p_elsewhere: float = P_ELSEWHERE) -> Symbolic
     return SymbolicSceneGraph.from_literals(objects, literals)
 
 
+def first_views(count: int) -> tuple[Camera, ...]:
+    """The first `count` fixed views; a count past them (or under one) is refused in a line."""
+    if not 1 <= count <= len(VIEWS):
+        raise InvalidInputError(f"views {count}: there are 1 to {len(VIEWS)} fixed views")
+    return VIEWS[:count]
+
+
 def render_sample(
     seed: int, index: int, p_elsewhere: float = P_ELSEWHERE, views: int = len(VIEWS)
 ) -> ImageSample | None:
@@ -118,7 +126,8 @@ def render_sample(
         _randomise_fixtures(scene, rng)
         for _ in range(rng.randint(0, DISTRACTORS)):
             _add_distractor(scene, rng)
-        cameras = tuple(_jittered(c, rng) for c in VIEWS[: min(views, ORIGINAL_VIEWS)])
+        # the first three's jitter is always drawn, so fewer views change nothing else
+        cameras = tuple(_jittered(c, rng) for c in VIEWS[:ORIGINAL_VIEWS])[:views]
         light = _light(rng)
         cameras += tuple(
             _jittered(VIEWS[k], random.Random(f"images-{seed}-{index}-view-{k}"))

@@ -87,3 +87,9 @@ def test_a_chunk_whose_draws_were_all_unstaged_packs_empty_arrays_of_its_views()
     empty = pack([], views=3)
     assert empty["images"].shape == (0, 3, VIEWS[0].height, VIEWS[0].width, 3)
     assert empty["keypoints"].shape[:2] == (0, 3)
+
+
+def test_fewer_than_three_views_render_the_first_ones_as_three_do():
+    one, three = render_sample(0, 3, views=1), render_sample(0, 3, views=3)
+    assert one is not None and three is not None
+    assert np.array_equal(one.images, three.images[:1]) and one.cameras == three.cameras[:1]
