@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -20,13 +19,11 @@ import torch
 from safetensors.torch import load_file, save_file
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.files import atomic, write_atomically
 from hsgplan.paths import shipped
 
 WEIGHTS, CONFIG, MANIFEST = "model.safetensors", "config.json", "manifest.json"
-
-
-def _tmp(path: Path) -> Path:
-    return path.with_name(f".{path.name}.tmp")
+PROGRESS = "progress.safetensors"  # an unfinished training's last epoch (`hsgplan.training`)
 
 
 def _digest(path: Path) -> dict:
@@ -48,18 +45,16 @@ def save_trained(folder: Path, model: torch.nn.Module, config: dict) -> None:
             f"'{folder}' (lower lr)"
         )
     (folder / MANIFEST).unlink(missing_ok=True)  # unfinished until the manifest is back
-    save_file(state, _tmp(folder / WEIGHTS))
-    os.replace(_tmp(folder / WEIGHTS), folder / WEIGHTS)
-    _tmp(folder / CONFIG).write_text(json.dumps(config, indent=2) + "\n")
-    os.replace(_tmp(folder / CONFIG), folder / CONFIG)
+    with atomic(folder / WEIGHTS) as tmp:
+        save_file(state, tmp)
+    write_atomically(folder / CONFIG, json.dumps(config, indent=2) + "\n")
     write_manifest(folder)
 
 
 def write_manifest(folder: Path) -> None:
     """The size and checksum of a network's files, the mark of a finished folder."""
     manifest = {name: _digest(folder / name) for name in (WEIGHTS, CONFIG)}
-    _tmp(folder / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n")
-    os.replace(_tmp(folder / MANIFEST), folder / MANIFEST)
+    write_atomically(folder / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 
 
 def verify(folder: Path, what: str = "network") -> None:
@@ -128,7 +123,7 @@ def fingerprint(folders: Iterable[Path]) -> str:
         else:
             files = []
         for path in files:
-            if path.name.startswith(".") or path.suffix in (".pt", ".tmp"):
+            if path.name.startswith(".") or path.name == PROGRESS or path.suffix == ".pt":
                 continue  # training leftovers are not what a run is evaluated with
             h.update(str(path.relative_to(folder)).encode() + b"\0")
             h.update(hashlib.sha256(path.read_bytes()).digest())

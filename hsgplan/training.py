@@ -1,6 +1,10 @@
-"""Training progress, shared by every trainer: `progress.pt` (model, optimiser, epoch and a
-fingerprint of the training data; loaded with weights_only) while training runs. A finished
-network is written by `hsgplan.checkpoint`.
+"""Training progress, shared by every trainer: `progress.safetensors` while training runs.
+
+The progress file holds no code, only data: the model's and the optimiser's tensors in
+safetensors, and in its JSON metadata the epoch, a fingerprint of the training data and the
+optimiser's structure (its hyperparameters, with each tensor named by its key). It is written
+atomically, so a kill leaves the last good progress. A finished network is written by
+`hsgplan.checkpoint`.
 """
 
 from __future__ import annotations
@@ -10,13 +14,24 @@ import math
 from pathlib import Path
 
 import torch
+from safetensors import safe_open
+from safetensors.torch import save_file
 
-from hsgplan.checkpoint import MANIFEST, WEIGHTS, is_finished, non_finite, save_trained
+from hsgplan.checkpoint import (
+    MANIFEST,
+    PROGRESS,
+    WEIGHTS,
+    is_finished,
+    non_finite,
+    save_trained,
+)
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.runner.run_folder import write_atomically
+from hsgplan.files import atomic, write_atomically
+from hsgplan.runner.lock import hold_folder, holds
+from hsgplan.runner.run_folder import has_files
 
-PROGRESS = "progress.pt"
+_STATE = "hsgplan.progress"  # the metadata key holding the JSON half of the progress
 TRAIN_CONFIG = "train_config.json"
 
 
@@ -26,7 +41,8 @@ def claim(out: Path, config: dict, defaults: dict | None = None) -> None:
     (a dataset, a run, another kind of checkpoint), and a checkpoint trained or in training
     with another configuration. A folder whose training never got as far as saving anything
     (it was refused or diverged) takes the new configuration. A saved configuration lacking a
-    setting of `defaults` was trained before the setting existed, with its default."""
+    setting of `defaults` was trained before the setting existed, with its default. The caller
+    is the folder's one writer from here until it ends (`runner/lock.py`)."""
     saved = out / TRAIN_CONFIG
     if out.exists() and not out.is_dir():
         raise InvalidInputError(f"'{out}' is a file, not a checkpoint folder")
@@ -39,9 +55,11 @@ def claim(out: Path, config: dict, defaults: dict | None = None) -> None:
             raise InvalidInputError(
                 f"'{out}' holds a checkpoint trained with another configuration; use another --out"
             )
-    elif out.is_dir() and any(out.iterdir()):
+    elif out.is_dir() and has_files(out):
         raise InvalidInputError(f"'{out}' holds other files and no checkpoint; use another --out")
-    out.mkdir(parents=True, exist_ok=True)
+    if not holds(out):
+        hold_folder(out)
+        return claim(out, config, defaults)  # checked again: it may have changed hands
     write_atomically(saved, json.dumps(config, indent=2) + "\n")
 
 
@@ -59,6 +77,41 @@ def finished(folder: Path) -> bool:
     return is_finished(folder)
 
 
+def _encode(value, key: str, tensors: dict[str, torch.Tensor]):
+    """`value` (a state dict, nested) as JSON, its tensors moved into `tensors` by key."""
+    if isinstance(value, torch.Tensor):
+        tensors[key] = value.detach().clone().contiguous()  # shared storage cannot be saved
+        return {"$tensor": key}
+    if isinstance(value, dict):  # keys may be integers (an optimiser's parameter ids)
+        return {"$dict": [[k, _encode(v, f"{key}.{k}", tensors)] for k, v in value.items()]}
+    if isinstance(value, tuple):
+        return {"$tuple": [_encode(v, f"{key}.{i}", tensors) for i, v in enumerate(value)]}
+    if isinstance(value, list):
+        return [_encode(v, f"{key}.{i}", tensors) for i, v in enumerate(value)]
+    if value is None or isinstance(value, bool | int | float | str):
+        return value
+    raise TypeError(f"{key}: a {type(value).__name__} has no place in training progress")
+
+
+def _decode(value, tensors: dict[str, torch.Tensor]):
+    if isinstance(value, list):
+        return [_decode(v, tensors) for v in value]
+    if not isinstance(value, dict):
+        return value
+    if "$tensor" in value:
+        return tensors[value["$tensor"]]
+    if "$tuple" in value:
+        return tuple(_decode(v, tensors) for v in value["$tuple"])
+    return {k: _decode(v, tensors) for k, v in value["$dict"]}
+
+
+def _read_progress(path: Path) -> dict:
+    with safe_open(path, framework="pt") as f:
+        tensors = {k: f.get_tensor(k) for k in f.keys()}  # noqa: SIM118 (not a mapping)
+        state = json.loads((f.metadata() or {})[_STATE])
+    return _decode(state, tensors)
+
+
 def resume(folder: Path, model: torch.nn.Module, optim: torch.optim.Optimizer, data: str) -> int:
     """Load the saved progress, if any, into model and optimiser; the epoch to start from.
     Progress made on other training data (`data`, a fingerprint) is refused, never mixed."""
@@ -66,7 +119,7 @@ def resume(folder: Path, model: torch.nn.Module, optim: torch.optim.Optimizer, d
     if not progress.exists():
         return 0
     try:
-        state = torch.load(progress, weights_only=True)
+        state = _read_progress(progress)
         saved_data = state.get("data")
         model.load_state_dict(state["model"])
         optim.load_state_dict(state["optim"])
@@ -86,10 +139,12 @@ def resume(folder: Path, model: torch.nn.Module, optim: torch.optim.Optimizer, d
 
 
 def save_progress(folder: Path, model, optim, epoch: int, data: str) -> None:
-    tmp = folder / "progress.tmp"
+    """The last finished epoch, written whole (a crash mid-write leaves the last good one)."""
+    tensors: dict[str, torch.Tensor] = {}
     state = {"model": model.state_dict(), "optim": optim.state_dict(), "epoch": epoch}
-    torch.save(state | {"data": data}, tmp)
-    tmp.replace(folder / PROGRESS)  # a crash mid-write leaves the last good progress
+    meta = json.dumps(_encode(state | {"data": data}, "state", tensors))
+    with atomic(folder / PROGRESS) as tmp:
+        save_file(tensors, tmp, metadata={_STATE: meta})
 
 
 def finish(folder: Path, model: torch.nn.Module, config: dict) -> None:

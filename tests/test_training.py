@@ -14,10 +14,36 @@ def _model_and_optim():
 
 def test_progress_is_saved_and_resumed(tmp_path):
     model, optim = _model_and_optim()
+    model(torch.ones(4, 3)).sum().backward()
+    optim.step()  # the optimiser now has state: moments and a step count per parameter
     training.save_progress(tmp_path, model, optim, 5, "data-a")
     other, other_optim = _model_and_optim()
     assert training.resume(tmp_path, other, other_optim, "data-a") == 5
     assert torch.equal(other.weight, model.weight)
+    saved, loaded = optim.state_dict(), other_optim.state_dict()
+    assert loaded["param_groups"] == saved["param_groups"]
+    for k, moments in saved["state"].items():
+        for name, value in moments.items():
+            assert torch.equal(loaded["state"][k][name], value)
+
+
+def test_progress_is_data_not_a_pickle(tmp_path):
+    from safetensors import safe_open
+
+    model, optim = _model_and_optim()
+    training.save_progress(tmp_path, model, optim, 3, "data-a")
+    assert [p.name for p in tmp_path.iterdir()] == [training.PROGRESS]
+    assert not (tmp_path / training.PROGRESS).read_bytes().startswith(b"PK")  # no torch zip
+    with safe_open(tmp_path / training.PROGRESS, framework="pt") as f:
+        assert "state.model.weight" in f.keys()  # noqa: SIM118
+
+
+def test_a_pickle_given_as_progress_is_refused_without_unpickling(tmp_path, capfd):
+    model, optim = _model_and_optim()
+    torch.save({"model": model.state_dict()}, tmp_path / training.PROGRESS)
+    with pytest.raises(InvalidInputError, match="not usable training progress"):
+        training.resume(tmp_path, *_model_and_optim(), "data-a")
+    assert capfd.readouterr().err == ""  # no pickle warning printed before the refusal
 
 
 def test_corrupted_progress_is_refused_in_one_line_and_left_in_place(tmp_path):

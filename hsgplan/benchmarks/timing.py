@@ -26,6 +26,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.table1 import TextTable
+from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim
 from hsgplan.viz.plots import plot_times_by_size
 
@@ -139,8 +140,8 @@ def run_timing(
         "workers": workers,
         "run": str(out),
     }
-    (out / "summary.json").write_text(json.dumps(report, indent=2) + "\n")
-    (out / "table2.md").write_text("\n\n".join(t.markdown() for t in tables(report)) + "\n")
+    write_atomically(out / "summary.json", json.dumps(report, indent=2) + "\n")
+    write_atomically(out / "table2.md", "\n\n".join(t.markdown() for t in tables(report)) + "\n")
     plot_times_by_size(_series(report), out / "table2.png")
     return report
 

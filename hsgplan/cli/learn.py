@@ -23,7 +23,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
-from hsgplan.domain.checks import MAX_GOALS, MAX_SEED, MAX_WORKERS
+from hsgplan.domain.checks import MAX_GOALS, MAX_SEED, MAX_WORKERS, resolve
 from hsgplan.paths import REACH_HELD_OUT, RUNS, TASK_CHECKPOINT
 
 train_app = typer.Typer(no_args_is_help=True, help="Train the learned models (resumable).")
@@ -103,7 +103,7 @@ def eval_task(
     size_list = parse_sizes(sizes)
     total = goals * len(size_list) if goals_file is None else None
     source = goals_file.stem if goals_file else f"g{goals}"
-    tag = "" if checkpoint == TASK_CHECKPOINT else f"-{checkpoint.resolve().name}"
+    tag = "" if checkpoint == TASK_CHECKPOINT else f"-{resolve(checkpoint).name}"
     run_dir = run_dir or RUNS / f"eval-task-{planner}{tag}-{sizes}-{source}-seed{seed}"
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(f"{planner} episodes", total=total)

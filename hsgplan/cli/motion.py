@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
@@ -37,8 +38,12 @@ class Model(StrEnum):
 
 @refuses_bad_input
 def train_motion(
-    primitive: Annotated[Primitive, typer.Option(help="place or push.")] = Primitive.place,
-    model: Annotated[Model, typer.Option(help="gnn or mlp.")] = Model.gnn,
+    primitive: Annotated[
+        Primitive | None, typer.Option(help="place or push [default: the config's, or place].")
+    ] = None,
+    model: Annotated[
+        Model | None, typer.Option(help="gnn or mlp [default: the config's, or gnn].")
+    ] = None,
     config: Annotated[
         Path | None, typer.Option(help="Training configuration (JSON).", parser=input_path)
     ] = None,
@@ -60,12 +65,19 @@ def train_motion(
     from hsgplan.motion.train import MotionTrainConfig
     from hsgplan.motion.train import train_motion as run
 
-    primitive, model = primitive.value, model.value
     settings = read_config(config)
-    settings |= {"primitive": primitive, "model": model}
-    if data is not None:
-        settings["data"] = str(data)
+    for name, given in (("primitive", primitive), ("model", model)):
+        if given is not None and settings.get(name, given.value) != given.value:
+            raise InvalidInputError(
+                f"--{name} {given.value}: the configuration '{config}' trains "
+                f"{name} {settings[name]!r}"
+            )
+        if given is not None:
+            settings[name] = given.value
     cfg = MotionTrainConfig.from_json(settings)
+    primitive, model = cfg.primitive, cfg.model
+    if data is not None:
+        cfg = replace(cfg, data=str(data))
     folder = out_dir or RUNS / f"train-motion-{primitive}-{model}"
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task(f"{primitive} {model}", total=cfg.epochs)

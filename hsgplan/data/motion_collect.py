@@ -93,7 +93,7 @@ def _done_chunks(config: CollectConfig, folder: Path) -> tuple[dict[int, int], i
     """Successful trials in each chunk on disk, and how many files were set aside: a damaged
     chunk, or one that is not the chunk its name says, is moved to `rejected/` (never kept,
     never silently deleted) and runs again."""
-    for leftover in folder.glob(".*.tmp"):
+    for leftover in folder.glob(".*.tmp*"):
         leftover.unlink()  # a write cut short
     done, rejected = {}, 0
     for k, path in store.chunk_files(folder).items():

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,8 +33,9 @@ import numpy as np
 from hsgplan.data.motion_trials import ChunkResult, Trial
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import ENTITY_TYPES
-from hsgplan.domain.parameters import MotionPrimitive
+from hsgplan.domain.parameters import BINS, MotionPrimitive
 from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.files import atomic, write_atomically
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.outcome import Status
@@ -113,11 +113,9 @@ def from_trials(primitive: MotionPrimitive, trials: list[Trial]) -> MotionData:
 def save(path: Path, data: MotionData, **extra: np.ndarray) -> None:
     """Write atomically (a temporary file renamed), so an interruption leaves no half file;
     the temporary name never looks like a chunk or a dataset."""
-    tmp = path.with_name(f".{path.name}.tmp")
     arrays = {f: getattr(data, f) for f in FIELDS}
-    with open(tmp, "wb") as f:
+    with atomic(path) as tmp, open(tmp, "wb") as f:
         np.savez_compressed(f, primitive=np.array(data.primitive.value), **arrays, **extra)
-    os.replace(tmp, path)
 
 
 def load(path: Path) -> MotionData:
@@ -139,7 +137,51 @@ def _read(path: Path) -> tuple[MotionData, dict[str, int]]:
     shapes = [getattr(data, f).shape[:1] == (n,) for f in FIELDS]
     if not all(shapes) or data.bins.shape[1:] != (2,) or data.poses.shape[1:] != (len(TYPES), 7):
         raise InvalidInputError(f"'{path}' does not follow the motion data schema")
+    if problem := row_problem(data):
+        raise InvalidInputError(f"'{path}' is damaged: {problem}")
     return data, extras
+
+
+def row_problem(data: MotionData) -> str | None:
+    """What breaks the schema in `data`'s rows (the first row and field), or None: every index
+    in range, every pose finite or absent, the object acted on and an object target present.
+    A damaged or hand-edited file is refused here rather than deep inside training."""
+    indices = ("task", "attempt", "status", "crowding", "obj", "target", "bins")
+    if any(getattr(data, f).dtype.kind not in "iu" for f in indices):
+        return "an index array does not hold integers"
+    if data.poses.dtype.kind != "f":
+        return "poses are not floating point"
+    nx, ny = BINS[data.primitive]
+    limits = {
+        "task": (data.task, None),
+        "attempt": (data.attempt, None),
+        "crowding": (data.crowding, None),
+        "status": (data.status, len(STATUSES)),
+        "obj": (data.obj, len(TYPES)),
+        "target": (data.target, len(ENTITY_TYPES)),
+        "x or angle bin": (data.bins[:, 0], nx),
+        "y or distance bin": (data.bins[:, 1], ny),
+    }
+    for name, (values, end) in limits.items():
+        bad = (values < 0) | (values >= end if end is not None else False)
+        if bad.any():
+            i = int(np.argmax(bad))
+            bound = f"0 to {end - 1}" if end is not None else "at least 0"
+            return f"row {i}: {name} {int(values[i])} (must be {bound})"
+    absent = np.isnan(data.poses).all(axis=2)
+    if not (absent | np.isfinite(data.poses).all(axis=2)).all():
+        return "a pose is partly missing or not finite"
+    rows = np.arange(len(data))
+    if len(data) and absent[rows, data.obj.astype(np.int64)].any():
+        i = int(np.argmax(absent[rows, data.obj.astype(np.int64)]))
+        return f"row {i}: the object acted on, {data.object_name(i)}, has no pose"
+    target_is_object = data.target < len(TYPES)
+    target = np.where(target_is_object, data.target, 0).astype(np.int64)
+    bad = target_is_object & (absent[rows, target] | (data.target == data.obj))
+    if bad.any():
+        i = int(np.argmax(bad))
+        return f"row {i}: target {data.target_name(i)} is absent or the object itself"
+    return None
 
 
 CHUNK_NAME = re.compile(r"chunk-(\d{6})\.npz")
@@ -198,9 +240,7 @@ def write_schema(folder: Path) -> None:
         "fields": FIELDS,
         "description": "Schema" + doc,
     }
-    tmp = folder / ".schema.json.tmp"
-    tmp.write_text(json.dumps(schema, indent=1) + "\n")
-    os.replace(tmp, folder / SCHEMA)
+    write_atomically(folder / SCHEMA, json.dumps(schema, indent=1) + "\n")
 
 
 def manifest_path(dataset: Path) -> Path:
@@ -210,9 +250,7 @@ def manifest_path(dataset: Path) -> Path:
 def write_manifest(dataset: Path, settings: dict) -> None:
     """What made a dataset file, and its checksum, as `place.json` beside `place.npz`."""
     manifest = settings | {"sha256": hashlib.sha256(dataset.read_bytes()).hexdigest()}
-    tmp = dataset.with_name(f".{dataset.stem}.json.tmp")
-    tmp.write_text(json.dumps(manifest, indent=1) + "\n")
-    os.replace(tmp, manifest_path(dataset))
+    write_atomically(manifest_path(dataset), json.dumps(manifest, indent=1) + "\n")
 
 
 def read_manifest(dataset: Path) -> dict | None:
@@ -224,9 +262,10 @@ def read_manifest(dataset: Path) -> dict | None:
     return manifest if isinstance(manifest, dict) else None
 
 
-def load_dataset(path: Path) -> MotionData:
-    """A dataset file, checked against its manifest's checksum where it has one: a file
-    replaced or damaged since it was collected is refused in one line."""
+def load_dataset(path: Path, primitive: MotionPrimitive | None = None) -> MotionData:
+    """A dataset file (of `primitive`, when given), checked against its manifest where it has
+    one (checksum, primitive, number of successes): a file replaced, swapped or damaged since
+    it was collected is refused in one line."""
     manifest = read_manifest(path)
     if (
         manifest
@@ -237,4 +276,19 @@ def load_dataset(path: Path) -> MotionData:
             f"'{path}' does not match its manifest {manifest_path(path).name} "
             "(damaged or replaced); collect it again"
         )
-    return load(path)
+    data = load(path)
+    if primitive is not None and data.primitive is not primitive:
+        raise InvalidInputError(
+            f"'{path}' holds {data.primitive.value} trials, not {primitive.value} ones"
+        )
+    if manifest and manifest.get("primitive", data.primitive.value) != data.primitive.value:
+        raise InvalidInputError(
+            f"'{path}' holds {data.primitive.value} trials; its manifest says "
+            f"{manifest.get('primitive')!r}"
+        )
+    if manifest and manifest.get("samples", int(data.ok.sum())) != int(data.ok.sum()):
+        raise InvalidInputError(
+            f"'{path}' holds {int(data.ok.sum())} successes; its manifest says "
+            f"{manifest.get('samples')!r}"
+        )
+    return data

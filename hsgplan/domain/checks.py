@@ -29,6 +29,8 @@ MAX_TRIALS = 100_000  # `eval-motion --trials` (per primitive)
 MAX_EPISODES = 10_000  # `bench sim --episodes`
 MAX_FAILURES = 1_000  # `report --failures`
 MAX_TASKS_PER_CHUNK = 100_000
+MAX_GOAL_FILE_GOALS = MAX_GOALS  # a goal file holds at most as many goals as --goals draws
+MAX_GOAL_FILE_BYTES = 32 * 2**20  # 100,000 goals of 12 objects fit; parsed in about 10 s
 
 
 def bounded(lo: float | None = None, hi: float | None = None, above: float | None = None) -> dict:
@@ -99,14 +101,19 @@ def from_settings(cls, settings: Any, what: str = "training setting"):
     return cls(**settings)
 
 
-def read_text(path: Path, what: str) -> str:
-    """A UTF-8 text file (a byte-order mark is allowed); anything else refused in one line."""
+def read_text(path: Path, what: str, max_bytes: int | None = None) -> str:
+    """A UTF-8 text file (a byte-order mark is allowed) of at most `max_bytes`; anything else
+    refused in one line, a file too large before it is read."""
     path = Path(path)
     if path.is_dir():
         raise InvalidInputError(f"{what} '{path}' is a folder, not a file")
     if path.exists() and not path.is_file():  # a FIFO or a device would block or never end
         raise InvalidInputError(f"{what} '{path}' is not a regular file")
     try:
+        if max_bytes is not None and (size := path.stat().st_size) > max_bytes:
+            raise InvalidInputError(
+                f"{what} '{path}' is {size / 2**20:.1f} MiB; at most {max_bytes / 2**20:.0f} MiB"
+            )
         data = path.read_bytes()
     except FileNotFoundError:
         raise InvalidInputError(f"{what} '{path}' does not exist") from None
@@ -140,6 +147,14 @@ def read_json(path: Path, what: str, shape: type = dict) -> Any:
 SYSTEM_TREES = ("/proc", "/sys", "/dev")
 
 
+def resolve(path: Path) -> Path:
+    """`path` made absolute with its links followed; a loop of links refused in one line."""
+    try:
+        return Path(path).resolve()
+    except (RuntimeError, OSError) as e:  # 3.11 raises RuntimeError for a loop, 3.13 OSError
+        raise InvalidInputError(f"'{path}' is a loop of symbolic links ({e})") from None
+
+
 def check_output(path: Path, kind: str = "folder") -> None:
     """Refuse, before anything is written, a place output cannot go: a `kind` ("folder" or
     "file") where something else stands, a path under a file, a system tree, a folder we may
@@ -148,7 +163,7 @@ def check_output(path: Path, kind: str = "folder") -> None:
     if not text.strip():
         raise InvalidInputError("an empty path; name a place for the output")
     path = Path(text).expanduser()
-    resolved = path.resolve()
+    resolved = resolve(path)
     if any(resolved == Path(t) or Path(t) in resolved.parents for t in SYSTEM_TREES):
         raise InvalidInputError(f"'{text}' is in a system tree, not a place for output")
     if path.exists():

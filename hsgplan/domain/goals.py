@@ -13,11 +13,12 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from hsgplan.domain.checks import read_text
+from hsgplan.domain.checks import MAX_GOAL_FILE_BYTES, MAX_GOAL_FILE_GOALS, read_text
 from hsgplan.domain.errors import GoalSyntaxError, InvalidInputError, UnknownNameError
 from hsgplan.domain.feasibility import check_literals
 from hsgplan.domain.objects import kind_of, sort_objects
 from hsgplan.domain.predicates import PREDICATES, Literal, Predicate
+from hsgplan.files import write_atomically
 
 MAX_GOAL_CHARS = 10_000
 
@@ -149,18 +150,26 @@ def write_goal_file(path: Path, goals: Iterable[Goal], header: str = "") -> None
     lines = [f"# {h}" for h in header.splitlines()] + [str(g) for g in goals]
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")  # an existing file is replaced whole or kept
-    tmp.write_text("\n".join(lines) + "\n")
-    tmp.replace(path)
+    write_atomically(path, "\n".join(lines) + "\n")  # an existing file is replaced or kept
 
 
 def read_goal_file(path: Path) -> list[Goal]:
-    """Every goal in a goal file; a bad line raises with its line number."""
+    """Every goal in a goal file; a bad line raises with its line number. A file larger than
+    `MAX_GOAL_FILE_BYTES` or holding more than `MAX_GOAL_FILE_GOALS` goals is refused before
+    any goal is parsed (parsing a million would take minutes with nothing shown)."""
+    lines = [
+        (n, text)
+        for n, line in enumerate(
+            read_text(Path(path), "goal file", MAX_GOAL_FILE_BYTES).splitlines(), start=1
+        )
+        if (text := line.strip()) and not text.startswith("#")
+    ]
+    if len(lines) > MAX_GOAL_FILE_GOALS:
+        raise InvalidInputError(
+            f"goal file '{path}' holds {len(lines)} goals; at most {MAX_GOAL_FILE_GOALS}"
+        )
     goals = []
-    for n, line in enumerate(read_text(Path(path), "goal file").splitlines(), start=1):
-        text = line.strip()
-        if not text or text.startswith("#"):
-            continue
+    for n, text in lines:
         try:
             goals.append(parse_goal(text))
         except InvalidInputError as e:

@@ -17,6 +17,7 @@ from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord, params_text, run_episode
+from hsgplan.files import atomic, write_atomically
 from hsgplan.runner.engines import one_core
 from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.observer import SceneObserver
@@ -108,6 +109,7 @@ def run_demo(
     if isinstance(agent, str):
         agent = make_agent(agent)
     record = run_episode(env, agent, goal, seed, on_frame, on_step_done, on_decide)
-    iio.imwrite(out / "episode.gif", frames, duration=90, loop=0)
-    (out / "episode.json").write_text(json.dumps(record.to_json(), indent=2) + "\n")
+    with atomic(out / "episode.gif") as tmp:
+        iio.imwrite(tmp, frames, duration=90, loop=0)
+    write_atomically(out / "episode.json", json.dumps(record.to_json(), indent=2) + "\n")
     return record

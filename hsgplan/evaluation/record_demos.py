@@ -14,6 +14,8 @@ from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.episode import run_episode
+from hsgplan.files import write_atomically
+from hsgplan.runner.lock import hold_folder
 from hsgplan.runner.run_folder import check_own
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.env import KitchenStorageEnv
@@ -52,7 +54,7 @@ def collect_demos(
 ) -> list[Demo]:
     """Record every task not yet in `out` (appending as each finishes); all demos, in order."""
     check_own(out, META, "demonstration set")  # never into another command's folder
-    out.mkdir(parents=True, exist_ok=True)
+    hold_folder(out)  # one writer: a second collection into `out` is refused
     meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
     meta_path = out / META
     if meta_path.exists():
@@ -60,7 +62,7 @@ def collect_demos(
         if saved.get("seed") != seed or saved.get("version") != VERSION:
             raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
     else:
-        meta_path.write_text(json.dumps(meta, indent=2) + "\n")
+        write_atomically(meta_path, json.dumps(meta, indent=2) + "\n")
     done = {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
     path = out / DEMOS
     if path.exists() and path.stat().st_size and not path.read_bytes().endswith(b"\n"):

@@ -23,6 +23,7 @@ from hsgplan.evaluation.observers import make_observer
 from hsgplan.evaluation.protocol import checkpoints, read_eval_config
 from hsgplan.evaluation.summary import FAILED_EXECUTION, failure_class
 from hsgplan.evaluation.table1 import label, tables
+from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import logged_rows
 from hsgplan.viz.html_page import heading, image, page, paragraph, table
 
@@ -165,9 +166,7 @@ def build_report(
         if on_rollout:
             on_rollout(r)
     path = run_dir / REPORT
-    tmp = path.with_suffix(".html.tmp")
-    tmp.write_text(page(f"Evaluation report: {run_dir.name}", parts), encoding="utf-8")
-    tmp.replace(path)
+    write_atomically(path, page(f"Evaluation report: {run_dir.name}", parts))
     return path
 
 

@@ -17,6 +17,7 @@ from pathlib import Path
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
+from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim, read_timing
 
 # Table 1 of the paper (success rate, subgoal completion), by motion generator and size.
@@ -97,8 +98,8 @@ def run_table(
         "seed": config.seed,
         "run": str(out),
     }
-    (out / "summary.json").write_text(json.dumps(report, indent=2) + "\n")
-    (out / "table1.md").write_text(markdown(report) + "\n")
+    write_atomically(out / "summary.json", json.dumps(report, indent=2) + "\n")
+    write_atomically(out / "table1.md", markdown(report) + "\n")
     from hsgplan.viz.plots import plot_success_by_size
 
     plot_success_by_size(

@@ -5,7 +5,7 @@ so the network learns which bins succeed in a scene like this one. `bce` (beyond
 every trial, failures included, teaches the logit of its own bin pair whether it succeeded, so
 the network estimates each bin's chance of success from more than twice the data. The
 checkpoint is a folder: `train_config.json`, `config.json` (the network's), `model.safetensors`;
-`progress.pt` (loaded with weights_only) holds the last finished epoch while training runs, so
+`progress.safetensors` holds the last finished epoch while training runs, so
 that a run started again with the same configuration continues from there.
 """
 
@@ -82,14 +82,20 @@ class MotionTrainConfig:
 def _training_rows(config: MotionTrainConfig) -> MotionData:
     """The first `samples` successes, and with `bce` every trial up to the last of them."""
     folder = shipped(config.data)
-    data = load_dataset(folder / f"{config.primitive}.npz")
+    primitive = MotionPrimitive(config.primitive)
+    data = load_dataset(folder / f"{config.primitive}.npz", primitive)
     if config.samples is not None:
+        if config.samples > len(data):
+            raise InvalidInputError(
+                f"samples {config.samples}: '{folder}' holds {len(data)} successful "
+                f"{config.primitive} samples"
+            )
         data = data.take(slice(0, config.samples))
     if len(data) == 0:
         raise InvalidInputError(f"no successful {config.primitive} samples in '{folder}'")
     if config.loss == "ce":
         return data
-    trials = load_dataset(folder / f"{config.primitive}_trials.npz")
+    trials = load_dataset(folder / f"{config.primitive}_trials.npz", primitive)
     last = (int(data.task[-1]), int(data.attempt[-1]))
     keep = [(int(t), int(a)) <= last for t, a in zip(trials.task, trials.attempt, strict=True)]
     return trials.take(np.array(keep, dtype=bool))

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -33,6 +32,7 @@ import numpy as np
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import split_instance
 from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.files import atomic, write_atomically
 from hsgplan.perception.keypoints import KEYPOINTS
 from hsgplan.perception.synthetic import (
     MAX_OBJECTS,
@@ -91,10 +91,9 @@ def render_chunk(
     kept = [s for s in samples if s is not None]
     path = chunk_path(Path(run_dir), chunk)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp.npz")
-    np.savez_compressed(tmp, **pack(kept, views))
-    digest = hashlib.sha256(tmp.read_bytes()).hexdigest()
-    os.replace(tmp, path)
+    with atomic(path) as tmp:
+        np.savez_compressed(tmp, **pack(kept, views))
+        digest = hashlib.sha256(tmp.read_bytes()).hexdigest()
     unstaged = len(indices) - len(kept)
     return {"chunk": chunk, "samples": len(kept), "unstaged": unstaged, "sha256": digest}
 
@@ -186,4 +185,4 @@ def write_format(run_dir: Path) -> None:
     """The format above, beside the chunks, for whoever reads them without this package."""
     doc = (__doc__ or "").split("Format", 1)[1].split("The run folder", 1)[0]
     text = json.dumps({"format": FORMAT, "types": TYPES, "description": "Format" + doc}, indent=1)
-    (run_dir / "format.json").write_text(text + "\n")
+    write_atomically(run_dir / "format.json", text + "\n")

@@ -14,6 +14,8 @@ from pathlib import Path
 
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.files import write_atomically
+from hsgplan.runner.lock import LOCK, hold_folder
 
 RESULTS = "episodes.jsonl"
 CONFIG = "config.json"
@@ -24,11 +26,12 @@ def claim(run_dir: Path, kind: str, config: dict, refusal: str) -> None:
     """Make `run_dir` the home of a `kind` run with `config`. Refused in one line, before
     anything is written: a folder of another kind (a checkpoint, a dataset, another command's
     run), a folder holding files but no run, and a run with another configuration (`refusal`,
-    which says what to do)."""
-    if check_claim(run_dir, kind, config, refusal):
-        return
-    run_dir.mkdir(parents=True, exist_ok=True)
-    write_atomically(run_dir / CONFIG, json.dumps({"kind": kind} | config) + "\n")
+    which says what to do), and a folder another process is writing (`runner/lock.py`): the
+    caller is its one writer from here until it ends."""
+    check_claim(run_dir, kind, config, refusal)
+    hold_folder(run_dir)
+    if not check_claim(run_dir, kind, config, refusal):  # again: it may have changed hands
+        write_atomically(run_dir / CONFIG, json.dumps({"kind": kind} | config) + "\n")
 
 
 def check_claim(run_dir: Path, kind: str, config: dict, refusal: str) -> bool:
@@ -47,7 +50,7 @@ def check_claim(run_dir: Path, kind: str, config: dict, refusal: str) -> bool:
         if other != config:
             raise InvalidInputError(refusal)
         return True
-    if run_dir.is_dir() and any(run_dir.iterdir()):
+    if run_dir.is_dir() and has_files(run_dir):
         raise InvalidInputError(
             f"'{run_dir}' holds other files and no {kind} run; use another --out"
         )
@@ -59,17 +62,15 @@ def check_own(folder: Path, marker: str, kind: str) -> None:
     a folder another command made is never written into."""
     if folder.exists() and not folder.is_dir():
         raise InvalidInputError(f"'{folder}' is a file, not a folder")
-    if folder.is_dir() and any(folder.iterdir()) and not (folder / marker).is_file():
+    if folder.is_dir() and has_files(folder) and not (folder / marker).is_file():
         raise InvalidInputError(
             f"'{folder}' holds other files and no {kind} ({marker}); use another --out"
         )
 
 
-def write_atomically(path: Path, text: str) -> None:
-    """A temporary file renamed over `path`: an interruption leaves the old file or the new."""
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+def has_files(folder: Path) -> bool:
+    """Whether `folder` holds anything but the lock a run left behind (`runner/lock.py`)."""
+    return any(p.name != LOCK for p in folder.iterdir())
 
 
 def logged_rows(run_dir: Path) -> list[dict]:

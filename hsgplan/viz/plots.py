@@ -9,6 +9,17 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from hsgplan.files import atomic  # noqa: E402
+
+
+def save_figure(fig, path: Path) -> None:
+    """Write a figure whole or not at all (`hsgplan.files.atomic`) and free it."""
+    try:
+        with atomic(path) as tmp:
+            fig.savefig(tmp)
+    finally:
+        plt.close(fig)
+
 
 def plot_success_by_size(
     ours: dict[str, dict[int, tuple[float, float | None]]],
@@ -48,8 +59,7 @@ def plot_success_by_size(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, ncol=2)
     fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def plot_times_by_size(series: dict[str, dict[str, dict[int, float]]], path: Path) -> None:
@@ -82,5 +92,4 @@ def plot_times_by_size(series: dict[str, dict[str, dict[int, float]]], path: Pat
     axes[0].set_ylabel("seconds (log scale)")
     axes[1].legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    save_figure(fig, path)

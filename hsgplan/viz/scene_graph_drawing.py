@@ -18,6 +18,7 @@ from hsgplan.domain.goals import Goal  # noqa: E402
 from hsgplan.domain.objects import EntityKind, kind_of, object_type  # noqa: E402
 from hsgplan.domain.predicates import Literal, Predicate  # noqa: E402
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph  # noqa: E402
+from hsgplan.viz.plots import save_figure  # noqa: E402
 
 FIXTURE_X = {"shelf_a": 0.0, "prepush_a": 2.0, "open_space": 4.5, "prepush_b": 7.0, "shelf_b": 9.0}
 COLUMN = 0.9
@@ -80,5 +81,4 @@ def draw_symbolic(
     ax.axis("off")
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    save_figure(fig, path)

@@ -116,7 +116,7 @@ def test_foreign_damaged_and_leftover_chunks_are_set_aside_and_redone(tmp_path):
     # chunk 1 copied over chunk 0 once gave another dataset with exit 0
     (chunks / names[0]).write_bytes((chunks / names[1]).read_bytes())
     (chunks / "chunk-000007.npz").write_bytes(b"")  # a 0-byte chunk blocked resume
-    (chunks / ".chunk-000003.npz.tmp").write_bytes(b"half")  # a write cut short
+    (chunks / ".chunk-000003.tmp.npz").write_bytes(b"half")  # a write cut short
     (chunks / "chunk-000003.npz.tmp.npz").write_bytes(b"old layout")  # once a traceback
     (tmp_path / "place.npz").unlink()
     (tmp_path / "place.json").unlink()
@@ -124,7 +124,7 @@ def test_foreign_damaged_and_leftover_chunks_are_set_aside_and_redone(tmp_path):
     assert again.set_aside == 2 and again.chunks_run >= 1
     assert _same(store.load(tmp_path / "place.npz"), before)
     assert len(list((chunks / "rejected").iterdir())) == 2  # kept for a look, not deleted
-    assert not (chunks / ".chunk-000003.npz.tmp").exists()
+    assert not (chunks / ".chunk-000003.tmp.npz").exists()
     assert first.samples == again.samples == 4
 
 

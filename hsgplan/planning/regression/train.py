@@ -5,7 +5,7 @@ slot) and the forward baseline (the next subgoal) on the demonstrations (and the
 added objects), f_reach (no / yes per supervised slot) on the labels its recipe names (see
 `examples.py`). A checkpoint is a folder: `train_config.json`, and one folder per network with
 `model.safetensors` and `config.json` (the network's configuration). Training saves its progress
-(`progress.pt`, loaded with weights_only) every `save_every` epochs, and a run started again
+(`progress.safetensors`) every `save_every` epochs, and a run started again
 with the same configuration continues from there.
 """
 
@@ -25,6 +25,7 @@ from hsgplan.checkpoint import fingerprint
 from hsgplan.data.world_trials import load_world_trials
 from hsgplan.domain.checks import MAX_SEED, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.files import write_atomically
 from hsgplan.paths import DEMOS, REACH_DATA, shipped
 from hsgplan.planning.regression.augment import trajectories
 from hsgplan.planning.regression.encoding import EDGE_DIM, NODE_DIM
@@ -141,7 +142,7 @@ def train_task(
         by_source = _examples(name, demos, trajs, config)
         (out / name).mkdir(exist_ok=True)
         counts = {source: label_counts(ex) for source, ex in by_source.items()}
-        (out / name / "labels.json").write_text(json.dumps(counts, indent=2) + "\n")
+        write_atomically(out / name / "labels.json", json.dumps(counts, indent=2) + "\n")
         examples = [e for ex in by_source.values() for e in ex]
         _train_one(name, classes, examples, config, out / name, on_epoch, data)
 

@@ -1,0 +1,65 @@
+"""One writer per folder: an OS file lock held by the process that writes a run, a collection or
+a checkpoint, for as long as it runs.
+
+The lock is `fcntl.flock` on the folder's `.lock` file, which also names its holder (process id
+and command). The kernel drops the lock when its process ends, however it ends, so the `.lock`
+of a run that was killed is simply taken over by the next run. A second process that finds the
+lock held is refused in one line that names the holder, before it has written anything.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import sys
+import time
+from pathlib import Path
+
+from hsgplan.domain.errors import InvalidInputError
+
+LOCK = ".lock"
+
+_held: dict[str, int] = {}  # resolved folder -> the open lock file's descriptor
+
+
+def hold_folder(folder: Path) -> None:
+    """Make this process the one writer of `folder` (made if missing) until it ends or
+    `release` is called; holding it already is fine. Refused in one line while another
+    process holds it."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    key = str(folder.resolve())
+    if key in _held:
+        return
+    fd = os.open(folder / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        holder = os.pread(fd, 1000, 0).decode("utf-8", errors="replace").strip()
+        os.close(fd)
+        raise InvalidInputError(
+            f"'{folder}' is being written by another run ({holder or 'a process'}); "
+            "wait for it to end or use another --out"
+        ) from None
+    command = " ".join(["hsgplan", *sys.argv[1:]])[:200].replace("\n", " ")
+    started = time.strftime("%Y-%m-%d %H:%M:%S")
+    os.ftruncate(fd, 0)  # the lock's own file: rewritten in place, it must stay this inode
+    os.pwrite(fd, f"pid {os.getpid()} since {started}: {command}\n".encode(), 0)
+    _held[key] = fd
+
+
+def holds(folder: Path) -> bool:
+    """Whether this process holds `folder`'s lock."""
+    return str(Path(folder).resolve()) in _held
+
+
+def release(folder: Path) -> None:
+    """Give `folder` up (its `.lock` stays, unheld)."""
+    fd = _held.pop(str(Path(folder).resolve()), None)
+    if fd is not None:
+        os.close(fd)  # closing the only descriptor drops the flock
+
+
+def release_all() -> None:
+    for key in list(_held):
+        os.close(_held.pop(key))

@@ -1,0 +1,80 @@
+"""One writer per folder (`hsgplan.runner.lock`), and the claims that take the lock."""
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from hsgplan import training
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.runner.lock import LOCK, hold_folder, holds, release
+from hsgplan.runner.run_folder import claim
+
+
+def _hold_in_another_process(folder):
+    """A child that holds `folder`'s lock until its stdin closes; its pid."""
+    code = textwrap.dedent(
+        f"""
+        import sys
+        from hsgplan.runner.lock import hold_folder
+        hold_folder({str(folder)!r})
+        print("held", flush=True)
+        sys.stdin.read()
+        """
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    assert child.stdout.readline().strip() == "held"
+    return child
+
+
+def test_a_folder_held_by_another_process_is_refused_naming_the_holder(tmp_path):
+    run = tmp_path / "run"
+    child = _hold_in_another_process(run)
+    try:
+        with pytest.raises(InvalidInputError, match=f"pid {child.pid}") as e:
+            claim(run, "eval", {"goals": 1}, "other configuration")
+        assert "\n" not in str(e.value)
+        assert sorted(p.name for p in run.iterdir()) == [LOCK]  # no config.json written
+        with pytest.raises(InvalidInputError, match="another run"):
+            training.claim(run, {"lr": 0.1})
+    finally:
+        child.stdin.close()
+        child.wait()
+    claim(run, "eval", {"goals": 1}, "other configuration")  # free again once it ended
+    assert (run / "config.json").is_file() and holds(run)
+
+
+def test_the_lock_of_a_dead_process_is_taken_over(tmp_path):
+    run = tmp_path / "run"
+    run.mkdir()
+    dead = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        text=True,
+        capture_output=True,
+        check=True,
+    ).stdout.strip()
+    (run / LOCK).write_text(f"pid {dead} since yesterday: hsgplan eval\n")
+    claim(run, "eval", {"goals": 1}, "other configuration")
+    assert f"pid {os.getpid()}" in (run / LOCK).read_text()
+
+
+def test_holding_is_reentrant_and_released(tmp_path):
+    hold_folder(tmp_path)
+    hold_folder(tmp_path)  # a table and its own claim of the same folder
+    assert holds(tmp_path)
+    release(tmp_path)
+    assert not holds(tmp_path)
+
+
+def test_an_unheld_lock_left_behind_is_not_other_files(tmp_path):
+    (tmp_path / LOCK).write_text("pid 1 since yesterday: hsgplan eval\n")
+    claim(tmp_path, "eval", {"goals": 1}, "other configuration")  # not "holds other files"
+    release(tmp_path)
+    other = tmp_path / "ck"
+    other.mkdir()
+    (other / LOCK).write_text("")
+    training.claim(other, {"lr": 0.1})
