@@ -16,10 +16,10 @@ from pathlib import Path
 from typing import Any
 
 import torch
-from safetensors.torch import load_file, save_file
+from safetensors.torch import load_file, save
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.files import atomic, write_atomically
+from hsgplan.files import write_atomically
 from hsgplan.paths import shipped
 
 WEIGHTS, CONFIG, MANIFEST = "model.safetensors", "config.json", "manifest.json"
@@ -45,8 +45,7 @@ def save_trained(folder: Path, model: torch.nn.Module, config: dict) -> None:
             f"'{folder}' (lower lr)"
         )
     (folder / MANIFEST).unlink(missing_ok=True)  # unfinished until the manifest is back
-    with atomic(folder / WEIGHTS) as tmp:
-        save_file(state, tmp)
+    write_atomically(folder / WEIGHTS, save(state))  # our writer: a full disk is an OSError
     write_atomically(folder / CONFIG, json.dumps(config, indent=2) + "\n")
     write_manifest(folder)
 

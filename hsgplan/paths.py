@@ -43,6 +43,6 @@ def home() -> Path:
 def shipped(path: Path | str) -> Path:
     """A path as the user meant it: as given when absolute or present here, else in `home()`."""
     path = Path(path).expanduser()
-    if path.is_absolute() or path.exists():
+    if path.is_absolute() or os.path.lexists(path):  # a link here, even a broken one, is meant
         return path
     return home() / path

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import torch
 from safetensors import safe_open
-from safetensors.torch import save_file
+from safetensors.torch import save
 
 from hsgplan.checkpoint import (
     MANIFEST,
@@ -27,7 +27,7 @@ from hsgplan.checkpoint import (
 )
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.files import atomic, write_atomically
+from hsgplan.files import write_atomically
 from hsgplan.runner.lock import hold_folder, holds
 from hsgplan.runner.run_folder import has_files
 
@@ -35,14 +35,16 @@ _STATE = "hsgplan.progress"  # the metadata key holding the JSON half of the pro
 TRAIN_CONFIG = "train_config.json"
 
 
-def claim(out: Path, config: dict, defaults: dict | None = None) -> None:
+def claim(out: Path, config: dict, defaults: dict | None = None, data: str | None = None) -> None:
     """Make `out` the checkpoint folder of a training with `config` (its `train_config.json`).
     Refused in one line, before anything is written: a file, a folder holding other things
     (a dataset, a run, another kind of checkpoint), and a checkpoint trained or in training
     with another configuration. A folder whose training never got as far as saving anything
     (it was refused or diverged) takes the new configuration. A saved configuration lacking a
-    setting of `defaults` was trained before the setting existed, with its default. The caller
-    is the folder's one writer from here until it ends (`runner/lock.py`)."""
+    setting of `defaults` was trained before the setting existed, with its default. With
+    `data` (the training data's fingerprint), progress saved anywhere below that is not
+    usable or was made on other data is refused here too. The caller is the folder's one
+    writer from here until it ends (`runner/lock.py`)."""
     saved = out / TRAIN_CONFIG
     if out.exists() and not out.is_dir():
         raise InvalidInputError(f"'{out}' is a file, not a checkpoint folder")
@@ -57,9 +59,12 @@ def claim(out: Path, config: dict, defaults: dict | None = None) -> None:
             )
     elif out.is_dir() and has_files(out):
         raise InvalidInputError(f"'{out}' holds other files and no checkpoint; use another --out")
+    if data is not None and out.is_dir():
+        for progress in sorted(out.rglob(PROGRESS)):
+            _check_progress(progress, data)
     if not holds(out):
         hold_folder(out)
-        return claim(out, config, defaults)  # checked again: it may have changed hands
+        return claim(out, config, defaults, data)  # checked again: it may have changed hands
     write_atomically(saved, json.dumps(config, indent=2) + "\n")
 
 
@@ -112,27 +117,42 @@ def _read_progress(path: Path) -> dict:
     return _decode(state, tensors)
 
 
+def _unusable(progress: Path, e: Exception) -> InvalidInputError:
+    return InvalidInputError(
+        f"'{progress}' is not usable training progress ({type(e).__name__}); "
+        "delete it to train from the start"
+    )
+
+
+def _check_progress(progress: Path, data: str) -> dict:
+    """The saved state of a progress file made on `data`; anything else refused in one line
+    (a truncated or foreign file, a pickle: nothing is ever unpickled)."""
+    try:
+        state = _read_progress(progress)
+        if not isinstance(state, dict):
+            raise TypeError("not a saved state")
+    except Exception as e:
+        raise _unusable(progress, e) from None
+    if state.get("data") != data:
+        raise InvalidInputError(
+            f"'{progress}' was made on other training data; delete it to train from the start"
+        )
+    return state
+
+
 def resume(folder: Path, model: torch.nn.Module, optim: torch.optim.Optimizer, data: str) -> int:
     """Load the saved progress, if any, into model and optimiser; the epoch to start from.
     Progress made on other training data (`data`, a fingerprint) is refused, never mixed."""
     progress = folder / PROGRESS
     if not progress.exists():
         return 0
+    state = _check_progress(progress, data)
     try:
-        state = _read_progress(progress)
-        saved_data = state.get("data")
         model.load_state_dict(state["model"])
         optim.load_state_dict(state["optim"])
         epoch = int(state["epoch"])
-    except Exception as e:  # truncated or foreign file: one line, and nothing else is touched
-        raise InvalidInputError(
-            f"'{progress}' is not usable training progress ({type(e).__name__}); "
-            "delete it to train from the start"
-        ) from None
-    if saved_data != data:
-        raise InvalidInputError(
-            f"'{progress}' was made on other training data; delete it to train from the start"
-        )
+    except Exception as e:  # another network's progress: one line, and nothing is touched
+        raise _unusable(progress, e) from None
     if non_finite(model.state_dict()):
         raise InvalidInputError(f"'{progress}' holds NaN or infinite weights; delete it")
     return epoch
@@ -143,8 +163,7 @@ def save_progress(folder: Path, model, optim, epoch: int, data: str) -> None:
     tensors: dict[str, torch.Tensor] = {}
     state = {"model": model.state_dict(), "optim": optim.state_dict(), "epoch": epoch}
     meta = json.dumps(_encode(state | {"data": data}, "state", tensors))
-    with atomic(folder / PROGRESS) as tmp:
-        save_file(tensors, tmp, metadata={_STATE: meta})
+    write_atomically(folder / PROGRESS, save(tensors, metadata={_STATE: meta}))
 
 
 def finish(folder: Path, model: torch.nn.Module, config: dict) -> None:

@@ -138,6 +138,15 @@ def test_bad_input_gets_one_line_and_exit_code_2(args, reason):
     assert "Traceback" not in r.output
 
 
+def test_goals_replace_an_existing_goal_file(tmp_path):
+    path = tmp_path / "goals.txt"
+    path.write_text("On(butter, shelf_a)\n")
+    r = run("goals", "--objects", "4", "--count", "3", "--out", str(path))
+    assert r.exit_code == 0, r.output
+    assert len(read_goal_file(path)) == 3
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["goals.txt"]
+
+
 def test_refused_command_leaves_an_existing_file_alone(tmp_path):
     path = tmp_path / "goals.txt"
     path.write_text("On(butter, shelf_a)\n")

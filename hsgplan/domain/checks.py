@@ -172,7 +172,8 @@ def check_output(path: Path, kind: str = "folder") -> None:
         if kind == "file" and not path.is_file():
             what = "a folder" if path.is_dir() else "not a regular file"
             raise InvalidInputError(f"'{text}' is {what}; name a file")
-    nearest = next(p for p in (resolved, *resolved.parents) if p.exists())
+    start = resolved.parent if kind == "file" else resolved  # a file is replaced in its folder
+    nearest = next(p for p in (start, *start.parents) if p.exists())
     if not nearest.is_dir():
         raise InvalidInputError(f"'{text}' is under '{nearest}', which is a file")
     if not os.access(nearest, os.W_OK):  # the path itself when it exists, else its folder

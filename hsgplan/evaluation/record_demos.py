@@ -54,16 +54,17 @@ def collect_demos(
 ) -> list[Demo]:
     """Record every task not yet in `out` (appending as each finishes); all demos, in order."""
     check_own(out, META, "demonstration set")  # never into another command's folder
-    hold_folder(out)  # one writer: a second collection into `out` is refused
     meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
     meta_path = out / META
-    if meta_path.exists():
-        saved = read_json(meta_path, "demonstration metadata")
-        if saved.get("seed") != seed or saved.get("version") != VERSION:
-            raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
-    else:
+    for _ in range(2):  # checked before the folder is taken, and again once it is ours
+        if meta_path.exists():
+            saved = read_json(meta_path, "demonstration metadata")
+            if saved.get("seed") != seed or saved.get("version") != VERSION:
+                raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
+        done = {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
+        hold_folder(out)  # one writer: a second collection into `out` is refused
+    if not meta_path.exists():
         write_atomically(meta_path, json.dumps(meta, indent=2) + "\n")
-    done = {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
     path = out / DEMOS
     if path.exists() and path.stat().st_size and not path.read_bytes().endswith(b"\n"):
         with open(path, "a") as f:  # a line cut short by an interruption: end it

@@ -135,7 +135,7 @@ def train_motion(
     if config.loss == "bce":
         files.append(folder / f"{config.primitive}_trials.npz")
     data = fingerprint(files)
-    training.claim(out, asdict(config))
+    training.claim(out, asdict(config), data=data)
     if training.finished(out):
         return  # finished earlier
     examples = grounded_examples(rows)

@@ -209,7 +209,7 @@ def train_perception(
         raise InvalidInputError("no image collection named")
     chunks = [chunk_path(f, r["result"]["chunk"]) for f in config.folders for r in logged_rows(f)]
     data_print = fingerprint(chunks + ([Path(config.init)] if config.init else []))
-    training.claim(out, asdict(config), asdict(PerceptionTrainConfig()))
+    training.claim(out, asdict(config), asdict(PerceptionTrainConfig()), data_print)
     found = joined([examples(p) for p in parts])  # collections of different view counts too
     if len(found.images) == 0:
         raise InvalidInputError(f"no images in '{config.images}'")

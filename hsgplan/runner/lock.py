@@ -27,11 +27,15 @@ def hold_folder(folder: Path) -> None:
     `release` is called; holding it already is fine. Refused in one line while another
     process holds it."""
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    key = str(folder.resolve())
-    if key in _held:
+    if str(folder.resolve()) in _held:
         return
-    fd = os.open(folder / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+    made = [p for p in (folder, *folder.parents) if not p.exists()]
+    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        fd = os.open(folder / LOCK, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644)
+        created = True
+    except FileExistsError:
+        fd, created = os.open(folder / LOCK, os.O_RDWR), False
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
@@ -43,9 +47,17 @@ def hold_folder(folder: Path) -> None:
         ) from None
     command = " ".join(["hsgplan", *sys.argv[1:]])[:200].replace("\n", " ")
     started = time.strftime("%Y-%m-%d %H:%M:%S")
-    os.ftruncate(fd, 0)  # the lock's own file: rewritten in place, it must stay this inode
-    os.pwrite(fd, f"pid {os.getpid()} since {started}: {command}\n".encode(), 0)
-    _held[key] = fd
+    try:
+        os.ftruncate(fd, 0)  # the lock's own file: rewritten in place, it must stay this inode
+        os.pwrite(fd, f"pid {os.getpid()} since {started}: {command}\n".encode(), 0)
+    except OSError as e:  # a full disk: leave nothing behind that this call made
+        if created:
+            (folder / LOCK).unlink(missing_ok=True)
+        os.close(fd)
+        for path in made:  # deepest first
+            path.rmdir()
+        raise OSError(e.errno, e.strerror, str(folder / LOCK)) from None
+    _held[str(folder.resolve())] = fd
 
 
 def holds(folder: Path) -> bool:

@@ -1,0 +1,67 @@
+"""The recovery rules: what the agent does after a failure, beyond the paper.
+
+The paper's agent has none: a primitive that fails ends its episode (the `paper` protocol,
+`hsgplan.evaluation.protocol`). Our loop lets a failed primitive cost one step and goes on
+(the `recovering` protocol), and these hand-written rules decide how it goes on. Each is named
+here, documented once, and switched off by name (`hsgplan eval --rules-off NAME,...`), so that
+what each buys is measured (README, "Recovery rules"). None of them consults the domain's
+rules (transition model, feasibility): they read only what the agent saw and did.
+
+Motion level (`hsgplan.motion.generator`):
+- `failed_bins`: parameters that failed for good are remembered with the scene they failed in;
+  in that unchanged scene the generator draws its next proposal from its own distribution over
+  the bins not yet failed there, instead of proposing its best again.
+- `push_give_up`: after three failed pushes of an object from where it was put down, the
+  generator gives up the spot: the agent takes the object up instead, and the place that put
+  it there counts as failed, so that the next place draws another spot.
+
+Task level (`hsgplan.planning.regression.planner`):
+- `avoid_taken`: an action already taken from the very state observed now (with this goal) is
+  avoided while the regression finds another.
+- `least_taken`: once every action found from a state has been taken there, the least often
+  taken goes again rather than the search giving up.
+- `likeliest_literal`: when the regression reaches nothing, the literal f_reach finds likeliest
+  is taken rather than the planner stopping ("regression stuck").
+- `failed_goal_waits`: a goal literal whose action came back to the same state (it failed)
+  waits while another goal literal can go on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+from hsgplan.domain.errors import InvalidInputError
+
+
+@dataclass(frozen=True)
+class RecoveryRules:
+    """Which recovery rules are on (all are, by default; the paper protocol has none)."""
+
+    failed_bins: bool = True
+    push_give_up: bool = True
+    avoid_taken: bool = True
+    least_taken: bool = True
+    likeliest_literal: bool = True
+    failed_goal_waits: bool = True
+
+    @staticmethod
+    def names() -> tuple[str, ...]:
+        return tuple(f.name for f in fields(RecoveryRules))
+
+    @staticmethod
+    def none() -> RecoveryRules:
+        return RecoveryRules(**dict.fromkeys(RecoveryRules.names(), False))
+
+    def without(self, names) -> RecoveryRules:
+        """These rules with `names` switched off; an unknown name refused in one line."""
+        names = tuple(names)
+        unknown = [n for n in names if n not in self.names()]
+        if unknown:
+            raise InvalidInputError(
+                f"unknown recovery rule(s) {', '.join(unknown)} (known: {', '.join(self.names())})"
+            )
+        return replace(self, **dict.fromkeys(names, False))
+
+    def off(self) -> tuple[str, ...]:
+        """The names of the rules switched off."""
+        return tuple(n for n in self.names() if not getattr(self, n))
