@@ -12,6 +12,7 @@ from hsgplan.domain.actions import Pick, Push
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.predicates import in_grasp
+from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.motion.generator import Feasibility, MotionGenerator
 from hsgplan.planning.base import TaskPlanner
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -24,12 +25,21 @@ class HierarchicalAgent:
     name: what episodes record as the agent.
     planner: the task level (`hsgplan.planning.base.TaskPlanner`).
     motion: the motion level (`hsgplan.motion.generator.MotionGenerator`).
+    rules: the recovery rules in force (`hsgplan.domain.recovery`); this class applies the
+        task half of `push_give_up` (a push with no parameters becomes a pick).
     """
 
-    def __init__(self, name: str, planner: TaskPlanner, motion: MotionGenerator) -> None:
+    def __init__(
+        self,
+        name: str,
+        planner: TaskPlanner,
+        motion: MotionGenerator,
+        rules: RecoveryRules = ALL_RULES,
+    ) -> None:
         self.name = name
         self.planner = planner
         self.motion = motion
+        self.rules = rules
 
     def reset(self, goal: Goal, seed: int) -> None:
         self.planner.reset(goal, seed)
@@ -48,7 +58,8 @@ class HierarchicalAgent:
         start = time.perf_counter()
         action, subgoal = task.action, task.subgoal
         params = self.motion.propose(sg, action, task.following, feasible)
-        if params is None and isinstance(action, Push) and sg.held is None:
+        give_up = params is None and isinstance(action, Push) and sg.held is None
+        if give_up and self.rules.push_give_up:
             # No push works from where the object stands (a generator that gives up, the
             # geometric sampler): take it up, so that the task level puts it down elsewhere
             # in the region, where the generator will not put it again.

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
 
 if TYPE_CHECKING:  # the names are read by the CLI's --help, which should not load torch
@@ -23,57 +24,59 @@ if TYPE_CHECKING:  # the names are read by the CLI's --help, which should not lo
     from hsgplan.planning.base import TaskPlanner
 
 
-def _regression(checkpoint: Path) -> TaskPlanner:
+def _regression(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     from hsgplan.planning.regression.planner import RegressionPlanner
 
-    return RegressionPlanner(checkpoint)
+    return RegressionPlanner(checkpoint, rules=rules)
 
 
-def _forward(checkpoint: Path) -> TaskPlanner:
+def _forward(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     from hsgplan.planning.regression.planner import ForwardPlanner
 
     return ForwardPlanner(checkpoint)
 
 
-def _fast_downward(checkpoint: Path) -> TaskPlanner:
+def _fast_downward(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     from hsgplan.planning.fast_downward import FastDownwardTaskPlanner
 
     return FastDownwardTaskPlanner()
 
 
-# name -> factory of a task planner from the learned planner's checkpoint folder
-TASK_PLANNERS: dict[str, Callable[[Path], TaskPlanner]] = {
+# name -> factory of a task planner from the learned planner's checkpoint folder and the
+# recovery rules in force (the forward baseline and Fast Downward keep their own ways)
+TASK_PLANNERS: dict[str, Callable[[Path, RecoveryRules], TaskPlanner]] = {
     "regression": _regression,
     "forward": _forward,
     "fd": _fast_downward,
 }
 
 
-def _sampler(checkpoints: Path) -> MotionGenerator:
+def _sampler(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
     from hsgplan.motion.sampler import GeometricSampler
 
     return GeometricSampler()
 
 
-def _learned(model: str) -> Callable[[Path], MotionGenerator]:
-    def make(checkpoints: Path) -> MotionGenerator:
+def _learned(model: str) -> Callable[[Path, RecoveryRules], MotionGenerator]:
+    def make(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
         from hsgplan.domain.parameters import MotionPrimitive
         from hsgplan.motion.generator import LearnedMotion
 
         folders = {kind: checkpoints / f"{kind.value}-{model}" for kind in MotionPrimitive}
-        return LearnedMotion(model, folders)
+        return LearnedMotion(model, folders, rules)
 
     return make
 
 
-def _random(checkpoints: Path) -> MotionGenerator:
+def _random(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
     from hsgplan.motion.generator import RandomMotion
 
-    return RandomMotion()
+    return RandomMotion(rules=rules)
 
 
-# name -> factory of a motion generator from the folder of motion checkpoints
-MOTION_GENERATORS: dict[str, Callable[[Path], MotionGenerator]] = {
+# name -> factory of a motion generator from the folder of motion checkpoints and the recovery
+# rules in force (the geometric sampler, the oracle's, keeps its own)
+MOTION_GENERATORS: dict[str, Callable[[Path, RecoveryRules], MotionGenerator]] = {
     "sampler": _sampler,
     "gnn": _learned("gnn"),
     "mlp": _learned("mlp"),
@@ -105,14 +108,18 @@ def _known(what: str, name: str, names) -> None:
         raise InvalidInputError(f"unknown {what} '{name}' (known: {', '.join(names)})")
 
 
-def make_planner(name: str, checkpoint: Path = TASK_CHECKPOINT) -> TaskPlanner:
+def make_planner(
+    name: str, checkpoint: Path = TASK_CHECKPOINT, rules: RecoveryRules = ALL_RULES
+) -> TaskPlanner:
     _known("task planner", name, TASK_PLANNERS)
-    return TASK_PLANNERS[name](checkpoint)
+    return TASK_PLANNERS[name](checkpoint, rules)
 
 
-def make_motion(name: str, checkpoints: Path = MOTION_CHECKPOINTS) -> MotionGenerator:
+def make_motion(
+    name: str, checkpoints: Path = MOTION_CHECKPOINTS, rules: RecoveryRules = ALL_RULES
+) -> MotionGenerator:
     _known("motion generator", name, MOTION_GENERATORS)
-    return MOTION_GENERATORS[name](checkpoints)
+    return MOTION_GENERATORS[name](checkpoints, rules)
 
 
 def agent_name(agent: str, planner: str | None = None, motion: str | None = None) -> str:
@@ -164,10 +171,14 @@ def agent_checkpoints(
 
 
 def make_agent(
-    name: str, checkpoint: Path = TASK_CHECKPOINT, motion_checkpoints: Path = MOTION_CHECKPOINTS
+    name: str,
+    checkpoint: Path = TASK_CHECKPOINT,
+    motion_checkpoints: Path = MOTION_CHECKPOINTS,
+    rules: RecoveryRules = ALL_RULES,
 ) -> Agent:
-    """An agent by name, its learned parts from these checkpoint folders; an unknown name or a
-    missing checkpoint is refused in one line."""
+    """An agent by name, its learned parts from these checkpoint folders, under the recovery
+    rules `rules` (`hsgplan.domain.recovery`; the search baselines have none); an unknown name
+    or a missing checkpoint is refused in one line."""
     from hsgplan.agents.hierarchical import HierarchicalAgent
 
     if name == "search":
@@ -186,5 +197,8 @@ def make_agent(
 
     planner, motion = agent_parts(name)
     return HierarchicalAgent(
-        name, make_planner(planner, checkpoint), make_motion(motion, motion_checkpoints)
+        name,
+        make_planner(planner, checkpoint, rules),
+        make_motion(motion, motion_checkpoints, rules),
+        rules,
     )

@@ -18,6 +18,7 @@ from typer.core import TyperGroup
 from hsgplan.agents.registry import AGENT_NAMES, MOTION_GENERATORS, TASK_PLANNERS
 from hsgplan.domain.checks import MAX_WORKERS, check_output, read_json
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.recovery import PROTOCOLS
 
 out = Console()
 err = Console(stderr=True)
@@ -144,6 +145,7 @@ def choice(what: str, names) -> type[StrEnum]:
 AgentName = choice("AgentName", AGENT_NAMES)
 PlannerName = choice("PlannerName", TASK_PLANNERS)
 MotionName = choice("MotionName", MOTION_GENERATORS)
+ProtocolName = choice("ProtocolName", PROTOCOLS)
 
 
 def read_config(path: Path | None) -> dict:

@@ -15,6 +15,7 @@ from hsgplan.cli.common import (
     MotionName,
     PerceptionCheckpoint,
     PlannerName,
+    ProtocolName,
     RayAddress,
     RunFolder,
     check_ray,
@@ -29,6 +30,7 @@ from hsgplan.cli.common import (
 )
 from hsgplan.domain.checks import MAX_FAILURES, MAX_GOALS, MAX_REPEATS, MAX_SEED, MAX_WORKERS
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.recovery import RECOVERING, RecoveryRules
 from hsgplan.paths import RUNS, shipped
 from hsgplan.runner.run_folder import check_own
 
@@ -112,6 +114,9 @@ def _print_step(s) -> None:
     )
 
 
+DEFAULT_PROTOCOL = ProtocolName(RECOVERING)
+
+
 @refuses_bad_input
 def evaluate(
     agent: AgentOption = ORACLE,
@@ -154,6 +159,21 @@ def evaluate(
         ),
     ] = "gt",
     perception_checkpoint: PerceptionCheckpoint = None,
+    protocol: Annotated[
+        ProtocolName,
+        typer.Option(
+            help="paper: no recovery rule, the first failed primitive ends the episode; "
+            "recovering: a failed primitive costs its step and the loop goes on."
+        ),
+    ] = DEFAULT_PROTOCOL,
+    rules_off: Annotated[
+        str,
+        typer.Option(
+            help="Recovery rules switched off, comma-separated (recovering protocol): "
+            + ", ".join(RecoveryRules.names())
+            + "."
+        ),
+    ] = "",
     workers: Annotated[
         int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
     ] = 2,
@@ -163,8 +183,8 @@ def evaluate(
     markdown: Annotated[bool, typer.Option(help="Print Markdown tables (for the README).")] = False,
 ) -> None:
     """Success rate and subgoal completion per problem size and method, beside the paper's
-    Table 1, with the failure taxonomy and the time per level; writes table1.md, table1.png
-    and summary.json into the run folder."""
+    Table 1, with the failure taxonomy and the time per level, under a protocol (paper or
+    recovering); writes table1.md, table1.png and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.evaluation.observers import make_observer
     from hsgplan.evaluation.protocol import EvalConfig, checkpoints, episode_specs
@@ -203,6 +223,8 @@ def evaluate(
         checkpoint and str(shipped(checkpoint)),
         motion_checkpoints and str(shipped(motion_checkpoints)),
         perception_checkpoint=perception_checkpoint and str(shipped(perception_checkpoint)),
+        protocol=protocol.value,
+        rules_off=_names(rules_off, "--rules-off"),
     )
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
         make_observer(p, config.perception_checkpoint)
@@ -225,13 +247,23 @@ def evaluate(
         out.print(f"wrote {shown(folder)}/table1.md, table1.png, summary.json", highlight=False)
 
 
+def _names(text: str, option: str) -> tuple[str, ...]:
+    """A comma-separated list of names, each once ('' names none)."""
+    names = tuple(n.strip() for n in text.split(",")) if text.strip() else ()
+    if "" in names or len(set(names)) != len(names):
+        raise InvalidInputError(f"{option} '{text}': name each one once, comma-separated")
+    return names
+
+
 def _run_name(methods, config) -> str:
     source = Path(config.goals_file).stem if config.goals_file else f"g{config.goals}"
     sizes = "-".join(map(str, config.sizes))
     agents = "_".join(
         m.agent + ("" if m.perception == "gt" else f"-{m.perception}") for m in methods
     )
-    return f"eval-{agents}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}"
+    protocol = "" if config.protocol == RECOVERING else f"-{config.protocol}"
+    protocol += "".join(f"-no_{rule}" for rule in config.rules_off)
+    return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}"
 
 
 @refuses_bad_input

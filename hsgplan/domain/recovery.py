@@ -32,6 +32,11 @@ from dataclasses import dataclass, fields, replace
 
 from hsgplan.domain.errors import InvalidInputError
 
+# The protocols an evaluation runs under (`hsgplan.evaluation.protocol`): the paper's, where the
+# first failed primitive ends the episode and no rule recovers; ours, where the rules do.
+PAPER, RECOVERING = "paper", "recovering"
+PROTOCOLS = (PAPER, RECOVERING)
+
 
 @dataclass(frozen=True)
 class RecoveryRules:
@@ -65,3 +70,6 @@ class RecoveryRules:
     def off(self) -> tuple[str, ...]:
         """The names of the rules switched off."""
         return tuple(n for n in self.names() if not getattr(self, n))
+
+
+ALL_RULES = RecoveryRules()  # the recovering protocol's default: every rule on

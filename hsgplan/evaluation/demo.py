@@ -43,9 +43,10 @@ def run_demo(
     scale: float = 1.0,
     frame_every: int = FRAME_EVERY,
     observer: SceneObserver | None = None,
+    end_at_failure: bool = False,
 ) -> EpisodeRecord:
     """Run the episode and write its pictures and record into `out`; `on_step` sees every
-    step as soon as it has been executed.
+    step as soon as it has been executed; `end_at_failure` as `run_episode` takes it.
 
     Args:
         agent: a registered agent's name (its shipped checkpoints), or the agent itself.
@@ -108,7 +109,7 @@ def run_demo(
 
     if isinstance(agent, str):
         agent = make_agent(agent)
-    record = run_episode(env, agent, goal, seed, on_frame, on_step_done, on_decide)
+    record = run_episode(env, agent, goal, seed, on_frame, on_step_done, on_decide, end_at_failure)
     with atomic(out / "episode.gif") as tmp:
         iio.imwrite(tmp, frames, duration=90, loop=0)
     write_atomically(out / "episode.json", json.dumps(record.to_json(), indent=2) + "\n")

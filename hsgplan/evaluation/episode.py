@@ -6,6 +6,10 @@ reached that does not truly hold is a failure (`MISPERCEIVED`), and a toppled or
 ends the episode whether the observer saw it or not. With the ground truth as observer the two
 are one.
 
+Under the paper's protocol (`end_at_failure`) a primitive that fails (refused while planning,
+or failed in execution) ends the episode, unless the goal holds all the same; otherwise a
+failed primitive costs its step and the agent goes on from what it observes.
+
 Every episode records its seed; the same seed, goal and agent give the same record (timings
 aside).
 """
@@ -91,9 +95,11 @@ def run_episode(
     on_frame: Callable[[], None] | None = None,
     on_step: Callable[[StepRecord | None, Observation], None] | None = None,
     on_decide: Callable[[int, Decision], None] | None = None,
+    end_at_failure: bool = False,
 ) -> EpisodeRecord:
     """Run one episode; `on_decide` sees each decision (with its step number) before it is
-    executed, `on_step` the start (record None) and every step after it."""
+    executed, `on_step` the start (record None) and every step after it. With
+    `end_at_failure` (the paper's protocol) the first failed primitive ends it."""
     start = time.perf_counter()
     _, info = env.reset(seed=seed, options=ResetOptions(goal))
     obs: Observation = info["observation"]
@@ -138,6 +144,9 @@ def run_episode(
         records.append(record)
         if on_step:
             on_step(record, obs)
+        if end_at_failure and not outcome.ok and not goal.satisfied_by(obs.symbols.state):
+            failure = Failure.FAILED_PRIMITIVE
+            break
     state = obs.true_symbols.state
     if failure is None and not goal.satisfied_by(state):
         failure = Failure.MISPERCEIVED

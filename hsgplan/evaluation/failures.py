@@ -9,6 +9,7 @@ class Failure(StrEnum):
     OVERSTEP = "overstep"  # the step limit (`domain.world.MAX_STEPS`) came first
     NO_SUBGOAL = "no_subgoal"  # the task planner named no next action
     NO_PARAMETERS = "no_parameters"  # every parameter choice for the next action had failed
+    FAILED_PRIMITIVE = "failed_primitive"  # the paper protocol: a primitive failed, which ends it
     KNOCKED_OVER = "knocked_over"  # simulated world: an object toppled
     OFF_TABLE = "off_table"  # simulated world: an object fell off the table
     MISPERCEIVED = "misperceived"  # the agent saw the goal reached where it truly was not

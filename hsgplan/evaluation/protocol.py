@@ -7,6 +7,12 @@ episode's seed is derived from the run's seed, the size, the goal's index and th
 any episode can be rerun alone. Finished episodes are appended to `episodes.jsonl` in the run
 folder as they finish: an interrupted run, started again with the same command, skips what is
 done. What the episodes sum to is `evaluation/summary.py`.
+
+Two protocols. `paper`, the paper's: the agent decides once per step from the scene it sees,
+with no recovery rule (`hsgplan.domain.recovery`), and the first primitive that fails (refused
+while planning, or failed in execution) ends the episode as an execution failure; the step
+limit ends it as overstep. `recovering`, ours: a failed primitive costs its step and the loop
+goes on from what it observes, under the recovery rules (all of them, or all but `rules_off`).
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ from pathlib import Path
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
+from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import check_observer, make_observer, perception_folder
 from hsgplan.runner.items import run_items
@@ -39,9 +46,23 @@ class EvalConfig:
     motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
     perception: str = "gt"  # what the agent sees: "gt" (the simulator's poses) or "rgb" (f_p)
     perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
+    protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
+    rules_off: tuple[str, ...] = ()  # recovery rules switched off (the recovering protocol)
 
     def __post_init__(self) -> None:
         check_observer(self.perception)
+        if self.protocol not in PROTOCOLS:
+            raise InvalidInputError(f"protocol '{self.protocol}': one of {', '.join(PROTOCOLS)}")
+        object.__setattr__(self, "rules_off", tuple(self.rules_off))
+        if self.protocol == PAPER and self.rules_off:
+            raise InvalidInputError("the paper protocol has no recovery rule to switch off")
+        self.rules()  # an unknown rule's name is refused here
+
+    def rules(self) -> RecoveryRules:
+        """The recovery rules its agent runs under: none under the paper's protocol."""
+        if self.protocol == PAPER:
+            return RecoveryRules.none()
+        return RecoveryRules().without(self.rules_off)
 
 
 @dataclass(frozen=True)
@@ -90,7 +111,7 @@ def _worker_agent(config: EvalConfig):
     and loading the networks once saves a third of a second an episode."""
     from hsgplan.agents.registry import make_agent
 
-    return make_agent(config.agent, *checkpoints(config))
+    return make_agent(config.agent, *checkpoints(config), config.rules())
 
 
 @lru_cache(maxsize=2)
@@ -114,6 +135,10 @@ def run_config(config: EvalConfig) -> dict:
         del settings["perception"], settings["perception_checkpoint"]
     else:
         folders = [*folders, perception_folder(config.perception_checkpoint)]
+    if config.protocol == RECOVERING and not config.rules_off:  # as before protocols were named
+        del settings["protocol"], settings["rules_off"]
+    else:
+        settings["rules_off"] = list(config.rules_off)
     files = [Path(config.goals_file)] if config.goals_file else []
     return settings | {
         "sizes": list(config.sizes),
@@ -127,7 +152,7 @@ def read_eval_config(run_dir: Path) -> EvalConfig:
     names = {f.name for f in fields(EvalConfig)}
     try:
         config = EvalConfig(**{k: v for k, v in saved.items() if k in names})
-        return replace(config, sizes=tuple(config.sizes))
+        return replace(config, sizes=tuple(config.sizes), rules_off=tuple(config.rules_off))
     except TypeError:
         raise InvalidInputError(
             f"'{run_dir / CONFIG}' is not an evaluation's configuration"
@@ -165,7 +190,8 @@ def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
 
     agent = _worker_agent(config)
     env = KitchenStorageEnv(observer=_worker_observer(config))
-    record = run_episode(env, agent, parse_goal(spec.goal), spec.seed)
+    goal = parse_goal(spec.goal)
+    record = run_episode(env, agent, goal, spec.seed, end_at_failure=config.protocol == PAPER)
     return replace(record, repeat=spec.repeat).to_json()
 
 

@@ -20,7 +20,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer
-from hsgplan.evaluation.protocol import checkpoints, read_eval_config
+from hsgplan.evaluation.protocol import PAPER, checkpoints, read_eval_config
 from hsgplan.evaluation.summary import FAILED_EXECUTION, failure_class
 from hsgplan.evaluation.table1 import label, tables
 from hsgplan.files import write_atomically
@@ -118,13 +118,14 @@ def rollout(run_dir: Path, method: str, agent: str, record: EpisodeRecord) -> Ro
         partial = folder.with_name(folder.name + ".partial")
         shutil.rmtree(partial, ignore_errors=True)
         run_demo(
-            make_agent(agent, *checkpoints(config)),
+            make_agent(agent, *checkpoints(config), config.rules()),
             parse_goal(record.goal),
             record.seed,
             partial,
             scale=GIF_SCALE,
             frame_every=FRAME_EVERY,
             observer=make_observer(config.perception, config.perception_checkpoint),
+            end_at_failure=config.protocol == PAPER,
         )
         partial.rename(folder)
     rerun = EpisodeRecord.from_json(json.loads(done.read_text()))

@@ -1,12 +1,14 @@
 """What a set of episodes sums to: success and subgoal completion per problem size, their
 spread over repeats, the failure taxonomy and the time spent per level.
 
-The failure taxonomy is the paper's (section 5.C): an **execution** failure is an episode lost
-to motion execution (a primitive failed in it: no IK, no path, dropped, an object knocked over
-or off the table, the effect not reached; the kind is the fatal anomaly, or else the status of
-the last primitive that failed), an **overstep** an episode in which every primitive did what
-it was asked (or was refused as inapplicable, a task-level mistake) and the step limit, or a
-planner with nothing reachable to offer, came first.
+The failure taxonomy is the paper's (section 5.C), by what ended the episode: an **execution**
+failure is an episode a failed primitive ended (under the paper's protocol the first failed
+primitive does; in any protocol an object knocked over or off the table, or a motion generator
+with nothing to propose; the kind is the fatal anomaly, or else the status of the primitive
+that failed last), an **overstep** one that the step limit, or a planner with nothing reachable
+to offer, ended. An overstep episode may have had primitives fail on its way (the recovering
+protocol goes on after them): they are counted apart (`failed_primitives`,
+`overstep_after_failures`), so that the classes stay the paper's.
 """
 
 from __future__ import annotations
@@ -27,6 +29,11 @@ FAILED_EXECUTION = frozenset(s.value for s in Status) - {Status.SUCCESS, Status.
 _ENDED_BY_EXECUTION = {Failure.KNOCKED_OVER, Failure.OFF_TABLE, Failure.NO_PARAMETERS}
 
 
+def failed_steps(record: EpisodeRecord) -> list[str]:
+    """The statuses of the episode's primitives that did not succeed, in order."""
+    return [s.status for s in record.steps if s.status != Status.SUCCESS]
+
+
 def failure_class(record: EpisodeRecord) -> tuple[str, str] | None:
     """(class, kind) of a failed episode, None for a success."""
     if record.success:
@@ -35,9 +42,9 @@ def failure_class(record: EpisodeRecord) -> tuple[str, str] | None:
         return PERCEPTION, str(record.failure)
     if record.failure in _ENDED_BY_EXECUTION:
         return EXECUTION, str(record.failure)
-    failed = [s.status for s in record.steps if s.status in FAILED_EXECUTION]
-    if failed:
-        return EXECUTION, failed[-1]
+    if record.failure == Failure.FAILED_PRIMITIVE:
+        failed = failed_steps(record)
+        return EXECUTION, failed[-1] if failed else str(record.failure)
     return OVERSTEP, "step limit" if record.failure == Failure.OVERSTEP else str(record.failure)
 
 
@@ -66,6 +73,13 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
             cls: dict(Counter(kind for c, kind in classes if c == cls))
             for cls in (EXECUTION, OVERSTEP, PERCEPTION)
         },
+        # primitives that failed, in every episode; and overstep episodes that had some
+        "failed_primitives": sum(len(failed_steps(r)) for r in rs),
+        "overstep_after_failures": sum(
+            1
+            for r in rs
+            if failure_class(r) and failure_class(r)[0] == OVERSTEP and failed_steps(r)
+        ),
         "median_steps": statistics.median(len(r.steps) for r in rs),
         "median_seconds": statistics.median(r.seconds for r in rs),
         "median_task_seconds": statistics.median(r.task_seconds for r in rs),

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
+from hsgplan.domain.recovery import RECOVERING
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
@@ -86,6 +87,8 @@ def run_table(
             ray,
         )
     report = {
+        "protocol": config.protocol,
+        "rules_off": list(config.rules_off),
         "methods": {
             m.name: {"agent": m.agent, "perception": m.perception}
             | read_timing(out / m.name)
@@ -169,6 +172,17 @@ def _sizes(methods: dict) -> list[int]:
     return sorted({int(n) for s in methods.values() for n in s["by_size"]})
 
 
+def _protocol(report: dict) -> str:
+    """The protocol's name as the tables say it, with any recovery rule switched off."""
+    protocol = report.get("protocol", RECOVERING)
+    off = report.get("rules_off") or []
+    return f"{protocol} protocol" + (f", without {', '.join(off)}" if off else "")
+
+
+def dash(value, spec: str) -> str:
+    return "—" if value is None else format(value, spec)
+
+
 def _results(report: dict) -> TextTable:
     methods = report["methods"]
     header = ["objects"]
@@ -186,8 +200,9 @@ def _results(report: dict) -> TextTable:
         rows.append(tuple(row))
     source = report["goals_file"] or f"{report['goals']} random goals per size"
     title = (
-        f"Success rate / subgoal completion: {source}, each run {report['repeats']} times "
-        f"(± the standard deviation of the success rate over the repeats), seed {report['seed']}"
+        f"Success rate / subgoal completion ({_protocol(report)}): {source}, each run "
+        f"{report['repeats']} times (± the standard deviation of the success rate over the "
+        f"repeats), seed {report['seed']}"
     )
     return TextTable(title, tuple(header), tuple(rows))
 
@@ -204,18 +219,22 @@ def _failures(report: dict) -> TextTable:
             if v := s["by_size"].get(str(n)):
                 failed = v["episodes"] - round(v["success_rate"] * v["episodes"])
                 fc = v["failure_classes"]
+                after = v.get("overstep_after_failures")
                 rows.append(
                     (label(m), str(n), str(v["episodes"]), str(failed))
                     + (_kinds(fc[EXECUTION]), _kinds(fc[OVERSTEP]))
                     + ((_kinds(fc.get(PERCEPTION, {})),) if seen else ())
+                    + (dash(v.get("failed_primitives"), "d"), dash(after, "d"))
                 )
     title = (
-        "Failures: execution (a primitive failed; by the fatal anomaly or the last failed "
-        "primitive's status) and overstep (the step limit, or nothing reachable, with every "
-        "primitive having done what it was asked)"
+        f"Failures ({_protocol(report)}), by what ended the episode: execution (a failed "
+        "primitive; by the fatal anomaly or its status) and overstep (the step limit, or "
+        "nothing reachable); failed primitives over all episodes, and overstep episodes that "
+        "had some"
     )
     header = ("method", "objects", "episodes", "failed", "execution", "overstep")
     header += (PERCEPTION,) if seen else ()
+    header += ("failed primitives", "overstep after failures")
     return TextTable(title, header, tuple(rows))
 
 
@@ -233,8 +252,8 @@ def _times(report: dict) -> TextTable:
         wall = f"{s['wall_seconds'] / 60:.1f} ({workers or '?'} workers)"
         rows.append((label(m), "all", str(episodes), "", "", wall))
     title = (
-        "Time per episode (medians): the task level's, and the motion level's (choosing "
-        "parameters and executing them); wall clock of each method's whole run"
+        f"Time per episode ({_protocol(report)}, medians): the task level's, and the motion "
+        "level's (choosing parameters and executing them); wall clock of each method's whole run"
     )
     header = ("method", "objects", "episodes", "task ms", "motion s", "wall min")
     return TextTable(title, header, tuple(rows))

@@ -7,8 +7,9 @@ has no parameters, and a stack takes its position from the object below, so only
 a surface and a push are chosen over bins.
 
 `propose` is what an agent calls, once per step. The learned generators are single shot as in
-the paper: one proposal, no dry run (they ignore the one an agent may offer). The rule for
-failures: parameters whose execution failed for good (`DO_NOT_RETRY`) are remembered with the
+the paper: one proposal, no dry run (they ignore the one an agent may offer). The recovery rule
+`failed_bins` (`hsgplan.domain.recovery`; without it a generator proposes its first choice in
+every scene): parameters whose execution failed for good (`DO_NOT_RETRY`) are remembered with the
 scene they failed in (`scene_key`: the held object and every pose to the centimetre). In a
 scene where nothing has failed, a generator proposes its first choice (a network its
 best-scored bins). In a scene where something has failed, it draws from its own distribution
@@ -41,6 +42,7 @@ from hsgplan.domain.parameters import (
     params_for,
 )
 from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.domain.world import SURFACES
 from hsgplan.motion.models import load_motion_net
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -92,9 +94,14 @@ def scene_key(sg: GeometricSceneGraph) -> tuple:
 
 class SingleShotMemory:
     """What every generator remembers within an episode: the parameters that failed for good,
-    by the scene they failed in."""
+    by the scene they failed in (nothing, with the `failed_bins` rule off).
 
-    def __init__(self) -> None:
+    Args:
+        rules: the recovery rules in force (`hsgplan.domain.recovery`).
+    """
+
+    def __init__(self, rules: RecoveryRules = ALL_RULES) -> None:
+        self.rules = rules
         self.failed: dict[tuple, set[PrimitiveParams]] = {}
         self._scene: tuple | None = None
 
@@ -109,7 +116,7 @@ class SingleShotMemory:
         return [o for o in options if o not in failed]
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
-        if outcome.status in DO_NOT_RETRY and self._scene is not None:
+        if self.rules.failed_bins and outcome.status in DO_NOT_RETRY and self._scene is not None:
             self.failed.setdefault(self._scene, set()).add(params)
 
 
@@ -119,15 +126,16 @@ class _BinGenerator(SingleShotMemory):
     (the first of all when every one has).
 
     A spot in a prepush region can leave no push that works (the hand would hit a neighbour,
-    the line is blocked). After `PUSH_TRIES` failed pushes of an object since it was put down,
-    the generator gives up on the spot: it proposes nothing (the agent then takes the object
-    up, as it does for the geometric sampler) and counts the place that put it there as failed
-    in that scene, so that putting it down again draws another spot."""
+    the line is blocked). The recovery rule `push_give_up`: after `PUSH_TRIES` failed pushes of
+    an object since it was put down, the generator gives up on the spot: it proposes nothing
+    (the agent then takes the object up, as it does for the geometric sampler) and counts the
+    place that put it there as failed in that scene, so that putting it down again draws
+    another spot."""
 
     name = "bins"
 
-    def __init__(self) -> None:
-        super().__init__()
+    def __init__(self, rules: RecoveryRules = ALL_RULES) -> None:
+        super().__init__(rules)
         self.rng = random.Random(f"{self.name}-motion-0")
         self._placed: dict[str, tuple[tuple, PlaceParams]] = {}
         self._push_failures: dict[str, int] = {}
@@ -172,7 +180,11 @@ class _BinGenerator(SingleShotMemory):
             ranked: list[PrimitiveParams] = [PickParams(action.obj)]
         elif isinstance(action, Place) and action.target not in SURFACES:
             ranked = [PlaceParams(action.obj, action.target)]
-        elif isinstance(action, Push) and self._push_failures.get(action.obj, 0) >= PUSH_TRIES:
+        elif (
+            isinstance(action, Push)
+            and self.rules.push_give_up
+            and self._push_failures.get(action.obj, 0) >= PUSH_TRIES
+        ):
             self._give_up(action.obj)
             return None
         else:
@@ -192,9 +204,14 @@ def _all_params(kind: MotionPrimitive, subgoal: Literal, flat: list[int]):
 class LearnedMotion(_BinGenerator):
     """A trained motion network (GNN or MLP) per primitive, from checkpoint folders."""
 
-    def __init__(self, name: str, folders: dict[MotionPrimitive, Path]) -> None:
+    def __init__(
+        self,
+        name: str,
+        folders: dict[MotionPrimitive, Path],
+        rules: RecoveryRules = ALL_RULES,
+    ) -> None:
         self.name = name
-        super().__init__()
+        super().__init__(rules)
         self._weights: dict[PlaceParams | PushParams, float] = {}
         self.nets = {
             kind: load_motion_net(folder, kind.value, name.split("_")[0])
@@ -227,8 +244,8 @@ class RandomMotion(_BinGenerator):
 
     name = "random"
 
-    def __init__(self, seed: int = 0) -> None:
-        super().__init__()
+    def __init__(self, seed: int = 0, rules: RecoveryRules = ALL_RULES) -> None:
+        super().__init__(rules)
         self.reset(seed)
 
     def ranked(self, sg: GeometricSceneGraph, subgoal: Literal) -> list[PlaceParams | PushParams]:

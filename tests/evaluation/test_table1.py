@@ -40,10 +40,15 @@ def _record(success: bool, failure=None, statuses=("success",), repeat=0, size=2
 
 def test_failures_are_classed_as_the_paper_classes_them():
     assert failure_class(_record(True)) is None
-    # a primitive failed in execution: an execution failure, of the last failed kind
-    assert failure_class(_record(False, "overstep", ("no_ik", "success", "no_path"))) == (
+    # a failed primitive that ended the episode (the paper protocol): execution, of its kind
+    assert failure_class(_record(False, "failed_primitive", ("success", "no_path"))) == (
         EXECUTION,
         "no_path",
+    )
+    # out of steps after failed primitives (the recovering protocol): overstep all the same
+    assert failure_class(_record(False, "overstep", ("no_ik", "success", "no_path"))) == (
+        OVERSTEP,
+        "step limit",
     )
     assert failure_class(_record(False, "knocked_over", ("success",))) == (
         EXECUTION,
@@ -69,7 +74,8 @@ def test_summary_spreads_success_over_repeats_and_counts_failure_classes():
     entry = summarize(records)["by_size"]["2"]
     assert entry["success_rate"] == 0.75 and entry["episodes"] == 4 and entry["repeats"] == 2
     assert entry["success_std"] == pytest.approx(0.25)  # repeat means 1.0 and 0.5
-    assert entry["failure_classes"] == {EXECUTION: {"no_ik": 1}, OVERSTEP: {}, PERCEPTION: {}}
+    assert entry["failure_classes"] == {EXECUTION: {}, OVERSTEP: {"step limit": 1}, PERCEPTION: {}}
+    assert entry["failed_primitives"] == 1 and entry["overstep_after_failures"] == 1
     assert entry["median_task_seconds"] == pytest.approx(0.01)
     assert entry["median_motion_seconds"] == pytest.approx(0.502)
     assert summarize([_record(True)])["by_size"]["2"]["success_std"] is None
@@ -98,7 +104,8 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
     assert header == "| objects | GNN | GNN (paper) | sampler |"
     paper = PAPER_TABLE1["gnn"][2]
     assert f"| 2 | 0.50 / 0.75 | {paper[0]:.2f} / {paper[1]:.2f} | 0.50 / 0.75 |" in text
-    assert "| GNN | 2 | 2 | 1 | 1 (no_ik 1) | 0 |" in text
+    assert "| GNN | 2 | 2 | 1 | 0 | 1 (step limit 1) | 1 | 1 |" in text
+    assert "(recovering protocol)" in text  # a report without a protocol predates the paper's
     assert "1.5 (2 workers)" in text
 
 

@@ -113,3 +113,25 @@ def test_after_failed_pushes_a_generator_gives_up_the_spot_and_draws_another_one
     # once put down elsewhere, pushes get their tries again
     motion.observe(motion.propose(held, Place(can, "prepush_a")), Outcome(Status.SUCCESS, "", 0))
     assert isinstance(motion.propose(standing, Push(can, "shelf_a")), PushParams)
+
+
+def test_without_the_recovery_rules_a_generator_neither_remembers_nor_gives_up():
+    from hsgplan.domain.recovery import RecoveryRules
+
+    rules = RecoveryRules().without(["failed_bins", "push_give_up"])
+    motion = _FixedScores(_logits(b_0_0=10.0, b_0_1=9.0))
+    motion.rules = rules
+    motion.reset(0)
+    for _ in range(3):  # a network's best, whatever failed before
+        proposal = motion.propose(_scene(), Place(HELD, "shelf_a"))
+        assert proposal == _place(0, 0)
+        motion.observe(proposal, Outcome(Status.NO_IK, "", 0.0))
+    can = "cherries"
+    pose = {can: Pose.from_xyz_yaw(0.30, 0.38, object_type(can).height / 2, 0.0)}
+    standing = GeometricSceneGraph.from_poses(pose)
+    random_motion = RandomMotion(rules=rules)
+    random_motion.reset(0)
+    for _ in range(PUSH_TRIES + 2):  # a fresh uniform draw every step, never giving up
+        push = random_motion.propose(standing, Push(can, "shelf_a"))
+        assert isinstance(push, PushParams)
+        random_motion.observe(push, Outcome(Status.NO_PATH, "", 0.0))

@@ -26,6 +26,7 @@ import torch
 from hsgplan.domain.actions import Action
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal
+from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.planning.base import TaskDecision, push_after
 from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.encoding import (
@@ -99,13 +100,25 @@ class RegressionPlanner:
     has its whole preimage holding in the state now observed, its action is taken without
     asking the networks again; otherwise (a primitive failed, the world moved) the chain is
     dropped and the planner regresses from the goal.
+
+    What it does after a failure is the recovery rules' (`hsgplan.domain.recovery`:
+    `avoid_taken`, `least_taken`, `likeliest_literal`, `failed_goal_waits`); with all of them
+    off it is the paper's planner: the shallowest reachable literal, drawn uniformly, or
+    "regression stuck".
     """
 
     name = "regression"
 
-    def __init__(self, checkpoint: Path, seed: int = 0, max_depth: int = MAX_DEPTH) -> None:
+    def __init__(
+        self,
+        checkpoint: Path,
+        seed: int = 0,
+        max_depth: int = MAX_DEPTH,
+        rules: RecoveryRules = ALL_RULES,
+    ) -> None:
         self.preimage, self.reach = _inference_networks(str(checkpoint))
         self.max_depth = max_depth
+        self.rules = rules
         self.reset(None, seed)
 
     def reset(self, goal: Goal | None, seed: int) -> None:
@@ -158,10 +171,11 @@ class RegressionPlanner:
         unsatisfied = [lit for lit in _in_order(goal) if not state.holds(lit)]
         if not unsatisfied:
             return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
-        if self._last is not None and self._last[0] == state:
+        rules = self.rules
+        if rules.failed_goal_waits and self._last is not None and self._last[0] == state:
             self._failed_roots.add(self._last[2])
         taken = self._taken.setdefault((goal, state), Counter())
-        if (step := self._follow(state, goal, taken)) is not None:
+        if (step := self._follow(state, goal, taken if rules.avoid_taken else ())) is not None:
             taken[step[1]] += 1
             self._last = (state, step[1], step[2])
             return _decision(step[1], step[0], start)
@@ -182,11 +196,16 @@ class RegressionPlanner:
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
         seen: dict[Literal, tuple[float, _Node]] = {}
-        for avoid, counts in ((set(taken), None), (set(), taken)):
+        passes = [(set(taken), None)] if rules.avoid_taken else []
+        if rules.least_taken:
+            passes.append((set(), taken))
+        for avoid, counts in passes or [(set(), None)]:
             for frontier in (free, [x for x in pairs if x not in free]):
                 found = self._search(state, frontier, avoid, seen, counts)
                 if found is not None:
                     return self._take(state, goal, *found, taken, start)
+            if not rules.likeliest_literal:
+                continue
             # Nothing reached: the literal f_reach finds likeliest (it learned the physical
             # world, which refuses more than some other world would), before repeating
             likely = [

@@ -1,0 +1,71 @@
+"""The two protocols: a failed primitive ends a paper-protocol episode, and a recovering one
+goes on; the recovery rules are named, refused when unknown, and none under the paper's."""
+
+from __future__ import annotations
+
+import pytest
+
+from hsgplan.agents.base import Decision
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.parameters import PickParams
+from hsgplan.domain.recovery import RecoveryRules
+from hsgplan.evaluation.episode import run_episode
+from hsgplan.evaluation.protocol import EvalConfig, run_config
+from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, failure_class
+from hsgplan.sim.env import KitchenStorageEnv
+
+GOAL = parse_goal("On(butter, shelf_a) & On(popcorn, shelf_b)")
+
+
+class PicksAbsentObject:
+    """An agent whose every decision is a primitive that fails: it picks an object that is not
+    in the scene, and the world refuses it (nothing moves)."""
+
+    name = "fails"
+
+    def reset(self, goal, seed):
+        self.decisions = 0
+
+    def decide(self, sg, state, goal, feasible=None):
+        self.decisions += 1
+        return Decision(None, PickParams("cherries"), 0.0, 0.0)
+
+    def observe(self, params, outcome):
+        pass
+
+
+def test_a_failed_primitive_ends_a_paper_protocol_episode():
+    agent = PicksAbsentObject()
+    record = run_episode(KitchenStorageEnv(), agent, GOAL, seed=3, end_at_failure=True)
+    assert len(record.steps) == 1 and record.steps[0].status != "success"
+    assert record.failure == "failed_primitive" and not record.success
+    assert failure_class(record) == (EXECUTION, record.steps[0].status)
+
+
+def test_a_recovering_episode_out_of_steps_after_failures_is_overstep():
+    env = KitchenStorageEnv(max_steps=4)
+    record = run_episode(env, PicksAbsentObject(), GOAL, seed=3)
+    assert len(record.steps) == 4 and all(s.status != "success" for s in record.steps)
+    assert record.failure == "overstep"
+    assert failure_class(record) == (OVERSTEP, "step limit")
+
+
+def test_the_paper_protocol_runs_without_any_recovery_rule():
+    assert EvalConfig("paper", (2,), 1, 0, protocol="paper").rules() == RecoveryRules.none()
+    assert EvalConfig("paper", (2,), 1, 0).rules() == RecoveryRules()
+    some = EvalConfig("paper", (2,), 1, 0, rules_off=("failed_bins", "least_taken"))
+    assert some.rules().off() == ("failed_bins", "least_taken")
+    with pytest.raises(InvalidInputError, match="unknown recovery rule"):
+        EvalConfig("paper", (2,), 1, 0, rules_off=("wizard",))
+    with pytest.raises(InvalidInputError, match="no recovery rule"):
+        EvalConfig("paper", (2,), 1, 0, protocol="paper", rules_off=("failed_bins",))
+    with pytest.raises(InvalidInputError, match="protocol 'x'"):
+        EvalConfig("paper", (2,), 1, 0, protocol="x")
+
+
+def test_a_run_folder_names_its_protocol_unless_it_is_the_default():
+    default = run_config(EvalConfig("oracle", (2,), 1, 0))
+    assert "protocol" not in default and "rules_off" not in default  # as older runs were claimed
+    paper = run_config(EvalConfig("oracle", (2,), 1, 0, protocol="paper"))
+    assert paper["protocol"] == "paper" and paper["rules_off"] == []
