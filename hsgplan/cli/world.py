@@ -174,6 +174,13 @@ def evaluate(
             + "."
         ),
     ] = "",
+    ablate_rules: Annotated[
+        bool,
+        typer.Option(
+            help="Run the table with every recovery rule on, then with each off in turn "
+            "(one folder each), and print what each buys."
+        ),
+    ] = False,
     workers: Annotated[
         int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
     ] = 2,
@@ -186,6 +193,7 @@ def evaluate(
     Table 1, with the failure taxonomy and the time per level, under a protocol (paper or
     recovering); writes table1.md, table1.png and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
+    from hsgplan.evaluation.ablation import ablation_table, check_ablation, run_ablation
     from hsgplan.evaluation.observers import make_observer
     from hsgplan.evaluation.protocol import EvalConfig, checkpoints, episode_specs
     from hsgplan.evaluation.table1 import Method, check_table, run_table, tables
@@ -231,19 +239,23 @@ def evaluate(
     total = len(episode_specs(config)) * len(methods)
     folder = run_dir or RUNS / _run_name(methods, config)
     check_ray(ray)
-    check_table(methods, config, folder)  # the cheap refusals first: loading agents takes seconds
+    if ablate_rules:  # the cheap refusals first: loading agents takes seconds
+        total *= len(check_ablation(methods, config, folder))
+    else:
+        check_table(methods, config, folder)
     for m in methods:  # an unknown name or a missing checkpoint: refused before any work
         make_agent(m.agent, *checkpoints(config))
+    run = run_ablation if ablate_rules else run_table
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(", ".join(m.agent for m in methods), total=total)
-        report = run_table(methods, config, folder, workers, ray, lambda r: progress.advance(task))
+        report = run(methods, config, folder, workers, ray, lambda r: progress.advance(task))
     if as_json:
         print(json.dumps(report, indent=2))
         return
-    for t in tables(report):
+    for t in [ablation_table(report)] if ablate_rules else tables(report):
         print_table(t.title, t.header, [list(r) for r in t.rows], markdown)
         print()
-    if not markdown:
+    if not markdown and not ablate_rules:
         out.print(f"wrote {shown(folder)}/table1.md, table1.png, summary.json", highlight=False)
 
 

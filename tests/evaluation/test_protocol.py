@@ -69,3 +69,27 @@ def test_a_run_folder_names_its_protocol_unless_it_is_the_default():
     assert "protocol" not in default and "rules_off" not in default  # as older runs were claimed
     paper = run_config(EvalConfig("oracle", (2,), 1, 0, protocol="paper"))
     assert paper["protocol"] == "paper" and paper["rules_off"] == []
+
+
+def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
+    from hsgplan.evaluation.ablation import ablation_table, variants
+    from hsgplan.evaluation.summary import summarize
+    from tests.evaluation.test_table1 import _record
+
+    config = EvalConfig("paper", (2,), 1, 0)
+    found = variants(config)
+    assert list(found)[0] == "all-rules" and found["all-rules"].rules_off == ()
+    assert [v.rules_off for v in list(found.values())[1:]] == [(r,) for r in RecoveryRules.names()]
+    with pytest.raises(InvalidInputError, match="ablate-rules"):
+        variants(EvalConfig("paper", (2,), 1, 0, protocol="paper"))
+    run = {"goals": 1, "goals_file": None, "repeats": 1, "seed": 0}
+    ok, failed = summarize([_record(True)]), summarize([_record(False, "overstep", ("no_ik",))])
+    report = {
+        "variants": {
+            "all-rules": run | {"methods": {"gnn": ok}},
+            "no-failed_bins": run | {"methods": {"gnn": failed}},
+        }
+    }
+    table = ablation_table(report)
+    assert table.header == ("recovery rules", "GNN 2", "GNN failed primitives / episode")
+    assert table.rows == (("all on", "1.00", "0.00"), ("failed_bins off", "0.00", "1.00"))

@@ -1,0 +1,98 @@
+"""What each recovery rule buys: Table 1 under the recovering protocol with every rule on, then
+with each rule off in turn (`hsgplan eval --ablate-rules`).
+
+Each variant is a whole Table 1 run of its own (`evaluation/table1.py`) in a folder under the
+ablation's, named by the rule switched off (`all-rules` for none), so an interrupted ablation
+resumes where it stopped. The result is one table: a row per variant, the success rate per
+method and size, and the failed primitives per episode.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import asdict, replace
+from pathlib import Path
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.recovery import PAPER, RecoveryRules
+from hsgplan.evaluation.episode import EpisodeRecord
+from hsgplan.evaluation.protocol import EvalConfig
+from hsgplan.evaluation.table1 import Method, TextTable, check_table, label, run_table
+from hsgplan.runner.run_folder import check_claim, claim
+
+ALL_RULES_ON = "all-rules"
+
+
+def variants(config: EvalConfig) -> dict[str, EvalConfig]:
+    """The configurations compared, by folder name: every rule on, then each one off."""
+    if config.protocol == PAPER or config.rules_off:
+        raise InvalidInputError(
+            "--ablate-rules switches each recovery rule off in turn under the recovering "
+            "protocol; give neither --protocol paper nor --rules-off"
+        )
+    out = {ALL_RULES_ON: config}
+    out |= {f"no-{rule}": replace(config, rules_off=(rule,)) for rule in RecoveryRules.names()}
+    return out
+
+
+ABLATION_KIND = "eval-ablation"
+
+
+def _claimed_with(methods: list[Method], config: EvalConfig) -> tuple[dict, str]:
+    settings = {k: v for k, v in asdict(config).items() if k != "agent"}
+    settings |= {"sizes": list(config.sizes), "methods": [asdict(m) for m in methods]}
+    return settings, "the folder holds an ablation of another configuration; use another --out"
+
+
+def check_ablation(methods: list[Method], config: EvalConfig, out: Path) -> list[str]:
+    """Every refusal of the ablation's folder and its variants', before anything is written;
+    the variants."""
+    check_claim(out, ABLATION_KIND, *_claimed_with(methods, config))
+    names = variants(config)
+    for name, variant in names.items():
+        check_table(methods, variant, out / name)
+    return list(names)
+
+
+def run_ablation(
+    methods: list[Method],
+    config: EvalConfig,
+    out: Path,
+    workers: int = 2,
+    ray: str | None = None,
+    on_episode: Callable[[EpisodeRecord], None] | None = None,
+) -> dict:
+    """Every variant's Table 1 (resumable); `{"variants": {NAME: report}}`."""
+    check_ablation(methods, config, out)
+    claim(out, ABLATION_KIND, *_claimed_with(methods, config))
+    reports = {
+        name: run_table(methods, variant, out / name, workers, ray, on_episode)
+        for name, variant in variants(config).items()
+    }
+    return {"protocol": config.protocol, "variants": reports, "run": str(out)}
+
+
+def ablation_table(report: dict) -> TextTable:
+    """Success rate per method and size, and failed primitives per episode, per variant."""
+    first = next(iter(report["variants"].values()))
+    methods = list(first["methods"])
+    sizes = sorted({int(n) for s in first["methods"].values() for n in s["by_size"]})
+    header = ["recovery rules"] + [f"{label(m)} {n}" for m in methods for n in sizes]
+    header += [f"{label(m)} failed primitives / episode" for m in methods]
+    rows = []
+    for name, r in report["variants"].items():
+        row = ["all on" if name == ALL_RULES_ON else f"{name.removeprefix('no-')} off"]
+        for m in methods:
+            by_size = r["methods"][m]["by_size"]
+            row += [f"{by_size[str(n)]['success_rate']:.2f}" for n in sizes]
+        for m in methods:
+            by_size = r["methods"][m]["by_size"].values()
+            episodes = sum(v["episodes"] for v in by_size)
+            row.append(f"{sum(v['failed_primitives'] for v in by_size) / episodes:.2f}")
+        rows.append(tuple(row))
+    source = first["goals_file"] or f"{first['goals']} random goals per size"
+    title = (
+        f"Success rate with each recovery rule off in turn (recovering protocol): {source}, "
+        f"each run {first['repeats']} times, seed {first['seed']}"
+    )
+    return TextTable(title, tuple(header), tuple(rows))
