@@ -81,7 +81,8 @@ def eval_perception(
     views: Annotated[
         int | None,
         typer.Option(
-            help="See from the first this many fixed views (3: those before stop 30).", min=1
+            help="See from the first this many fixed views (3: the shoulder and front views).",
+            min=1,
         ),
     ] = None,
 ) -> None:

@@ -48,7 +48,7 @@ from hsgplan.sim.render import Camera
 
 TYPES = tuple(OBJECT_TYPES)
 # A free (tilted) fit stands for a toppled object only where its reprojection cost is at most
-# this fraction of the best upright fit's. At 1 (the rule until stop 28), a thin box half
+# this fraction of the best upright fit's. At 1 (no preference for upright), a thin box half
 # hidden under a can was often fitted a little better tilted, was no carrier to settle on,
 # and the can fell onto the table: symbolic match on 100 tuning scenes (seed 2) 0.66 at 1,
 # 0.69 at 0.5 and at 0.25, and 0.69 always upright. One view alone never says toppled: a can
@@ -62,7 +62,7 @@ TOPPLED_COST = 0.5
 # under it, with nothing found under it, is taken for two: nothing floats, so a box found that
 # high with nothing under it is the upper one of two, or the two as one. Unless what it
 # carries rests a box's height up. Symbolic match on 100 tuning scenes, seed 2: 0.82 without,
-# 0.91 with (0.75, 1.25), the band until stop 29, 0.95 with this band (and the rule of what it
+# 0.91 with the narrower band (0.75, 1.25), 0.95 with this band (and the rule of what it
 # carries); seed 3: 0.78, 0.89 and 0.91; on the evaluation's seed 1, 0.84, 0.92 and 0.94. The
 # blob of seed 1's scene 96 was found at 1.29 box heights.
 STACK_BAND = (0.75, 1.75)
@@ -374,8 +374,8 @@ def _fitted(name: str, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[Pos
 def _apart(detections: list[Detection]) -> list[Detection]:
     """Two objects cannot fill one space. Detections that fill one (`settle.same_place`) are
     one object found twice, mostly once in each look-alike type's maps; the one whose type the
-    colour network is surest of, among every type, is kept (then the stronger). Until stop 29
-    it was among the types of its kind: a box the keypoint network saw where a soup stands, the
+    colour network is surest of, among every type, is kept (then the stronger). Choosing among
+    the types of its kind alone fails: a box the keypoint network saw where a soup stands, the
     likeliest box by a soup's colour, could win over the soup (symbolic match on 500 scenes of
     seeds 1 to 5, 3 scenes better). But a can a single view saw where a can of its type that
     several views saw stands is that can found again, whatever the colour: the lower of two

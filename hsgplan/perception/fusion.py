@@ -8,17 +8,17 @@ object can be (over the table's footprint, from 5 cm under its top, an estimate'
 
 Instances are grouped as cliques: sets of instances of one type, at most one per view, every
 two of whose rays pass within `RAY_GAP`. Cliques of more views are taken first, and among those
-of one size the one whose farthest pair is closest; an instance is in one group at most. The
-rule until stop 28 grew each group from its strongest instance, taking in each other view the
-ray nearest to it: with look-alike boxes side by side a strong instance took another object's
+of one size the one whose farthest pair is closest; an instance is in one group at most. Growing
+each group from its strongest instance instead, taking in each other view the ray nearest to
+it, fails: with look-alike boxes side by side a strong instance took another object's
 instance a centimetre off, and that object was left as a lone view's phantom. Joining the
 closest pairs first mended that (symbolic match on 100 tuning scenes, seed 2: 0.70 to 0.78),
 but two views' rays to two different objects can pass closer than a true pair's: in the loop
 (Table 1 rgb, 2 objects, seed 20033) a soup on shelf A's top from one view and a soup pushed in
 under it from another made a phantom, the tracker gave the pushed soup the phantom, and the
 agent pushed it again until the step limit. A third view seldom agrees with such a pair, so
-groups of every view come first (with every other rule of stop 28: 0.91 to 0.92 on seed 2, 0.89
-to 0.90 on seed 3, 0.90 to 0.92 on the evaluation's seed 1).
+groups of every view come first (with the tracker's and estimator's other rules: 0.91 to 0.92 on
+seed 2, 0.89 to 0.90 on seed 3, 0.90 to 0.92 on the evaluation's seed 1).
 """
 
 from __future__ import annotations

@@ -57,7 +57,7 @@ class ImagesConfig:
     seed: int = 0
     chunk: int = CHUNK
     p_elsewhere: float = P_ELSEWHERE  # see `synthetic.P_ELSEWHERE`
-    views: int = len(VIEWS)  # the first this many fixed views (3: those before stop 30)
+    views: int = len(VIEWS)  # the first this many fixed views (3: shoulders and front)
 
     def __post_init__(self) -> None:
         if self.count < 1 or self.chunk < 1:

@@ -147,9 +147,9 @@ def _straight_down(
     """The centre moved up or down onto the top under it nearest its bottom: nothing here
     floats, and two objects cannot overlap. A stacked object's centroid tends to be found a
     centimetre or two low or high; a thin box (2.4 cm) found that low has its centre below its
-    carrier's top, and the highest top below the centre (the rule until stop 26) put it on the
-    table beneath, inside its carrier (symbolic match on the tuning scenes, seed 2: 0.60 then,
-    0.65 with this rule).
+    carrier's top, and the highest top below the centre put it on the table beneath, inside its
+    carrier (symbolic match on the tuning scenes, seed 2: 0.60 with that rule, 0.65 with this
+    one).
 
     No top is taken that would put it through a `solid` carrier (one several views saw, or one
     believed there, unseen; a lone view's may be a phantom) under its centre, by more than

@@ -95,9 +95,9 @@ def logged_rows(run_dir: Path) -> list[dict]:
 
 
 def add_wall_seconds(run_dir: Path, seconds: float, workers: int) -> None:
-    """Add a session's wall-clock seconds to the folder's timing (`timing.json`), with the
-    workers it ran and the cores of the machine: a run interrupted and resumed is timed over
-    all its sessions."""
+    """Add one sitting's wall-clock seconds to the folder's timing (`timing.json`, a list
+    `sessions` of them), with the workers it ran and the cores of the machine: a run
+    interrupted and resumed is timed over all its sittings."""
     timing = read_timing(run_dir)
     timing["wall_seconds"] = round(timing["wall_seconds"] + seconds, 3)
     timing["sessions"].append(

