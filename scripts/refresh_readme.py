@@ -1,9 +1,10 @@
-"""Replace a README results block with what a command prints, so no table is typed by hand.
+"""Replace a results block with what a command prints, so no table is typed by hand.
 
 Usage: python scripts/refresh_readme.py NAME -- hsgplan bench symbolic --markdown
 
-The block is the text between `<!-- BEGIN NAME -->` and `<!-- END NAME -->`; it becomes the
-command's standard output followed by a line naming the command, the date and the machine.
+The block is the text between `<!-- BEGIN NAME -->` and `<!-- END NAME -->`, in the README or in
+one of the pages under docs/; it becomes the command's standard output followed by a line naming
+the command, the date and the machine.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-README = Path(__file__).resolve().parent.parent / "README.md"
+ROOT = Path(__file__).resolve().parent.parent
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 
 
 def main(argv: list[str]) -> int:
@@ -25,12 +27,12 @@ def main(argv: list[str]) -> int:
         print(__doc__.strip().splitlines()[2], file=sys.stderr)
         return 2
     name, command = argv[0], argv[2:]
-    text = README.read_text()
     pattern = re.compile(
         rf"(<!-- BEGIN {re.escape(name)} -->\n).*?(<!-- END {re.escape(name)} -->)", re.S
     )
-    if not pattern.search(text):
-        print(f"README.md has no block named '{name}'", file=sys.stderr)
+    page = next((p for p in PAGES if pattern.search(p.read_text())), None)
+    if page is None:
+        print(f"no page (README.md, docs/*.md) has a block named '{name}'", file=sys.stderr)
         return 2
     result = subprocess.run(command, capture_output=True, text=True, check=False)
     if result.returncode != 0:
@@ -41,9 +43,9 @@ def main(argv: list[str]) -> int:
         f"({platform.machine()}, {os.cpu_count()} cores)._\n"
     )
     block = result.stdout.strip() + "\n" + stamp
-    # read again: the README may have changed while the command ran (another refresh, an edit)
-    text = README.read_text()
-    README.write_text(pattern.sub(lambda m: m.group(1) + block + m.group(2), text))
+    # read again: the page may have changed while the command ran (another refresh, an edit)
+    text = page.read_text()
+    page.write_text(pattern.sub(lambda m: m.group(1) + block + m.group(2), text))
     return 0
 
 
