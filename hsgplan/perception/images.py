@@ -177,8 +177,42 @@ def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:
         if not path.is_file() or hashlib.sha256(path.read_bytes()).hexdigest() != row["sha256"]:
             raise InvalidInputError(f"'{path}' is missing or not the chunk logged; collect again")
         with np.load(path, allow_pickle=False) as data:
-            parts.append({k: data[k] for k in data.files})
+            part = {k: data[k] for k in data.files}
+        if problem := chunk_problem(part, row["samples"]):
+            raise InvalidInputError(f"'{path}' is damaged: {problem}; collect again")
+        parts.append(part)
+    views = {p["images"].shape[1] for p in parts if len(p["images"])}
+    if len(views) > 1:  # collections of several view counts train together (`train.joined`)
+        raise InvalidInputError(f"'{run_dir}' mixes chunks of {sorted(views)} views")
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def chunk_problem(arrays: dict[str, np.ndarray], samples: int) -> str | None:
+    """What breaks the format in a chunk's arrays (`pack`'s), or None: every array present,
+    one row per sample as logged, the views and objects alike in every array, every type an
+    index into `TYPES` (or -1, no object)."""
+    names = ("index", "images", "types", "instance", "poses", "keypoints", "visible", "cameras")
+    if missing := [n for n in names if n not in arrays]:
+        return f"no {', '.join(missing)}"
+    if any(len(arrays[n]) != samples for n in names):
+        return f"not {samples} samples in every array"
+    v = arrays["images"].shape[1] if arrays["images"].ndim == 5 else -1
+    shapes = {
+        "images": (v, VIEWS[0].height, VIEWS[0].width, 3),
+        "types": (MAX_OBJECTS,),
+        "instance": (MAX_OBJECTS,),
+        "poses": (MAX_OBJECTS, 7),
+        "keypoints": (v, MAX_OBJECTS, KEYPOINTS, 2),
+        "visible": (v, MAX_OBJECTS),
+        "cameras": (v, 7),
+    }
+    for name, shape in shapes.items():
+        if arrays[name].shape[1:] != shape:
+            return f"{name} of shape {arrays[name].shape[1:]}, not {shape}"
+    types = arrays["types"]
+    if types.dtype.kind not in "iu" or ((types < -1) | (types >= len(TYPES))).any():
+        return f"an object type outside -1 to {len(TYPES) - 1}"
+    return None
 
 
 def write_format(run_dir: Path) -> None:

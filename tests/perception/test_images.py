@@ -93,3 +93,17 @@ def test_fewer_than_three_views_render_the_first_ones_as_three_do():
     one, three = render_sample(0, 3, views=1), render_sample(0, 3, views=3)
     assert one is not None and three is not None
     assert np.array_equal(one.images, three.images[:1]) and one.cameras == three.cameras[:1]
+
+
+def test_a_chunk_whose_arrays_break_the_format_is_named_damaged():
+    from hsgplan.perception.images import chunk_problem, pack
+
+    good = pack([render_sample(0, 0)])
+    assert chunk_problem(good, 1) is None
+    assert "samples" in chunk_problem(good, 2)
+    bad_type = dict(good, types=good["types"].copy())
+    bad_type["types"][0, 0] = 42
+    assert "object type" in chunk_problem(bad_type, 1)
+    swapped = dict(good, poses=good["keypoints"])
+    assert "poses of shape" in chunk_problem(swapped, 1)
+    assert "no cameras" in chunk_problem({k: v for k, v in good.items() if k != "cameras"}, 1)
