@@ -298,6 +298,11 @@ eval-motion    | eval-motion --trials 1 --workers 1 --primitives place,place
 bench collect  | bench collect --samples 1 --workers 1 --primitives ''
 bench collect  | bench collect --samples 1 --workers 1 --primitives wizard
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ray ''
+eval           | eval --sizes 2 --goals 1 --workers 1 --out run --rules-off wizard
+eval           | eval --sizes 2 --goals 1 --workers 1 --out run --rules-off failed_bins,,least_taken
+eval           | eval --sizes 2 --goals 1 --workers 1 --out run --protocol paper --rules-off failed_bins
+eval           | eval --sizes 2 --goals 1 --workers 1 --out run --protocol ''
+eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ablate-rules --protocol paper
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ray 127.0.0.1:1
 collect place  | collect place --samples 1 --workers 1 --out ds --ray ''
 collect place  | collect place --samples 1 --workers 1 --out ds --ray 127.0.0.1:1
