@@ -47,9 +47,9 @@ def _run_folder(tmp_path, method: str, records: list[EpisodeRecord], config: Eva
 
 def test_the_sample_takes_each_kind_of_failure_in_turn(tmp_path):
     records = [
-        _record(1, "overstep", "no_path"),
-        _record(2, "overstep", "no_path"),
-        _record(3, "overstep", "no_path"),
+        _record(1, "failed_primitive", "no_path"),
+        _record(2, "failed_primitive", "no_path"),
+        _record(3, "failed_primitive", "no_path"),
         _record(4, "knocked_over"),
         _record(5, None),
         _record(6, "overstep"),
