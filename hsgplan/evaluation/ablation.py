@@ -40,7 +40,11 @@ ABLATION_KIND = "eval-ablation"
 
 def _claimed_with(methods: list[Method], config: EvalConfig) -> tuple[dict, str]:
     settings = {k: v for k, v in asdict(config).items() if k != "agent"}
-    settings |= {"sizes": list(config.sizes), "methods": [asdict(m) for m in methods]}
+    settings |= {
+        "sizes": list(config.sizes),
+        "rules_off": list(config.rules_off),
+        "methods": [asdict(m) for m in methods],
+    }
     return settings, "the folder holds an ablation of another configuration; use another --out"
 
 

@@ -58,7 +58,9 @@ def check_table(methods: list[Method], config: EvalConfig, out: Path) -> tuple[d
         k: v
         for k, v in asdict(config).items()
         if k not in per_method and not (k == "perception_checkpoint" and v is None)
-    } | {"sizes": list(config.sizes)}
+    } | {"sizes": list(config.sizes), "rules_off": list(config.rules_off)}
+    if config.protocol == RECOVERING and not config.rules_off:  # as before protocols were named
+        del table["protocol"], table["rules_off"]
     refusal = f"'{out}' holds a table of another configuration or goal file; use another --out"
     check_claim(out, TABLE_KIND, table, refusal)
     check_runs(config, out, {m.name: (m.agent, m.perception) for m in methods})

@@ -93,3 +93,20 @@ def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
     table = ablation_table(report)
     assert table.header == ("recovery rules", "GNN 2", "GNN failed primitives / episode")
     assert table.rows == (("all on", "1.00", "0.00"), ("failed_bins off", "0.00", "1.00"))
+
+
+@pytest.mark.parametrize("protocol", ["paper", "recovering"])
+def test_a_table_folder_claimed_under_a_protocol_is_its_own_again(tmp_path, protocol):
+    from hsgplan.evaluation.ablation import ABLATION_KIND, _claimed_with
+    from hsgplan.evaluation.table1 import TABLE_KIND, Method, check_table
+    from hsgplan.runner.run_folder import check_claim, claim
+
+    methods = [Method("gnn", "regression+gnn")]
+    config = EvalConfig("", (2,), 1, 0, protocol=protocol)
+    table, refusal = check_table(methods, config, tmp_path / "table")
+    claim(tmp_path / "table", TABLE_KIND, table, refusal)
+    again = check_table(methods, config, tmp_path / "table")  # refuses if it differs
+    assert check_claim(tmp_path / "table", TABLE_KIND, *again)
+    if protocol == "recovering":  # read back from JSON, a resumed ablation is the same one
+        claim(tmp_path / "ablation", ABLATION_KIND, *_claimed_with(methods, config))
+        assert check_claim(tmp_path / "ablation", ABLATION_KIND, *_claimed_with(methods, config))

@@ -300,7 +300,7 @@ bench collect  | bench collect --samples 1 --workers 1 --primitives wizard
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ray ''
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --rules-off wizard
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --rules-off failed_bins,,least_taken
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --protocol paper --rules-off failed_bins
+eval           | eval --sizes 2 --goals 1 --out run --protocol paper --rules-off failed_bins
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --protocol ''
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ablate-rules --protocol paper
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ray 127.0.0.1:1
