@@ -11,6 +11,7 @@ from rich.progress import Progress
 
 from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
 from hsgplan.cli.common import (
+    PerceptionCheckpoint,
     RunFolder,
     choice,
     err,
@@ -266,5 +267,51 @@ def bench_collect(
         "Motion data collection speed",
         ("primitive", "workers", "samples", "trials successful", "seconds", "samples per s"),
         cells,
+        markdown,
+    )
+
+
+@app.command("observe")
+@refuses_bad_input
+def bench_observe(
+    scenes: Annotated[
+        int, typer.Option(help="Scenes staged, rendered and seen.", min=1, max=MAX_EPISODES)
+    ] = 30,
+    seed: Annotated[int, typer.Option(help="Seed of the scenes.", min=0, max=MAX_SEED)] = 100,
+    checkpoint: PerceptionCheckpoint = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    markdown: Annotated[
+        bool, typer.Option(help="Print a Markdown table (for the README).")
+    ] = False,
+) -> None:
+    """Seconds per observation through f_p (rendering timed apart and excluded): the keypoint
+    network, PnP, fusion, naming and resting, and the tracker; medians over the scenes."""
+    from hsgplan.benchmarks.observe import bench_observe as run
+    from hsgplan.evaluation.observers import make_observer, perception_folder
+
+    make_observer("rgb", checkpoint)  # a missing or damaged checkpoint: refused before work
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task("scenes", total=scenes)
+        rows = run(
+            perception_folder(checkpoint), scenes, seed, on_scene=lambda: progress.advance(task)
+        )
+    if as_json:
+        print(json.dumps([r.to_json() for r in rows], indent=2))
+        return
+    print_table(
+        f"One observation through f_p, one core: seconds per scene, {scenes} scenes, seed {seed}",
+        ("objects", "scenes", "stage + render (excluded)", "f_p", "tracker", "observation", "p90"),
+        [
+            (
+                r.objects,
+                str(r.scenes),
+                f"{r.render_median:.3f}",
+                f"{r.detect_median:.3f}",
+                f"{r.track_median:.4f}",
+                f"{r.observation_median:.3f}",
+                f"{r.observation_p90:.3f}",
+            )
+            for r in rows
+        ],
         markdown,
     )

@@ -36,6 +36,7 @@ COMMANDS = (
     "bench task",
     "bench timing",
     "bench collect",
+    "bench observe",
     "collect demos",
     "collect place",
     "collect push",

@@ -71,6 +71,7 @@ bench collect  | bench collect --workers 1 --primitives place         | --sample
 report         | report run                                           | --failures  | -1
 collect images | collect images --workers 1 --out ds                  | --count     | ALL
 eval-perception | eval-perception                                     | --scenes    | ALL
+bench observe  | bench observe                                        | --scenes    | -1 0 1e12
 """
 # a small count each: a huge pool for one item would still start one process
 WORKERS = """
@@ -290,6 +291,7 @@ eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception rgb
 eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception '[red]x'
 eval           | eval --sizes 2 --goals 1 --out run --perception rgb --perception-checkpoint .
 demo           | demo --perception ''
+bench observe  | bench observe --scenes 1 --checkpoint .
 demo           | demo --perception rgb --perception-checkpoint .
 eval-motion    | eval-motion --trials 1 --workers 1 --primitives ''
 eval-motion    | eval-motion --trials 1 --workers 1 --primitives wizard
