@@ -122,7 +122,7 @@ def fingerprint(folders: Iterable[Path]) -> str:
         else:
             files = []
         for path in files:
-            if path.name.startswith(".") or path.name == PROGRESS or path.suffix == ".pt":
+            if path.name.startswith(".") or path.name == PROGRESS or path.suffix in (".pt", ".tmp"):
                 continue  # training leftovers are not what a run is evaluated with
             h.update(str(path.relative_to(folder)).encode() + b"\0")
             h.update(hashlib.sha256(path.read_bytes()).digest())

@@ -19,10 +19,11 @@ from pathlib import Path
 
 
 def temporary_name(path: Path) -> Path:
-    """The hidden temporary file beside `path`, keeping its suffix (writers that choose a
-    format by the suffix, numpy's `.npz` or an image's, still see it); a name starting with a
-    dot never looks like a chunk, a dataset or a run's file."""
-    return path.with_name(f".{path.stem}.tmp{path.suffix}")
+    """The hidden temporary file beside `path`, this process's own (two processes writing one
+    file never write into each other's), keeping its suffix (writers that choose a format by
+    the suffix, numpy's `.npz` or an image's, still see it); a name starting with a dot never
+    looks like a chunk, a dataset or a run's file."""
+    return path.with_name(f".{path.stem}.tmp{os.getpid()}{path.suffix}")
 
 
 def _fsync_folder(folder: Path) -> None:
@@ -52,7 +53,7 @@ def atomic(path: Path | str) -> Iterator[Path]:
         os.replace(tmp, path)
     except OSError as e:  # a full disk: said of the file we were writing
         tmp.unlink(missing_ok=True)
-        if e.filename is None or Path(e.filename) == tmp:
+        if e.errno is not None and (e.filename is None or Path(e.filename) == tmp):
             raise OSError(e.errno, e.strerror, str(path)) from None
         raise
     except BaseException:

@@ -32,6 +32,7 @@ from hsgplan.runner.lock import hold_folder, holds
 from hsgplan.runner.run_folder import has_files
 
 _STATE = "hsgplan.progress"  # the metadata key holding the JSON half of the progress
+OLD_PROGRESS = "progress.pt"  # what older versions saved: a pickle, which is never loaded
 TRAIN_CONFIG = "train_config.json"
 
 
@@ -62,6 +63,11 @@ def claim(out: Path, config: dict, defaults: dict | None = None, data: str | Non
     if data is not None and out.is_dir():
         for progress in sorted(out.rglob(PROGRESS)):
             _check_progress(progress, data)
+        if old := next(out.rglob(OLD_PROGRESS), None):
+            raise InvalidInputError(
+                f"'{old}' is training progress in an older format (a pickle, never read); "
+                "delete it to train from the start"
+            )
     if not holds(out):
         hold_folder(out)
         return claim(out, config, defaults, data)  # checked again: it may have changed hands

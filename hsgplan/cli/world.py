@@ -237,7 +237,7 @@ def evaluate(
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
         make_observer(p, config.perception_checkpoint)
     total = len(episode_specs(config)) * len(methods)
-    folder = run_dir or RUNS / _run_name(methods, config)
+    folder = run_dir or RUNS / (_run_name(methods, config) + ("-ablation" if ablate_rules else ""))
     check_ray(ray)
     if ablate_rules:  # the cheap refusals first: loading agents takes seconds
         total *= len(check_ablation(methods, config, folder))

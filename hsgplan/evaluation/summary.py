@@ -30,7 +30,9 @@ _ENDED_BY_EXECUTION = {Failure.KNOCKED_OVER, Failure.OFF_TABLE, Failure.NO_PARAM
 
 
 def failed_steps(record: EpisodeRecord) -> list[str]:
-    """The statuses of the episode's primitives that did not succeed, in order."""
+    """The statuses of the episode's primitives that did not succeed, in order: those that
+    failed in execution and those the world refused as inapplicable (`invalid`, nothing moved)
+    alike, as the paper's protocol ends an episode at either."""
     return [s.status for s in record.steps if s.status != Status.SUCCESS]
 
 

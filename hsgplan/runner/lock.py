@@ -9,6 +9,7 @@ lock held is refused in one line that names the holder, before it has written an
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import os
 import sys
@@ -31,14 +32,18 @@ def hold_folder(folder: Path) -> None:
         return
     made = [p for p in (folder, *folder.parents) if not p.exists()]
     folder.mkdir(parents=True, exist_ok=True)
+    flags = os.O_RDWR | os.O_NOFOLLOW  # a link planted as the lock is never written through
     try:
-        fd = os.open(folder / LOCK, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644)
+        fd = os.open(folder / LOCK, flags | os.O_CREAT | os.O_EXCL, 0o644)
         created = True
     except FileExistsError:
-        fd, created = os.open(folder / LOCK, os.O_RDWR), False
+        fd, created = os.open(folder / LOCK, flags), False
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
+    except OSError as e:
+        if e.errno not in (errno.EWOULDBLOCK, errno.EAGAIN):  # no locks on this file system
+            os.close(fd)
+            raise OSError(e.errno, f"cannot lock the folder ({e.strerror})", str(folder)) from None
         holder = os.pread(fd, 1000, 0).decode("utf-8", errors="replace").strip()
         os.close(fd)
         raise InvalidInputError(

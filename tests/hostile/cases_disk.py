@@ -78,9 +78,9 @@ def _manifest(rel: str, **changes) -> Setup:
     return step
 
 
-def _motion_progress(rel: str, payload: bytes | None) -> list[Setup]:
+def _motion_progress(rel: str, payload: bytes | None, name: str | None = None) -> list[Setup]:
     """A checkpoint folder in training with the tiny motion configuration, whose progress file
-    is `payload` (None: a torch pickle, as older versions wrote)."""
+    (`name`, by default today's) is `payload` (None: a torch pickle)."""
     from dataclasses import asdict
 
     from hsgplan.motion.train import MotionTrainConfig
@@ -89,7 +89,7 @@ def _motion_progress(rel: str, payload: bytes | None) -> list[Setup]:
     config = asdict(MotionTrainConfig.from_json(TINY_MOTION | {"primitive": "place"}))
 
     def progress(cwd: Path, home: Path) -> None:
-        path = cwd / rel / PROGRESS
+        path = cwd / rel / (name or PROGRESS)
         if payload is None:
             import torch
 
@@ -209,6 +209,14 @@ def disk_cases() -> list[Case]:
             MOTION_TINY,
             mkdir("ck"),
             *_motion_progress("ck", None),
+        ),
+        case(
+            "train motion",
+            "progress.pt of an older version (a pickle)",
+            base("train motion", "--out ck"),
+            MOTION_TINY,
+            mkdir("ck"),
+            *_motion_progress("ck", None, "progress.pt"),
         ),
         case(
             "train motion",

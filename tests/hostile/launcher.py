@@ -9,7 +9,9 @@ program would (`_exit_as_python_does`): the exit code of `sys.exit`, an exceptio
 top printed by `sys.excepthook` with code 1, then the threads joined, the atexit handlers run
 and the output flushed; only the teardown of the modules is skipped (a second a process, and
 nothing a command does depends on it). The server never runs torch code itself, so forking it
-is as safe as starting afresh (no thread pool is copied).
+is as safe as starting afresh (no thread pool is copied). What a fork cannot give: every
+command shares the server's hash seed (random per server), and what a module reads from the
+environment when it is imported is the server's; no command of the package does either.
 
 The server waits for the child up to the request's timeout, kills the child's process group
 if it is still running (a hang), and answers one JSON line: the exit code (None for a hang),
@@ -65,9 +67,9 @@ def _become_command(request: dict) -> None:
         code = 0
     except SystemExit as e:
         code = _exit_code(e.code)
-    except BaseException:
+    except BaseException as e:
         sys.excepthook(*sys.exc_info())
-        code = 1
+        code = 130 if isinstance(e, KeyboardInterrupt) else 1  # as the interpreter exits
     _exit_as_python_does(code)
 
 

@@ -78,3 +78,14 @@ def test_an_unheld_lock_left_behind_is_not_other_files(tmp_path):
     other.mkdir()
     (other / LOCK).write_text("")
     training.claim(other, {"lr": 0.1})
+
+
+def test_a_link_planted_as_the_lock_is_never_written_through(tmp_path):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me\n")
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / LOCK).symlink_to(victim)
+    with pytest.raises(OSError):
+        hold_folder(run)
+    assert victim.read_text() == "keep me\n"
