@@ -69,8 +69,13 @@ def check_own(folder: Path, marker: str, kind: str) -> None:
 
 
 def has_files(folder: Path) -> bool:
-    """Whether `folder` holds anything but the lock a run left behind (`runner/lock.py`)."""
-    return any(p.name != LOCK for p in folder.iterdir())
+    """Whether `folder` holds anything but what a run that was killed leaves behind: its lock
+    (`runner/lock.py`) and a temporary file it was writing (`hsgplan.files`)."""
+    return any(not _leftover(p.name) for p in folder.iterdir())
+
+
+def _leftover(name: str) -> bool:
+    return name == LOCK or (name.startswith(".") and ".tmp" in name)
 
 
 def logged_rows(run_dir: Path) -> list[dict]:

@@ -89,3 +89,10 @@ def test_a_link_planted_as_the_lock_is_never_written_through(tmp_path):
     with pytest.raises(OSError):
         hold_folder(run)
     assert victim.read_text() == "keep me\n"
+
+
+def test_what_a_killed_claim_leaves_is_not_other_files(tmp_path):
+    (tmp_path / LOCK).write_text("")
+    (tmp_path / ".config.tmp4242.json").write_text('{"kind": "ev')  # killed while writing
+    claim(tmp_path, "eval", {"goals": 1}, "other configuration")
+    assert (tmp_path / "config.json").is_file()
