@@ -119,9 +119,10 @@ def eval_perception(
     )
     title = (
         f"f_p on {report['scenes']} fresh scenes, seed {seed}"
-        f"{f' (the first {views} views)' if views else ''}: objects found "
-        f"{report['found_rate']:.3f}, symbolic scene graph equal "
-        f"{report['symbolic_match_rate']:.3f}"
+        f"{f' (the first {views} views)' if views else ''}: objects found (recall) "
+        f"{report['found_rate']:.3f}, detections matching an object (precision) "
+        f"{report['precision']:.3f} ({report['unmatched_detections']} matched none), "
+        f"symbolic scene graph equal {report['symbolic_match_rate']:.3f}"
     )
     print_table(
         title,

@@ -6,7 +6,9 @@ estimator; its detections are matched to the scene's objects type by type, neare
 up to the cuboid's symmetries (a box looks the same turned half way about any of its axes; a
 can about its axis, and upside down). A scene's symbolic scene graph from the estimated poses
 (each matched detection named as the object it matched) must equal the one from the true
-poses, every object found, for the scene to count as a symbolic match.
+poses, every object found, for the scene to count as a symbolic match. Recall is the share of
+objects found; precision the share of detections that match an object (a detection matching
+none is a phantom, or an object found twice).
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ class SceneResult:
     rotation_deg: tuple[float, ...]
     types: tuple[str, ...]  # of the matched objects, in the order of the errors
     symbolic_match: bool
+    detections: int = 0  # everything f_p reported, matched or not
 
 
 def rotation_error(obj: str, truth: Pose, estimate: Pose) -> float:
@@ -87,6 +90,7 @@ def score_scene(sample: ImageSample, detections: list[Detection]) -> SceneResult
         tuple(rotation),
         tuple(type_of(o) for o in names),
         same,
+        len(detections),
     )
 
 
@@ -127,10 +131,15 @@ def summary(results: list[SceneResult]) -> dict:
         }
 
     objects = sum(r.objects for r in results)
+    detections = sum(r.detections for r in results)
+    found = sum(r.found for r in results)
     return {
         **medians(rows),
         "scenes": len(results),
-        "found_rate": sum(r.found for r in results) / objects if objects else 0.0,
+        "found_rate": found / objects if objects else 0.0,
+        # detections that match an object (each object is matched by one detection at most)
+        "precision": found / detections if detections else 1.0,
+        "unmatched_detections": detections - found,
         "symbolic_match_rate": (
             sum(r.symbolic_match for r in results) / len(results) if results else 0.0
         ),

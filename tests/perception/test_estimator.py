@@ -69,6 +69,9 @@ def test_perfect_maps_give_the_scene_back_duplicates_and_all():
     assert np.median(result.translation_cm) < 0.5 and np.median(result.rotation_deg) < 3
     report = summary([result])
     assert report["scenes"] == 1 and report["translation_cm_median"] < 0.5
+    assert result.detections == len(detections) >= result.found
+    assert report["precision"] == result.found / len(detections)
+    assert report["unmatched_detections"] == len(detections) - result.found
 
 
 def test_rotation_error_counts_a_cuboid_symmetry_as_no_error():
