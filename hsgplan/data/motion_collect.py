@@ -13,13 +13,22 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from hsgplan.data import motion_store as store
 from hsgplan.data.motion_trials import ATTEMPTS_PER_TASK, TASKS_PER_CHUNK, run_chunk
+from hsgplan.domain.checks import (
+    MAX_SAMPLES,
+    MAX_SEED,
+    MAX_TASKS_PER_CHUNK,
+    MAX_WORKERS,
+    bounded,
+    check_fields,
+    setting,
+)
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.runner.engines import engine
@@ -32,19 +41,15 @@ REJECTED = "rejected"
 @dataclass(frozen=True)
 class CollectConfig:
     primitive: MotionPrimitive
-    samples: int
-    seed: int = 0
-    workers: int = 2
+    samples: int = field(metadata=bounded(lo=0, hi=MAX_SAMPLES))
+    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    workers: int = setting(2, lo=1, hi=MAX_WORKERS)
     ray_address: str | None = None
-    tasks_per_chunk: int = TASKS_PER_CHUNK  # the unit of work, and of what an interruption loses
+    # the unit of work, and of what an interruption loses
+    tasks_per_chunk: int = setting(TASKS_PER_CHUNK, lo=1, hi=MAX_TASKS_PER_CHUNK)
 
     def __post_init__(self) -> None:
-        if self.samples < 0:
-            raise InvalidInputError(f"--samples {self.samples}: cannot be negative")
-        if self.workers < 1:
-            raise InvalidInputError(f"--workers {self.workers}: at least one is needed")
-        if self.tasks_per_chunk < 1:
-            raise InvalidInputError(f"tasks per chunk {self.tasks_per_chunk}: at least one")
+        check_fields(self)
 
     def dataset_settings(self) -> dict:
         """What decides a dataset's rows (the chunking does not), kept in its manifest."""

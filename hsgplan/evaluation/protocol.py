@@ -19,11 +19,19 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from functools import lru_cache, partial
 from pathlib import Path
 
-from hsgplan.domain.checks import read_json
+from hsgplan.domain.checks import (
+    MAX_GOALS,
+    MAX_REPEATS,
+    MAX_SEED,
+    bounded,
+    check_fields,
+    read_json,
+    setting,
+)
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
@@ -38,10 +46,10 @@ from hsgplan.symbolic.generator import random_goals
 class EvalConfig:
     agent: str
     sizes: tuple[int, ...]
-    goals: int
-    seed: int
+    goals: int = field(metadata=bounded(lo=0, hi=MAX_GOALS))  # per size (a goal file: unused)
+    seed: int = field(metadata=bounded(lo=0, hi=MAX_SEED))
     goals_file: str | None = None
-    repeats: int = 1
+    repeats: int = setting(1, lo=1, hi=MAX_REPEATS)
     checkpoint: str | None = None  # the task planner's folder (None: the shipped one)
     motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
     perception: str = "gt"  # what the agent sees: "gt" (the simulator's poses) or "rgb" (f_p)
@@ -50,6 +58,7 @@ class EvalConfig:
     rules_off: tuple[str, ...] = ()  # recovery rules switched off (the recovering protocol)
 
     def __post_init__(self) -> None:
+        check_fields(self)
         check_observer(self.perception)
         if self.protocol not in PROTOCOLS:
             raise InvalidInputError(f"protocol '{self.protocol}': one of {', '.join(PROTOCOLS)}")

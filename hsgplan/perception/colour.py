@@ -32,6 +32,7 @@ from torch import nn
 
 from hsgplan import training
 from hsgplan.checkpoint import load_trained
+from hsgplan.domain.checks import MAX_SEED, check_fields, from_settings, setting
 from hsgplan.domain.world import OBJECT_TYPES
 
 PATCH = 3  # pixels each side of the centroid's pixel
@@ -45,18 +46,22 @@ BACKGROUND = TYPE_COUNT  # the background's class index (a network of `TYPE_COUN
 
 @dataclass(frozen=True)
 class ColourConfig:
-    types: int = TYPE_COUNT + 1  # the object types, then the background
-    hidden: int = 32
-    steps: int = 400
-    lr: float = 0.01
-    seed: int = 0
+    # the object types, then the background
+    types: int = setting(TYPE_COUNT + 1, lo=TYPE_COUNT, hi=TYPE_COUNT + 1)
+    hidden: int = setting(32, lo=1, hi=4096)
+    steps: int = setting(400, lo=1, hi=1_000_000)
+    lr: float = setting(0.01, above=0, hi=10)
+    seed: int = setting(0, lo=0, hi=MAX_SEED)
+
+    def __post_init__(self) -> None:
+        check_fields(self)
 
     def to_json(self) -> dict:
         return asdict(self)
 
     @staticmethod
     def from_json(d: dict) -> ColourConfig:
-        return ColourConfig(**d)
+        return from_settings(ColourConfig, d, "colour network setting")
 
 
 class ColourNet(nn.Module):

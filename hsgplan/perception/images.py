@@ -24,11 +24,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from hsgplan.domain.checks import MAX_SAMPLES, MAX_SEED, bounded, check_fields, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import split_instance
 from hsgplan.domain.world import OBJECT_TYPES
@@ -53,18 +54,16 @@ TYPES = tuple(OBJECT_TYPES)
 
 @dataclass(frozen=True)
 class ImagesConfig:
-    count: int  # samples wanted (unstaged draws are skipped, so the last chunk may hold fewer)
-    seed: int = 0
-    chunk: int = CHUNK
-    p_elsewhere: float = P_ELSEWHERE  # see `synthetic.P_ELSEWHERE`
+    # samples wanted (unstaged draws are skipped, so the last chunk may hold fewer)
+    count: int = field(metadata=bounded(lo=1, hi=MAX_SAMPLES))
+    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    chunk: int = setting(CHUNK, lo=1, hi=MAX_SAMPLES)
+    p_elsewhere: float = setting(P_ELSEWHERE, lo=0.0, hi=1.0)  # see `synthetic.P_ELSEWHERE`
     views: int = len(VIEWS)  # the first this many fixed views (3: shoulders and front)
 
     def __post_init__(self) -> None:
-        if self.count < 1 or self.chunk < 1:
-            raise InvalidInputError("an image collection needs at least one sample per chunk")
+        check_fields(self)
         first_views(self.views)
-        if not 0.0 <= self.p_elsewhere <= 1.0:
-            raise InvalidInputError(f"p_elsewhere {self.p_elsewhere}: need a chance in 0..1")
 
     @property
     def chunks(self) -> int:

@@ -92,7 +92,7 @@ def test_the_ray_path_gives_the_same_samples(tmp_path):
 
 
 def test_bad_collection_settings_are_refused(tmp_path):
-    with pytest.raises(InvalidInputError, match="negative"):
+    with pytest.raises(InvalidInputError, match="samples -1: must be at least 0"):
         CollectConfig(PLACE, -1)
     with pytest.raises(InvalidInputError, match="workers"):
         CollectConfig(PLACE, 5, workers=0)
