@@ -28,7 +28,7 @@ from hsgplan.checkpoint import (
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.files import write_atomically
-from hsgplan.runner.lock import hold_folder, holds
+from hsgplan.runner.lock import hold_folder
 from hsgplan.runner.run_folder import has_files
 
 _STATE = "hsgplan.progress"  # the metadata key holding the JSON half of the progress
@@ -46,6 +46,14 @@ def claim(out: Path, config: dict, defaults: dict | None = None, data: str | Non
     `data` (the training data's fingerprint), progress saved anywhere below that is not
     usable or was made on other data is refused here too. The caller is the folder's one
     writer from here until it ends (`runner/lock.py`)."""
+    _check_claim(out, config, defaults, data)
+    hold_folder(out)
+    _check_claim(out, config, defaults, data)  # again: it may have changed hands
+    write_atomically(out / TRAIN_CONFIG, json.dumps(config, indent=2) + "\n")
+
+
+def _check_claim(out: Path, config: dict, defaults: dict | None, data: str | None) -> None:
+    """`claim`'s refusals, without writing anything."""
     saved = out / TRAIN_CONFIG
     if out.exists() and not out.is_dir():
         raise InvalidInputError(f"'{out}' is a file, not a checkpoint folder")
@@ -68,10 +76,6 @@ def claim(out: Path, config: dict, defaults: dict | None = None, data: str | Non
                 f"'{old}' is training progress in an older format (a pickle, never read); "
                 "delete it to train from the start"
             )
-    if not holds(out):
-        hold_folder(out)
-        return claim(out, config, defaults, data)  # checked again: it may have changed hands
-    write_atomically(saved, json.dumps(config, indent=2) + "\n")
 
 
 def check_loss(loss: float, what: str, epoch: int) -> None:

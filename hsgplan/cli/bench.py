@@ -287,9 +287,8 @@ def bench_observe(
     """Seconds per observation through f_p (rendering timed apart and excluded): the keypoint
     network, PnP, fusion, naming and resting, and the tracker; medians over the scenes."""
     from hsgplan.benchmarks.observe import bench_observe as run
-    from hsgplan.evaluation.observers import make_observer, perception_folder
+    from hsgplan.evaluation.observers import perception_folder
 
-    make_observer("rgb", checkpoint)  # a missing or damaged checkpoint: refused before work
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         rows = run(

@@ -203,9 +203,7 @@ def evaluate(
         name = agent_name(agent.value, planner_name)
         methods = [Method(name, name)]
     else:
-        motions = [m.strip() for m in motion.split(",")]
-        if len(set(motions)) != len(motions) or "" in motions:
-            raise InvalidInputError(f"--motion '{motion}': name each generator once")
+        motions = _names(motion, "--motion", "generator")
         agents = [agent_name(agent.value, planner_name, m) for m in motions]
         # a column is named by its generator (and set beside the paper's) only where the task
         # planner is the paper's; other planners' columns carry their agent's whole name
@@ -213,9 +211,7 @@ def evaluate(
         methods = [
             Method(m if paper_planner else a, a) for m, a in zip(motions, agents, strict=True)
         ]
-    seeing = [p.strip() for p in perception.split(",")]
-    if len(set(seeing)) != len(seeing) or "" in seeing:
-        raise InvalidInputError(f"--perception '{perception}': name each observer once")
+    seeing = _names(perception, "--perception", "observer")
     methods = [
         Method(m.name if p == "gt" else f"{m.name}-{p}", m.agent, p)
         for m in methods
@@ -232,7 +228,7 @@ def evaluate(
         motion_checkpoints and str(shipped(motion_checkpoints)),
         perception_checkpoint=perception_checkpoint and str(shipped(perception_checkpoint)),
         protocol=protocol.value,
-        rules_off=_names(rules_off, "--rules-off"),
+        rules_off=_names(rules_off, "--rules-off", "rule", none=True),
     )
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
         make_observer(p, config.perception_checkpoint)
@@ -259,11 +255,13 @@ def evaluate(
         out.print(f"wrote {shown(folder)}/table1.md, table1.png, summary.json", highlight=False)
 
 
-def _names(text: str, option: str) -> tuple[str, ...]:
-    """A comma-separated list of names, each once ('' names none)."""
-    names = tuple(n.strip() for n in text.split(",")) if text.strip() else ()
+def _names(text: str, option: str, what: str, none: bool = False) -> tuple[str, ...]:
+    """A comma-separated list of names, each once; with `none`, '' names none."""
+    if none and not text.strip():
+        return ()
+    names = tuple(n.strip() for n in text.split(","))
     if "" in names or len(set(names)) != len(names):
-        raise InvalidInputError(f"{option} '{text}': name each one once, comma-separated")
+        raise InvalidInputError(f"{option} '{text}': name each {what} once, comma-separated")
     return names
 
 

@@ -17,7 +17,14 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import PAPER, RecoveryRules
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import EvalConfig
-from hsgplan.evaluation.table1 import Method, TextTable, check_table, label, run_table
+from hsgplan.evaluation.table1 import (
+    Method,
+    TextTable,
+    check_table,
+    label,
+    run_table,
+    table_settings,
+)
 from hsgplan.runner.run_folder import check_claim, claim
 
 ALL_RULES_ON = "all-rules"
@@ -39,12 +46,7 @@ ABLATION_KIND = "eval-ablation"
 
 
 def _claimed_with(methods: list[Method], config: EvalConfig) -> tuple[dict, str]:
-    settings = {k: v for k, v in asdict(config).items() if k != "agent"}
-    settings |= {
-        "sizes": list(config.sizes),
-        "rules_off": list(config.rules_off),
-        "methods": [asdict(m) for m in methods],
-    }
+    settings = table_settings(config) | {"methods": [asdict(m) for m in methods]}
     return settings, "the folder holds an ablation of another configuration; use another --out"
 
 

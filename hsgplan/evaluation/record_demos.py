@@ -49,6 +49,16 @@ def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
     )
 
 
+def _recorded(out: Path, seed: int) -> dict[str, Demo]:
+    """The demonstrations already in `out`, by task; a set made with another seed refused."""
+    meta_path = out / META
+    if meta_path.exists():
+        saved = read_json(meta_path, "demonstration metadata")
+        if saved.get("seed") != seed or saved.get("version") != VERSION:
+            raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
+    return {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
+
+
 def collect_demos(
     out: Path, seed: int, command: str = "", on_demo: Callable[[Demo], None] | None = None
 ) -> list[Demo]:
@@ -56,13 +66,9 @@ def collect_demos(
     check_own(out, META, "demonstration set")  # never into another command's folder
     meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
     meta_path = out / META
-    for _ in range(2):  # checked before the folder is taken, and again once it is ours
-        if meta_path.exists():
-            saved = read_json(meta_path, "demonstration metadata")
-            if saved.get("seed") != seed or saved.get("version") != VERSION:
-                raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
-        done = {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
-        hold_folder(out)  # one writer: a second collection into `out` is refused
+    _recorded(out, seed)
+    hold_folder(out)  # one writer: a second collection into `out` is refused
+    done = _recorded(out, seed)  # again, now that the folder is ours
     if not meta_path.exists():
         write_atomically(meta_path, json.dumps(meta, indent=2) + "\n")
     path = out / DEMOS

@@ -60,7 +60,8 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
     by_repeat: dict[int, list[EpisodeRecord]] = {}
     for r in rs:
         by_repeat.setdefault(r.repeat, []).append(r)
-    classes = [c for r in rs if (c := failure_class(r))]
+    classed = [(r, c) for r in rs if (c := failure_class(r))]
+    classes = [c for _, c in classed]
     return {
         "success_rate": sum(r.success for r in rs) / len(rs),
         "subgoal_completion": sum(r.subgoal_completion for r in rs) / len(rs),
@@ -78,9 +79,7 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         # primitives that failed, in every episode; and overstep episodes that had some
         "failed_primitives": sum(len(failed_steps(r)) for r in rs),
         "overstep_after_failures": sum(
-            1
-            for r in rs
-            if failure_class(r) and failure_class(r)[0] == OVERSTEP and failed_steps(r)
+            1 for r, c in classed if c[0] == OVERSTEP and failed_steps(r)
         ),
         "median_steps": statistics.median(len(r.steps) for r in rs),
         "median_seconds": statistics.median(r.seconds for r in rs),

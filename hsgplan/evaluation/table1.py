@@ -41,6 +41,7 @@ class Method:
 
 
 TABLE_KIND = "eval-table"
+COUNTED = ("failed_primitives", "overstep_after_failures")  # a failure table's last columns
 
 
 def label(method: str) -> str:
@@ -50,17 +51,24 @@ def label(method: str) -> str:
     return LABELS.get(method, method)
 
 
-def check_table(methods: list[Method], config: EvalConfig, out: Path) -> tuple[dict, str]:
-    """Every refusal of a table's run folders before anything is written (the table's own,
-    then each method's); what the table folder is claimed with and its refusal."""
+def table_settings(config: EvalConfig) -> dict:
+    """What a table folder is claimed with: the configuration less what differs by method (as
+    JSON gives it back; the default protocol left out, as before protocols were named)."""
     per_method = ("agent", "perception")
     table = {
         k: v
         for k, v in asdict(config).items()
         if k not in per_method and not (k == "perception_checkpoint" and v is None)
     } | {"sizes": list(config.sizes), "rules_off": list(config.rules_off)}
-    if config.protocol == RECOVERING and not config.rules_off:  # as before protocols were named
+    if config.protocol == RECOVERING and not config.rules_off:
         del table["protocol"], table["rules_off"]
+    return table
+
+
+def check_table(methods: list[Method], config: EvalConfig, out: Path) -> tuple[dict, str]:
+    """Every refusal of a table's run folders before anything is written (the table's own,
+    then each method's); what the table folder is claimed with and its refusal."""
+    table = table_settings(config)
     refusal = f"'{out}' holds a table of another configuration or goal file; use another --out"
     check_claim(out, TABLE_KIND, table, refusal)
     check_runs(config, out, {m.name: (m.agent, m.perception) for m in methods})
@@ -181,10 +189,6 @@ def _protocol(report: dict) -> str:
     return f"{protocol} protocol" + (f", without {', '.join(off)}" if off else "")
 
 
-def dash(value, spec: str) -> str:
-    return "—" if value is None else format(value, spec)
-
-
 def _results(report: dict) -> TextTable:
     methods = report["methods"]
     header = ["objects"]
@@ -221,12 +225,14 @@ def _failures(report: dict) -> TextTable:
             if v := s["by_size"].get(str(n)):
                 failed = v["episodes"] - round(v["success_rate"] * v["episodes"])
                 fc = v["failure_classes"]
-                after = v.get("overstep_after_failures")
                 rows.append(
                     (label(m), str(n), str(v["episodes"]), str(failed))
                     + (_kinds(fc[EXECUTION]), _kinds(fc[OVERSTEP]))
                     + ((_kinds(fc.get(PERCEPTION, {})),) if seen else ())
-                    + (dash(v.get("failed_primitives"), "d"), dash(after, "d"))
+                    # a summary from before these counts existed has none
+                    + tuple(
+                        str(v.get(k, "—")) for k in ("failed_primitives", "overstep_after_failures")
+                    )
                 )
     title = (
         f"Failures ({_protocol(report)}), by what ended the episode: execution (a failed "
