@@ -49,32 +49,36 @@ turning the plan into parameters.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
+from hsgplan.agents.stream_problem import (
+    StreamPlan,
+    StreamProblem,
+    add_grasp,
+    aim,
+    decode_step,
+    goal_surface,
+    initial_problem,
+    params_at,
+    pddl_objects,
+    stackable,
+)
 from hsgplan.agents.streams import (
-    PoseTable,
-    PoseValue,
-    PushValue,
     StreamWorld,
     bin_order,
-    observed_pose,
     push_shelf,
     stack_pose,
     surface_pose,
 )
-from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.objects import EntityKind, kind_of
-from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams, PushParams
-from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import REGIONS, SHELVES, SURFACES
+from hsgplan.domain.parameters import PrimitiveParams
+from hsgplan.domain.world import SURFACES
 from hsgplan.planning.fast_downward import NoPlanError, solve_pddl
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.symbolic.stream_pddl import DOMAIN, Fact, problem_text
+from hsgplan.symbolic.stream_pddl import DOMAIN, problem_text
 
 # Fast Downward's search as the project's (`SATISFICING_SEARCH`), but with the FF heuristic's
 # negated axioms over-approximated: computed exactly (the default), the negation of
@@ -119,75 +123,6 @@ GOAL_DIRECTED = IncrementalConfig(
 )
 
 
-@dataclass(frozen=True)
-class StreamStep:
-    action: Action
-    params: PrimitiveParams
-
-
-@dataclass(frozen=True)
-class StreamPlan:
-    """What a planning call came to: the steps (None when no plan was found), its seconds at
-    the task and motion levels, the levels it went through and how many facts the last
-    problem held."""
-
-    steps: tuple[StreamStep, ...] | None
-    task_seconds: float
-    motion_seconds: float
-    levels: int
-    facts: int
-    note: str = ""
-
-
-@dataclass
-class _Problem:
-    """The objects and certified facts so far, and the streams' progress."""
-
-    rng: np.random.Generator
-    facts: dict[Fact, None] = field(default_factory=dict)  # ordered, without repeats
-    poses: dict[str, PoseValue] = field(default_factory=dict)
-    table: PoseTable = field(default_factory=PoseTable)  # the poses' geometry, in that order
-    level: dict[str, int] = field(default_factory=dict)  # pose or grasp name -> its level
-    grasps: dict[str, str] = field(default_factory=dict)  # object -> its grasp's name
-    confs: list[str] = field(default_factory=list)
-    pushes: dict[str, PushValue] = field(default_factory=dict)
-    observed: dict[str, str] = field(default_factory=dict)  # object -> its observed pose
-    bins: dict[tuple[str, str], list[tuple[int, int]]] = field(default_factory=dict)
-    push_streams: dict[tuple[str, str], Iterator] = field(default_factory=dict)
-    done: set[tuple[str, ...]] = field(default_factory=set)  # stream instances evaluated
-    below: dict[str, str] = field(default_factory=dict)  # stacked pose -> the pose under it
-    stacks: dict[str, set[str]] | None = None  # b -> what stack-pose puts on b; None: anything
-    sites: dict[str, str] = field(default_factory=dict)  # o -> what o's On goal puts it on
-    shelves: dict[str, str] = field(default_factory=dict)  # o -> the shelf o's In goal names
-
-    def add(self, *fact: str) -> None:
-        self.facts[fact] = None
-
-    def new_pose(self, value: PoseValue, level: int, below: str = "") -> str:
-        """A pose object with its certified facts and its collision tests against every other
-        object's poses; `below`: the pose of the object a stacked pose rests on."""
-        name = f"p{len(self.poses)}"
-        names = list(self.poses)
-        for i in self.table.collisions(value):
-            other = names[i]
-            self.add("collide", value.obj, name, self.poses[other].obj, other)
-            self.add("collide", self.poses[other].obj, other, value.obj, name)
-        self.table.add(value)
-        self.poses[name] = value
-        self.level[name] = level
-        self.add("pose", value.obj, name)
-        if value.relation == "stacked":
-            self.below[name] = below
-            self.add("stacked", value.obj, name, value.support, below)
-        elif value.relation in ("supported", "inside"):
-            self.add(value.relation, value.obj, name, value.support)
-        return name
-
-    def new_conf(self) -> str:
-        self.confs.append(f"q{len(self.confs)}")
-        return self.confs[-1]
-
-
 class IncrementalPlanner:
     """Args:
     config: samples per level and the limits (`IncrementalConfig`).
@@ -210,8 +145,8 @@ class IncrementalPlanner:
         cfg, start = self.config, time.perf_counter()
         task = motion = 0.0
         t0 = time.perf_counter()
-        prob = _initial(sg, state, np.random.default_rng(seed))
-        _aim(prob, goal, cfg)
+        prob = initial_problem(sg, state, np.random.default_rng(seed))
+        aim(prob, goal, cfg.goal_stacks)
         motion += time.perf_counter() - t0
         for level in range(1, cfg.max_levels + 1):
             if time.perf_counter() - start > cfg.time_limit_s:
@@ -223,20 +158,24 @@ class IncrementalPlanner:
                 return StreamPlan(None, task, motion, level, len(prob.facts), "too many facts")
             t0 = time.perf_counter()
             try:
-                text = problem_text(_objects(prob, state), prob.facts, goal)
+                text = problem_text(pddl_objects(prob, state), prob.facts, goal)
                 found = solve_pddl(DOMAIN, text, STREAM_SEARCH, cfg.fd_timeout_s)
             except NoPlanError:
                 task += time.perf_counter() - t0
                 continue
             task += time.perf_counter() - t0
             t0 = time.perf_counter()
-            steps = tuple(_decode(prob, name, args) for name, args in found.steps)
+            steps = tuple(decode_step(prob, name, args) for name, args in found.steps)
             motion += time.perf_counter() - t0
             return StreamPlan(steps, task, motion, level, len(prob.facts))
         return StreamPlan(None, task, motion, cfg.max_levels, len(prob.facts), "level limit")
 
     def _evaluate(
-        self, prob: _Problem, level: int, world: StreamWorld, banned: frozenset[PrimitiveParams]
+        self,
+        prob: StreamProblem,
+        level: int,
+        world: StreamWorld,
+        banned: frozenset[PrimitiveParams],
     ) -> None:
         """Every stream once on the inputs that existed before this level."""
         cfg = self.config
@@ -245,14 +184,14 @@ class IncrementalPlanner:
         grasped = {o for o, g in prob.grasps.items() if prob.level[g] < level}
         for o in objects:
             if o not in prob.grasps:
-                _grasp(prob, o, level)
+                add_grasp(prob, o, level)
         for o in objects:
-            for s, samples in _surfaces(prob, o, cfg):
+            for s, samples in place_surfaces(prob, o, cfg):
                 order = prob.bins.setdefault((o, s), bin_order(o, s, prob.rng))
                 for _ in range(min(samples, len(order))):
                     prob.new_pose(surface_pose(o, s, order.pop(0)), level)
         for pb in poses:
-            for o in _stackable(prob, pb, objects):
+            for o in stackable(prob, prob.poses[pb], objects):
                 if ("stack", o, pb) in prob.done:
                     continue
                 prob.done.add(("stack", o, pb))
@@ -263,7 +202,7 @@ class IncrementalPlanner:
             v = prob.poses[p]
             if v.obj in grasped and ("kin", p) not in prob.done and v.relation != "inside":
                 prob.done.add(("kin", p))
-                params = _params_at(prob, p)
+                params = params_at(prob, p)
                 if params is None or params not in banned:
                     q = world.kin(v)
                     if q is not None:
@@ -286,124 +225,14 @@ class IncrementalPlanner:
                     break
 
 
-def _aim(prob: _Problem, goal: Goal, cfg: IncrementalConfig) -> None:
-    """What the goal-restricted streams (`goal_stacks`, `goal_places`) take from the goal:
-    where its On and In literals put each object, and what it stacks on what."""
-    for lit in goal.literals:
-        if lit.positive and lit.predicate is Predicate.ON:
-            prob.sites[lit.subject] = lit.args[1]
-        elif lit.positive and lit.predicate is Predicate.IN:
-            prob.shelves[lit.subject] = lit.args[1]
-    if cfg.goal_stacks:
-        prob.stacks = {}
-        for o, x in prob.sites.items():
-            if kind_of(x) is EntityKind.OBJECT:
-                prob.stacks.setdefault(x, set()).add(o)
-
-
-def _surfaces(prob: _Problem, obj: str, cfg: IncrementalConfig) -> list[tuple[str, int]]:
+def place_surfaces(prob: StreamProblem, obj: str, cfg: IncrementalConfig) -> list[tuple[str, int]]:
     """The surfaces place-pose samples for an object, and how many poses on each a level:
     with `goal_places`, the open space (where anything may wait) and the surface the goal
     puts it on, or the prepush region of the shelf its In goal names."""
-    goal = prob.sites.get(obj)
-    if obj in prob.shelves:
-        goal = SHELVES[prob.shelves[obj]].prepush
+    goal = goal_surface(prob, obj)
     if not cfg.goal_places or goal is None:
         return [(s, cfg.place_samples) for s in SURFACES]
     wanted = [("open_space", cfg.place_samples)]
     if goal in SURFACES and goal != "open_space":
         wanted.append((goal, cfg.goal_place_samples))
     return wanted
-
-
-def _stackable(prob: _Problem, pb: str, objects: list[str]) -> list[str]:
-    """The objects stack-pose puts on the pose pb: with `goal_stacks`, those the goal puts on
-    its object, and only where that object's own On goal (if any) would have it."""
-    if prob.stacks is None:
-        return objects
-    below = prob.poses[pb]
-    site = prob.sites.get(below.obj)
-    if site is not None and below.support != site:
-        return []
-    return sorted(prob.stacks.get(below.obj, ()))
-
-
-def _grasp(prob: _Problem, obj: str, level: int) -> str:
-    g = f"g_{obj}"
-    prob.grasps[obj] = g
-    prob.level[g] = level
-    prob.add("grasp", obj, g)
-    return g
-
-
-def _initial(sg: GeometricSceneGraph, state: SymbolicSceneGraph, rng) -> _Problem:
-    """Level 0: the observed poses (objects below first, so a stacked pose names the pose
-    under it), the grasp of a held object, and whether the hand is empty."""
-    prob = _Problem(rng)
-    held = state.held()
-    if held is None:
-        prob.add("handempty")
-    else:
-        prob.add("atgrasp", held, _grasp(prob, held, 0))
-    pending = [o for o in state.objects if o != held]
-    while pending:
-        for o in list(pending):
-            loc = state.location(o)
-            x = loc.args[1] if len(loc.args) > 1 else ""
-            if kind_of(x) is EntityKind.OBJECT and x in pending:
-                continue  # its support first
-            pending.remove(o)
-            if loc.predicate is Predicate.IN:
-                value = observed_pose(o, sg.pose(o), "inside", x)
-            elif x in SURFACES:
-                value = observed_pose(o, sg.pose(o), "supported", x)
-            elif x in prob.observed:
-                value = observed_pose(o, sg.pose(o), "stacked", x)
-            else:
-                value = observed_pose(o, sg.pose(o), "loose", "")
-            prob.observed[o] = prob.new_pose(value, 0, below=prob.observed.get(x, ""))
-            prob.add("atpose", o, prob.observed[o])
-    return prob
-
-
-def _objects(prob: _Problem, state: SymbolicSceneGraph) -> dict[str, list[str]]:
-    return {
-        "obj": list(state.objects),
-        "surface": [*REGIONS, *SHELVES],
-        "pose": list(prob.poses),
-        "grasp": list(prob.grasps.values()),
-        "conf": prob.confs,
-        "push": list(prob.pushes),
-    }
-
-
-def _params_at(prob: _Problem, p: str) -> PrimitiveParams | None:
-    """The parameters that, in the observed scene, take the object up from pose p (its
-    observed pose) or put it down there; None for a pose no such parameters name."""
-    v = prob.poses[p]
-    if prob.observed.get(v.obj) == p:
-        return PickParams(v.obj)
-    if v.relation == "stacked":
-        # a place on an object puts it on that object where it stands now
-        now = prob.observed.get(v.support) == prob.below[p]
-        return PlaceParams(v.obj, v.support) if now else None
-    if v.relation == "supported" and v.bins is not None:
-        return PlaceParams(v.obj, v.support, *v.bins)
-    return None
-
-
-def _decode(prob: _Problem, name: str, args: tuple[str, ...]) -> StreamStep:
-    """A step of Fast Downward's plan as the project's action and parameters."""
-    if name == "pick":
-        return StreamStep(Pick(args[0]), PickParams(args[0]))
-    if name == "place":
-        o, p, s = args[:3]
-        return StreamStep(Place(o, s), PlaceParams(o, s, *prob.poses[p].bins))
-    if name == "stack":
-        o, _, b = args[:3]
-        return StreamStep(Place(o, b), PlaceParams(o, b))
-    if name == "push":
-        o, _, s, u = args[:4]
-        params: PushParams = prob.pushes[u].params
-        return StreamStep(Push(o, s), params)
-    raise ValueError(f"unknown action '{name}' in a plan")

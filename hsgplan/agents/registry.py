@@ -4,8 +4,8 @@ An agent is a task planner and a motion generator (`HierarchicalAgent`). The reg
 are named pairs; any other pair is asked for as `PLANNER+MOTION` (`regression+gnn`). The
 search-based baselines plan both levels together and are agents of their own (`search`;
 `stream`, PDDLStream's incremental algorithm; `stream-goal`, the same with goal-directed
-streams). Shipped checkpoints are found as `hsgplan.paths` finds them, wherever the command
-runs.
+streams; `stream-focused` and `stream-focused-goal`, PDDLStream's focused algorithm).
+Shipped checkpoints are found as `hsgplan.paths` finds them, wherever the command runs.
 """
 
 from __future__ import annotations
@@ -95,11 +95,15 @@ WHOLE_AGENTS: dict[str, str] = {
     "search": "Fast Downward's plan refined by sampling and simulating, backtracking",
     "stream": "PDDLStream's incremental algorithm: Fast Downward over sampled poses and grasps",
     "stream-goal": "the same, its stack and place streams sampling where the goal leads",
+    "stream-focused": "PDDLStream's focused algorithm: plan with optimistic stream outputs, "
+    "then evaluate only the streams the plan uses",
+    "stream-focused-goal": "the same with the goal-directed streams of stream-goal",
 }
+STREAM_AGENTS = ("stream", "stream-goal", "stream-focused", "stream-focused-goal")
 AGENT_NAMES = [*AGENTS, *WHOLE_AGENTS]
 # The search-based baselines Table 2 may time against ours (`hsgplan bench timing --search`),
 # and the one it times unless told.
-SEARCH_BASELINES = ("search", "stream", "stream-goal")
+SEARCH_BASELINES = ("search", *STREAM_AGENTS)
 DEFAULT_SEARCH = "search"
 
 
@@ -185,15 +189,10 @@ def make_agent(
         from hsgplan.agents.search import SearchAgent
 
         return SearchAgent()
-    if name == "stream":
-        from hsgplan.agents.stream import StreamAgent
+    if name in STREAM_AGENTS:
+        from hsgplan.agents.stream import make_stream_agent
 
-        return StreamAgent()
-    if name == "stream-goal":
-        from hsgplan.agents.incremental import GOAL_DIRECTED
-        from hsgplan.agents.stream import StreamAgent
-
-        return StreamAgent(GOAL_DIRECTED, name)
+        return make_stream_agent(name)
 
     planner, motion = agent_parts(name)
     return HierarchicalAgent(

@@ -1,7 +1,7 @@
-"""The PDDLStream-style baseline: PDDLStream's incremental algorithm (`agents/incremental.py`)
-plans over poses, grasps, configurations and pushes that streams sample with the project's
-geometry and robot (`agents/streams.py`), Fast Downward searching each level's grounded
-problem (`symbolic/stream_pddl.py`).
+"""The PDDLStream-style baselines: PDDLStream's incremental algorithm (`agents/incremental.py`)
+or its focused one (`agents/focused.py`) plans over poses, grasps, configurations and pushes
+that streams sample with the project's geometry and robot (`agents/streams.py`), Fast Downward
+searching the grounded problems (`symbolic/stream_pddl.py`).
 
 The agent plans once, from what it observes, and executes the plan step by step; when the
 world departs from it (a primitive fails or the state is not the one the plan expects) it
@@ -19,7 +19,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from hsgplan.agents.base import Decision
-from hsgplan.agents.incremental import IncrementalConfig, IncrementalPlanner
+from hsgplan.agents.incremental import IncrementalPlanner
+from hsgplan.agents.stream_problem import StreamPlanner
 from hsgplan.agents.streams import StreamWorld
 from hsgplan.domain.actions import Action, intended_literal
 from hsgplan.domain.goals import Goal
@@ -43,13 +44,14 @@ class Step:
 
 class StreamAgent:
     """Args:
-    config: the incremental algorithm's samples, streams and limits (`IncrementalConfig`).
-    name: the agent's name in records (`stream`, or `stream-goal` with `GOAL_DIRECTED`).
+    planner: the algorithm (`IncrementalPlanner`, the default, or `FocusedPlanner`) with its
+        streams and limits.
+    name: the agent's name in records (`agents/registry.py`'s `WHOLE_AGENTS`).
     """
 
-    def __init__(self, config: IncrementalConfig | None = None, name: str = "stream") -> None:
+    def __init__(self, planner: StreamPlanner | None = None, name: str = "stream") -> None:
         self.name = name
-        self.planner = IncrementalPlanner(config)
+        self.planner = planner or IncrementalPlanner()
         self.reset(None, 0)
 
     def reset(self, goal: Goal | None, seed: int) -> None:
@@ -115,3 +117,17 @@ def expected_after(state: SymbolicSceneGraph, action: Action) -> SymbolicSceneGr
 def scene_key(sg: GeometricSceneGraph) -> SceneKey:
     poses = tuple((n.name, *(round(v, 2) for v in n.pose.position)) for n in sg.nodes)
     return (sg.held, poses)
+
+
+def make_stream_agent(name: str) -> StreamAgent:
+    """A PDDLStream-style baseline by its registered name (`agents/registry.py`)."""
+    from hsgplan.agents.focused import FOCUSED_GOAL_DIRECTED, FocusedPlanner
+    from hsgplan.agents.incremental import GOAL_DIRECTED
+
+    planners: dict[str, StreamPlanner] = {
+        "stream": IncrementalPlanner(),
+        "stream-goal": IncrementalPlanner(GOAL_DIRECTED),
+        "stream-focused": FocusedPlanner(),
+        "stream-focused-goal": FocusedPlanner(FOCUSED_GOAL_DIRECTED),
+    }
+    return StreamAgent(planners[name], name)

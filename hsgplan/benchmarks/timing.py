@@ -3,8 +3,8 @@
 run and on the same goals and start scenes. The baseline is one of `SEARCH_BASELINES`
 (`agents/registry.py`):
 `search` (`agents/search.py`: Fast Downward on the abstract domain, its plan refined by trials)
-or `stream` (`agents/stream.py`: PDDLStream's incremental algorithm over poses, grasps,
-configurations and pushes).
+or one of the PDDLStream-style ones (`agents/stream.py`: PDDLStream's incremental or focused
+algorithm over poses, grasps, configurations and pushes).
 
 Each agent's episodes go into a run folder of its own (`ours/`, and `search/` or `stream/`),
 resumable as every evaluation is; `table2.md`, `table2.png` and `summary.json` are written
@@ -46,6 +46,8 @@ LABELS = {
     "search": "search",
     "stream": "stream (PDDLStream-style)",
     "stream-goal": "stream-goal (PDDLStream-style, goal-directed streams)",
+    "stream-focused": "stream-focused (PDDLStream-style, focused algorithm)",
+    "stream-focused-goal": "stream-focused-goal (PDDLStream-style, focused, goal-directed)",
     "pddlstream": "PDDLStream (paper)",
     "paper": "theirs (paper)",
 }

@@ -9,11 +9,10 @@ from hsgplan.agents.incremental import (
     GOAL_DIRECTED,
     IncrementalConfig,
     IncrementalPlanner,
-    _aim,
-    _initial,
 )
 from hsgplan.agents.registry import make_agent
 from hsgplan.agents.stream import StreamAgent, expected_after, scene_key
+from hsgplan.agents.stream_problem import aim, initial_problem
 from hsgplan.agents.streams import collides, stack_pose, surface_pose
 from hsgplan.benchmarks.timing import tables, timing_agents
 from hsgplan.cli import app
@@ -70,7 +69,7 @@ def test_follows_its_plan_and_leaves_out_what_failed_in_that_scene():
     env = KitchenStorageEnv()
     _, info = env.reset(seed=5, options=ResetOptions(goal))
     obs = info["observation"]
-    agent = StreamAgent(IncrementalConfig(max_levels=3))
+    agent = StreamAgent(IncrementalPlanner(IncrementalConfig(max_levels=3)))
     agent.reset(goal, 5)
     first = agent.decide(obs.scene_graph, obs.symbols.state, goal, env.lookahead)
     assert first.action == Pick("butter") and first.params == PickParams("butter")
@@ -149,8 +148,8 @@ def test_goal_restricted_streams_stack_and_place_only_where_the_goal_leads():
     env.close()
 
     def sampled(config):
-        prob = _initial(obs.scene_graph, obs.symbols.state, np.random.default_rng(0))
-        _aim(prob, goal, config)
+        prob = initial_problem(obs.scene_graph, obs.symbols.state, np.random.default_rng(0))
+        aim(prob, goal, config.goal_stacks)
         for level in (1, 2, 3):
             IncrementalPlanner(config)._evaluate(prob, level, _NoRobot(), frozenset())
         new = [p for p in prob.poses if prob.level[p] > 0]
