@@ -11,6 +11,9 @@ from hsgplan.domain.goals import parse_goal, read_goal_file
 runner = CliRunner()
 
 
+WORLD = ("eval", "world")
+
+
 def run(*args):
     return runner.invoke(app, list(args))
 
@@ -32,7 +35,7 @@ def test_plan_from_a_given_start_with_extra_objects():
         "plan",
         "--goal",
         "On(butter, shelf_a)",
-        "--objects",
+        "--names",
         "butter,cherries",
         "--init",
         "On(butter, open_space) & On(cherries, butter)",
@@ -44,12 +47,12 @@ def test_plan_from_a_given_start_with_extra_objects():
 def test_goals_file_is_deterministic(tmp_path):
     a, b = tmp_path / "a.txt", tmp_path / "b.txt"
     for path in (a, b):
-        r = run("goals", "--objects", "4", "--count", "7", "--seed", "3", "--out", str(path))
+        r = run("goals", "--objects", "4", "--goals", "7", "--seed", "3", "--out", str(path))
         assert r.exit_code == 0, r.output
     assert a.read_text() == b.read_text()
     goals = read_goal_file(a)
     assert len(goals) == 7 and all(g.size == 4 for g in goals)
-    r = run("goals", "--objects", "4", "--count", "7", "--seed", "3")
+    r = run("goals", "--objects", "4", "--goals", "7", "--seed", "3")
     assert r.stdout == a.read_text()
 
 
@@ -72,59 +75,59 @@ BAD = [
     (["plan", "--goal", "InGrasp(butter) & InGrasp(cherries)"], "one object at a time"),
     (["plan", "--goal", "In(popcorn, shelf_a)"], "does not fit"),
     (["plan", "--goal", ""], "empty"),
-    (["plan", "--goal", "On(butter, shelf_a)", "--objects", "cherries"], "lacks 'butter'"),
-    (["plan", "--goal", "On(butter, shelf_a)", "--objects", "butter,pear"], "unknown name 'pear'"),
+    (["plan", "--goal", "On(butter, shelf_a)", "--names", "cherries"], "lacks 'butter'"),
+    (["plan", "--goal", "On(butter, shelf_a)", "--names", "butter,pear"], "unknown name 'pear'"),
     (["plan", "--goal", "On(butter, shelf_a)", "--init", "On(butter, butter)"], "itself"),
     (
         ["plan", "--goal", "On(butter, shelf_a)", "--init", "On(cherries, shelf_a)"],
         "not in the scene",
     ),
     (["plan", "--goal", "On(cherries, shelf_b)", "--init", "In(cherries, shelf_a)"], "no sequence"),
-    (["goals", "--objects", "4", "--count", "-3"], "greater than or equal to 1"),
-    (["goals", "--objects", "13", "--count", "3"], "between 2 and 12"),
-    (["goals", "--objects", "0", "--count", "3"], "between 2 and 12"),
+    (["goals", "--objects", "4", "--goals", "-3"], "greater than or equal to 1"),
+    (["goals", "--objects", "13", "--goals", "3"], "between 2 and 12"),
+    (["goals", "--objects", "0", "--goals", "3"], "between 2 and 12"),
     (["bench", "symbolic", "--sizes", "2-x"], "expected a range"),
     (["bench", "symbolic", "--sizes", "1-3"], "between 2 and 12"),
     (["bench", "symbolic", "--goals", "-1"], "greater than or equal to 1"),
     (["demo", "--objects", "40"], "between 2 and 12"),
     (["demo", "--agent", "wizard"], "'wizard' is not one of 'oracle'"),
     (["demo", "--goal", "On(butter, butter)"], "itself"),
-    (["eval", "--sizes", "2", "--goals", "0"], "greater than or equal to 1"),
-    (["eval", "--sizes", "2", "--workers", "0"], "greater than or equal to 1"),
-    (["eval", "--motion", "wizard"], "unknown motion generator 'wizard'"),
+    ([*WORLD, "--sizes", "2", "--goals", "0"], "greater than or equal to 1"),
+    ([*WORLD, "--sizes", "2", "--workers", "0"], "greater than or equal to 1"),
+    ([*WORLD, "--motion", "wizard"], "unknown motion generator 'wizard'"),
     (
-        ["eval", "--planner", "regression", "--motion", "gnn,wand"],
+        [*WORLD, "--planner", "regression", "--motion", "gnn,wand"],
         "unknown motion generator 'wand'",
     ),
-    (["eval", "--motion", "gnn,gnn"], "name each generator once"),
-    (["eval", "--sizes", "2", "--repeats", "0"], "greater than or equal to 1"),
-    (["eval", "--sizes", "1-6"], "between 2 and 12"),
-    (["eval", "--sizes", "2-13"], "between 2 and 12"),
-    (["eval", "--agent", "paper", "--checkpoint", "/nonexistent/task"], "/nonexistent/task"),
-    (["eval", "--agent", "paper", "--motion-checkpoints", "/nonexistent/m"], "/nonexistent/m"),
-    (["eval", "--goals-file", "/nonexistent/goals.txt"], "does not exist"),
-    (["eval", "--sizes", "2", "--perception", "sonar"], "--perception 'sonar': one of gt, rgb"),
-    (["eval", "--sizes", "2", "--perception", "gt,gt"], "name each observer once"),
+    ([*WORLD, "--motion", "gnn,gnn"], "name each generator once"),
+    ([*WORLD, "--sizes", "2", "--repeats", "0"], "greater than or equal to 1"),
+    ([*WORLD, "--sizes", "1-6"], "between 2 and 12"),
+    ([*WORLD, "--sizes", "2-13"], "between 2 and 12"),
+    ([*WORLD, "--agent", "paper", "--checkpoint", "/nonexistent/task"], "/nonexistent/task"),
+    ([*WORLD, "--agent", "paper", "--motion-checkpoints", "/nonexistent/m"], "/nonexistent/m"),
+    ([*WORLD, "--goals-file", "/nonexistent/goals.txt"], "does not exist"),
+    ([*WORLD, "--sizes", "2", "--perception", "sonar"], "--perception 'sonar': one of gt, rgb"),
+    ([*WORLD, "--sizes", "2", "--perception", "gt,gt"], "name each observer once"),
     (
-        ["eval", "--sizes", "2", "--perception", "rgb", "--perception-checkpoint", "/no/f_p"],
+        [*WORLD, "--sizes", "2", "--perception", "rgb", "--perception-checkpoint", "/no/f_p"],
         "/no/f_p",
     ),
     (["demo", "--perception", "sonar"], "--perception 'sonar': one of gt, rgb"),
     (["demo", "--perception", "rgb", "--perception-checkpoint", "/no/f_p"], "/no/f_p"),
     (["bench", "sim", "--episodes", "0"], "greater than or equal to 1"),
     (["plan", "--goal", "On(cherries, shelf_a) &"], "ends with '&'"),
-    (["eval", "--goals", "many"], "valid integer"),
-    (["eval-task", "--planner", "wizard"], "'wizard' is not one of 'regression'"),
-    (["eval-motion", "--workers", "0"], "greater than or equal to 1"),
+    ([*WORLD, "--goals", "many"], "valid integer"),
+    (["eval", "task", "--planner", "wizard"], "'wizard' is not one of 'regression'"),
+    (["eval", "motion", "--workers", "0"], "greater than or equal to 1"),
     (["bench", "timing", "--goals", "0"], "greater than or equal to 1"),
     (["bench", "timing", "--sizes", "1-3"], "between 2 and 12"),
     (["bench", "timing", "--workers", "0"], "greater than or equal to 1"),
-    (["eval", "--agent", "search", "--motion", "gnn"], "no task planner or motion generator"),
+    ([*WORLD, "--agent", "search", "--motion", "gnn"], "no task planner or motion generator"),
     (["report", "/nonexistent/run"], "is not a folder"),
     (["report", "/nonexistent/run", "--failures", "-1"], "greater than or equal to 0"),
-    (["collect", "images", "--count", "1", "--views", "9"], "views 9: there are 1 to 5"),
-    (["collect", "images", "--count", "1", "--views", "0"], "greater than or equal to 1"),
-    (["eval-perception", "--scenes", "1", "--views", "6"], "views 6: there are 1 to 5"),
+    (["collect", "images", "--samples", "1", "--views", "9"], "views 9: there are 1 to 5"),
+    (["collect", "images", "--samples", "1", "--views", "0"], "greater than or equal to 1"),
+    (["eval", "perception", "--scenes", "1", "--views", "6"], "views 6: there are 1 to 5"),
 ]
 
 
@@ -141,7 +144,7 @@ def test_bad_input_gets_one_line_and_exit_code_2(args, reason):
 def test_goals_replace_an_existing_goal_file(tmp_path):
     path = tmp_path / "goals.txt"
     path.write_text("On(butter, shelf_a)\n")
-    r = run("goals", "--objects", "4", "--count", "3", "--out", str(path))
+    r = run("goals", "--objects", "4", "--goals", "3", "--out", str(path))
     assert r.exit_code == 0, r.output
     assert len(read_goal_file(path)) == 3
     assert sorted(p.name for p in tmp_path.iterdir()) == ["goals.txt"]
@@ -150,6 +153,36 @@ def test_goals_replace_an_existing_goal_file(tmp_path):
 def test_refused_command_leaves_an_existing_file_alone(tmp_path):
     path = tmp_path / "goals.txt"
     path.write_text("On(butter, shelf_a)\n")
-    r = run("goals", "--objects", "4", "--count", "-1", "--out", str(path))
+    r = run("goals", "--objects", "4", "--goals", "-1", "--out", str(path))
     assert r.exit_code == 2
     assert path.read_text() == "On(butter, shelf_a)\n"
+
+
+@pytest.mark.parametrize(
+    "args, hint",
+    [
+        (["eval-task", "--sizes", "2"], "'hsgplan eval-task' is now 'hsgplan eval task'"),
+        (["eval-perception"], "'hsgplan eval-perception' is now 'hsgplan eval perception'"),
+        (["eval", "--protocol", "paper"], "'hsgplan eval world --protocol paper ...'"),
+        (["goals", "--objects", "3", "--count", "2"], "'hsgplan goals --count' is now '--goals'"),
+        (["plan", "--goal", "On(butter, shelf_a)", "--objects=butter"], "is now '--names'"),
+        (["eval", "reach", "--trials", "x"], "'hsgplan eval reach --trials' is now '--data'"),
+        (["eval", "motion", "--checkpoints", "m"], "is now '--motion-checkpoints'"),
+        (["collect", "images", "--count", "1"], "is now '--samples'"),
+    ],
+)
+def test_older_spellings_are_refused_with_the_new_one(args, hint):
+    r = run(*args)
+    assert r.exit_code == 2
+    lines = [line for line in r.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and hint in lines[0]
+
+
+def test_the_new_spellings_are_not_mistaken_for_older_ones():
+    from hsgplan.cli.renamed import hint
+
+    assert hint([*WORLD, "--sizes", "2"]) is None
+    assert hint(["goals", "--objects", "3", "--goals", "2"]) is None
+    assert hint(["eval", "--help"]) is None
+    assert hint(["eval", "task", "--checkpoints", "x"]) is None  # the option is eval motion's
+    assert hint([]) is None

@@ -31,7 +31,7 @@ def _tree(folder):
 def test_eval_task_refuses_to_resume_under_a_replaced_checkpoint(tmp_path):
     checkpoint = tmp_path / "task"
     shutil.copytree(home() / TASK_CHECKPOINT, checkpoint)
-    args = ["eval-task", "--sizes", "2", "--goals", "1", "--workers", "1", "--json"]
+    args = ["eval", "task", "--sizes", "2", "--goals", "1", "--workers", "1", "--json"]
     args += ["--checkpoint", checkpoint, "--out", tmp_path / "run"]
     first = run(*args)
     assert first.exit_code == 0, first.output
@@ -105,9 +105,11 @@ def test_eval_never_writes_into_a_checkpoint_folder(tmp_path):
     checkpoint = tmp_path / "task"
     shutil.copytree(home() / TASK_CHECKPOINT, checkpoint)
     before = _tree(checkpoint)
-    r = run("eval", "--agent", "oracle", "--sizes", "2", "--goals", "1", "--out", checkpoint)
+    r = run(
+        "eval", "world", "--agent", "oracle", "--sizes", "2", "--goals", "1", "--out", checkpoint
+    )
     _refused(r, "holds other files and no eval-table run")
-    r = run("eval-task", "--planner", "fd", "--sizes", "2", "--goals", "1", "--out", checkpoint)
+    r = run("eval", "task", "--planner", "fd", "--sizes", "2", "--goals", "1", "--out", checkpoint)
     _refused(r, "holds other files and no eval-task run")
     assert _tree(checkpoint) == before
 
@@ -116,7 +118,7 @@ def test_one_commands_run_folder_is_refused_by_another(tmp_path):
     folder = tmp_path / "run"
     folder.mkdir()
     (folder / "config.json").write_text(json.dumps({"kind": "eval-task", "planner": "fd"}))
-    r = run("eval-motion", "--trials", "1", "--out", folder)
+    r = run("eval", "motion", "--trials", "1", "--out", folder)
     _refused(r, "is not a eval-motion run folder (it holds a eval-task run)")
     r = run("collect", "reach", "--states", "1", "--out", folder)
     _refused(r, "is not a reach run folder")

@@ -1,8 +1,9 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
-One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval, report), `data`
-(collect), `learn` (train task, eval-task, eval-reach), `motion` (train motion, eval-motion),
-`perception` (train perception, eval-perception), `bench`.
+One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval world, report),
+`data` (collect), `learn` (train task, eval task, eval reach), `motion` (train motion, eval
+motion), `perception` (train perception, eval perception), `bench`; `renamed` refuses the older
+spellings.
 """
 
 from __future__ import annotations
@@ -20,20 +21,27 @@ app = typer.Typer(
     no_args_is_help=True,
     help="Hierarchical planning with geometric and symbolic scene graphs (kitchen storage).",
 )
+eval_app = typer.Typer(
+    no_args_is_help=True,
+    help="Evaluate: the agent in the world (Table 1), the task planner, f_reach, the motion "
+    "generators, f_p.",
+)
+eval_app.command("world")(world.evaluate)
+eval_app.command("task")(learn.eval_task)
+eval_app.command("reach")(learn.eval_reach)
+eval_app.command("motion")(motion.eval_motion)
+eval_app.command("perception")(perception.eval_perception)
+
 app.command()(symbolic.plan)
 app.command()(symbolic.goals)
 app.command()(world.demo)
-app.command("eval")(world.evaluate)
+app.add_typer(eval_app, name="eval")
 app.command()(world.report)
-app.add_typer(bench.app, name="bench")
 app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
-app.command("eval-task")(learn.eval_task)
-app.command("eval-reach")(learn.eval_reach)
+app.add_typer(bench.app, name="bench")
 learn.train_app.command("motion")(motion.train_motion)
 learn.train_app.command("perception")(perception.train_perception)
-app.command("eval-perception")(perception.eval_perception)
-app.command("eval-motion")(motion.eval_motion)
 
 
 def main() -> None:

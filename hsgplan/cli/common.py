@@ -26,11 +26,20 @@ err = Console(stderr=True)
 
 class OneLineErrors(TyperGroup):
     """The top-level group: a usage error (an unknown choice, a malformed number) is one line on
-    stderr and exit code 2, like every other refusal, instead of click's framed box."""
+    stderr and exit code 2, like every other refusal, instead of click's framed box; so is an
+    older spelling of a command or option (`cli/renamed.py`), with the new one."""
 
-    def main(self, *args, standalone_mode: bool = True, **kwargs):
+    def main(self, args=None, *rest, standalone_mode: bool = True, **kwargs):
+        from hsgplan.cli.renamed import hint
+
+        older = hint(sys.argv[1:] if args is None else list(args))
+        if older is not None:
+            print_error(older)
+            if standalone_mode:
+                sys.exit(2)
+            return 2
         try:
-            code = super().main(*args, standalone_mode=False, **kwargs)
+            code = super().main(args, *rest, standalone_mode=False, **kwargs)
         except typer.TyperException as e:  # click's exceptions, as typer ships them
             if type(e).__name__ == "NoArgsIsHelpError":
                 e.show()
@@ -97,7 +106,7 @@ out_folder = _output("folder")
 out_file = _output("file")
 
 
-# the --out of every resumable job (eval, eval-task, bench timing)
+# the --out of every resumable job (eval, eval task, bench timing)
 RunFolder = Annotated[
     Path | None,
     typer.Option(

@@ -117,7 +117,7 @@ def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir
 @app.command("images")
 @refuses_bad_input
 def images(
-    count: Annotated[
+    samples: Annotated[
         int, typer.Option(help="Samples to render (scenes x views).", min=1, max=MAX_SAMPLES)
     ] = 2000,
     seed: Annotated[
@@ -146,7 +146,7 @@ def images(
     from hsgplan.perception.images import ImagesConfig, collect_images
 
     check_ray(ray)
-    config = ImagesConfig(count, seed, p_elsewhere=p_elsewhere)
+    config = ImagesConfig(samples, seed, p_elsewhere=p_elsewhere)
     if views is not None:
         config = replace(config, views=views)
     with Progress(console=err, transient=True) as progress:

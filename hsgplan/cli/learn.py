@@ -1,4 +1,4 @@
-"""Commands of the learned task planner: `train task`, `eval-task`."""
+"""Commands of the learned task planner: `train task`, `eval task`, `eval reach`."""
 
 from __future__ import annotations
 
@@ -156,7 +156,7 @@ def eval_reach(
     checkpoint: Annotated[
         Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
     ] = TASK_CHECKPOINT,
-    trials: Annotated[
+    data: Annotated[
         Path,
         typer.Option(
             help="Held-out executed primitives (`hsgplan collect reach`).", parser=input_path
@@ -172,7 +172,7 @@ def eval_reach(
     from hsgplan.evaluation.reach_eval import evaluate_reach
     from hsgplan.paths import shipped
 
-    report = evaluate_reach(shipped(checkpoint), shipped(trials))
+    report = evaluate_reach(shipped(checkpoint), shipped(data))
     if as_json:
         print(json.dumps(report, indent=2))
         return
@@ -193,7 +193,7 @@ def eval_reach(
         for kind, v in [*report["by_kind"].items(), ("all", report["overall"])]
     ]
     print_table(
-        f"f_reach of {checkpoint} on {report['trials']} executed primitives from {trials}",
+        f"f_reach of {checkpoint} on {report['trials']} executed primitives from {data}",
         ("question", "n", "reachable", "precision", "recall", "yes when not", "accuracy"),
         rows,
         markdown,

@@ -1,4 +1,4 @@
-"""Commands of the motion level: `train motion`, `eval-motion`."""
+"""Commands of the motion level: `train motion`, `eval motion`."""
 
 from __future__ import annotations
 
@@ -100,7 +100,7 @@ def eval_motion(
         int, typer.Option(help="Seed of the evaluation scenes.", min=0, max=MAX_SEED)
     ] = 0,
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
-    checkpoints: Annotated[
+    motion_checkpoints: Annotated[
         Path, typer.Option(help="Folder of motion checkpoints.", parser=input_path)
     ] = MOTION_CHECKPOINTS,
     workers: Annotated[int, typer.Option(help="Processes.", min=1, max=MAX_WORKERS)] = 2,
@@ -127,7 +127,7 @@ def eval_motion(
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("scenes", total=trials * len(kinds))
         report = evaluate_motion(
-            kinds, trials, seed, checkpoints, workers, lambda: progress.advance(bar), run_dir
+            kinds, trials, seed, motion_checkpoints, workers, lambda: progress.advance(bar), run_dir
         )
     if as_json:
         print(json.dumps(report, indent=2))

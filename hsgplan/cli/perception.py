@@ -1,4 +1,4 @@
-"""Commands of f_p, the pose estimator: `train perception`, `eval-perception`."""
+"""Commands of f_p, the pose estimator: `train perception`, `eval perception`."""
 
 from __future__ import annotations
 

@@ -25,22 +25,22 @@ class Search(StrEnum):
         return {"auto": None, "optimal": True, "fast": False}[self.value]
 
 
-def _scene(goal_text: str, objects: str | None, init: str | None):
+def _scene(goal_text: str, names_text: str | None, init: str | None):
     from hsgplan.domain.goals import parse_goal
     from hsgplan.domain.objects import kind_of, sort_objects
     from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
     goal = parse_goal(goal_text)
     names = list(goal.objects)
-    if objects is not None:
-        given = [o.strip() for o in objects.split(",") if o.strip()]
+    if names_text is not None:
+        given = [o.strip() for o in names_text.split(",") if o.strip()]
         if not given:
-            raise InvalidInputError(f"--objects '{objects}' names no object")
+            raise InvalidInputError(f"--names '{names_text}' names no object")
         for o in given:
             kind_of(o)
         missing = [o for o in goal.objects if o not in given]
         if missing:
-            raise InvalidInputError(f"--objects lacks '{missing[0]}', which the goal names")
+            raise InvalidInputError(f"--names lacks '{missing[0]}', which the goal names")
         names = list(sort_objects(given))
     if init:
         literals = parse_goal(init, validate=False).literals
@@ -71,7 +71,7 @@ def plan(
     goal: Annotated[
         str, typer.Option(help="Goal literals, e.g. 'On(butter, shelf_a) & In(cherries, shelf_a)'.")
     ],
-    objects: Annotated[
+    names: Annotated[
         str | None,
         typer.Option(help="Comma-separated objects in the scene (default: those the goal names)."),
     ] = None,
@@ -91,7 +91,7 @@ def plan(
     """Plan a goal with Fast Downward and show the symbolic state after each step."""
     from hsgplan.planning.fast_downward import FastDownwardPlanner
 
-    g, state = _scene(goal, objects, init)
+    g, state = _scene(goal, names, init)
     result = FastDownwardPlanner(optimal=search.optimal_flag).plan(state, g)
     if as_json:
         steps = [
@@ -110,7 +110,7 @@ def plan(
 @refuses_bad_input
 def goals(
     objects: Annotated[int, typer.Option(help="Objects per goal (2-12).")],
-    count: Annotated[int, typer.Option(help="How many goals.", min=1, max=MAX_GOALS)],
+    goals: Annotated[int, typer.Option(help="How many goals.", min=1, max=MAX_GOALS)],
     seed: Annotated[
         int,
         typer.Option(help="Random seed; the same seed gives the same goals.", min=0, max=MAX_SEED),
@@ -126,8 +126,8 @@ def goals(
     from hsgplan.symbolic.generator import check_size, random_goals
 
     check_size(objects)
-    drawn = random_goals(objects, count, seed, stacking=stacking)
-    header = f"hsgplan goals --objects {objects} --count {count} --seed {seed}" + (
+    drawn = random_goals(objects, goals, seed, stacking=stacking)
+    header = f"hsgplan goals --objects {objects} --goals {goals} --seed {seed}" + (
         "" if stacking else " --no-stacking"
     )
     if out_file is None:

@@ -21,11 +21,11 @@ from hsgplan.domain.errors import InvalidInputError
 
 MAX_SEED = 2**32 - 1  # numpy's and torch's seeders both take it
 MAX_WORKERS = 256
-MAX_GOALS = 100_000  # `goals --count`, `eval --goals` and `eval-task --goals` (per size)
+MAX_GOALS = 100_000  # `goals --goals`, `eval --goals` and `eval task --goals` (per size)
 MAX_REPEATS = 100
 MAX_SAMPLES = 1_000_000  # `collect place/push --samples`
 MAX_STATES = 1_000_000  # `collect reach --states`
-MAX_TRIALS = 100_000  # `eval-motion --trials` (per primitive)
+MAX_TRIALS = 100_000  # `eval motion --trials` (per primitive)
 MAX_EPISODES = 10_000  # `bench sim --episodes`
 MAX_FAILURES = 1_000  # `report --failures`
 MAX_TASKS_PER_CHUNK = 100_000

@@ -3,7 +3,7 @@
 The paper's agent has none: a primitive that fails ends its episode (the `paper` protocol,
 `hsgplan.evaluation.protocol`). Our loop lets a failed primitive cost one step and goes on
 (the `recovering` protocol), and these hand-written rules decide how it goes on. Each is named
-here, documented once, and switched off by name (`hsgplan eval --rules-off NAME,...`), so that
+here, documented once, and switched off by name (`hsgplan eval world --rules-off NAME,...`), so that
 what each buys is measured (README, "Recovery rules"). None of them consults the domain's
 rules (transition model, feasibility): they read only what the agent saw and did.
 

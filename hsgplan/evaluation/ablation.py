@@ -1,5 +1,5 @@
 """What each recovery rule buys: Table 1 under the recovering protocol with every rule on, then
-with each rule off in turn (`hsgplan eval --ablate-rules`).
+with each rule off in turn (`hsgplan eval world --ablate-rules`).
 
 Each variant is a whole Table 1 run of its own (`evaluation/table1.py`) in a folder under the
 ablation's, named by the rule switched off (`all-rules` for none), so an interrupted ablation

@@ -1,4 +1,4 @@
-"""`hsgplan eval-motion`: single-shot success of each motion model on fresh scenes.
+"""`hsgplan eval motion`: single-shot success of each motion model on fresh scenes.
 
 Scenes come from the same generator as the training data but from another stream
 (`EVAL_STREAM + seed`), so no evaluation scene is a training scene. In every staged scene each
@@ -107,7 +107,7 @@ def summarize(rows: list[dict]) -> dict:
 
 @dataclass(frozen=True)
 class MotionChunk:
-    """CHUNK consecutive evaluation scenes of one primitive: a unit of `eval-motion` work."""
+    """CHUNK consecutive evaluation scenes of one primitive: a unit of `eval motion` work."""
 
     primitive: str
     seed: int

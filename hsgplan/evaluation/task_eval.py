@@ -89,7 +89,7 @@ def fd_length(goal: Goal, seed: int) -> int:
 
 @dataclass(frozen=True)
 class TaskJob:
-    """One episode of an `eval-task` run: which planner, from which checkpoint, on which goal."""
+    """One episode of an `eval task` run: which planner, from which checkpoint, on which goal."""
 
     planner: str
     checkpoint: str

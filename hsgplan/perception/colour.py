@@ -17,12 +17,12 @@ cheese under another was named butter from its strip of sides and table.
 Labels come from the renderer: each in-sight object's type and its centroid projected
 through the camera that rendered the image; the background, by the objects' cuboids projected
 through it. Saved in the keypoint network's checkpoint folder, in `colour/` (its own
-`config.json`, weights and manifest).
+`config.json`, weights and manifest); trained by `perception/train.py` (`train_colour`), which
+this module, read at inference, does not import.
 """
 
 from __future__ import annotations
 
-import random
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -30,7 +30,6 @@ import numpy as np
 import torch
 from torch import nn
 
-from hsgplan import training
 from hsgplan.checkpoint import load_trained
 from hsgplan.domain.checks import MAX_SEED, check_fields, from_settings, setting
 from hsgplan.domain.world import OBJECT_TYPES
@@ -138,31 +137,6 @@ def _chromaticity(rgb: np.ndarray) -> np.ndarray:
     [N, FEATURES] float32."""
     total = np.maximum(rgb.sum(axis=1, keepdims=True), 1e-6)
     return np.concatenate([rgb / total, total / 3], axis=1).astype(np.float32)
-
-
-def train_colour(
-    samples: list[tuple[np.ndarray, int]], out: Path, config: ColourConfig = ColourConfig()
-) -> ColourNet:
-    """Fit the colour network to (features, type index) pairs into the folder `out` (a
-    finished one is loaded, not redone)."""
-    training.claim(out, config.to_json())
-    if training.finished(out):
-        return load_colour(out)
-    torch.manual_seed(config.seed)
-    order = list(range(len(samples)))
-    random.Random(config.seed).shuffle(order)
-    x = torch.from_numpy(np.stack([samples[i][0] for i in order]))
-    y = torch.tensor([samples[i][1] for i in order])
-    model = ColourNet(config)
-    optim = torch.optim.Adam(model.parameters(), lr=config.lr)
-    for _ in range(config.steps):  # full batch: a few thousand rows of four numbers
-        loss = nn.functional.cross_entropy(model(x), y)
-        optim.zero_grad()
-        loss.backward()
-        optim.step()
-    training.check_loss(float(loss.detach()), "the colour network", config.steps)
-    training.finish(out, model.eval(), config.to_json())
-    return model
 
 
 def load_colour(folder: Path) -> ColourNet:

@@ -1,4 +1,4 @@
-"""`hsgplan eval-perception`: f_p against the ground truth on fresh synthetic scenes.
+"""`hsgplan eval perception`: f_p against the ground truth on fresh synthetic scenes.
 
 Each scene (`perception.synthetic.render_sample`, another seed than training's) is seen by the
 estimator; its detections are matched to the scene's objects type by type, nearest first

@@ -26,7 +26,14 @@ from hsgplan import training
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.checks import MAX_SEED, MAX_WORKERS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.perception.colour import BACKGROUND, PATCH, ColourConfig, features, train_colour
+from hsgplan.perception.colour import (
+    BACKGROUND,
+    PATCH,
+    ColourConfig,
+    ColourNet,
+    features,
+    load_colour,
+)
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
 from hsgplan.perception.images import TYPES, chunk_path, load_chunks
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, view_keypoints
@@ -298,3 +305,29 @@ def _train_keypoints(
         if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
             training.save_progress(out, model, optim, epoch + 1, data_print)
     training.finish(out, model.eval(), net_config.to_json())
+
+
+def train_colour(
+    samples: list[tuple[np.ndarray, int]], out: Path, config: ColourConfig | None = None
+) -> ColourNet:
+    """Fit the colour network to (features, type index) pairs into the folder `out` (a
+    finished one is loaded, not redone)."""
+    config = config or ColourConfig()
+    training.claim(out, config.to_json())
+    if training.finished(out):
+        return load_colour(out)
+    torch.manual_seed(config.seed)
+    order = list(range(len(samples)))
+    random.Random(config.seed).shuffle(order)
+    x = torch.from_numpy(np.stack([samples[i][0] for i in order]))
+    y = torch.tensor([samples[i][1] for i in order])
+    model = ColourNet(config)
+    optim = torch.optim.Adam(model.parameters(), lr=config.lr)
+    for _ in range(config.steps):  # full batch: a few thousand rows of four numbers
+        loss = torch.nn.functional.cross_entropy(model(x), y)
+        optim.zero_grad()
+        loss.backward()
+        optim.step()
+    training.check_loss(float(loss.detach()), "the colour network", config.steps)
+    training.finish(out, model.eval(), config.to_json())
+    return model

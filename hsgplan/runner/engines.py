@@ -1,5 +1,5 @@
 """Where work items run: a local process pool or a Ray cluster, behind one small interface
-(`submit`, `next_done`, `close`). Every long job (eval, eval-task, eval-motion, collect) runs
+(`submit`, `next_done`, `close`). Every long job (eval, eval task, eval motion, collect) runs
 through one of them."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Work items run once each, resumably: the loop `eval`, `eval-task` and `eval-motion` share.
+"""Work items run once each, resumably: the loop `eval`, `eval task` and `eval motion` share.
 
 A job is a list of items (small picklable values) and a top-level function that turns one into
 a JSON-able result. Results are appended to the run folder's `episodes.jsonl` as they finish,

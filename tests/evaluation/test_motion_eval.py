@@ -47,7 +47,7 @@ def test_every_model_is_tried_once_in_the_same_scenes(checkpoints):
 def test_eval_motion_cli_prints_json(checkpoints):
     r = runner.invoke(
         app,
-        ["eval-motion", "--trials", "2", "--primitives", "place", "--checkpoints",
+        ["eval", "motion", "--trials", "2", "--primitives", "place", "--motion-checkpoints",
          str(checkpoints), "--workers", "1", "--json"],
     )  # fmt: skip
     assert r.exit_code == 0, r.output
@@ -58,8 +58,11 @@ def test_eval_motion_cli_prints_json(checkpoints):
     "args,message",
     [
         (["collect", "place", "--samples", "-3"], "greater than or equal to 1"),
-        (["eval-motion", "--checkpoints", "nowhere", "--trials", "2"], "no trained motion"),
-        (["eval-motion", "--primitives", "pour"], "place or push"),
+        (
+            ["eval", "motion", "--motion-checkpoints", "nowhere", "--trials", "2"],
+            "no trained motion",
+        ),
+        (["eval", "motion", "--primitives", "pour"], "place or push"),
         (["train", "motion", "--model", "cnn"], "'cnn' is not one of 'gnn', 'mlp'"),
         (["train", "motion", "--data", "nowhere"], "no such motion data"),
     ],

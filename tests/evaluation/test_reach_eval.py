@@ -61,10 +61,10 @@ def test_eval_reach_scores_the_shipped_planner_on_a_few_held_out_states(tmp_path
     lines = (held_out / "episodes.jsonl").read_text().splitlines()[:5]
     (tmp_path / "episodes.jsonl").write_text("\n".join(lines) + "\n")
     (tmp_path / "config.json").write_bytes((held_out / "config.json").read_bytes())
-    r = CliRunner().invoke(app, ["eval-reach", "--trials", str(tmp_path), "--json"])
+    r = CliRunner().invoke(app, ["eval", "reach", "--data", str(tmp_path), "--json"])
     assert r.exit_code == 0, r.output
     report = json.loads(r.stdout)
     assert report["overall"]["questions"] == sum(v["questions"] for v in report["by_kind"].values())
     assert report["overall"]["questions"] > 0
-    r = CliRunner().invoke(app, ["eval-reach", "--trials", str(tmp_path / "none")])
+    r = CliRunner().invoke(app, ["eval", "reach", "--data", str(tmp_path / "none")])
     assert r.exit_code == 2 and "no collection" in r.stderr

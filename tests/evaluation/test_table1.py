@@ -135,6 +135,7 @@ def _eval(out, *extra):
         "-m",
         "hsgplan.cli",
         "eval",
+        "world",
         "--planner",
         "regression",
         "--motion",

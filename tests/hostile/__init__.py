@@ -28,9 +28,9 @@ COMMANDS = (
     "demo",
     "eval",
     "report",
-    "eval-task",
-    "eval-reach",
-    "eval-motion",
+    "eval task",
+    "eval reach",
+    "eval motion",
     "bench sim",
     "bench symbolic",
     "bench task",
@@ -45,7 +45,7 @@ COMMANDS = (
     "train motion",
     "collect images",
     "train perception",
-    "eval-perception",
+    "eval perception",
 )
 
 

@@ -160,11 +160,11 @@ def eval_run(rel: str) -> list[Setup]:
 TASK_TINY = write("tiny.json", tiny_config(TINY_TASK))
 MOTION_TINY = write("tiny.json", tiny_config(TINY_MOTION))
 BASE: dict[str, tuple[str, list[Setup]]] = {
-    "goals": ("goals --objects 2 --count 1", []),
+    "goals": ("goals --objects 2 --goals 1", []),
     "demo": ("demo --agent oracle --objects 2", []),
-    "eval": ("eval --sizes 2 --goals 1 --workers 1", []),
-    "eval-task": ("eval-task --sizes 2 --goals 1 --workers 1", []),
-    "eval-motion": ("eval-motion --trials 1 --workers 1 --primitives place", []),
+    "eval": ("eval world --sizes 2 --goals 1 --workers 1", []),
+    "eval task": ("eval task --sizes 2 --goals 1 --workers 1", []),
+    "eval motion": ("eval motion --trials 1 --workers 1 --primitives place", []),
     "collect demos": ("collect demos", []),
     "collect place": ("collect place --samples 1 --workers 1", []),
     "collect push": ("collect push --samples 1 --workers 1", []),
@@ -172,7 +172,7 @@ BASE: dict[str, tuple[str, list[Setup]]] = {
     "train task": ("train task --config tiny.json", [TASK_TINY]),
     "train motion": ("train motion --config tiny.json", [MOTION_TINY]),
     "bench timing": ("bench timing --sizes 2 --goals 1 --workers 1", []),
-    "collect images": ("collect images --count 1 --workers 1", []),
+    "collect images": ("collect images --samples 1 --workers 1", []),
     "train perception": ("train perception --images imgs", [mkdir("imgs")]),
 }
 

@@ -101,13 +101,13 @@ def _motion_progress(rel: str, payload: bytes | None, name: str | None = None) -
 
 
 def disk_cases() -> list[Case]:
-    big = "eval --sizes 2 --goals 1 --workers 1 --goals-file g.txt --out run"
-    task = "eval-task --sizes 2 --goals 1 --workers 1 --goals-file g.txt --out run"
+    big = "eval world --sizes 2 --goals 1 --workers 1 --goals-file g.txt --out run"
+    task = "eval task --sizes 2 --goals 1 --workers 1 --goals-file g.txt --out run"
     cases = [
         case("eval", "--goals-file of 40 MiB", big, _goal_lines("g.txt", 40_000, LONG_GOAL)),
         case("eval", "--goals-file of 100,001 goals", big, _goal_lines("g.txt", 100_001, GOAL2)),
         case(
-            "eval-task", "--goals-file of 100,001 goals", task, _goal_lines("g.txt", 100_001, GOAL2)
+            "eval task", "--goals-file of 100,001 goals", task, _goal_lines("g.txt", 100_001, GOAL2)
         ),
         case("eval", "--goals-file a loop of links", big.replace("g.txt", "loop"), *LOOP),
         case(
@@ -117,9 +117,9 @@ def disk_cases() -> list[Case]:
             *LOOP,
         ),
         case(
-            "eval-task",
+            "eval task",
             "--checkpoint a loop of links",
-            base("eval-task", "--checkpoint loop --out run"),
+            base("eval task", "--checkpoint loop --out run"),
             *LOOP,
         ),
         case(
@@ -129,7 +129,7 @@ def disk_cases() -> list[Case]:
         case(
             "goals",
             "--out over a file, disk full",
-            "goals --objects 6 --count 500 --out g.txt",
+            "goals --objects 6 --goals 500 --out g.txt",
             write("g.txt", f"{SMALL_GOAL}\n"),
             file_bytes=4096,
         ),

@@ -53,15 +53,15 @@ def output_cases() -> list[Case]:
 
 # command | base command line | option | values (ALL: -1 0 1e9 1e12 2**70)
 COUNTS = """
-goals          | goals --objects 2                                    | --count     | ALL
-eval           | eval --sizes 2 --workers 1                           | --goals     | ALL
-eval           | eval --sizes 2 --goals 1 --workers 1                 | --repeats   | 0
-eval-task      | eval-task --sizes 2 --workers 1                      | --goals     | -1 2**70
+goals          | goals --objects 2                                    | --goals     | ALL
+eval           | eval world --sizes 2 --workers 1                           | --goals     | ALL
+eval           | eval world --sizes 2 --goals 1 --workers 1                 | --repeats   | 0
+eval task      | eval task --sizes 2 --workers 1                      | --goals     | -1 2**70
 collect place  | collect place --workers 1 --out ds                   | --samples   | ALL
 collect push   | collect push --workers 1 --out ds                    | --samples   | -1 1e12
 collect place  | collect place --samples 1 --workers 1 --out ds       | --tasks-per-chunk | 0
 collect reach  | collect reach --workers 1 --out ds                   | --states    | ALL
-eval-motion    | eval-motion --workers 1 --primitives place           | --trials    | ALL
+eval motion    | eval motion --workers 1 --primitives place           | --trials    | ALL
 bench sim      | bench sim --sizes 2                                  | --episodes  | -1 1e12
 bench symbolic | bench symbolic --sizes 2                             | --goals     | -1 1e12
 bench symbolic | bench symbolic --sizes 2 --goals 1                   | --optimal-max-size | -1
@@ -69,44 +69,44 @@ bench task     | bench task --sizes 2                                 | --goals 
 bench timing   | bench timing --sizes 2 --workers 1                   | --goals     | -1 1e12
 bench collect  | bench collect --workers 1 --primitives place         | --samples   | -1 1e12
 report         | report run                                           | --failures  | -1
-collect images | collect images --workers 1 --out ds                  | --count     | ALL
-eval-perception | eval-perception                                     | --scenes    | ALL
+collect images | collect images --workers 1 --out ds                  | --samples   | ALL
+eval perception | eval perception                                     | --scenes    | ALL
 bench observe  | bench observe                                        | --scenes    | -1 0 1e12
 """
 # a small count each: a huge pool for one item would still start one process
 WORKERS = """
-eval           | eval --sizes 2 --goals 1
-eval-task      | eval-task --sizes 2 --goals 1
-eval-motion    | eval-motion --trials 1 --primitives place
+eval           | eval world --sizes 2 --goals 1
+eval task      | eval task --sizes 2 --goals 1
+eval motion    | eval motion --trials 1 --primitives place
 collect place  | collect place --samples 1 --out ds
 collect push   | collect push --samples 1 --out ds
 collect reach  | collect reach --states 1 --out ds
-collect images | collect images --count 1 --out ds
+collect images | collect images --samples 1 --out ds
 """
 SEEDS = """
-goals          | goals --objects 2 --count 1
+goals          | goals --objects 2 --goals 1
 demo           | demo --agent oracle --objects 2 --out pics
-eval           | eval --sizes 2 --goals 1 --workers 1
-eval-task      | eval-task --sizes 2 --goals 1 --workers 1
+eval           | eval world --sizes 2 --goals 1 --workers 1
+eval task      | eval task --sizes 2 --goals 1 --workers 1
 collect demos  | collect demos --out ds
 collect place  | collect place --samples 1 --workers 1 --out ds
 collect reach  | collect reach --states 1 --workers 1 --out ds
 train task     | train task --config tiny.json --out ck
-collect images | collect images --count 1 --workers 1 --out ds
-eval-perception | eval-perception --scenes 1
+collect images | collect images --samples 1 --workers 1 --out ds
+eval perception | eval perception --scenes 1
 """
 MALFORMED = """
-goals          | goals --objects 2 --count abc
-goals          | goals --objects 2 --count 1.5
-goals          | goals --objects 2 --count ''
-eval           | eval --sizes 2 --goals 1 --workers 1e3
+goals          | goals --objects 2 --goals abc
+goals          | goals --objects 2 --goals 1.5
+goals          | goals --objects 2 --goals ''
+eval           | eval world --sizes 2 --goals 1 --workers 1e3
 collect place  | collect place --samples 0x10 --out ds
 bench timing   | bench timing --sizes 2 --goals 1 --workers 1 --search pddl
 """
 # command | base command line | --sizes values (a space-separated list; '' is the empty value)
 SIZES = """
-eval           | eval --goals 1 --workers 1                 | '' 6-2 0 13 2-1000000000
-eval-task      | eval-task --goals 1 --workers 1            | '' 6-2 13 2-1000000000
+eval           | eval world --goals 1 --workers 1                 | '' 6-2 0 13 2-1000000000
+eval task      | eval task --goals 1 --workers 1            | '' 6-2 13 2-1000000000
 bench sim      | bench sim --episodes 1                     | 6-2 2-1000000000
 bench symbolic | bench symbolic --goals 1                   | 6-2 2-1000000000
 bench task     | bench task --goals 1                       | 13 2-1000000000
@@ -128,7 +128,7 @@ def number_cases() -> list[Case]:
         for v in ("-1", "2**70"):
             cases.append(case(command, f"--seed {v}", f"{args} --seed {number(v)}", *setup))
     for v in ("0", "1", "13", "-1", "2**70"):
-        cases.append(case("goals", f"--objects {v}", f"goals --objects {number(v)} --count 1"))
+        cases.append(case("goals", f"--objects {v}", f"goals --objects {number(v)} --goals 1"))
     for v in ("1", "13", "2**70"):
         args = f"demo --agent oracle --objects {number(v)} --out pics"
         cases.append(case("demo", f"--objects {v}", args))
@@ -210,7 +210,7 @@ def config_cases() -> list[Case]:
     return cases
 
 
-GOAL_FILES = [  # (name, setup, size asked, also for eval-task)
+GOAL_FILES = [  # (name, setup, size asked, also for eval task)
     ("UTF-16 with BOM", [write("g.txt", GOALS_TEXT.encode("utf-16"))], 2, True),
     ("UTF-16-LE without BOM", [write("g.txt", GOALS_TEXT.encode("utf-16-le"))], 2, False),
     ("Latin-1 bytes", [write("g.txt", b"# " + LATIN1 + b"\n" + GOALS_TEXT.encode())], 2, True),
@@ -230,7 +230,7 @@ GOAL_FILES = [  # (name, setup, size asked, also for eval-task)
 def goal_file_cases() -> list[Case]:
     cases = []
     for name, setup, size, both in GOAL_FILES:
-        for command in ("eval", "eval-task") if both else ("eval",):
+        for command in ("eval", "eval task") if both else ("eval",):
             args = f"{command} --goals 1 --workers 1 --sizes {size} --goals-file g.txt --out run"
             cases.append(case(command, f"--goals-file {name}", args, *setup))
     return cases
@@ -241,19 +241,19 @@ MARKUP = """
 plan | plan --goal '[/]' | [/]
 plan | plan --goal '[bold]x' | [bold]x
 plan | plan --goal 'On([red]butter, shelf_a)' | On([red]butter, shelf_a)
-plan | plan --goal 'On(butter, shelf_a)' --objects '[/]' | [/]
+plan | plan --goal 'On(butter, shelf_a)' --names '[/]' | [/]
 demo | demo --agent oracle --out pics --goal '[/]' | [/]
 demo | demo --agent oracle --out pics --goal '[bold]x' | [bold]x
 demo | demo --agent oracle --out pics --goal 'On([red]butter, shelf_a)' | On([red]butter, shelf_a)
-eval | eval --goals 1 --workers 1 --sizes '[/]' | [/]
-eval | eval --goals 1 --workers 1 --sizes 2 --motion '[/]' | [/]
-eval-task | eval-task --sizes '[/]' | [/]
+eval | eval world --goals 1 --workers 1 --sizes '[/]' | [/]
+eval | eval world --goals 1 --workers 1 --sizes 2 --motion '[/]' | [/]
+eval task | eval task --sizes '[/]' | [/]
 bench sim | bench sim --sizes '[bold]2' | [bold]2
-eval | eval --goals 1 --workers 1 --sizes 2 --goals-file 'g[/]oals.txt' | g[/]oals.txt
-eval-task | eval-task --sizes 2 --goals 1 --checkpoint 'ck[/]' | ck[/]
+eval | eval world --goals 1 --workers 1 --sizes 2 --goals-file 'g[/]oals.txt' | g[/]oals.txt
+eval task | eval task --sizes 2 --goals 1 --checkpoint 'ck[/]' | ck[/]
 report | report 'run[/]' | run[/]
 train task | train task --config 'c[/].json' --out ck | c[/].json
-eval-reach | eval-reach --trials 't[/]' | t[/]
+eval reach | eval reach --data 't[/]' | t[/]
 """
 
 
@@ -264,7 +264,7 @@ def markup_cases() -> list[Case]:
         case(
             "eval",
             "--goals-file a directory '[red]x'",
-            "eval --goals 1 --workers 1 --sizes 2 --goals-file '[red]x'",
+            "eval world --goals 1 --workers 1 --sizes 2 --goals-file '[red]x'",
             mkdir("[red]x"),
             echo="[red]x",
         ),
@@ -280,42 +280,42 @@ def markup_cases() -> list[Case]:
 
 
 NAMES = """
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --motion ''
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --motion ,
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --motion gnn,gnn
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --motion wizard
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --agent wizard
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --planner ''
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception ''
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception rgb,,gt
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --perception '[red]x'
-eval           | eval --sizes 2 --goals 1 --out run --perception rgb --perception-checkpoint .
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --motion ''
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --motion ,
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --motion gnn,gnn
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --motion wizard
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --agent wizard
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --planner ''
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --perception ''
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --perception rgb,,gt
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --perception '[red]x'
+eval           | eval world --sizes 2 --goals 1 --out run --perception rgb --perception-checkpoint .
 demo           | demo --perception ''
 bench observe  | bench observe --scenes 1 --checkpoint .
 demo           | demo --perception rgb --perception-checkpoint .
-eval-motion    | eval-motion --trials 1 --workers 1 --primitives ''
-eval-motion    | eval-motion --trials 1 --workers 1 --primitives wizard
-eval-motion    | eval-motion --trials 1 --workers 1 --primitives ,
-eval-motion    | eval-motion --trials 1 --workers 1 --primitives place,place
+eval motion    | eval motion --trials 1 --workers 1 --primitives ''
+eval motion    | eval motion --trials 1 --workers 1 --primitives wizard
+eval motion    | eval motion --trials 1 --workers 1 --primitives ,
+eval motion    | eval motion --trials 1 --workers 1 --primitives place,place
 bench collect  | bench collect --samples 1 --workers 1 --primitives ''
 bench collect  | bench collect --samples 1 --workers 1 --primitives wizard
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ray ''
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --rules-off wizard
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --rules-off failed_bins,,least_taken
-eval           | eval --sizes 2 --goals 1 --out run --protocol paper --rules-off failed_bins
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --protocol ''
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ablate-rules --protocol paper
-eval           | eval --sizes 2 --goals 1 --workers 1 --out run --ray 127.0.0.1:1
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --ray ''
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --rules-off wizard
+eval           | eval world --sizes 2 --goals 1 --out run --rules-off failed_bins,,least_taken
+eval           | eval world --sizes 2 --goals 1 --out run --protocol paper --rules-off failed_bins
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --protocol ''
+eval           | eval world --sizes 2 --goals 1 --out run --ablate-rules --protocol paper
+eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --ray 127.0.0.1:1
 collect place  | collect place --samples 1 --workers 1 --out ds --ray ''
 collect place  | collect place --samples 1 --workers 1 --out ds --ray 127.0.0.1:1
 collect reach  | collect reach --states 1 --workers 1 --out ds --ray ''
 collect reach  | collect reach --states 1 --workers 1 --out ds --ray 127.0.0.1:1
 demo           | demo --out pics --agent wizard
 demo           | demo --out pics --motion ''
-eval-task      | eval-task --planner wizard
+eval task      | eval task --planner wizard
 plan           | plan --goal 'On(butter, shelf_a)' --search wizard
-plan           | plan --goal 'On(butter, shelf_a)' --objects wizard
-plan           | plan --goal 'On(butter, shelf_a)' --objects ''
+plan           | plan --goal 'On(butter, shelf_a)' --names wizard
+plan           | plan --goal 'On(butter, shelf_a)' --names ''
 plan           | plan --goal 'On(butter, shelf_a)' --init garbage
 plan           | plan --goal ''
 plan           | plan --goal 'On(wizard, shelf_a)'

@@ -50,7 +50,7 @@ def state_cases() -> list[Case]:
     }
     for command, names in [
         (
-            "eval-task",
+            "eval task",
             [
                 "config.json a directory",
                 "episodes.jsonl a directory",
@@ -58,7 +58,7 @@ def state_cases() -> list[Case]:
                 "config.json not UTF-8",
             ],
         ),
-        ("eval-motion", ["config.json a directory", "config.json a number"]),
+        ("eval motion", ["config.json a directory", "config.json a number"]),
         ("bench timing", ["config.json a list"]),
         ("collect reach", ["config.json a directory", "config.json a list"]),
     ]:
@@ -92,9 +92,9 @@ def state_cases() -> list[Case]:
         ("a file", [write("ck", "x\n")]),
     ]
     for command, args, which in [
-        ("eval-task", base("eval-task", "--out run"), task_damage),
+        ("eval task", base("eval task", "--out run"), task_damage),
         ("eval", base("eval", "--agent regression --out run"), task_damage[:4]),
-        ("eval-reach", "eval-reach", task_damage[1:3]),
+        ("eval reach", "eval reach", task_damage[1:3]),
         ("bench task", "bench task --sizes 2 --goals 1", task_damage[1:2]),
     ]:
         for name, damage in which:
@@ -116,7 +116,7 @@ def state_cases() -> list[Case]:
             base("eval", "--agent paper --out run --motion-checkpoints mk"),
             motion_damage[:2] + motion_damage[4:],
         ),
-        ("eval-motion", base("eval-motion", "--checkpoints mk"), motion_damage),
+        ("eval motion", base("eval motion", "--motion-checkpoints mk"), motion_damage),
     ]:
         for name, damage in which:
             cases.append(case(command, f"motion checkpoints {name}", args, *damage))
@@ -145,7 +145,7 @@ def state_cases() -> list[Case]:
         ("episodes.jsonl binary junk", [heldout, write("tr/episodes.jsonl", JUNK)]),
         ("a motion dataset", [copy_shipped("data/motion", "tr")]),
     ]:
-        cases.append(case("eval-reach", f"--trials {name}", "eval-reach --trials tr", *setup))
+        cases.append(case("eval reach", f"--trials {name}", "eval reach --data tr", *setup))
 
     motion = copy_shipped("data/motion", "dd")
     for name, setup in [
@@ -169,8 +169,8 @@ def cross_cases() -> list[Case]:
     pg = copy_shipped("checkpoints/motion/place-gnn", "pg")
     cases = [
         case("eval", "--out a task checkpoint", base("eval", "--out ck"), ck),
-        case("eval-task", "--out a task checkpoint", base("eval-task", "--out ck"), ck),
-        case("eval-motion", "--out the motion checkpoints", base("eval-motion", "--out mk"), mk),
+        case("eval task", "--out a task checkpoint", base("eval task", "--out ck"), ck),
+        case("eval motion", "--out the motion checkpoints", base("eval motion", "--out mk"), mk),
         case(
             "bench timing",
             "--out a demos dataset",
@@ -192,12 +192,12 @@ def cross_cases() -> list[Case]:
             ck,
         ),
         case(
-            "eval-task",
+            "eval task",
             "--checkpoint a motion checkpoint",
-            base("eval-task", "--out run --checkpoint pg"),
+            base("eval task", "--out run --checkpoint pg"),
             pg,
         ),
-        case("eval-reach", "--checkpoint a motion checkpoint", "eval-reach --checkpoint pg", pg),
+        case("eval reach", "--checkpoint a motion checkpoint", "eval reach --checkpoint pg", pg),
         case(
             "eval",
             "--checkpoint the motion checkpoints",
@@ -211,9 +211,9 @@ def cross_cases() -> list[Case]:
             ck,
         ),
         case(
-            "eval-motion",
-            "--checkpoints a task checkpoint",
-            base("eval-motion", "--checkpoints ck"),
+            "eval motion",
+            "--motion-checkpoints a task checkpoint",
+            base("eval motion", "--motion-checkpoints ck"),
             ck,
         ),
     ]

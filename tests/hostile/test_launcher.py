@@ -13,9 +13,9 @@ from tests.hostile.harness import child_env, launch
 pytestmark = pytest.mark.slow
 
 COMMANDS = [
-    ["eval", "--sizes", "13"],  # refused by the parser's checks
+    ["eval", "world", "--sizes", "13"],  # refused by the parser's checks
     ["train", "motion", "--config", "missing.json", "--out", "ck"],  # refused after imports
-    ["goals", "--objects", "3", "--count", "2", "--seed", "4"],  # runs, prints goals
+    ["goals", "--objects", "3", "--goals", "2", "--seed", "4"],  # runs, prints goals
 ]
 
 

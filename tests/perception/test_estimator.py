@@ -1,6 +1,6 @@
 """f_p's decoding, PnP and fusion on a rendered scene, with a stand-in network that outputs
 the scene's true maps: what the estimator makes of perfect maps, and how the evaluation
-scores it. (The trained network's quality is measured by `hsgplan eval-perception`.)"""
+scores it. (The trained network's quality is measured by `hsgplan eval perception`.)"""
 
 import math
 

@@ -162,7 +162,7 @@ def test_eval_sees_through_the_shipped_f_p_beside_the_ground_truth(tmp_path):
 
     r = CliRunner().invoke(
         app,
-        ["eval", "--agent", "paper", "--sizes", "2", "--goals", "1", "--workers", "1"]
+        ["eval", "world", "--agent", "paper", "--sizes", "2", "--goals", "1", "--workers", "1"]
         + ["--perception", "gt,rgb", "--json", "--out", str(tmp_path / "run")],
     )
     assert r.exit_code == 0, r.output

@@ -1,6 +1,6 @@
 """Training the keypoint network end to end on a tiny collection: it finishes into a
 checkpoint folder that loads, and a second run with the same configuration does nothing.
-How well it learns is measured by `hsgplan eval-perception`, not here."""
+How well it learns is measured by `hsgplan eval perception`, not here."""
 
 import pytest
 import torch

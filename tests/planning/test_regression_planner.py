@@ -1,6 +1,6 @@
 """The learned regression planner from the shipped checkpoint (`checkpoints/task`), closing the
 symbolic loop on goals no demonstration shows. The networks are fixed weights, not trained here:
-how well training does is measured by `hsgplan eval-task`, not by the suite."""
+how well training does is measured by `hsgplan eval task`, not by the suite."""
 
 import random
 

@@ -133,7 +133,8 @@ def test_eval_task_cli_with_fast_downward(tmp_path):
     r = CliRunner().invoke(
         app,
         [
-            "eval-task",
+            "eval",
+            "task",
             "--planner",
             "fd",
             "--sizes",
@@ -174,7 +175,7 @@ def test_eval_task_resumes_from_its_run_folder(tmp_path):
 
 def test_eval_task_without_a_checkpoint_is_one_line(tmp_path):
     r = CliRunner().invoke(
-        app, ["eval-task", "--checkpoint", str(tmp_path), "--goals", "1", "--out", str(tmp_path)]
+        app, ["eval", "task", "--checkpoint", str(tmp_path), "--goals", "1", "--out", str(tmp_path)]
     )
     assert r.exit_code == 2 and "no trained network" in r.stderr
     r = CliRunner().invoke(app, ["train", "task", "--config", str(tmp_path / "none.json")])
@@ -207,7 +208,8 @@ def test_eval_task_runs_a_trained_checkpoint_in_worker_processes(tmp_path):
     r = CliRunner().invoke(
         app,
         [
-            "eval-task",
+            "eval",
+            "task",
             "--checkpoint",
             str(tmp_path),
             "--sizes",
