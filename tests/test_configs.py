@@ -3,13 +3,13 @@
 
 import pytest
 
-from hsgplan.data.motion_collect import CollectConfig
+from hsgplan.collect.images import ImagesConfig
+from hsgplan.collect.motion import CollectConfig
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.evaluation.protocol import EvalConfig
 from hsgplan.motion.train import MotionTrainConfig
 from hsgplan.perception.colour import ColourConfig
-from hsgplan.perception.images import ImagesConfig
 from hsgplan.perception.train import PerceptionTrainConfig
 from hsgplan.planning.regression.train import TaskTrainConfig
 

@@ -12,7 +12,7 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from hsgplan.data.motion_collect import CollectConfig, collect
+from hsgplan.collect.motion import CollectConfig, collect
 from hsgplan.domain.parameters import MotionPrimitive
 
 BENCH_SEED = 777

@@ -46,8 +46,8 @@ def demos(
     ] = RUNS / "collect-demos",
 ) -> None:
     """Record the paper's 18 short demonstrations with the oracle in the simulated world."""
+    from hsgplan.collect.demos import collect_demos
     from hsgplan.data.demos import TASKS
-    from hsgplan.evaluation.record_demos import collect_demos
 
     command = f"hsgplan collect demos --seed {seed} --out {out_dir}"
     with Progress(console=err, transient=True) as progress:
@@ -100,7 +100,7 @@ app.command("push")(_collect_command("push", 8000))
 
 
 def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir: Path, chunk: int):
-    from hsgplan.data.motion_collect import CollectConfig, collect
+    from hsgplan.collect.motion import CollectConfig, collect
     from hsgplan.domain.parameters import MotionPrimitive
 
     config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray, chunk)
@@ -143,7 +143,7 @@ def images(
 ) -> None:
     """Synthetic training images for f_p: random scenes from the fixed cameras, domain
     randomised, with every object's pose and cuboid keypoints (format: perception/images.py)."""
-    from hsgplan.perception.images import ImagesConfig, collect_images
+    from hsgplan.collect.images import ImagesConfig, collect_images
 
     check_ray(ray)
     config = ImagesConfig(samples, seed, p_elsewhere=p_elsewhere)
@@ -172,7 +172,7 @@ def reach(
 ) -> None:
     """Self-supervised reachability: primitives executed in the simulated world from staged
     symbolic states, and what the world showed after each (f_reach's labels)."""
-    from hsgplan.evaluation.record_reach import collect_reach
+    from hsgplan.collect.reach import collect_reach
 
     check_ray(ray)
     with Progress(console=err, transient=True) as progress:

@@ -1,5 +1,5 @@
 """The paper's 18 short demonstrations: which tasks they are and their format on disk (the
-recorder is `hsgplan.evaluation.record_demos`).
+recorder is `hsgplan.collect.demos`).
 
 Tasks (fixed, so that the dataset is the same everywhere): place one object on a shelf top
 (each of the six types once, shelves alternating), stack two objects on a shelf top (nine

@@ -1,6 +1,6 @@
 """Primitives executed in the simulated world from staged symbolic states: f_reach's labels.
 
-Made by `hsgplan collect reach` (`evaluation/record_reach.py`). A collection is a run folder
+Made by `hsgplan collect reach` (`collect/reach.py`). A collection is a run folder
 (`runner/items.py`): `config.json` and `episodes.jsonl`, one line per staged state,
 `{"key": "SEED/INDEX", "result": R}`, with
 

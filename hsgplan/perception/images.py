@@ -1,4 +1,5 @@
-"""`hsgplan collect images`: synthetic samples (`perception.synthetic`) in resumable chunks.
+"""The format of f_p's training images: synthetic samples (`perception.synthetic`) in chunks,
+as `hsgplan collect images` (`collect/images.py`) writes them.
 
 Format (version `FORMAT`), one compressed `.npz` per chunk of `CHUNK` samples in
 `RUN/chunks/chunk-NNNNN.npz`, objects padded to `MAX_OBJECTS` (n samples, V views, K = 9
@@ -24,12 +25,10 @@ from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from hsgplan.domain.checks import MAX_SAMPLES, MAX_SEED, bounded, check_fields, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import split_instance
 from hsgplan.domain.world import OBJECT_TYPES
@@ -40,34 +39,13 @@ from hsgplan.perception.synthetic import (
     P_ELSEWHERE,
     VIEWS,
     ImageSample,
-    first_views,
     render_sample,
 )
-from hsgplan.runner.items import run_items
 from hsgplan.runner.run_folder import logged_rows
 
 FORMAT = 1
 CHUNK = 16
-KIND = "collect-images"
 TYPES = tuple(OBJECT_TYPES)
-
-
-@dataclass(frozen=True)
-class ImagesConfig:
-    # samples wanted (unstaged draws are skipped, so the last chunk may hold fewer)
-    count: int = field(metadata=bounded(lo=1, hi=MAX_SAMPLES))
-    seed: int = setting(0, lo=0, hi=MAX_SEED)
-    chunk: int = setting(CHUNK, lo=1, hi=MAX_SAMPLES)
-    p_elsewhere: float = setting(P_ELSEWHERE, lo=0.0, hi=1.0)  # see `synthetic.P_ELSEWHERE`
-    views: int = len(VIEWS)  # the first this many fixed views (3: shoulders and front)
-
-    def __post_init__(self) -> None:
-        check_fields(self)
-        first_views(self.views)
-
-    @property
-    def chunks(self) -> int:
-        return -(-self.count // self.chunk)
 
 
 def chunk_path(run_dir: Path, chunk: int) -> Path:
@@ -122,43 +100,6 @@ def pack(samples: list[ImageSample], views: int = len(VIEWS)) -> dict[str, np.nd
         out["visible"][i, :, :m] = s.visible
         out["cameras"][i] = [[*c.eye, *c.target, c.fov] for c in s.cameras]
     return out
-
-
-def collect_images(
-    config: ImagesConfig,
-    run_dir: Path,
-    workers: int = 2,
-    ray: str | None = None,
-    on_chunk=None,
-) -> list[dict]:
-    """Render every chunk not yet logged in `run_dir`; the log rows of all chunks."""
-    # The views are recorded as cameras (a collection from before the count was a setting
-    # holds the first three), not as the count.
-    settings = {k: v for k, v in asdict(config).items() if k != "views"} | {
-        "format": FORMAT,
-        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in first_views(config.views)],
-    }
-    items = [
-        (str(run_dir), config.seed, c, config.chunk, config.count, config.p_elsewhere, config.views)
-        for c in range(config.chunks)
-    ]
-    rows = run_items(
-        _render,
-        items,
-        key=lambda item: item[2],
-        run_dir=run_dir,
-        kind=KIND,
-        config=settings,
-        workers=workers,
-        ray=ray,
-        on_result=on_chunk,
-    )
-    write_format(run_dir)
-    return rows
-
-
-def _render(item: tuple[str, int, int, int, int, float, int]) -> dict:
-    return render_chunk(*item)
 
 
 def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:

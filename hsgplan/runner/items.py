@@ -6,7 +6,7 @@ one line `{"key": ..., "result": ...}` each; a run started again with the same c
 reads them back and runs only the items whose key is missing, so an interruption loses at most
 the items in flight and repeats nothing that was logged. Without a run folder nothing is kept.
 `collect` runs its chunks through the same engines and run-folder claim, keeping each chunk as
-a file of its own (`hsgplan.data.motion_collect`).
+a file of its own (`hsgplan.collect.motion`).
 """
 
 from __future__ import annotations

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from hsgplan.collect.reach import draw_reach_state
 from hsgplan.data.world_trials import (
     UNSTAGED,
     WorldTrial,
@@ -19,7 +20,6 @@ from hsgplan.data.world_trials import (
 from hsgplan.domain.actions import parse_action
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.predicates import Predicate, on
-from hsgplan.evaluation.record_reach import draw_reach_state
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.outcome import Status

@@ -6,7 +6,7 @@ import pytest
 from typer.testing import CliRunner
 
 from hsgplan.cli import app
-from hsgplan.data.motion_collect import CollectConfig, collect
+from hsgplan.collect.motion import CollectConfig, collect
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.evaluation.motion_eval import evaluate_motion
 from hsgplan.motion.train import MotionTrainConfig, train_motion

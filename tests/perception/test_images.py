@@ -4,8 +4,9 @@ camera model, collected in resumable chunks that are checked when read back."""
 import numpy as np
 import pytest
 
+from hsgplan.collect.images import ImagesConfig, collect_images
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.perception.images import ImagesConfig, chunk_path, collect_images, load_chunks
+from hsgplan.perception.images import chunk_path, load_chunks
 from hsgplan.perception.keypoints import PinholeCamera, in_world
 from hsgplan.perception.synthetic import VIEWS, render_sample
 from hsgplan.scene_graph.geometry import Pose

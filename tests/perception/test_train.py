@@ -5,9 +5,9 @@ How well it learns is measured by `hsgplan eval perception`, not here."""
 import pytest
 import torch
 
+from hsgplan.collect.images import ImagesConfig, collect_images
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.perception.estimator import PoseEstimator
-from hsgplan.perception.images import ImagesConfig, collect_images
 from hsgplan.perception.model import PerceptionNetConfig, build, load_perception_net
 from hsgplan.perception.synthetic import VIEWS
 from hsgplan.perception.train import PerceptionTrainConfig, train_perception

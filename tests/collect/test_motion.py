@@ -9,8 +9,8 @@ import time
 import numpy as np
 import pytest
 
+from hsgplan.collect.motion import CollectConfig, collect, work_folder
 from hsgplan.data import motion_store as store
-from hsgplan.data.motion_collect import CollectConfig, collect, work_folder
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive

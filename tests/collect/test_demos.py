@@ -7,10 +7,10 @@ import pytest
 from typer.testing import CliRunner
 
 from hsgplan.cli import app
+from hsgplan.collect import demos as record_demos
+from hsgplan.collect.demos import collect_demos
 from hsgplan.data.demos import TASKS, load_demos
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.evaluation import record_demos
-from hsgplan.evaluation.record_demos import collect_demos
 from hsgplan.symbolic.transition import apply
 
 SHIPPED = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"

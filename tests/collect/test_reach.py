@@ -10,11 +10,7 @@ from typer.testing import CliRunner
 
 import hsgplan
 from hsgplan.cli import app
-from hsgplan.data.world_trials import load_world_trials, trials_of
-from hsgplan.domain.actions import Pick, Place, Push
-from hsgplan.domain.predicates import in_grasp, on
-from hsgplan.domain.world import INTERIOR_CAPACITY, SHELVES, SURFACE_CAPACITY
-from hsgplan.evaluation.record_reach import (
+from hsgplan.collect.reach import (
     ACTIONS_PER_STATE,
     MAX_OBJECTS,
     MIN_OBJECTS,
@@ -25,6 +21,10 @@ from hsgplan.evaluation.record_reach import (
     run_reach_item,
     run_trials,
 )
+from hsgplan.data.world_trials import load_world_trials, trials_of
+from hsgplan.domain.actions import Pick, Place, Push
+from hsgplan.domain.predicates import in_grasp, on
+from hsgplan.domain.world import INTERIOR_CAPACITY, SHELVES, SURFACE_CAPACITY
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.scene import Scene

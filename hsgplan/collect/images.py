@@ -1,0 +1,69 @@
+"""`hsgplan collect images`: synthetic training images for f_p, rendered in resumable chunks
+(format: `perception/images.py`)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+from hsgplan.domain.checks import MAX_SAMPLES, MAX_SEED, bounded, check_fields, setting
+from hsgplan.perception.images import CHUNK, FORMAT, render_chunk, write_format
+from hsgplan.perception.synthetic import P_ELSEWHERE, VIEWS, first_views
+from hsgplan.runner.items import run_items
+
+KIND = "collect-images"
+
+
+@dataclass(frozen=True)
+class ImagesConfig:
+    # samples wanted (unstaged draws are skipped, so the last chunk may hold fewer)
+    count: int = field(metadata=bounded(lo=1, hi=MAX_SAMPLES))
+    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    chunk: int = setting(CHUNK, lo=1, hi=MAX_SAMPLES)
+    p_elsewhere: float = setting(P_ELSEWHERE, lo=0.0, hi=1.0)  # see `synthetic.P_ELSEWHERE`
+    views: int = len(VIEWS)  # the first this many fixed views (3: shoulders and front)
+
+    def __post_init__(self) -> None:
+        check_fields(self)
+        first_views(self.views)
+
+    @property
+    def chunks(self) -> int:
+        return -(-self.count // self.chunk)
+
+
+def collect_images(
+    config: ImagesConfig,
+    run_dir: Path,
+    workers: int = 2,
+    ray: str | None = None,
+    on_chunk=None,
+) -> list[dict]:
+    """Render every chunk not yet logged in `run_dir`; the log rows of all chunks."""
+    # The views are recorded as cameras (a collection from before the count was a setting
+    # holds the first three), not as the count.
+    settings = {k: v for k, v in asdict(config).items() if k != "views"} | {
+        "format": FORMAT,
+        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in first_views(config.views)],
+    }
+    items = [
+        (str(run_dir), config.seed, c, config.chunk, config.count, config.p_elsewhere, config.views)
+        for c in range(config.chunks)
+    ]
+    rows = run_items(
+        _render,
+        items,
+        key=lambda item: item[2],
+        run_dir=run_dir,
+        kind=KIND,
+        config=settings,
+        workers=workers,
+        ray=ray,
+        on_result=on_chunk,
+    )
+    write_format(run_dir)
+    return rows
+
+
+def _render(item: tuple[str, int, int, int, int, float, int]) -> dict:
+    return render_chunk(*item)
