@@ -179,8 +179,9 @@ def bench_timing(
         SearchName,
         typer.Option(
             help="The search baseline: stream (PDDLStream's incremental algorithm over poses), "
-            "stream-goal (the same with goal-directed streams) or search (Fast Downward's "
-            "abstract plan, refined by trials)."
+            "stream-focused (its focused algorithm: optimistic outputs, then only the streams "
+            "a plan uses), stream-goal and stream-focused-goal (the same with goal-directed "
+            "streams) or search (Fast Downward's abstract plan, refined by trials)."
         ),
     ] = DEFAULT_SEARCH_NAME,
     run_dir: RunFolder = None,
