@@ -186,3 +186,26 @@ def test_the_new_spellings_are_not_mistaken_for_older_ones():
     assert hint(["eval", "--help"]) is None
     assert hint(["eval", "task", "--checkpoints", "x"]) is None  # the option is eval motion's
     assert hint([]) is None
+
+
+def test_every_count_and_seed_takes_its_bounds_from_the_one_table():
+    import typer.main
+
+    from hsgplan.domain.checks import BOUNDS
+
+    def commands(group, path=()):
+        for name, cmd in group.commands.items():
+            if hasattr(cmd, "commands"):
+                yield from commands(cmd, (*path, name))
+            else:
+                yield (*path, name), cmd
+
+    checked = 0
+    for path, cmd in commands(typer.main.get_command(app)):
+        for param in cmd.params:
+            if param.name not in BOUNDS or param.min is None:
+                continue
+            expected = (BOUNDS[param.name]["lo"], BOUNDS[param.name]["hi"])
+            assert (param.min, param.max) == expected, (path, param.name)
+            checked += 1
+    assert checked >= 20  # seeds, goals, workers, samples, ... across the commands

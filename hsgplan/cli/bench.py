@@ -13,6 +13,7 @@ from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
 from hsgplan.cli.common import (
     PerceptionCheckpoint,
     RunFolder,
+    bounded_option,
     choice,
     err,
     input_path,
@@ -22,7 +23,6 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
-from hsgplan.domain.checks import MAX_EPISODES, MAX_GOALS, MAX_SAMPLES, MAX_SEED, MAX_WORKERS
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.paths import RUNS, TASK_CHECKPOINT
@@ -36,10 +36,8 @@ DEFAULT_SEARCH_NAME = SearchName(DEFAULT_SEARCH)
 @refuses_bad_input
 def bench_sim(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
-    episodes: Annotated[
-        int, typer.Option(help="Oracle episodes per size.", min=1, max=MAX_EPISODES)
-    ] = 5,
-    seed: Annotated[int, typer.Option(help="Random seed.", min=0, max=MAX_SEED)] = 0,
+    episodes: Annotated[int, bounded_option("episodes", "Oracle episodes per size.")] = 5,
+    seed: Annotated[int, bounded_option("seed", "Random seed.")] = 0,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")
     ] = False,
@@ -67,8 +65,8 @@ def bench_sim(
 @refuses_bad_input
 def bench_symbolic(
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
-    goals: Annotated[int, typer.Option(help="Goals per size.", min=1, max=MAX_GOALS)] = 20,
-    seed: Annotated[int, typer.Option(help="Random seed.", min=0, max=MAX_SEED)] = 0,
+    goals: Annotated[int, bounded_option("goals", "Goals per size.")] = 20,
+    seed: Annotated[int, bounded_option("seed", "Random seed.")] = 0,
     optimal_max_size: Annotated[
         int,
         typer.Option(
@@ -112,8 +110,8 @@ def bench_symbolic(
 @refuses_bad_input
 def bench_task(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
-    goals: Annotated[int, typer.Option(help="Goals per size.", min=1, max=MAX_GOALS)] = 20,
-    seed: Annotated[int, typer.Option(help="Random seed.", min=0, max=MAX_SEED)] = 0,
+    goals: Annotated[int, bounded_option("goals", "Goals per size.")] = 20,
+    seed: Annotated[int, bounded_option("seed", "Random seed.")] = 0,
     checkpoint: Annotated[
         Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
     ] = TASK_CHECKPOINT,
@@ -162,18 +160,12 @@ def bench_timing(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6,8,10",
     goals: Annotated[
         int,
-        typer.Option(help="Goals per size, the same for both agents.", min=1, max=MAX_GOALS),
+        bounded_option("goals", "Goals per size, the same for both agents."),
     ] = 10,
-    seed: Annotated[
-        int, typer.Option(help="Seed of the goals and the episodes.", min=0, max=MAX_SEED)
-    ] = 0,
+    seed: Annotated[int, bounded_option("seed", "Seed of the goals and the episodes.")] = 0,
     workers: Annotated[
         int,
-        typer.Option(
-            help="Episodes side by side (1: nothing competes for the core).",
-            min=1,
-            max=MAX_WORKERS,
-        ),
+        bounded_option("workers", "Episodes side by side (1: nothing competes for the core)."),
     ] = 1,
     search: Annotated[
         SearchName,
@@ -231,10 +223,8 @@ def bench_timing(
 @refuses_bad_input
 def bench_collect(
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
-    samples: Annotated[
-        int, typer.Option(help="Successful samples per primitive.", min=1, max=MAX_SAMPLES)
-    ] = 300,
-    workers: Annotated[int, typer.Option(help="Processes.", min=1, max=MAX_WORKERS)] = 2,
+    samples: Annotated[int, bounded_option("samples", "Successful samples per primitive.")] = 300,
+    workers: Annotated[int, bounded_option("workers", "Processes.")] = 2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
     markdown: Annotated[
         bool, typer.Option(help="Print a Markdown table (for the README).")
@@ -275,10 +265,8 @@ def bench_collect(
 @app.command("observe")
 @refuses_bad_input
 def bench_observe(
-    scenes: Annotated[
-        int, typer.Option(help="Scenes staged, rendered and seen.", min=1, max=MAX_EPISODES)
-    ] = 30,
-    seed: Annotated[int, typer.Option(help="Seed of the scenes.", min=0, max=MAX_SEED)] = 100,
+    scenes: Annotated[int, bounded_option("scenes", "Scenes staged, rendered and seen.")] = 30,
+    seed: Annotated[int, bounded_option("seed", "Seed of the scenes.")] = 100,
     checkpoint: PerceptionCheckpoint = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
     markdown: Annotated[

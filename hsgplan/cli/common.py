@@ -16,7 +16,7 @@ from rich.text import Text
 from typer.core import TyperGroup
 
 from hsgplan.agents.registry import AGENT_NAMES, MOTION_GENERATORS, TASK_PLANNERS
-from hsgplan.domain.checks import MAX_WORKERS, check_output, read_json
+from hsgplan.domain.checks import BOUNDS, check_output, read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import PROTOCOLS
 
@@ -53,6 +53,13 @@ class OneLineErrors(TyperGroup):
         if standalone_mode:
             sys.exit(code)
         return code
+
+
+def bounded_option(concept: str, help: str, **more) -> typer.models.OptionInfo:
+    """An option for a count or a seed, its bounds those the configurations hold it to
+    (`domain.checks.BOUNDS[concept]`)."""
+    bounds = BOUNDS[concept]
+    return typer.Option(help=help, min=bounds["lo"], max=bounds["hi"], **more)
 
 
 def shown(value) -> str:
@@ -118,7 +125,7 @@ RunFolder = Annotated[
 # --workers and --ray of the jobs that can run on Ray (collections, eval)
 CollectWorkers = Annotated[
     int,
-    typer.Option(help="Processes (or Ray tasks in flight / 2).", min=1, max=MAX_WORKERS),
+    bounded_option("workers", "Processes (or Ray tasks in flight / 2)."),
 ]
 RayAddress = Annotated[
     str | None, typer.Option(help="Run on Ray at this address ('local' starts one).")

@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     CollectWorkers,
     RayAddress,
+    bounded_option,
     check_ray,
     err,
     out,
@@ -20,9 +21,6 @@ from hsgplan.cli.common import (
     shown,
 )
 from hsgplan.domain.checks import (
-    MAX_SAMPLES,
-    MAX_SEED,
-    MAX_STATES,
     MAX_TASKS_PER_CHUNK,
 )
 from hsgplan.paths import RUNS
@@ -37,9 +35,7 @@ CollectionFolder = Annotated[
 @app.command("demos")
 @refuses_bad_input
 def demos(
-    seed: Annotated[
-        int, typer.Option(help="Seed of the demonstration scenes.", min=0, max=MAX_SEED)
-    ] = 0,
+    seed: Annotated[int, bounded_option("seed", "Seed of the demonstration scenes.")] = 0,
     out_dir: Annotated[
         Path,
         typer.Option("--out", help="Dataset folder (resumed if it exists).", parser=out_folder),
@@ -64,12 +60,10 @@ def _collect_command(primitive: str, default_samples: int):
     @refuses_bad_input
     def command(
         samples: Annotated[
-            int, typer.Option(help="Successful trials to collect.", min=1, max=MAX_SAMPLES)
+            int, bounded_option("samples", "Successful trials to collect.")
         ] = default_samples,
         workers: CollectWorkers = 2,
-        seed: Annotated[
-            int, typer.Option(help="Seed of the scene and parameter stream.", min=0, max=MAX_SEED)
-        ] = 0,
+        seed: Annotated[int, bounded_option("seed", "Seed of the scene and parameter stream.")] = 0,
         ray: RayAddress = None,
         out_dir: Annotated[
             Path,
@@ -118,11 +112,9 @@ def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir
 @refuses_bad_input
 def images(
     samples: Annotated[
-        int, typer.Option(help="Samples to render (scenes x views).", min=1, max=MAX_SAMPLES)
+        int, bounded_option("samples", "Samples to render (scenes x views).")
     ] = 2000,
-    seed: Annotated[
-        int, typer.Option(help="Seed of the scenes and their looks.", min=0, max=MAX_SEED)
-    ] = 0,
+    seed: Annotated[int, bounded_option("seed", "Seed of the scenes and their looks.")] = 0,
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     out_dir: CollectionFolder = RUNS / "collect-images",
@@ -161,11 +153,9 @@ def images(
 def reach(
     states: Annotated[
         int,
-        typer.Option(help="Staged states (a rerun may ask for more).", min=1, max=MAX_STATES),
+        bounded_option("states", "Staged states (a rerun may ask for more)."),
     ] = 4000,
-    seed: Annotated[
-        int, typer.Option(help="Seed of the states and actions.", min=0, max=MAX_SEED)
-    ] = 0,
+    seed: Annotated[int, bounded_option("seed", "Seed of the states and actions.")] = 0,
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     out_dir: CollectionFolder = RUNS / "collect-reach",

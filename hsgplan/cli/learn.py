@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     PlannerName,
     RunFolder,
+    bounded_option,
     dash,
     err,
     input_path,
@@ -23,7 +24,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
-from hsgplan.domain.checks import MAX_GOALS, MAX_SEED, MAX_WORKERS, resolve
+from hsgplan.domain.checks import resolve
 from hsgplan.paths import REACH_HELD_OUT, RUNS, TASK_CHECKPOINT
 
 train_app = typer.Typer(no_args_is_help=True, help="Train the learned models (resumable).")
@@ -47,7 +48,7 @@ def train_task(
     ] = RUNS / "train-task",
     seed: Annotated[
         int | None,
-        typer.Option(help="Overrides the configuration's seed.", min=0, max=MAX_SEED),
+        bounded_option("seed", "Overrides the configuration's seed."),
     ] = None,
 ) -> None:
     """Train f_preimage, f_reach and the forward baseline on the demonstrations."""
@@ -74,19 +75,15 @@ def train_task(
 def eval_task(
     planner: Annotated[PlannerName, typer.Option(help="Task planner.")] = REGRESSION,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
-    goals: Annotated[int, typer.Option(help="Random goals per size.", min=1, max=MAX_GOALS)] = 500,
-    seed: Annotated[
-        int, typer.Option(help="Seed of the goals and start states.", min=0, max=MAX_SEED)
-    ] = 0,
+    goals: Annotated[int, bounded_option("goals", "Random goals per size.")] = 500,
+    seed: Annotated[int, bounded_option("seed", "Seed of the goals and start states.")] = 0,
     goals_file: Annotated[
         Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
     ] = None,
     checkpoint: Annotated[
         Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
     ] = TASK_CHECKPOINT,
-    workers: Annotated[
-        int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
-    ] = 2,
+    workers: Annotated[int, bounded_option("workers", "Episodes run side by side.")] = 2,
     run_dir: RunFolder = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[

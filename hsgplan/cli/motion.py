@@ -12,6 +12,7 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import (
+    bounded_option,
     err,
     input_path,
     out,
@@ -21,7 +22,6 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
-from hsgplan.domain.checks import MAX_SEED, MAX_TRIALS, MAX_WORKERS
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import MOTION_CHECKPOINTS, RUNS
 
@@ -93,17 +93,13 @@ def train_motion(
 
 @refuses_bad_input
 def eval_motion(
-    trials: Annotated[
-        int, typer.Option(help="Fresh scenes per primitive.", min=1, max=MAX_TRIALS)
-    ] = 200,
-    seed: Annotated[
-        int, typer.Option(help="Seed of the evaluation scenes.", min=0, max=MAX_SEED)
-    ] = 0,
+    trials: Annotated[int, bounded_option("trials", "Fresh scenes per primitive.")] = 200,
+    seed: Annotated[int, bounded_option("seed", "Seed of the evaluation scenes.")] = 0,
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
     motion_checkpoints: Annotated[
         Path, typer.Option(help="Folder of motion checkpoints.", parser=input_path)
     ] = MOTION_CHECKPOINTS,
-    workers: Annotated[int, typer.Option(help="Processes.", min=1, max=MAX_WORKERS)] = 2,
+    workers: Annotated[int, bounded_option("workers", "Processes.")] = 2,
     run_dir: Annotated[
         Path | None,
         typer.Option(

@@ -10,6 +10,7 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import (
+    bounded_option,
     dash,
     err,
     input_path,
@@ -20,7 +21,6 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
-from hsgplan.domain.checks import MAX_SEED, MAX_TRIALS
 from hsgplan.paths import PERCEPTION_CHECKPOINT, RUNS
 
 
@@ -69,10 +69,8 @@ def eval_perception(
     checkpoint: Annotated[
         Path, typer.Option(help="Keypoint network checkpoint.", parser=input_path)
     ] = PERCEPTION_CHECKPOINT,
-    scenes: Annotated[int, typer.Option(help="Fresh scenes.", min=1, max=MAX_TRIALS)] = 100,
-    seed: Annotated[
-        int, typer.Option(help="Seed of the scenes (training's is 0).", min=0, max=MAX_SEED)
-    ] = 1,
+    scenes: Annotated[int, bounded_option("scenes", "Fresh scenes.")] = 100,
+    seed: Annotated[int, bounded_option("seed", "Seed of the scenes (training's is 0).")] = 1,
     raw: Annotated[
         bool, typer.Option(help="The fused PnP poses, not made to rest on their supports.")
     ] = False,

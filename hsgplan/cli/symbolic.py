@@ -9,9 +9,8 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli.common import err, out, refuses_bad_input, shown
+from hsgplan.cli.common import bounded_option, err, out, refuses_bad_input, shown
 from hsgplan.cli.common import out_file as file_to_write
-from hsgplan.domain.checks import MAX_GOALS, MAX_SEED
 from hsgplan.domain.errors import InvalidInputError
 
 
@@ -110,10 +109,10 @@ def plan(
 @refuses_bad_input
 def goals(
     objects: Annotated[int, typer.Option(help="Objects per goal (2-12).")],
-    goals: Annotated[int, typer.Option(help="How many goals.", min=1, max=MAX_GOALS)],
+    goals: Annotated[int, bounded_option("goals", "How many goals.")],
     seed: Annotated[
         int,
-        typer.Option(help="Random seed; the same seed gives the same goals.", min=0, max=MAX_SEED),
+        bounded_option("seed", "Random seed; the same seed gives the same goals."),
     ] = 0,
     out_file: Annotated[
         Path | None,

@@ -18,6 +18,7 @@ from hsgplan.cli.common import (
     ProtocolName,
     RayAddress,
     RunFolder,
+    bounded_option,
     check_ray,
     err,
     input_path,
@@ -28,7 +29,6 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
-from hsgplan.domain.checks import MAX_FAILURES, MAX_GOALS, MAX_REPEATS, MAX_SEED, MAX_WORKERS
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import RECOVERING, RecoveryRules
 from hsgplan.paths import RUNS, shipped
@@ -58,9 +58,7 @@ def demo(
         str | None, typer.Option(help="Goal literals (default: a random goal).")
     ] = None,
     objects: Annotated[int, typer.Option(help="Objects in the random goal (2-12).")] = 4,
-    seed: Annotated[
-        int, typer.Option(help="Seed for the goal and the scene.", min=0, max=MAX_SEED)
-    ] = 0,
+    seed: Annotated[int, bounded_option("seed", "Seed for the goal and the scene.")] = 0,
     out_dir: Annotated[
         Path, typer.Option("--out", help="Folder for the pictures.", parser=out_folder)
     ] = RUNS / "demo",
@@ -129,14 +127,12 @@ def evaluate(
         ),
     ] = None,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-6.")] = "2-6",
-    goals: Annotated[int, typer.Option(help="Random goals per size.", min=1, max=MAX_GOALS)] = 50,
+    goals: Annotated[int, bounded_option("goals", "Random goals per size.")] = 50,
     repeats: Annotated[
         int,
-        typer.Option(help="Episodes per goal, each from its own scene.", min=1, max=MAX_REPEATS),
+        bounded_option("repeats", "Episodes per goal, each from its own scene."),
     ] = 1,
-    seed: Annotated[
-        int, typer.Option(help="Seed of the goals and the episodes.", min=0, max=MAX_SEED)
-    ] = 0,
+    seed: Annotated[int, bounded_option("seed", "Seed of the goals and the episodes.")] = 0,
     goals_file: Annotated[
         Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
     ] = None,
@@ -181,9 +177,7 @@ def evaluate(
             "(one folder each), and print what each buys."
         ),
     ] = False,
-    workers: Annotated[
-        int, typer.Option(help="Episodes run side by side.", min=1, max=MAX_WORKERS)
-    ] = 2,
+    workers: Annotated[int, bounded_option("workers", "Episodes run side by side.")] = 2,
     run_dir: RunFolder = None,
     ray: RayAddress = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
@@ -284,11 +278,7 @@ def report(
     ],
     failures: Annotated[
         int,
-        typer.Option(
-            help="Failed episodes re-simulated and shown, GIF and graphs.",
-            min=0,
-            max=MAX_FAILURES,
-        ),
+        bounded_option("failures", "Failed episodes re-simulated and shown, GIF and graphs."),
     ] = 6,
 ) -> None:
     """One self-contained HTML page for an eval run: its tables and plot, and failed episodes

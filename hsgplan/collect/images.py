@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from hsgplan.domain.checks import MAX_SAMPLES, MAX_SEED, bounded, check_fields, setting
+from hsgplan.domain.checks import BOUNDS, MAX_SAMPLES, bounded, check_fields, setting
 from hsgplan.perception.images import CHUNK, FORMAT, render_chunk, write_format
 from hsgplan.perception.synthetic import P_ELSEWHERE, VIEWS, first_views
 from hsgplan.runner.items import run_items
@@ -17,8 +17,8 @@ KIND = "collect-images"
 @dataclass(frozen=True)
 class ImagesConfig:
     # samples wanted (unstaged draws are skipped, so the last chunk may hold fewer)
-    count: int = field(metadata=bounded(lo=1, hi=MAX_SAMPLES))
-    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    count: int = field(metadata=bounded(**BOUNDS["samples"]))
+    seed: int = setting(0, **BOUNDS["seed"])
     chunk: int = setting(CHUNK, lo=1, hi=MAX_SAMPLES)
     p_elsewhere: float = setting(P_ELSEWHERE, lo=0.0, hi=1.0)  # see `synthetic.P_ELSEWHERE`
     views: int = len(VIEWS)  # the first this many fixed views (3: shoulders and front)

@@ -21,10 +21,9 @@ import numpy as np
 from hsgplan.data import motion_store as store
 from hsgplan.data.motion_trials import ATTEMPTS_PER_TASK, TASKS_PER_CHUNK, run_chunk
 from hsgplan.domain.checks import (
+    BOUNDS,
     MAX_SAMPLES,
-    MAX_SEED,
     MAX_TASKS_PER_CHUNK,
-    MAX_WORKERS,
     bounded,
     check_fields,
     setting,
@@ -42,8 +41,8 @@ REJECTED = "rejected"
 class CollectConfig:
     primitive: MotionPrimitive
     samples: int = field(metadata=bounded(lo=0, hi=MAX_SAMPLES))
-    seed: int = setting(0, lo=0, hi=MAX_SEED)
-    workers: int = setting(2, lo=1, hi=MAX_WORKERS)
+    seed: int = setting(0, **BOUNDS["seed"])
+    workers: int = setting(2, **BOUNDS["workers"])
     ray_address: str | None = None
     # the unit of work, and of what an interruption loses
     tasks_per_chunk: int = setting(TASKS_PER_CHUNK, lo=1, hi=MAX_TASKS_PER_CHUNK)

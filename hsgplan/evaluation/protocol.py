@@ -24,9 +24,7 @@ from functools import lru_cache, partial
 from pathlib import Path
 
 from hsgplan.domain.checks import (
-    MAX_GOALS,
-    MAX_REPEATS,
-    MAX_SEED,
+    BOUNDS,
     bounded,
     check_fields,
     read_json,
@@ -46,10 +44,10 @@ from hsgplan.symbolic.generator import random_goals
 class EvalConfig:
     agent: str
     sizes: tuple[int, ...]
-    goals: int = field(metadata=bounded(lo=0, hi=MAX_GOALS))  # per size (a goal file: unused)
-    seed: int = field(metadata=bounded(lo=0, hi=MAX_SEED))
+    goals: int = field(metadata=bounded(**BOUNDS["goals"]))  # per size (a goal file: unused)
+    seed: int = field(metadata=bounded(**BOUNDS["seed"]))
     goals_file: str | None = None
-    repeats: int = setting(1, lo=1, hi=MAX_REPEATS)
+    repeats: int = setting(1, **BOUNDS["repeats"])
     checkpoint: str | None = None  # the task planner's folder (None: the shipped one)
     motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
     perception: str = "gt"  # what the agent sees: "gt" (the simulator's poses) or "rgb" (f_p)

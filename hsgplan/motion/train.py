@@ -24,9 +24,7 @@ from hsgplan import training
 from hsgplan.checkpoint import fingerprint
 from hsgplan.data.motion_store import MotionData, load_dataset
 from hsgplan.domain.checks import (
-    MAX_SAMPLES,
-    MAX_SEED,
-    MAX_WORKERS,
+    BOUNDS,
     check_fields,
     from_settings,
     setting,
@@ -44,7 +42,7 @@ class MotionTrainConfig:
     primitive: str = "place"
     model: str = "gnn"
     data: str = str(MOTION_DATA)
-    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    seed: int = setting(0, **BOUNDS["seed"])
     epochs: int = setting(40, lo=1, hi=10_000)
     lr: float = setting(1e-3, above=0, hi=10)
     batch_size: int = setting(64, lo=1, hi=65_536)
@@ -53,10 +51,10 @@ class MotionTrainConfig:
     rounds: int = setting(2, lo=0, hi=16)
     save_every: int = setting(5, lo=1, hi=10_000)
     # the first this many samples of the dataset (None: all)
-    samples: int | None = setting(None, lo=1, hi=MAX_SAMPLES)
+    samples: int | None = setting(None, **BOUNDS["samples"])
     # The networks are small: measured on 2 busy cores, 2 threads trained ten times slower
     # than 1 (they fight the simulation workers for the cores).
-    threads: int = setting(1, lo=1, hi=MAX_WORKERS)
+    threads: int = setting(1, **BOUNDS["workers"])
     loss: str = "ce"  # "ce" (successes, the paper's) or "bce" (every trial)
     head: str = "mlp"  # the GNN's head: "mlp" (the paper's) or "bins" (`models.BinQueryHead`)
 

@@ -31,7 +31,7 @@ import torch
 from torch import nn
 
 from hsgplan.checkpoint import load_trained
-from hsgplan.domain.checks import MAX_SEED, check_fields, from_settings, setting
+from hsgplan.domain.checks import BOUNDS, check_fields, from_settings, setting
 from hsgplan.domain.world import OBJECT_TYPES
 
 PATCH = 3  # pixels each side of the centroid's pixel
@@ -50,7 +50,7 @@ class ColourConfig:
     hidden: int = setting(32, lo=1, hi=4096)
     steps: int = setting(400, lo=1, hi=1_000_000)
     lr: float = setting(0.01, above=0, hi=10)
-    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    seed: int = setting(0, **BOUNDS["seed"])
 
     def __post_init__(self) -> None:
         check_fields(self)

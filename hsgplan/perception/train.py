@@ -24,7 +24,12 @@ import torch
 
 from hsgplan import training
 from hsgplan.checkpoint import fingerprint
-from hsgplan.domain.checks import MAX_SEED, MAX_WORKERS, check_fields, from_settings, setting
+from hsgplan.domain.checks import (
+    BOUNDS,
+    check_fields,
+    from_settings,
+    setting,
+)
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.perception.colour import (
     BACKGROUND,
@@ -50,7 +55,7 @@ BACKGROUND_PATCHES = 3  # patches of background an image, for the colour network
 @dataclass(frozen=True)
 class PerceptionTrainConfig:
     images: str = "runs/collect-images"
-    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    seed: int = setting(0, **BOUNDS["seed"])
     epochs: int = setting(9, lo=1, hi=10_000)
     lr: float = setting(1e-3, above=0, hi=10)
     # The learning rate falls along a half cosine from `lr` to this fraction of it by the last
@@ -61,7 +66,7 @@ class PerceptionTrainConfig:
     stages: int = setting(2, lo=1, hi=6)
     stride: int = setting(4, lo=2, hi=4)  # see `perception.model`: 4, or 2 (not trained yet)
     save_every: int = setting(1, lo=1, hi=10_000)
-    threads: int = setting(2, lo=1, hi=MAX_WORKERS)
+    threads: int = setting(2, **BOUNDS["workers"])
     # A trained checkpoint folder whose weights start the network (a stride-2 network from a
     # stride-4 one of the same sizes, its refinement head fresh); "": from scratch.
     init: str = ""

@@ -23,7 +23,7 @@ from torch_geometric.data import Batch
 from hsgplan import training
 from hsgplan.checkpoint import fingerprint
 from hsgplan.data.world_trials import load_world_trials
-from hsgplan.domain.checks import MAX_SEED, check_fields, from_settings, setting
+from hsgplan.domain.checks import BOUNDS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.files import write_atomically
 from hsgplan.paths import DEMOS, REACH_DATA, shipped
@@ -54,7 +54,7 @@ class TaskTrainConfig:
     f_reach from primitives executed in the simulated world)."""
 
     demos: str = str(DEMOS)
-    seed: int = setting(0, lo=0, hi=MAX_SEED)
+    seed: int = setting(0, **BOUNDS["seed"])
     epochs: int = setting(8, lo=1, hi=10_000)
     lr: float = setting(1e-3, above=0, hi=10)
     batch_size: int = setting(32, lo=1, hi=65_536)
