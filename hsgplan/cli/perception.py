@@ -85,8 +85,8 @@ def eval_perception(
     ] = None,
 ) -> None:
     """f_p on fresh synthetic scenes: pose errors per object type, symbolic scene graph match."""
+    from hsgplan.evaluation.perception_eval import evaluate, summary
     from hsgplan.perception.estimator import PoseEstimator
-    from hsgplan.perception.evaluate import evaluate, summary
     from hsgplan.perception.synthetic import VIEWS, first_views
 
     shown = len(first_views(views)) if views is not None else len(VIEWS)  # before loading

@@ -11,8 +11,8 @@ from scipy.spatial.transform import Rotation
 
 from hsgplan.domain.objects import type_of
 from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.evaluation.perception_eval import rotation_error, score_scene, summary
 from hsgplan.perception.estimator import Detection, PoseEstimator, _apart, _fitted, _of_kind
-from hsgplan.perception.evaluate import rotation_error, score_scene, summary
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE
@@ -141,7 +141,7 @@ def test_an_object_on_its_side_stays_toppled_and_a_noisy_upright_one_stands():
 
 
 def test_the_evaluation_sees_from_the_first_views_asked_for():
-    from hsgplan.perception.evaluate import evaluate
+    from hsgplan.evaluation.perception_eval import evaluate
 
     class Counting:
         def __init__(self):

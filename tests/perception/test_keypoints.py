@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from hsgplan.domain.objects import object_type
-from hsgplan.perception.evaluate import rotation_error
+from hsgplan.evaluation.perception_eval import rotation_error
 from hsgplan.perception.keypoints import (
     KEYPOINTS,
     PinholeCamera,
