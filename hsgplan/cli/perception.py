@@ -83,9 +83,16 @@ def eval_perception(
             min=1,
         ),
     ] = None,
+    loop: Annotated[
+        bool,
+        typer.Option(
+            help="Scenes from inside the loop (the oracle part way through a random goal, the "
+            "scene's own look) instead of synthetic ones."
+        ),
+    ] = False,
 ) -> None:
     """f_p on fresh synthetic scenes: pose errors per object type, symbolic scene graph match."""
-    from hsgplan.evaluation.perception_eval import evaluate, summary
+    from hsgplan.evaluation.perception_eval import evaluate, evaluate_loop, summary
     from hsgplan.perception.estimator import PoseEstimator
     from hsgplan.perception.synthetic import VIEWS, first_views
 
@@ -93,7 +100,8 @@ def eval_perception(
     estimator = PoseEstimator.load(checkpoint, settled=not raw)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
-        report = summary(evaluate(estimator, scenes, seed, lambda: progress.advance(task), shown))
+        run = evaluate_loop if loop else evaluate
+        report = summary(run(estimator, scenes, seed, lambda: progress.advance(task), shown))
     if as_json:
         print(json.dumps(report, indent=2))
         return
@@ -116,7 +124,8 @@ def eval_perception(
         )
     )
     title = (
-        f"f_p on {report['scenes']} fresh scenes, seed {seed}"
+        f"f_p on {report['scenes']} {'scenes from inside the loop' if loop else 'fresh scenes'}, "
+        f"seed {seed}"
         f"{f' (the first {views} views)' if views else ''}: objects found (recall) "
         f"{report['found_rate']:.3f}, detections matching an object (precision) "
         f"{report['precision']:.3f} ({report['unmatched_detections']} matched none), "

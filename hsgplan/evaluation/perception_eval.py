@@ -1,4 +1,5 @@
-"""`hsgplan eval perception`: f_p against the ground truth on fresh synthetic scenes.
+"""`hsgplan eval perception`: f_p against the ground truth on fresh synthetic scenes, or on
+scenes taken from inside the loop (`loop_scenes`).
 
 Each scene (`perception.synthetic.render_sample`, another seed than training's) is seen by the
 estimator; its detections are matched to the scene's objects type by type, nearest first
@@ -71,20 +72,24 @@ def match(truth: dict[str, Pose], detections: list[Detection]) -> dict[str, Dete
 
 
 def score_scene(sample: ImageSample, detections: list[Detection]) -> SceneResult:
-    truth = {o: _pose(sample, i) for i, o in enumerate(sample.objects)}
+    return score({o: _pose(sample, i) for i, o in enumerate(sample.objects)}, detections)
+
+
+def score(truth: dict[str, Pose], detections: list[Detection]) -> SceneResult:
+    """A scene's detections against its objects' true poses."""
     matched = match(truth, detections)
-    names = [o for o in sample.objects if o in matched]
+    names = [o for o in truth if o in matched]
     translation = [
         100 * float(np.linalg.norm(np.subtract(matched[o].pose.position, truth[o].position)))
         for o in names
     ]
     rotation = [rotation_error(o, truth[o], matched[o].pose) for o in names]
-    same = len(names) == len(sample.objects) and (
+    same = len(names) == len(truth) and (
         map_symbols(GeometricSceneGraph.from_poses(truth)).state
         == map_symbols(GeometricSceneGraph.from_poses({o: matched[o].pose for o in names})).state
     )
     return SceneResult(
-        len(sample.objects),
+        len(truth),
         len(names),
         tuple(translation),
         tuple(rotation),
@@ -108,6 +113,32 @@ def evaluate(
         sample = render_sample(seed, index, views=views)
         if sample is not None:
             out.append(score_scene(sample, estimator.detect(sample.images, sample.cameras)))
+        if on_scene:
+            on_scene()
+    return out
+
+
+def evaluate_loop(
+    estimator: PoseEstimator,
+    scenes: int,
+    seed: int,
+    on_scene: Callable[[], None] | None = None,
+    views: int = len(VIEWS),
+) -> list[SceneResult]:
+    """f_p on scenes from inside the loop (`loop_scenes`), seen from the first `views` fixed
+    views as the rgb observer sees them."""
+    from hsgplan.evaluation.loop_scenes import loop_scenes
+    from hsgplan.perception.synthetic import first_views
+
+    cameras = first_views(views)
+    out = []
+    for scene in loop_scenes(scenes, seed, cameras):
+        detections = estimator.detect(scene.images, cameras)
+        if scene.held is not None:  # the robot knows where its hand is: not f_p's to find
+            hand = np.asarray(scene.held.position)
+            far = [np.linalg.norm(np.subtract(d.pose.position, hand)) for d in detections]
+            detections = [d for d, f in zip(detections, far, strict=True) if f > MATCH_DISTANCE]
+        out.append(score(scene.truth, detections))
         if on_scene:
             on_scene()
     return out
