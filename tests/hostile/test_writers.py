@@ -23,7 +23,8 @@ def _temporary_files(folder):
 def test_a_second_run_into_a_folder_being_written_is_refused(launcher, home, tmp_path):
     cwd = tmp_path / "cwd"
     cwd.mkdir()
-    args = [*EVAL[:4], "6", *EVAL[5:]]  # long enough to be caught running
+    at = EVAL.index("--goals") + 1
+    args = [*EVAL[:at], "6", *EVAL[at + 1 :]]  # long enough to be caught running
     first = subprocess.Popen(
         [sys.executable, "-m", "hsgplan.cli", *args],
         cwd=cwd,
