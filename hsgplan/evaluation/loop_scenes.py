@@ -1,9 +1,10 @@
 """Scenes from inside the loop, for scoring f_p where the agent uses it: the oracle agent
 (Fast Downward and the geometric sampler) runs a random goal of 2 to 6 objects for a random
-number of steps (1 to `MAX_STEPS_INTO`), and the scene is taken as it stands then: objects
-stacked, pushed into a shelf, put down where a primitive left them, one in the hand. The
-fixed cameras render it with the scene's own look, as the rgb observer sees it; the object in
-the hand is left out of the truth (the robot knows where its hand is).
+number of steps (1 to `MAX_STEPS_INTO`, fewer where the goal holds sooner), and the scene is
+taken as it stands then: objects stacked, pushed into a shelf, put down where a primitive left
+them, one in the hand. The fixed cameras render it with the scene's own look, as the rgb
+observer sees it; the object in the hand is left out of the truth (the robot knows where its
+hand is). An episode that ends on a failure before gives no scene.
 
 The same seed gives the same scenes. Goals and step counts come from `random.Random(seed)`
 drawn per scene, the episodes' seeds from them.
@@ -53,6 +54,8 @@ def loop_scenes(scenes: int, seed: int, cameras: tuple[Camera, ...]) -> Iterator
             wanted = rng.randint(1, MAX_STEPS_INTO)
             steps = _run_into(env, agent, goal, rng.randrange(MAX_SEED), wanted)
             scene = env.scene
+            if scene is None:  # the episode ended on a failure before: no scene to take
+                continue
             held = scene.held()
             poses = scene.poses()
             images = np.stack([c.capture(scene.bc) for c in cameras])
@@ -63,12 +66,13 @@ def loop_scenes(scenes: int, seed: int, cameras: tuple[Camera, ...]) -> Iterator
 
 
 def _run_into(env: KitchenStorageEnv, agent, goal, seed: int, wanted: int) -> int:
-    """Run the episode until `wanted` steps have run or it ends; the steps run."""
+    """Run the episode until `wanted` steps have run or the goal holds, its scene left open;
+    the steps run."""
     steps = [0]
 
-    def stop(record, _obs) -> None:
+    def stop(record, obs) -> None:
         steps[0] = 0 if record is None else record.step
-        if steps[0] >= wanted:
+        if steps[0] >= wanted or (record is not None and goal.satisfied_by(obs.symbols.state)):
             raise _Taken
 
     with contextlib.suppress(_Taken):
