@@ -35,20 +35,16 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
-import numpy as np
-
-from hsgplan.agents.incremental import STREAM_SEARCH
 from hsgplan.agents.stream_problem import (
     StreamPlan,
     StreamProblem,
     add_grasp,
-    aim,
     decode_step,
     goal_surface,
-    initial_problem,
     params_at,
     pddl_objects,
     stackable,
+    start_problem,
 )
 from hsgplan.agents.streams import (
     PoseValue,
@@ -64,7 +60,7 @@ from hsgplan.domain.world import SURFACES
 from hsgplan.planning.fast_downward import NoPlanError, solve_pddl
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.symbolic.stream_pddl import DOMAIN, Fact, problem_text
+from hsgplan.symbolic.stream_pddl import DOMAIN, STREAM_SEARCH, Fact, problem_text
 
 
 @dataclass(frozen=True)
@@ -140,8 +136,7 @@ class FocusedPlanner:
         cfg, start = self.config, time.perf_counter()
         task = motion = 0.0
         t0 = time.perf_counter()
-        prob = initial_problem(sg, state, np.random.default_rng(seed))
-        aim(prob, goal, cfg.goal_stacks)
+        prob = start_problem(sg, state, goal, seed, cfg.goal_stacks)
         for o in state.objects:
             if o not in prob.grasps:
                 add_grasp(prob, o, 0)

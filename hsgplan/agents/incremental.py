@@ -51,19 +51,16 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-import numpy as np
-
 from hsgplan.agents.stream_problem import (
     StreamPlan,
     StreamProblem,
     add_grasp,
-    aim,
     decode_step,
     goal_surface,
-    initial_problem,
     params_at,
     pddl_objects,
     stackable,
+    start_problem,
 )
 from hsgplan.agents.streams import (
     StreamWorld,
@@ -78,14 +75,7 @@ from hsgplan.domain.world import SURFACES
 from hsgplan.planning.fast_downward import NoPlanError, solve_pddl
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.symbolic.stream_pddl import DOMAIN, problem_text
-
-# Fast Downward's search as the project's (`SATISFICING_SEARCH`), but with the FF heuristic's
-# negated axioms over-approximated: computed exactly (the default), the negation of
-# `unsafepose`, a conjunction over every pose it could collide with, made the heuristic's set-up
-# run out of 19 s and 800 MB on a 6-object problem of 20,000 facts; approximated, the search
-# proved that problem unsolvable in 5 s.
-STREAM_SEARCH = "let(hff,ff(axioms=approximate_negative),lazy_wastar([hff],preferred=[hff],w=2))"
+from hsgplan.symbolic.stream_pddl import DOMAIN, STREAM_SEARCH, problem_text
 
 
 @dataclass(frozen=True)
@@ -145,8 +135,7 @@ class IncrementalPlanner:
         cfg, start = self.config, time.perf_counter()
         task = motion = 0.0
         t0 = time.perf_counter()
-        prob = initial_problem(sg, state, np.random.default_rng(seed))
-        aim(prob, goal, cfg.goal_stacks)
+        prob = start_problem(sg, state, goal, seed, cfg.goal_stacks)
         motion += time.perf_counter() - t0
         for level in range(1, cfg.max_levels + 1):
             if time.perf_counter() - start > cfg.time_limit_s:

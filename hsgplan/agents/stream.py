@@ -16,6 +16,7 @@ tests) and turning the plan into parameters.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from hsgplan.agents.base import Decision
@@ -124,10 +125,10 @@ def make_stream_agent(name: str) -> StreamAgent:
     from hsgplan.agents.focused import FOCUSED_GOAL_DIRECTED, FocusedPlanner
     from hsgplan.agents.incremental import GOAL_DIRECTED
 
-    planners: dict[str, StreamPlanner] = {
-        "stream": IncrementalPlanner(),
-        "stream-goal": IncrementalPlanner(GOAL_DIRECTED),
-        "stream-focused": FocusedPlanner(),
-        "stream-focused-goal": FocusedPlanner(FOCUSED_GOAL_DIRECTED),
+    planners: dict[str, Callable[[], StreamPlanner]] = {
+        "stream": IncrementalPlanner,
+        "stream-goal": lambda: IncrementalPlanner(GOAL_DIRECTED),
+        "stream-focused": FocusedPlanner,
+        "stream-focused-goal": lambda: FocusedPlanner(FOCUSED_GOAL_DIRECTED),
     }
-    return StreamAgent(planners[name], name)
+    return StreamAgent(planners[name](), name)

@@ -182,6 +182,16 @@ def initial_problem(sg: GeometricSceneGraph, state: SymbolicSceneGraph, rng) -> 
     return prob
 
 
+def start_problem(
+    sg: GeometricSceneGraph, state: SymbolicSceneGraph, goal: Goal, seed: int, goal_stacks: bool
+) -> StreamProblem:
+    """The observed scene as a problem's first facts (`initial_problem`), its samplers drawing
+    from `seed`, and what the goal tells the goal-directed streams (`aim`)."""
+    prob = initial_problem(sg, state, np.random.default_rng(seed))
+    aim(prob, goal, goal_stacks)
+    return prob
+
+
 def pddl_objects(prob: StreamProblem, state: SymbolicSceneGraph) -> dict[str, list[str]]:
     return {
         "obj": list(state.objects),

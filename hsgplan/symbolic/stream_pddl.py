@@ -95,6 +95,13 @@ DOMAIN = """\
     :effect (and (atpose ?o ?p2) (not (atpose ?o ?p)))))
 """
 
+# Fast Downward's search as the project's (`SATISFICING_SEARCH`), but with the FF heuristic's
+# negated axioms over-approximated: computed exactly (the default), the negation of
+# `unsafepose`, a conjunction over every pose it could collide with, made the heuristic's set-up
+# run out of 19 s and 800 MB on a 6-object problem of 20,000 facts; approximated, the search
+# proved that problem unsolvable in 5 s.
+STREAM_SEARCH = "let(hff,ff(axioms=approximate_negative),lazy_wastar([hff],preferred=[hff],w=2))"
+
 # PDDL type of each kind of object a problem declares.
 TYPES = ("obj", "surface", "pose", "grasp", "conf", "push")
 

@@ -4,10 +4,9 @@ too little."""
 
 import pytest
 
-from hsgplan.agents.incremental import STREAM_SEARCH
 from hsgplan.domain.goals import parse_goal
 from hsgplan.planning.fast_downward import NoPlanError, solve_pddl
-from hsgplan.symbolic.stream_pddl import DOMAIN, goal_text, problem_text
+from hsgplan.symbolic.stream_pddl import DOMAIN, STREAM_SEARCH, goal_text, problem_text
 
 SURFACES = ["open_space", "prepush_a", "prepush_b", "shelf_a", "shelf_b"]
 
