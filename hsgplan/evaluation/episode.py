@@ -40,6 +40,7 @@ class StepRecord:
     task_seconds: float
     motion_seconds: float
     execution_seconds: float
+    relooks: int = 0  # looks taken before the primitive, from out of the cameras' way
 
 
 @dataclass(frozen=True)
@@ -118,6 +119,9 @@ def run_episode(
         if env.steps >= env.max_steps:
             failure = Failure.OVERSTEP
             break
+        if obs.unknown:  # nothing to plan with: no view has found it yet
+            failure = Failure.NEVER_SEEN
+            break
         d = agent.decide(obs.scene_graph, obs.symbols.state, goal, feasible=env.lookahead)
         if d.params is None:
             failure = Failure.NO_SUBGOAL if d.action is None else Failure.NO_PARAMETERS
@@ -140,6 +144,7 @@ def run_episode(
             d.task_seconds,
             d.motion_seconds,
             outcome.seconds,
+            outcome.relooks,
         )
         records.append(record)
         if on_step:

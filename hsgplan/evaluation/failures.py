@@ -13,3 +13,4 @@ class Failure(StrEnum):
     KNOCKED_OVER = "knocked_over"  # simulated world: an object toppled
     OFF_TABLE = "off_table"  # simulated world: an object fell off the table
     MISPERCEIVED = "misperceived"  # the agent saw the goal reached where it truly was not
+    NEVER_SEEN = "never_seen"  # the agent had to decide with no pose for an object of the goal

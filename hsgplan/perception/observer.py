@@ -1,22 +1,31 @@
-"""f_p in the loop: the scene graph the agent plans on, from the fixed cameras' images.
+"""f_p in the loop: the robot's belief of where the objects are, from the fixed cameras' images.
 
-Every observation renders the fixed views (`perception.synthetic.VIEWS`, the scene's own look),
-runs the pose estimator and names what it found. The goal names object instances, so the
-observer keeps a track of each: detections of a kind (cans, boxes) are given to that kind's
-objects by an optimal assignment on the type f_p named and the distance to where each object
-was last seen (`assign`). Tracks start where the scene was staged (the goal's names must refer
-to something; only look-alike duplicates need it), and an object no view found this time keeps
-its last pose and is reported unseen; what was found is then made to rest again with the unseen
+The observer is given what a real robot has (`sim.observer.Look`): the images, the cameras'
+calibration, the arm's joints and what it knows of its own hand; and, when an episode starts,
+the goal's object names (their types follow from them). Nothing else: no staged pose, no
+simulated scene. Every look runs the pose estimator and names what it found. The goal names
+object instances, so the observer keeps a track of each: detections of a kind (cans, boxes)
+are given to that kind's tracked objects by an optimal assignment on the type f_p named and
+the distance to where each object was last seen (`assign`). An object has no pose until it is
+first seen: what is left of a look's detections after the tracks took theirs is given to the
+objects never seen, by type, the surest first (`first_sight`); look-alike duplicates of one
+type are named in the order f_p is surest of them. An object no view found this time keeps its
+last pose and is reported unseen; what was found is then made to rest again with the unseen
 objects where they are believed as supports too (a can put down on a butter hides it from
-every view, and would otherwise be seen sunk onto the shelf under it). The object in the
-hand is the robot's own knowledge: its pose is the gripper's (the arm's kinematics and the
-grasp), not an estimate; and one let go since the last look was last seen where the hand let
-it go (`Panda.released`), not where it was carried.
+every view, and would otherwise be seen sunk onto the shelf under it). The object in the hand
+is the robot's own knowledge: its pose is the arm's kinematics and the grasp as planned, not an
+estimate, and detections at the hand are not other objects; one let go since the last look was
+last seen where the hand let it go, not where it was carried.
+
+Each object's belief is as sure as its last sighting: one not seen this time, or seen by a
+single view (whose depth along its line of sight PnP gets worst), is reported `uncertain`.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -28,9 +37,8 @@ from hsgplan.perception.estimator import Detection, PoseEstimator
 from hsgplan.perception.synthetic import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
-from hsgplan.sim.observer import Seen
+from hsgplan.sim.observer import Look, Seen
 from hsgplan.sim.render import Camera
-from hsgplan.sim.scene import Scene
 
 # A detection f_p named another type is only an object's if it is within this of where the
 # object was last seen (within `STILL` if a single view saw it).
@@ -47,6 +55,11 @@ FORBIDDEN = 1e6
 STILL = 0.05  # m
 
 
+# m from the held object's pose within which a detection is the hand's load or the hand: the
+# robot knows where its hand is, so nothing there is another object.
+HAND_RADIUS = 0.1
+
+
 class RgbObserver:
     """Args:
     estimator: the trained pose estimator.
@@ -58,34 +71,69 @@ class RgbObserver:
     def __init__(self, estimator: PoseEstimator, cameras: tuple[Camera, ...] = VIEWS) -> None:
         self.estimator = estimator
         self.cameras = cameras
+        self._objects: tuple[str, ...] = ()
         self._last: dict[str, Pose] = {}
-        self._held: str | None = None
+        self._views: dict[str, int] = {}
 
     @staticmethod
     def load(folder: Path) -> RgbObserver:
         return RgbObserver(PoseEstimator.load(folder))
 
-    def reset(self, scene: Scene) -> None:
-        self._last = scene.poses()
-        self._held = scene.held()
+    def start(self, objects: tuple[str, ...]) -> None:
+        self._objects = tuple(objects)
+        self._last, self._views = {}, {}
 
-    def observe(self, scene: Scene) -> Seen:
-        images = np.stack([camera.capture(scene.bc) for camera in self.cameras])
-        detections = self.estimator.detect(images, self.cameras)
-        held = scene.held()
-        let_go = self._held if self._held not in (None, held) else None
-        released = scene.robot.released
-        if let_go is not None and released and released[0] == scene.bodies[let_go]:
+    def look(self, look: Look) -> Seen:
+        start = time.perf_counter()
+        detections = self.estimator.detect(look.images, look.cameras)
+        held = look.holding
+        if look.released is not None:
             # last seen in the hand: it is where the hand let it go, which the robot knows
-            self._last[let_go] = released[1]
-        self._held = held
-        last = {o: p for o, p in self._last.items() if o != held}
+            name, pose = look.released
+            self._last[name] = pose
+        if held is not None and look.held_pose is not None:
+            hand = np.array(look.held_pose.position)
+            detections = [
+                d for d in detections if np.linalg.norm(d.pose.position - hand) > HAND_RADIUS
+            ]
+        known = {o: p for o, p in self._last.items() if o != held}
         rest = self.estimator.rest if self.estimator.settled else None
-        poses, unseen = tracked(detections, last, rest)
-        if held is not None:
-            poses[held] = scene.pose(held)
-        self._last = {o: poses[o] for o in self._last}
-        return Seen(GeometricSceneGraph.from_poses(self._last, held=held), unseen)
+        tracks = tracked(detections, known, rest)
+        never = [o for o in self._objects if o not in self._last and o != held]
+        first = first_sight(tracks.left, never, self._objects)
+        poses = tracks.poses | {o: d.pose for o, d in first.items()}
+        views = {o: d.views for o, d in (tracks.found | first).items()}
+        if held is not None and look.held_pose is not None:
+            poses[held] = look.held_pose
+            views[held] = len(look.cameras)  # the robot's own knowledge: sure
+        self._last = {o: poses[o] for o in self._objects if o in poses}
+        self._views = {o: views.get(o, 0) for o in self._last}
+        unknown = tuple(o for o in self._objects if o not in self._last)
+        uncertain = tuple(o for o in self._last if self._views[o] <= 1) + unknown
+        return Seen(
+            GeometricSceneGraph.from_poses(self._last, held=held),
+            tracks.unseen,
+            unknown,
+            uncertain,
+            time.perf_counter() - start,
+        )
+
+
+@dataclass(frozen=True)
+class Tracks:
+    """A look's detections given to the tracked objects.
+
+    Attributes:
+        poses: every tracked object's pose (by its detection, else its last pose).
+        unseen: tracked objects no detection was given to (their last poses kept).
+        found: each object given a detection, and that detection.
+        left: detections given to no tracked object.
+    """
+
+    poses: dict[str, Pose]
+    unseen: tuple[str, ...]
+    found: dict[str, Detection] = field(default_factory=dict)
+    left: tuple[Detection, ...] = ()
 
 
 def tracked(
@@ -93,7 +141,7 @@ def tracked(
     last: dict[str, Pose],
     rest: Callable[[list[Detection], list[tuple[str, Pose]], dict[int, Pose]], list[Detection]]
     | None = None,
-) -> tuple[dict[str, Pose], tuple[str, ...]]:
+) -> Tracks:
     """Every object's pose (by its last pose `last`) and those no detection was given
     (`assigned`), which keep their last poses; with `rest` (`PoseEstimator.rest`), the
     detections are made to rest again with the unseen objects as supports, a lone view's at
@@ -105,10 +153,47 @@ def tracked(
     near = {index[id(d)]: last[o] for o, d in found.items() if len(d.rays) == 1}
     if (unseen or near) and rest is not None:
         fixed = [(type_of(o), last[o]) for o in unseen]
-        found = assigned(rest(detections, fixed, near), last)
+        detections = rest(detections, fixed, near)
+        found = assigned(detections, last)
         unseen = tuple(o for o in last if o not in found)
     poses = {o: d.pose for o, d in found.items()}
-    return poses | {o: last[o] for o in unseen}, unseen
+    taken = {id(d) for d in found.values()}
+    left = tuple(d for d in detections if id(d) not in taken)
+    return Tracks(poses | {o: last[o] for o in unseen}, unseen, found, left)
+
+
+def first_sight(
+    detections: tuple[Detection, ...], never: list[str], objects: tuple[str, ...]
+) -> dict[str, Detection]:
+    """Objects never seen before (`never`, of the episode's `objects`), given the detections no
+    tracked object took: each object (in its name's order) the detection f_p named its type,
+    the surest first (more views, then the colour network's confidence, then the keypoint
+    network's score); then, to an object still unseen, a detection of its kind whose type is
+    none of the episode's objects' (f_p misnamed it: the scene holds the goal's objects and no
+    others), the surest first. A detection of a type already seen is never a guess's: it is
+    likelier that object's phantom."""
+    out: dict[str, Detection] = {}
+    pool = sorted(detections, key=lambda d: (-d.views, -d.type_confidence, -d.score))
+    for o in never:
+        d = next((d for d in pool if d.type_name == type_of(o)), None)
+        if d is not None:
+            out[o] = d
+            pool.remove(d)
+    present = {type_of(o) for o in objects}
+    for o in (o for o in never if o not in out):
+        kind = object_type(o).kind
+        d = next(
+            (
+                d
+                for d in pool
+                if OBJECT_TYPES[d.type_name].kind is kind and d.type_name not in present
+            ),
+            None,
+        )
+        if d is not None:
+            out[o] = d
+            pool.remove(d)
+    return out
 
 
 def assign(detections: list[Detection], last: dict[str, Pose]) -> dict[str, Pose]:

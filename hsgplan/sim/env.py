@@ -6,6 +6,12 @@ Gymnasium; the typed one (the geometric scene graph, its symbols and, when rende
 RGB image from the fixed camera) is in `info["observation"]`: what the env's observer
 (`sim.observer`, the ground truth by default) makes of the scene, with the true symbols beside
 it to judge by. The reward is 1 on the step where the goal truly holds.
+
+With a camera observer (`sim.observer.CameraObserver`) the robot knows only its belief: every
+primitive is planned in the model of that belief (`sim.belief_world`) and the simulated scene
+runs its joint motions; a step's outcome is judged on what the gripper feels and on the belief
+before and after it (a new look), and before acting on an object the belief is unsure of the
+arm moves out of the cameras' way and looks again (`relook`).
 """
 
 from __future__ import annotations
@@ -18,17 +24,19 @@ import gymnasium
 import numpy as np
 
 from hsgplan.domain.goals import Goal, parse_goal
-from hsgplan.domain.parameters import PrimitiveParams
+from hsgplan.domain.parameters import PickParams, PrimitiveParams
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
+from hsgplan.sim.belief_world import BeliefWorld
 from hsgplan.sim.gym_spaces import action_space, decode, encode, observation_space
 from hsgplan.sim.lookahead import Lookahead
-from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
-from hsgplan.sim.observer import GroundTruth, SceneObserver
-from hsgplan.sim.outcome import Outcome, Status
-from hsgplan.sim.primitives import execute
+from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive, plan_transit
+from hsgplan.sim.observer import CameraObserver, GroundTruth, Look, SceneObserver, Seen
+from hsgplan.sim.outcome import Outcome, Status, compare
+from hsgplan.sim.primitives import execute, run_path, run_plan
 from hsgplan.sim.render import Camera
+from hsgplan.sim.robot import REST
 from hsgplan.sim.sampler import sample_scene
 from hsgplan.sim.scene import Scene
 from hsgplan.symbolic.generator import check_size, random_goals
@@ -51,6 +59,8 @@ class Observation:
     rgb: np.ndarray | None
     true_symbols: SymbolMapping
     unseen: tuple[str, ...] = ()
+    unknown: tuple[str, ...] = ()
+    uncertain: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -74,7 +84,10 @@ class KitchenStorageEnv(gymnasium.Env):
         max_steps: after this many primitives an episode is truncated.
         objects: the size of the random goal drawn when `reset` is given none.
         render_mode: "rgb_array" (what `render()` returns) or None.
-        observer: what the agent sees of the scene (default: the ground truth).
+        observer: what the agent sees of the scene (default: the ground truth); a camera
+            observer makes the robot act on its belief (see the module).
+        relook: with a camera observer, look again from out of the cameras' way before acting
+            on an object the belief is unsure of (a recovery rule of perception's, switchable).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
@@ -86,7 +99,8 @@ class KitchenStorageEnv(gymnasium.Env):
         max_steps: int = MAX_STEPS,
         objects: int = 3,
         render_mode: str | None = None,
-        observer: SceneObserver | None = None,
+        observer: SceneObserver | CameraObserver | None = None,
+        relook: bool = True,
     ):
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
@@ -99,12 +113,18 @@ class KitchenStorageEnv(gymnasium.Env):
         self.max_steps = max_steps
         self.objects = objects
         self.observer = observer or GroundTruth()
+        self.believing = isinstance(self.observer, CameraObserver)
+        self.relook = relook
+        self.world: BeliefWorld | None = None  # the robot's model, with a camera observer
+        self._seen: Seen | None = None  # the belief's last look
+        self._judged: Seen | None = None  # the look that judged the last step, if one did
+        self._released = None
         self.scene: Scene | None = None
         self.goal: Goal | None = None
         self.steps = 0
         self._checked: dict[PrimitiveParams, tuple[MotionPlan, float]] = {}
         # dry runs (as a feasibility check) and trials of whole plans, for agents that look ahead
-        self.lookahead = Lookahead(lambda: self.scene, self.check)
+        self.lookahead = Lookahead(self._planning_scene, self.check)
 
     def reset(
         self, *, seed: int | None = None, options: ResetOptions | dict | None = None
@@ -121,7 +141,12 @@ class KitchenStorageEnv(gymnasium.Env):
         self.scene, _ = sample_scene(options.goal.objects, scene_seed, options.p_elsewhere)
         self.steps = 0
         self._checked.clear()
-        self.observer.reset(self.scene)
+        self._seen = self._judged = self._released = None
+        if self.believing:
+            self.world = BeliefWorld(options.goal.objects, scene_seed)
+            self.observer.start(options.goal.objects)
+        else:
+            self.observer.reset(self.scene)
         typed = self._observe()
         return self._encode(typed), {"seed": scene_seed, "observation": typed}
 
@@ -135,6 +160,8 @@ class KitchenStorageEnv(gymnasium.Env):
         )
         if isinstance(params, str):  # nothing to execute: a step spent, nothing moved
             outcome = Outcome(Status.INVALID, params, 0.0)
+        elif self.believing:
+            outcome = self._step_believed(params, on_frame)
         else:
             plan, plan_seconds = self._checked.get(params, (None, 0.0))
             outcome = execute(self.scene, params, on_frame, plan)
@@ -152,7 +179,7 @@ class KitchenStorageEnv(gymnasium.Env):
         """A dry run: whether the primitive can be planned in the scene as it is. Nothing
         moves, no step is spent, and a following `step` with the same action reuses the plan."""
         start = time.perf_counter()
-        plan = plan_primitive(self.scene, action)
+        plan = plan_primitive(self._planning_scene(), action)
         if isinstance(plan, PlanFailure):
             return False
         self._checked[action] = (plan, time.perf_counter() - start)
@@ -168,16 +195,104 @@ class KitchenStorageEnv(gymnasium.Env):
         if self.scene is not None:
             self.scene.close()
             self.scene = None
+        if self.world is not None:
+            self.world.close()
+            self.world = None
+
+    def _planning_scene(self) -> Scene:
+        """Where primitives are planned: the robot's model of its belief, or the scene."""
+        return self.world.scene if self.world is not None else self.scene
+
+    def _step_believed(self, params: PrimitiveParams, on_frame) -> Outcome:
+        """One primitive planned in the model of the belief, run in the scene, judged on what
+        the gripper feels and on the belief before and after it."""
+        start = time.perf_counter()
+        plan, plan_seconds = self._checked.pop(params, (None, 0.0))
+        relooks = 0
+        if plan is None and self.relook and self._unsure_of(params):
+            relooks = self._look_again(on_frame)
+        before = self._seen.scene_graph
+        world = self.world
+        world.follow(self.scene.robot.q())
+        if plan is None:
+            plan = world.plan(params)
+        if isinstance(plan, PlanFailure):
+            seconds = time.perf_counter() - start + plan_seconds
+            return Outcome(plan.status, plan.detail, seconds, relooks)
+        run_plan(self.scene, plan, on_frame, blind=True)
+        holds = self.scene.robot.held_body is not None
+        self._released = world.executed(plan, holds)
+        if world.holding is not None and not holds:
+            world.dropped()
+        world.follow(self.scene.robot.q())
+        seconds = time.perf_counter() - start + plan_seconds
+        if isinstance(params, PickParams) and not holds:
+            detail = f"the fingers closed on nothing where '{params.obj}' was believed"
+            return Outcome(Status.DROPPED, detail, seconds, relooks)
+        # the look that judges the step is the next observation's: made once, by step()
+        self._seen = self._look()
+        status, detail = compare(before, self._seen.scene_graph, params.obj, plan.expected)
+        return Outcome(status, detail, seconds, relooks)
+
+    def _unsure_of(self, params: PrimitiveParams) -> bool:
+        """Whether the belief is unsure of an object the primitive acts on or places onto."""
+        uncertain = self._seen.uncertain
+        target = getattr(params, "target", None)
+        return params.obj in uncertain or target in uncertain
+
+    def _look_again(self, on_frame) -> int:
+        """The arm moves to its rest pose, out of the cameras' way, along a path planned in
+        the model, and the robot looks again: 1 if it did, 0 if it was there already or no
+        path was found."""
+        q = self.scene.robot.q()
+        if np.allclose(q, REST, atol=1e-3):
+            return 0
+        self.world.follow(q)
+        path = plan_transit(self.world.scene, REST)
+        if path is None:
+            return 0
+        run_path(self.scene, path, on_frame)
+        self.world.follow(self.scene.robot.q())
+        self._seen = self._look()
+        return 1
+
+    def _look(self) -> Seen:
+        scene, world = self.scene, self.world
+        look = Look(
+            np.stack([c.capture(scene.bc) for c in self.observer.cameras]),
+            self.observer.cameras,
+            scene.robot.q(),
+            world.holding,
+            world.held_pose(),
+            self._released,
+        )
+        self._released = None
+        seen = self.observer.look(look)
+        world.believe(seen.scene_graph)
+        return seen
 
     def _observe(self) -> Observation:
-        seen = self.observer.observe(self.scene)
+        if not self.believing:
+            seen = self.observer.observe(self.scene)
+        elif self._judged is not None:
+            seen, self._judged = self._judged, None
+        else:
+            seen = self._seen = self._look()
         rgb = self.render() if self.render_images else None
         symbols = map_symbols(seen.scene_graph)
         if isinstance(self.observer, GroundTruth):  # what it sees is the truth: mapped once
             true_symbols = symbols
         else:
             true_symbols = map_symbols(self.scene.scene_graph())
-        return Observation(seen.scene_graph, symbols, rgb, true_symbols, seen.unseen)
+        return Observation(
+            seen.scene_graph,
+            symbols,
+            rgb,
+            true_symbols,
+            seen.unseen,
+            seen.unknown,
+            seen.uncertain,
+        )
 
     def _encode(self, typed: Observation) -> dict:
         return encode(self.goal.objects, typed.scene_graph, typed.symbols.state)

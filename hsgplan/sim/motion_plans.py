@@ -96,6 +96,14 @@ def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFa
         return PlanFailure(Status.INVALID, str(e))
 
 
+def plan_transit(scene: Scene, q_goal: np.ndarray) -> tuple[np.ndarray, ...] | None:
+    """A collision-free path of the arm (and what it holds) from where it is to `q_goal`."""
+    q0 = scene.robot.q()
+    held = () if scene.held() is None else (scene.held(),)
+    with scene.robot.preserved():
+        return _path(scene, q0, q_goal, ignore=held)
+
+
 def can_pick(scene: Scene, obj: str) -> bool:
     """Whether a pick could take `obj` up from the scene as it is (a dry run)."""
     return isinstance(plan_primitive(scene, PickParams(obj)), MotionPlan)

@@ -30,11 +30,14 @@ class Status(StrEnum):
 
 @dataclass(frozen=True)
 class Outcome:
-    """The result of one primitive: its status, a sentence on why, and its wall time."""
+    """The result of one primitive: its status, a sentence on why, and its wall time
+    (`relooks`: the looks a camera observer took first, from out of the cameras' way, whose
+    time is in it)."""
 
     status: Status
     detail: str
     seconds: float
+    relooks: int = 0
 
     @property
     def ok(self) -> bool:
@@ -43,7 +46,15 @@ class Outcome:
 
 def verify(scene, before: GeometricSceneGraph, obj: str, expected: Literal) -> tuple[Status, str]:
     """Compare the scene after a primitive with its intended symbolic effect."""
-    after = scene.scene_graph()
+    return compare(before, scene.scene_graph(), obj, expected)
+
+
+def compare(
+    before: GeometricSceneGraph, after: GeometricSceneGraph, obj: str, expected: Literal
+) -> tuple[Status, str]:
+    """A primitive's outcome from the scene graphs before and after it: the simulator's, or
+    what a camera observer believed before and believes after (objects in one and not the
+    other are not compared)."""
     mapping = map_symbols(after)
     prior_mapping = map_symbols(before)
     prior = prior_mapping.state
@@ -63,7 +74,7 @@ def verify(scene, before: GeometricSceneGraph, obj: str, expected: Literal) -> t
         )
         return status, f"'{expected}' does not hold: '{mapping.state.location(obj)}' instead"
     for o in after.objects:
-        if o == obj:
+        if o == obj or o not in before.objects:
             continue
         moved = before.pose(o).distance(after.pose(o))
         if moved > DISTURB_TOL or prior.location(o) != mapping.state.location(o):

@@ -49,14 +49,28 @@ def execute(
     planned = plan if plan is not None else plan_primitive(scene, params)
     if isinstance(planned, PlanFailure):
         return Outcome(planned.status, planned.detail, time.perf_counter() - start)
-    if isinstance(params, PickParams):
-        _run_pick(scene, planned, watch)
-    elif isinstance(params, PlaceParams):
-        _run_place(scene, planned, watch)
-    else:
-        _run_push(scene, planned, watch)
+    run_plan(scene, planned, watch)
     status, detail = verify(scene, before, params.obj, planned.expected)
     return Outcome(status, detail, time.perf_counter() - start - watched)
+
+
+def run_plan(scene: Scene, plan: MotionPlan, on_frame: Frame | None = None, blind: bool = False):
+    """Run a planned primitive's joint motions in the scene; physics does the rest.
+
+    `blind`: the plan was made in the robot's model of the scene, not in this one (a camera
+    observer's belief): a pick then holds whatever body its closed fingers touch, if any,
+    rather than the one it was planned for (whose true pose the robot does not know)."""
+    if isinstance(plan.params, PickParams):
+        _run_pick(scene, plan, on_frame, blind)
+    elif isinstance(plan.params, PlaceParams):
+        _run_place(scene, plan, on_frame)
+    else:
+        _run_push(scene, plan, on_frame)
+
+
+def run_path(scene: Scene, path, on_frame: Frame | None = None) -> None:
+    """Move the arm along a planned path (what it holds goes with it)."""
+    _follow(scene, path, on_frame)
 
 
 def _follow(scene: Scene, path, on_frame: Frame | None) -> None:
@@ -70,14 +84,19 @@ def _follow(scene: Scene, path, on_frame: Frame | None) -> None:
             on_frame()
 
 
-def _run_pick(scene: Scene, plan: MotionPlan, on_frame) -> None:
+def _run_pick(scene: Scene, plan: MotionPlan, on_frame, blind: bool = False) -> None:
     robot = scene.robot
     robot.set_fingers(plan.opening)
     _follow(scene, plan.path, on_frame)
     _follow(scene, [plan.q_above, plan.q_at], on_frame)
     # The fingers close to the object's width, then a fixed constraint makes the grasp firm.
     robot.set_fingers(plan.grip)
-    robot.attach(scene.bodies[plan.params.obj])
+    if not blind:
+        robot.attach(scene.bodies[plan.params.obj])
+    elif (body := robot.between_fingers(tuple(scene.bodies.values()))) is not None:
+        robot.attach(body)
+    else:
+        robot.set_fingers(0.0)  # closed on nothing
     _follow(scene, [plan.q_at, plan.q_above], on_frame)
 
 

@@ -217,6 +217,22 @@ class Panda:
         )
         self.bc.changeConstraint(self.grasp_constraint, maxForce=200.0)
 
+    def between_fingers(self, bodies: tuple[int, ...], reach: float = 0.01) -> int | None:
+        """The body both fingers touch (within `reach`), if any: what closing them on it
+        holds. Of several, the one the fingers are nearest."""
+        touching = []
+        for body in bodies:
+            gaps = [
+                min(
+                    (c[8] for c in self.bc.getClosestPoints(self.body, body, reach, f, -1)),
+                    default=None,
+                )
+                for f in FINGERS
+            ]
+            if None not in gaps:
+                touching.append((sum(gaps), body))
+        return min(touching)[1] if touching else None
+
     def detach(self) -> None:
         if self.held_body is not None and self.held_offset is not None:
             self.released = (self.held_body, self.tcp().compose(self.held_offset))

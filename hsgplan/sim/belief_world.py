@@ -1,0 +1,85 @@
+"""The robot's own model of the scene, for a camera observer's belief: a second physics client
+with the arena, the arm and the objects where the robot believes them.
+
+Every primitive is planned here (inverse kinematics, collision checks, paths, push lines), so
+that the arm acts at the believed poses; the simulated scene only runs the planned joint
+motions (`sim.primitives.run_plan`). The model's arm follows the real one's joints (its
+encoders), and an object the robot took up rides in the model's hand with the grasp as planned:
+what the robot knows of where its hand holds it, and where it let it go. Objects the robot has
+never seen are parked out of the way: no pose, no obstacle.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from hsgplan.domain.parameters import PickParams, PlaceParams
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
+from hsgplan.sim.scene import Scene
+
+
+class BeliefWorld:
+    """Args:
+    objects: the goal's object names (each gets a body, parked until believed somewhere).
+    seed: seeds the model's inverse-kinematics restarts and motion planning.
+    """
+
+    def __init__(self, objects: Iterable[str], seed: int) -> None:
+        self.scene = Scene(objects, seed)
+        self.holding: str | None = None
+
+    def close(self) -> None:
+        self.scene.close()
+
+    def believe(self, sg: GeometricSceneGraph) -> None:
+        """Put every object where the belief has it; one it has no pose for is parked. The
+        held object stays in the model's hand."""
+        for name in self.scene.objects:
+            if name == self.holding:
+                continue
+            if name in sg.objects:
+                self.scene.set_pose(name, sg.pose(name))
+            else:
+                self.scene.park(name)
+
+    def follow(self, q: np.ndarray) -> None:
+        """The model's arm to the real arm's joints (carrying what it holds)."""
+        self.scene.robot.set_q(q)
+
+    def plan(self, params) -> MotionPlan | PlanFailure:
+        """A primitive planned at the believed poses; nothing in the model moves."""
+        return plan_primitive(self.scene, params)
+
+    def held_pose(self) -> Pose | None:
+        return None if self.holding is None else self.scene.pose(self.holding)
+
+    def executed(self, plan: MotionPlan, gripper_holds: bool) -> tuple[str, Pose] | None:
+        """The model after the real arm ran `plan`: a pick whose fingers closed on something
+        holds the object it was planned for (the robot's own record), by the grasp as
+        planned; a place lets it go where the planned hand put it. Returns the object let go
+        and where, if any. The arm is left where the plan ends (`follow` puts it right)."""
+        robot = self.scene.robot
+        if isinstance(plan.params, PickParams) and gripper_holds:
+            robot.set_q(plan.q_at)
+            robot.set_fingers(plan.grip)
+            robot.attach(self.scene.bodies[plan.params.obj])
+            self.holding = plan.params.obj
+            robot.set_q(plan.q_above)
+            return None
+        if isinstance(plan.params, PlaceParams) and self.holding is not None:
+            robot.set_q(plan.q_at)
+            robot.detach()
+            released = self.holding, robot.released[1]
+            self.holding = None
+            robot.set_q(plan.q_above)
+            return released
+        return None
+
+    def dropped(self) -> None:
+        """The gripper no longer feels the object it held: the model lets it go too."""
+        self.scene.robot.detach()
+        self.holding = None
