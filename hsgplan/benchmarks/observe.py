@@ -5,9 +5,9 @@ rendered from the fixed views first; rendering is timed but kept out of the obse
 (a real robot's cameras deliver the images). The observation is what the agent's observer does
 with them: the keypoint network on every view, PnP, fusion across views, naming by colour and
 resting (`PoseEstimator.detect`), then the tracker's assignment of detections to the objects it
-knows (`perception.observer.tracked`, the known poses being the scene's, as after a first look). One core (one torch
-thread), as an evaluation worker runs; medians and the 90th percentile over the scenes, by the
-number of objects in them.
+knows (`perception.observer.tracked`, the known poses being the scene's, as after a first
+look). One core (one torch thread), as an evaluation worker runs; medians and the 90th
+percentile over the scenes, by the number of objects in them.
 """
 
 from __future__ import annotations

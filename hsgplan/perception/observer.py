@@ -33,12 +33,12 @@ from scipy.optimize import linear_sum_assignment
 
 from hsgplan.domain.objects import object_type, type_of
 from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.estimator import Detection, PoseEstimator
-from hsgplan.perception.synthetic import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
-from hsgplan.sim.observer import Look, Seen
 from hsgplan.sim.render import Camera
+from hsgplan.sim.sensing import Look, Seen
 
 # A detection f_p named another type is only an object's if it is within this of where the
 # object was last seen (within `STILL` if a single view saw it).

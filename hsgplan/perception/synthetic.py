@@ -22,6 +22,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import draw_objects, object_type
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.world import INTERIOR_CAPACITY, Kind
+from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, in_world
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.render import Camera
@@ -39,20 +40,6 @@ P_ELSEWHERE = 0.5
 MAX_NOISE = 6.0  # pixel noise standard deviation, at most (0..255 scale)
 NEAR, FAR = 0.05, 4.0
 
-# Five fixed views at 320 x 240: facing the robot over the table (shelf tops, open space);
-# from behind the robot's shoulders on either side, low enough to look into the shelves and
-# over the prepush regions past the arm (which hides the middle from straight behind); and,
-# from the table's far corners as low, which see the sides of the stacks on the open space and
-# the shelf tops that the first three see from one side only (a box under a can or another box
-# was often seen by one view alone). The keypoint network was first trained on the first three
-# (see `ORIGINAL_VIEWS`), then fine-tuned on all five.
-VIEWS: tuple[Camera, ...] = (
-    Camera(320, 240, (1.15, 0.0, 1.0), (0.42, 0.0, 0.05), 46.0),
-    Camera(320, 240, (-0.25, 0.7, 0.55), (0.45, 0.2, 0.06), 50.0),
-    Camera(320, 240, (-0.25, -0.7, 0.55), (0.45, -0.2, 0.06), 50.0),
-    Camera(320, 240, (1.1, 0.7, 0.55), (0.45, 0.1, 0.06), 50.0),
-    Camera(320, 240, (1.1, -0.7, 0.55), (0.45, -0.1, 0.06), 50.0),
-)
 # Views past these draw their jitter from a stream of their own, so that a sample rendered from
 # the first three is the same with or without the others (`collect images --views 3` renders
 # the collection the shipped network was first trained on, byte for byte).

@@ -230,7 +230,7 @@ class KitchenStorageEnv(gymnasium.Env):
             detail = f"the fingers closed on nothing where '{params.obj}' was believed"
             return Outcome(Status.DROPPED, detail, seconds, relooks)
         # the look that judges the step is the next observation's: made once, by step()
-        self._seen = self._look()
+        self._seen = self._judged = self._look()
         status, detail = compare(before, self._seen.scene_graph, params.obj, plan.expected)
         return Outcome(status, detail, seconds, relooks)
 

@@ -75,11 +75,14 @@ def entity_names(objects: tuple[str, ...]) -> list[str | None]:
 def encode(
     objects: tuple[str, ...], sg: GeometricSceneGraph, state: SymbolicSceneGraph
 ) -> dict[str, np.ndarray]:
-    """The numeric observation of a scene (its objects in slot order)."""
+    """The numeric observation of a scene (its objects in slot order); an object the observer
+    has never seen (not in `sg`) has its type and a zero pose."""
     index = {name: i for i, name in enumerate(entity_names(objects)) if name is not None}
     obs = {k: np.zeros(s.shape, s.dtype) for k, s in observation_space().spaces.items()}
     for i, name in enumerate(objects):
         obs["types"][i] = TYPES.index(type_of(name)) + 1
+        if name not in sg.objects:
+            continue
         pose = sg.pose(name)
         values = np.nan_to_num(pose.position + pose.orientation)  # NaN: a physics blow-up
         obs["poses"][i] = np.clip(values, -POSITION_BOUND, POSITION_BOUND)

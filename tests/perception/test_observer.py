@@ -13,19 +13,21 @@ import torch
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.objects import type_of
+from hsgplan.domain.parameters import PickParams
 from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.failures import Failure
+from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.estimator import Detection, PoseEstimator
 from hsgplan.perception.keypoints import PinholeCamera, in_world, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE
-from hsgplan.perception.observer import RgbObserver, assign, tracked
-from hsgplan.perception.synthetic import VIEWS
+from hsgplan.perception.observer import RgbObserver, assign, first_sight, tracked
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.env import KitchenStorageEnv
-from hsgplan.sim.observer import Seen
+from hsgplan.sim.outcome import Status
+from hsgplan.sim.sensing import Look, Seen
 
 TYPES = list(OBJECT_TYPES)
 
@@ -84,9 +86,10 @@ class _SceneMaps(torch.nn.Module):
     def __init__(self) -> None:
         super().__init__()
         self.scene = None
+        self.hidden: str | None = None  # an object it does not draw
 
     def forward(self, images):
-        poses = self.scene.poses()
+        poses = {o: p for o, p in self.scene.poses().items() if o != self.hidden}
         kinds = np.array([TYPES.index(type_of(o)) for o in poses])
         height, width = images.shape[2] // STRIDE, images.shape[3] // STRIDE
         maps = []
@@ -103,19 +106,120 @@ class _SceneMaps(torch.nn.Module):
 
 
 class _Watching(RgbObserver):
-    def observe(self, scene) -> Seen:
-        self.estimator.net.scene = scene
-        return super().observe(scene)
+    """The observer with the stand-in network, which the test lets draw the env's scene."""
+
+    def __init__(self, estimator: PoseEstimator) -> None:
+        super().__init__(estimator)
+        self.env: KitchenStorageEnv | None = None
+        self.looks: list[Look] = []
+
+    def look(self, look: Look) -> Seen:
+        self.looks.append(look)
+        self.estimator.net.scene = self.env.scene
+        return super().look(look)
+
+
+def _watched_env(**kwargs) -> tuple[KitchenStorageEnv, _Watching]:
+    observer = _Watching(PoseEstimator(_SceneMaps()))
+    env = KitchenStorageEnv(observer=observer, **kwargs)
+    observer.env = env
+    return env, observer
 
 
 def test_the_loop_runs_on_what_the_cameras_make_of_the_scene_and_is_judged_on_the_truth():
-    observer = _Watching(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer)
+    env, observer = _watched_env()
     goal = parse_goal("On(butter, shelf_b) & On(cherries, butter)")
     record = run_episode(env, make_agent("oracle"), goal, seed=4)
     assert record.observer == "rgb"
     assert record.success and record.failure is None, record.steps
     assert record.unseen_objects == 0
+    # a look is the images, the calibration, the joints and the hand's own record: no scene
+    first = observer.looks[0]
+    assert first.images.shape[0] == len(first.cameras) == len(VIEWS)
+    assert first.holding is None and first.held_pose is None and first.released is None
+    assert any(look.holding == "cherries" for look in observer.looks)
+    assert any(look.released and look.released[0] == "cherries" for look in observer.looks)
+
+
+def test_the_robot_plans_in_its_belief_and_the_world_only_runs_the_joints():
+    """A belief 10 cm off the butter's true place: the pick is planned there, the fingers close
+    on nothing, and the step is judged by the gripper (dropped), not by the truth."""
+
+    class Shifted(_Watching):
+        def look(self, look: Look) -> Seen:
+            seen = super().look(look)
+            poses = {n.name: n.pose for n in seen.scene_graph.nodes}
+            x, y, z = poses["butter"].position
+            poses["butter"] = replace(poses["butter"], position=(x + 0.1, y, z))
+            sg = GeometricSceneGraph.from_poses(poses, held=seen.scene_graph.held)
+            return replace(seen, scene_graph=sg)
+
+    observer = Shifted(PoseEstimator(_SceneMaps()))
+    env = KitchenStorageEnv(observer=observer)
+    observer.env = env
+    _, info = env.reset(seed=4, options={"goal": "On(butter, shelf_b)"})
+    believed = info["observation"].scene_graph.pose("butter")
+    assert believed.distance(env.scene.pose("butter")) == pytest.approx(0.1, abs=1e-6)
+    _, _, _, _, info = env.step(PickParams("butter"))
+    outcome = info["outcome"]
+    assert outcome.status is Status.DROPPED and "closed on nothing" in outcome.detail
+    assert env.scene.held() is None and env.world.holding is None
+    env.close()
+
+
+def test_a_pick_at_the_belief_holds_whatever_the_fingers_close_on():
+    env, _ = _watched_env()
+    env.reset(seed=4, options={"goal": "On(butter, shelf_b)"})
+    _, _, _, _, info = env.step(PickParams("butter"))
+    assert info["outcome"].ok, info["outcome"]
+    assert env.scene.held() == "butter" and env.world.holding == "butter"
+    # the robot's record of where it holds the butter is the grasp as planned, near the truth
+    held = info["observation"].scene_graph
+    assert held.held == "butter"
+    assert held.pose("butter").distance(env.scene.pose("butter")) < 0.01
+    env.close()
+
+
+def test_an_object_no_view_has_found_has_no_pose_and_ends_the_episode_as_never_seen():
+    class Blind(_Watching):  # finds everything but the butter
+        def look(self, look: Look) -> Seen:
+            self.estimator.net.hidden = "butter"
+            return super().look(look)
+
+    observer = Blind(PoseEstimator(_SceneMaps()))
+    env = KitchenStorageEnv(observer=observer)
+    observer.env = env
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)")
+    record = run_episode(env, make_agent("oracle"), goal, seed=4)
+    assert record.failure == Failure.NEVER_SEEN and record.steps == ()
+
+
+def test_tracks_start_from_the_first_look_never_from_a_staged_pose():
+    observer = RgbObserver(PoseEstimator(_SceneMaps()))
+    observer.start(("butter", "tomato_soup"))
+    soup = Pose.from_xyz_yaw(0.5, 0.1, OBJECT_TYPES["tomato_soup"].size[2] / 2)
+    lone = Detection("tomato_soup", soup, 0.9, 1, 1.0)
+    observer.estimator.detect = lambda images, cameras: [lone]
+    look = Look(np.zeros((1, 2, 2, 3), np.uint8), VIEWS[:1], np.zeros(7))
+    seen = observer.look(look)
+    assert seen.scene_graph.objects == ("tomato_soup",)
+    assert seen.unknown == ("butter",) and set(seen.uncertain) == {"butter", "tomato_soup"}
+    butter = Pose.from_xyz_yaw(0.3, -0.2, OBJECT_TYPES["butter"].size[2] / 2)
+    both = [replace(lone, views=3), Detection("butter", butter, 0.8, 2, 1.0)]
+    observer.estimator.detect = lambda images, cameras: both
+    seen = observer.look(look)
+    assert seen.unknown == () and seen.uncertain == ()
+    assert seen.scene_graph.pose("butter") == butter
+
+
+def test_first_sight_names_a_type_by_the_surest_detection_and_a_misnamed_one_by_its_kind():
+    weak, sure = _at("butter", 0.2, 0.3, 0.5), replace(_at("butter", 0.6, 0.3, 0.4), views=4)
+    assert first_sight((weak, sure), ["butter"], ("butter",)) == {"butter": sure}
+    # no cream cheese in the episode: a detection named so is the butter misnamed
+    misnamed = _at("cream_cheese", 0.4, 0.1)
+    assert first_sight((misnamed,), ["butter"], ("butter",)) == {"butter": misnamed}
+    # a popcorn in the episode, already seen: a second one is its phantom, not the butter
+    assert first_sight((_at("popcorn", 0.4, 0.1),), ["butter"], ("butter", "popcorn")) == {}
 
 
 def test_a_goal_only_seen_reached_is_a_failure_of_perception():
@@ -208,11 +312,14 @@ def test_the_tracker_keeps_a_hidden_butter_where_it_was_and_the_can_on_it_up():
         [Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)]
     )
     last = {"butter": butter, "tomato_soup": Pose.from_xyz_yaw(0.5, 0.0, top + can_half)}
-    poses, unseen = tracked([seen], last)
-    assert unseen == ("butter",) and poses["butter"] == butter
+    tracks = tracked([seen], last)
+    poses = tracks.poses
+    assert tracks.unseen == ("butter",) and poses["butter"] == butter
     assert poses["tomato_soup"].position[2] == pytest.approx(can_half)  # sunk onto the table
-    poses, unseen = tracked([seen], last, PoseEstimator.rest)
-    assert unseen == ("butter",) and poses["butter"] == butter
+    tracks = tracked([seen], last, PoseEstimator.rest)
+    poses = tracks.poses
+    assert tracks.unseen == ("butter",) and poses["butter"] == butter
+    assert tracks.left == () and set(tracks.found) == {"tomato_soup"}
     assert poses["tomato_soup"].position[2] == pytest.approx(top + can_half)  # on the butter
 
 
@@ -232,10 +339,11 @@ def test_a_lone_views_butter_is_put_where_its_ray_passes_its_last_pose_and_holds
     found = PoseEstimator.rest([lone, can])
     assert found[0].pose.position[2] == pytest.approx(half)  # on the table, far off
     last = {"butter": butter, "tomato_soup": replace(measured, position=(0.45, 0.35, 0.3))}
-    poses, unseen = tracked(found, last, PoseEstimator.rest)
-    assert unseen == () and np.allclose(poses["butter"].position, butter.position, atol=1e-6)
+    tracks = tracked(found, last, PoseEstimator.rest)
+    poses = tracks.poses
+    assert tracks.unseen == () and np.allclose(poses["butter"].position, butter.position, atol=1e-6)
     assert poses["tomato_soup"].position[2] == pytest.approx(SHELF_TOP_Z + 2 * half + can_half)
     # a lone view's ray far from where the object was leaves its estimate as it was measured
     moved = {**last, "butter": Pose.from_xyz_yaw(0.45, 0.0, half, 0.0)}
-    poses, _ = tracked(found, moved, PoseEstimator.rest)
+    poses = tracked(found, moved, PoseEstimator.rest).poses
     assert poses["butter"].position == pytest.approx(found[0].pose.position)
