@@ -24,6 +24,12 @@ Task level (`hsgplan.planning.regression.planner`):
   is taken rather than the planner stopping ("regression stuck").
 - `failed_goal_waits`: a goal literal whose action came back to the same state (it failed)
   waits while another goal literal can go on.
+
+Perception (`hsgplan.sim.env`, seeing through a camera observer; nothing under the ground
+truth):
+- `relook`: before a primitive on an object the belief is unsure of (not seen at the last
+  look, or seen by a single view), or onto one, the arm moves to its rest pose, out of the
+  cameras' way, and the robot looks again; the primitive is planned on that look.
 """
 
 from __future__ import annotations
@@ -48,6 +54,7 @@ class RecoveryRules:
     least_taken: bool = True
     likeliest_literal: bool = True
     failed_goal_waits: bool = True
+    relook: bool = True
 
     @staticmethod
     def names() -> tuple[str, ...]:
@@ -72,4 +79,5 @@ class RecoveryRules:
         return tuple(n for n in self.names() if not getattr(self, n))
 
 
+PERCEPTION_RULES = ("relook",)  # rules that act only when the agent sees through a camera observer
 ALL_RULES = RecoveryRules()  # the recovering protocol's default: every rule on

@@ -20,7 +20,7 @@ from hsgplan.evaluation.episode import EpisodeRecord, StepRecord, params_text, r
 from hsgplan.files import atomic, write_atomically
 from hsgplan.runner.engines import one_core
 from hsgplan.sim.env import KitchenStorageEnv
-from hsgplan.sim.observer import SceneObserver
+from hsgplan.sim.observer import CameraObserver, SceneObserver
 from hsgplan.sim.render import DEMO_VIEWS
 from hsgplan.symbolic.generator import random_goal
 from hsgplan.viz.frames import compose
@@ -42,7 +42,7 @@ def run_demo(
     on_step: Callable[[StepRecord], None] | None = None,
     scale: float = 1.0,
     frame_every: int = FRAME_EVERY,
-    observer: SceneObserver | None = None,
+    observer: SceneObserver | CameraObserver | None = None,
     end_at_failure: bool = False,
 ) -> EpisodeRecord:
     """Run the episode and write its pictures and record into `out`; `on_step` sees every

@@ -9,7 +9,7 @@ from hsgplan.agents.base import Decision
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.parameters import PickParams
-from hsgplan.domain.recovery import RecoveryRules
+from hsgplan.domain.recovery import PERCEPTION_RULES, RecoveryRules
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.protocol import EvalConfig, run_config
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, failure_class
@@ -79,7 +79,10 @@ def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
     config = EvalConfig("paper", (2,), 1, 0)
     found = variants(config)
     assert list(found)[0] == "all-rules" and found["all-rules"].rules_off == ()
-    assert [v.rules_off for v in list(found.values())[1:]] == [(r,) for r in RecoveryRules.names()]
+    rules = [r for r in RecoveryRules.names() if r not in PERCEPTION_RULES]
+    assert [v.rules_off for v in list(found.values())[1:]] == [(r,) for r in rules]
+    seeing = variants(config, seeing=True)  # relook acts only through the cameras
+    assert [v.rules_off for v in list(seeing.values())[1:]] == [(r,) for r in RecoveryRules.names()]
     with pytest.raises(InvalidInputError, match="ablate-rules"):
         variants(EvalConfig("paper", (2,), 1, 0, protocol="paper"))
     run = {"goals": 1, "goals_file": None, "repeats": 1, "seed": 0}
