@@ -209,8 +209,10 @@ class KitchenStorageEnv(gymnasium.Env):
         start = time.perf_counter()
         plan, plan_seconds = self._checked.pop(params, (None, 0.0))
         relooks = 0
-        if plan is None and self.relook and self._unsure_of(params):
+        if self.relook and self._unsure_of(params):
             relooks = self._look_again(on_frame)
+            if relooks:  # a dry run's plan was made on the older belief: planned again
+                plan, plan_seconds = None, 0.0
         before = self._seen.scene_graph
         world = self.world
         world.follow(self.scene.robot.q())

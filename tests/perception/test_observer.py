@@ -347,3 +347,28 @@ def test_a_lone_views_butter_is_put_where_its_ray_passes_its_last_pose_and_holds
     moved = {**last, "butter": Pose.from_xyz_yaw(0.45, 0.0, half, 0.0)}
     poses = tracked(found, moved, PoseEstimator.rest).poses
     assert poses["butter"].position == pytest.approx(found[0].pose.position)
+
+
+class _Unsure(_Watching):
+    """Reports every object uncertain, as if a single view saw each."""
+
+    def look(self, look: Look) -> Seen:
+        seen = super().look(look)
+        return replace(seen, uncertain=seen.scene_graph.objects)
+
+
+@pytest.mark.parametrize("relook", [True, False])
+def test_an_uncertain_target_is_looked_at_again_from_out_of_the_way_unless_the_rule_is_off(
+    relook,
+):
+    observer = _Unsure(PoseEstimator(_SceneMaps()))
+    env = KitchenStorageEnv(observer=observer, relook=relook)
+    observer.env = env
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)")
+    record = run_episode(env, make_agent("oracle"), goal, seed=4)
+    assert record.success, record.steps
+    looks = sum(s.relooks for s in record.steps)
+    # the first step starts at rest, where a look would see what the last one saw
+    assert record.steps[0].relooks == 0
+    assert (looks == len(record.steps) - 1) if relook else looks == 0
+    assert len(observer.looks) == 1 + len(record.steps) + looks
