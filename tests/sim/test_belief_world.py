@@ -1,0 +1,68 @@
+"""The robot's model of its belief, and a step judged on beliefs: on tiny hand-built scenes."""
+
+import pytest
+
+from hsgplan.domain.parameters import PickParams
+from hsgplan.domain.predicates import in_grasp, on
+from hsgplan.domain.world import OBJECT_TYPES, TABLE
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.belief_world import BeliefWorld
+from hsgplan.sim.motion_plans import MotionPlan
+from hsgplan.sim.outcome import Status, compare
+from hsgplan.sim.primitives import run_plan
+from hsgplan.sim.scene import Scene
+
+
+def _on_table(name: str, x: float, y: float) -> Pose:
+    return Pose.from_xyz_yaw(x, y, TABLE.z + OBJECT_TYPES[name].size[2] / 2)
+
+
+def test_the_model_holds_only_what_is_believed_and_parks_what_was_never_seen():
+    world = BeliefWorld(("butter", "tomato_soup"), seed=0)
+    try:
+        butter = _on_table("butter", 0.5, 0.1)
+        world.believe(GeometricSceneGraph.from_poses({"butter": butter}))
+        assert world.scene.pose("butter").distance(butter) < 1e-6
+        parked = world.scene.pose("tomato_soup")
+        assert parked.position[0] < 0  # behind the robot: no obstacle, no pose
+        assert world.held_pose() is None
+    finally:
+        world.close()
+
+
+def test_a_pick_planned_in_the_belief_takes_up_the_true_object_near_it():
+    truth = _on_table("butter", 0.5, 0.1)
+    off = Pose((0.5, 0.107, truth.position[2]), truth.orientation)  # 7 mm along its long side
+    with Scene(("butter",), seed=0, poses={"butter": truth}) as scene:
+        world = BeliefWorld(("butter",), seed=0)
+        try:
+            world.believe(GeometricSceneGraph.from_poses({"butter": off}))
+            plan = world.plan(PickParams("butter"))
+            assert isinstance(plan, MotionPlan)
+            run_plan(scene, plan, blind=True)
+            assert scene.held() == "butter"
+            world.executed(plan, gripper_holds=scene.robot.held_body is not None)
+            assert world.holding == "butter"
+            # the robot's record: where the planned grasp holds it, 7 mm from the truth
+            assert world.held_pose().distance(scene.pose("butter")) == pytest.approx(
+                0.007, abs=2e-3
+            )
+        finally:
+            world.close()
+
+
+def test_a_step_is_judged_on_the_belief_before_and_after_it():
+    butter, soup = _on_table("butter", 0.5, 0.1), _on_table("tomato_soup", 0.5, -0.2)
+    before = GeometricSceneGraph.from_poses({"butter": butter, "tomato_soup": soup})
+    lifted = Pose((0.5, 0.1, 0.3), butter.orientation)
+    held = GeometricSceneGraph.from_poses({"butter": lifted, "tomato_soup": soup}, held="butter")
+    assert compare(before, held, "butter", in_grasp("butter"))[0] is Status.SUCCESS
+    # the soup seen 3 cm from where it was believed: the pick disturbed it
+    moved = Pose((0.5, -0.17, soup.position[2]), soup.orientation)
+    bumped = GeometricSceneGraph.from_poses({"butter": lifted, "tomato_soup": moved}, held="butter")
+    assert compare(before, bumped, "butter", in_grasp("butter"))[0] is Status.DISTURBED
+    # an object first seen after the step was not disturbed by it
+    alone = GeometricSceneGraph.from_poses({"butter": butter})
+    status, detail = compare(alone, before, "butter", on("butter", "open_space"))
+    assert status is Status.SUCCESS, detail
