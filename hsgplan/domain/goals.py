@@ -8,6 +8,7 @@ A goal file holds one goal per line; blank lines and lines starting with `#` are
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -16,7 +17,7 @@ from pathlib import Path
 from hsgplan.domain.checks import MAX_GOAL_FILE_BYTES, MAX_GOAL_FILE_GOALS, read_text
 from hsgplan.domain.errors import GoalSyntaxError, InvalidInputError, UnknownNameError
 from hsgplan.domain.feasibility import check_literals
-from hsgplan.domain.objects import kind_of, sort_objects
+from hsgplan.domain.objects import kind_of, sort_objects, split_instance
 from hsgplan.domain.predicates import PREDICATES, Literal, Predicate
 from hsgplan.files import write_atomically
 
@@ -59,6 +60,34 @@ class Goal:
 
     def __str__(self) -> str:
         return " & ".join(str(lit) for lit in self.sorted_literals())
+
+    def readings(self) -> list[Goal]:
+        """The goal with the instances of each type it names twice or more (`cherries`,
+        `cherries_2`) swapped in every way, itself first: to a robot that tells objects apart
+        by how they look alone, look-alikes are one another, and a goal over them is reached
+        when any reading holds."""
+        by_type: dict[str, list[str]] = {}
+        for o in self.objects:
+            by_type.setdefault(split_instance(o)[0], []).append(o)
+        groups = [names for names in by_type.values() if len(names) > 1]
+        out = []
+        for orders in itertools.product(*(itertools.permutations(g) for g in groups)):
+            mapping = {
+                a: b
+                for g, order in zip(groups, orders, strict=True)
+                for a, b in zip(g, order, strict=True)
+            }
+            out.append(
+                Goal(
+                    frozenset(
+                        Literal(
+                            lit.predicate, tuple(mapping.get(a, a) for a in lit.args), lit.positive
+                        )
+                        for lit in self.literals
+                    )
+                )
+            )
+        return out
 
 
 def _snake(name: str) -> str:

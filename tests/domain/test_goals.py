@@ -183,3 +183,14 @@ def test_goal_is_satisfied_by_state():
     unmet = Goal(frozenset({clear("cherries"), on("butter", "cherries")}))
     assert not unmet.satisfied_by(state)
     assert unmet.unsatisfied(state) == [clear("cherries")]
+
+
+def test_a_goal_over_look_alikes_is_read_with_them_swapped_in_every_way():
+    goal = parse_goal("On(cherries, shelf_a) & On(cherries_2, butter) & On(popcorn, shelf_b)")
+    readings = goal.readings()
+    assert readings[0] == goal and len(readings) == 2
+    swapped = parse_goal("On(cherries_2, shelf_a) & On(cherries, butter) & On(popcorn, shelf_b)")
+    assert readings[1] == swapped
+    assert parse_goal("On(popcorn, shelf_b) & On(cherries, butter)").readings() == [
+        parse_goal("On(popcorn, shelf_b) & On(cherries, butter)")
+    ]
