@@ -34,7 +34,7 @@ from hsgplan.sim.lookahead import Lookahead
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive, plan_transit
 from hsgplan.sim.observer import CameraObserver, GroundTruth, Look, SceneObserver, Seen
 from hsgplan.sim.outcome import Outcome, Status, compare
-from hsgplan.sim.primitives import execute, run_path, run_plan
+from hsgplan.sim.primitives import Watch, execute, run_path, run_plan
 from hsgplan.sim.render import Camera
 from hsgplan.sim.robot import REST
 from hsgplan.sim.sampler import sample_scene
@@ -207,6 +207,8 @@ class KitchenStorageEnv(gymnasium.Env):
         """One primitive planned in the model of the belief, run in the scene, judged on what
         the gripper feels and on the belief before and after it."""
         start = time.perf_counter()
+        watch = Watch(on_frame)
+        on_frame = watch.frame
         plan, plan_seconds = self._checked.pop(params, (None, 0.0))
         relooks = 0
         if self.relook and self._unsure_of(params):
@@ -219,7 +221,7 @@ class KitchenStorageEnv(gymnasium.Env):
         if plan is None:
             plan = world.plan(params)
         if isinstance(plan, PlanFailure):
-            seconds = time.perf_counter() - start + plan_seconds
+            seconds = time.perf_counter() - start - watch.seconds + plan_seconds
             return Outcome(plan.status, plan.detail, seconds, relooks)
         run_plan(self.scene, plan, on_frame, blind=True)
         holds = self.scene.robot.held_body is not None
@@ -227,11 +229,11 @@ class KitchenStorageEnv(gymnasium.Env):
         if world.holding is not None and not holds:
             world.dropped()
         world.follow(self.scene.robot.q())
-        seconds = time.perf_counter() - start + plan_seconds
+        seconds = time.perf_counter() - start - watch.seconds + plan_seconds
         if isinstance(params, PickParams) and not holds:
             detail = f"the fingers closed on nothing where '{params.obj}' was believed"
             return Outcome(Status.DROPPED, detail, seconds, relooks)
-        # the look that judges the step is the next observation's: made once, by step()
+        # the look that judges the step is the next observation's: made once
         self._seen = self._judged = self._look()
         status, detail = compare(before, self._seen.scene_graph, params.obj, plan.expected)
         return Outcome(status, detail, seconds, relooks)
