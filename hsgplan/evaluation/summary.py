@@ -23,7 +23,8 @@ from hsgplan.sim.outcome import Status
 
 EXECUTION = "execution"
 OVERSTEP = "overstep"
-PERCEPTION = "perception"  # the agent saw the goal reached where it truly was not
+PERCEPTION = "perception"  # the goal seen reached where it truly was not, or an object never seen
+_ENDED_BY_PERCEPTION = {Failure.MISPERCEIVED, Failure.NEVER_SEEN}
 # statuses of a primitive that failed in execution (an inapplicable one is the task level's)
 FAILED_EXECUTION = frozenset(s.value for s in Status) - {Status.SUCCESS, Status.INVALID}
 _ENDED_BY_EXECUTION = {Failure.KNOCKED_OVER, Failure.OFF_TABLE, Failure.NO_PARAMETERS}
@@ -40,7 +41,7 @@ def failure_class(record: EpisodeRecord) -> tuple[str, str] | None:
     """(class, kind) of a failed episode, None for a success."""
     if record.success:
         return None
-    if record.failure == Failure.MISPERCEIVED:
+    if record.failure in _ENDED_BY_PERCEPTION:
         return PERCEPTION, str(record.failure)
     if record.failure in _ENDED_BY_EXECUTION:
         return EXECUTION, str(record.failure)
@@ -81,6 +82,8 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "overstep_after_failures": sum(
             1 for r, c in classed if c[0] == OVERSTEP and failed_steps(r)
         ),
+        # looks taken again before a primitive, seeing through f_p (`relook`)
+        "relooks": sum(s.relooks for r in rs for s in r.steps),
         "median_steps": statistics.median(len(r.steps) for r in rs),
         "median_seconds": statistics.median(r.seconds for r in rs),
         "median_task_seconds": statistics.median(r.task_seconds for r in rs),

@@ -214,7 +214,8 @@ def _results(report: dict) -> TextTable:
 
 
 def _failures(report: dict) -> TextTable:
-    seen = any(  # a column for what the observer got wrong, when one did
+    # columns for perception where a method sees through f_p, or an observer got something wrong
+    seen = any(s.get("perception", "gt") != "gt" for s in report["methods"].values()) or any(
         v["failure_classes"].get(PERCEPTION)
         for s in report["methods"].values()
         for v in s["by_size"].values()
@@ -233,6 +234,7 @@ def _failures(report: dict) -> TextTable:
                     + tuple(
                         str(v.get(k, "—")) for k in ("failed_primitives", "overstep_after_failures")
                     )
+                    + ((str(v.get("relooks", "—")),) if seen else ())
                 )
     title = (
         f"Failures ({_protocol(report)}), by what ended the episode: execution (a failed "
@@ -240,9 +242,15 @@ def _failures(report: dict) -> TextTable:
         "nothing reachable); failed primitives over all episodes, and overstep episodes that "
         "had some"
     )
+    if seen:
+        title += (
+            "; seeing through f_p, perception (the goal seen reached where it was not, or an "
+            "object no view found) and the looks taken again before a primitive (relook)"
+        )
     header = ("method", "objects", "episodes", "failed", "execution", "overstep")
     header += (PERCEPTION,) if seen else ()
     header += ("failed primitives", "overstep after failures")
+    header += ("relooks",) if seen else ()
     return TextTable(title, header, tuple(rows))
 
 

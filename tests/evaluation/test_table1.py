@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import replace
 
 import pytest
 
@@ -62,6 +63,7 @@ def test_failures_are_classed_as_the_paper_classes_them():
     assert failure_class(_record(False, "no_subgoal", ("success",))) == (OVERSTEP, "no_subgoal")
     seen_done = _record(False, "misperceived", ("success",))
     assert failure_class(seen_done) == (PERCEPTION, "misperceived")
+    assert failure_class(_record(False, "never_seen", ())) == (PERCEPTION, "never_seen")
 
 
 def test_summary_spreads_success_over_repeats_and_counts_failure_classes():
@@ -76,6 +78,9 @@ def test_summary_spreads_success_over_repeats_and_counts_failure_classes():
     assert entry["success_std"] == pytest.approx(0.25)  # repeat means 1.0 and 0.5
     assert entry["failure_classes"] == {EXECUTION: {}, OVERSTEP: {"step limit": 1}, PERCEPTION: {}}
     assert entry["failed_primitives"] == 1 and entry["overstep_after_failures"] == 1
+    assert entry["relooks"] == 0
+    looked = replace(records[0], steps=(replace(_step("success"), relooks=2),))
+    assert summarize([looked])["by_size"]["2"]["relooks"] == 2
     assert entry["median_task_seconds"] == pytest.approx(0.01)
     assert entry["median_motion_seconds"] == pytest.approx(0.502)
     assert summarize([_record(True)])["by_size"]["2"]["success_std"] is None
