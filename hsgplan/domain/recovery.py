@@ -29,7 +29,8 @@ Perception (`hsgplan.sim.env`, seeing through a camera observer; nothing under t
 truth):
 - `relook`: before a primitive on an object the belief is unsure of (not seen at the last
   look, or seen by a single view), or onto one, the arm moves to its rest pose, out of the
-  cameras' way, and the robot looks again; the primitive is planned on that look.
+  cameras' way, and the robot looks again; the primitive is planned on that look. So too
+  before the agent believes its goal reached while it is unsure of an object of the goal.
 """
 
 from __future__ import annotations

@@ -62,6 +62,8 @@ class EpisodeRecord:
     observer: str = "gt"
     # Over every observation, objects the observer did not see (their poses carried over).
     unseen_objects: int = 0
+    # Looks taken again (`relook`) before the agent believed its goal reached.
+    closing_relooks: int = 0
 
     @property
     def task_seconds(self) -> float:
@@ -111,7 +113,16 @@ def run_episode(
     failure = None
     unexecuted = (0.0, 0.0)
     unseen = len(obs.unseen)
-    while not goal.satisfied_by(obs.symbols.state):
+    closing = 0
+    while True:
+        if goal.satisfied_by(obs.symbols.state):
+            # unsure of an object of the goal, the agent looks again before it believes it
+            again = env.look_again(goal.objects)
+            if again is None:
+                break
+            obs, closing = again, closing + 1
+            unseen += len(obs.unseen)
+            continue
         fatal = [a for a in obs.true_symbols.anomalies if a.kind in _FATAL]
         if fatal:
             failure = _FATAL[fatal[0].kind]
@@ -174,4 +185,5 @@ def run_episode(
         unexecuted_motion_seconds=unexecuted[1],
         observer=env.observer.name,
         unseen_objects=unseen,
+        closing_relooks=closing,
     )

@@ -82,8 +82,8 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "overstep_after_failures": sum(
             1 for r, c in classed if c[0] == OVERSTEP and failed_steps(r)
         ),
-        # looks taken again before a primitive, seeing through f_p (`relook`)
-        "relooks": sum(s.relooks for r in rs for s in r.steps),
+        # looks taken again before a primitive or the goal's end, seeing through f_p (`relook`)
+        "relooks": sum(s.relooks for r in rs for s in r.steps) + sum(r.closing_relooks for r in rs),
         "median_steps": statistics.median(len(r.steps) for r in rs),
         "median_seconds": statistics.median(r.seconds for r in rs),
         "median_task_seconds": statistics.median(r.task_seconds for r in rs),

@@ -238,6 +238,18 @@ class KitchenStorageEnv(gymnasium.Env):
         status, detail = compare(before, self._seen.scene_graph, params.obj, plan.expected)
         return Outcome(status, detail, seconds, relooks)
 
+    def look_again(self, objects: tuple[str, ...]) -> Observation | None:
+        """With a camera observer and the `relook` rule: if the belief is unsure of any of
+        `objects`, the arm moves out of the cameras' way and the robot looks again; the new
+        observation, or None where nothing was done (sure of them, or already at rest). The
+        agent asks before it believes its goal reached."""
+        if not (self.believing and self.relook) or self._seen is None:
+            return None
+        if not set(objects) & set(self._seen.uncertain) or not self._look_again(None):
+            return None
+        self._judged = self._seen
+        return self._observe()
+
     def _unsure_of(self, params: PrimitiveParams) -> bool:
         """Whether the belief is unsure of an object the primitive acts on or places onto."""
         uncertain = self._seen.uncertain
