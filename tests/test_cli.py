@@ -209,3 +209,45 @@ def test_every_count_and_seed_takes_its_bounds_from_the_one_table():
             assert (param.min, param.max) == expected, (path, param.name)
             checked += 1
     assert checked >= 20  # seeds, goals, workers, samples, ... across the commands
+
+
+def test_a_commands_defaults_are_its_configurations_defaults():
+    """Where an option sets a configuration's field, its default is the field's: written beside
+    each other (the configurations' modules are too heavy for `--help` to import), held equal
+    here."""
+    import dataclasses
+
+    import typer.main
+
+    from hsgplan.collect.images import ImagesConfig
+    from hsgplan.collect.motion import CollectConfig
+    from hsgplan.evaluation.protocol import EvalConfig
+
+    group = typer.main.get_command(app)
+
+    def option(path: tuple[str, ...], name: str):
+        cmd = group
+        for part in path:
+            cmd = cmd.commands[part]
+        (param,) = [p for p in cmd.params if p.name == name]
+        return param.default
+
+    def field_default(config, name: str):
+        (f,) = [f for f in dataclasses.fields(config) if f.name == name]
+        return f.default
+
+    pairs = [
+        (("collect", "place"), "seed", CollectConfig, "seed"),
+        (("collect", "place"), "workers", CollectConfig, "workers"),
+        (("collect", "place"), "tasks_per_chunk", CollectConfig, "tasks_per_chunk"),
+        (("collect", "push"), "tasks_per_chunk", CollectConfig, "tasks_per_chunk"),
+        (("collect", "images"), "seed", ImagesConfig, "seed"),
+        (("collect", "images"), "p_elsewhere", ImagesConfig, "p_elsewhere"),
+        (("eval", "world"), "repeats", EvalConfig, "repeats"),
+        (("eval", "world"), "perception", EvalConfig, "perception"),
+        (("eval", "world"), "protocol", EvalConfig, "protocol"),
+    ]
+    for path, name, config, field in pairs:
+        got = option(path, name)
+        got = getattr(got, "value", got)  # an enum's choice
+        assert got == field_default(config, field), (path, name)
