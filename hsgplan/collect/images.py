@@ -17,7 +17,7 @@ KIND = "collect-images"
 @dataclass(frozen=True)
 class ImagesConfig:
     # samples wanted (unstaged draws are skipped, so the last chunk may hold fewer)
-    count: int = field(metadata=bounded(**BOUNDS["samples"]))
+    samples: int = field(metadata=bounded(**BOUNDS["samples"]))
     seed: int = setting(0, **BOUNDS["seed"])
     chunk: int = setting(CHUNK, lo=1, hi=MAX_SAMPLES)
     p_elsewhere: float = setting(P_ELSEWHERE, lo=0.0, hi=1.0)  # see `synthetic.P_ELSEWHERE`
@@ -29,7 +29,7 @@ class ImagesConfig:
 
     @property
     def chunks(self) -> int:
-        return -(-self.count // self.chunk)
+        return -(-self.samples // self.chunk)
 
 
 def collect_images(
@@ -41,13 +41,15 @@ def collect_images(
 ) -> list[dict]:
     """Render every chunk not yet logged in `run_dir`; the log rows of all chunks."""
     # The views are recorded as cameras (a collection from before the count was a setting
-    # holds the first three), not as the count.
-    settings = {k: v for k, v in asdict(config).items() if k != "views"} | {
+    # holds the first three), not as the count; the samples wanted under the key collections
+    # have always recorded them by ("count"), so that every collection resumes.
+    settings = {k: v for k, v in asdict(config).items() if k not in ("views", "samples")} | {
+        "count": config.samples,
         "format": FORMAT,
         "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in first_views(config.views)],
     }
     items = [
-        (str(run_dir), config.seed, c, config.chunk, config.count, config.p_elsewhere, config.views)
+        (str(run_dir), config.seed, c, config.chunk, config.samples, config.p_elsewhere, config.views)
         for c in range(config.chunks)
     ]
     rows = run_items(

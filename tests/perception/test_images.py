@@ -27,7 +27,7 @@ def test_a_sample_is_its_seed_and_index_alone_and_its_keypoints_are_its_poses_pr
 
 
 def test_a_collection_resumes_without_rendering_again_and_refuses_a_damaged_chunk(tmp_path):
-    config = ImagesConfig(count=3, seed=0, chunk=2)
+    config = ImagesConfig(samples=3, seed=0, chunk=2)
     rows = collect_images(config, tmp_path, workers=1)
     assert [r["chunk"] for r in rows] == [0, 1]
     stamps = [chunk_path(tmp_path, c).stat().st_mtime_ns for c in (0, 1)]
@@ -56,7 +56,7 @@ def test_a_collection_may_ask_for_more_stacks_and_refuses_a_chance_outside_0_to_
 
     assert stacked(0.85) > stacked(0.5) > stacked(0.0) == 0
     with pytest.raises(InvalidInputError, match="p_elsewhere"):
-        ImagesConfig(count=1, p_elsewhere=1.5)
+        ImagesConfig(samples=1, p_elsewhere=1.5)
 
 
 def test_the_first_views_of_a_sample_do_not_change_when_views_are_added():
@@ -72,14 +72,14 @@ def test_a_collection_of_fewer_views_records_them_and_a_count_past_the_views_is_
 ):
     import json
 
-    collect_images(ImagesConfig(count=1, chunk=1, views=3), tmp_path, workers=1)
+    collect_images(ImagesConfig(samples=1, chunk=1, views=3), tmp_path, workers=1)
     assert load_chunks(tmp_path)["images"].shape[1] == 3
     saved = json.loads((tmp_path / "config.json").read_text())
     assert len(saved["views"]) == 3 and "count" in saved
     with pytest.raises(InvalidInputError, match="views"):
-        ImagesConfig(count=1, views=len(VIEWS) + 1)
+        ImagesConfig(samples=1, views=len(VIEWS) + 1)
     with pytest.raises(InvalidInputError, match="views"):
-        ImagesConfig(count=1, views=0)
+        ImagesConfig(samples=1, views=0)
 
 
 def test_a_chunk_whose_draws_were_all_unstaged_packs_empty_arrays_of_its_views():

@@ -15,7 +15,7 @@ from hsgplan.perception.train import PerceptionTrainConfig, train_perception
 
 def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_path):
     images = tmp_path / "images"
-    collect_images(ImagesConfig(count=2, chunk=2), images, workers=1)
+    collect_images(ImagesConfig(samples=2, chunk=2), images, workers=1)
     config = PerceptionTrainConfig(
         images=str(images), epochs=1, batch_size=3, width=4, stages=1, threads=1, stride=2
     )
@@ -42,7 +42,7 @@ def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_pat
 
 def test_a_stride_2_network_starts_from_a_stride_4_one_and_a_bad_stride_is_refused(tmp_path):
     images = tmp_path / "images"
-    collect_images(ImagesConfig(count=1, chunk=1), images, workers=1)
+    collect_images(ImagesConfig(samples=1, chunk=1), images, workers=1)
     base = PerceptionTrainConfig(
         images=str(images), epochs=1, batch_size=3, width=4, stages=1, threads=1, stride=4
     )
@@ -163,8 +163,8 @@ def test_examples_keep_the_keypoints_of_objects_in_sight_and_the_cuboids_of_all(
 
 def test_collections_of_different_view_counts_train_together(tmp_path):
     three, every = tmp_path / "three", tmp_path / "every"
-    collect_images(ImagesConfig(count=1, chunk=1, views=3), three, workers=1)
-    collect_images(ImagesConfig(count=1, chunk=1), every, workers=1)
+    collect_images(ImagesConfig(samples=1, chunk=1, views=3), three, workers=1)
+    collect_images(ImagesConfig(samples=1, chunk=1), every, workers=1)
     from hsgplan.perception.images import load_chunks
     from hsgplan.perception.train import examples, joined
 
