@@ -48,14 +48,11 @@ def collect_images(
         "format": FORMAT,
         "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in first_views(config.views)],
     }
-    items = [
-        (str(run_dir), config.seed, c, config.chunk, config.samples, config.p_elsewhere, config.views)
-        for c in range(config.chunks)
-    ]
+    items = [(str(run_dir), c, config) for c in range(config.chunks)]
     rows = run_items(
         _render,
         items,
-        key=lambda item: item[2],
+        key=lambda item: item[1],
         run_dir=run_dir,
         kind=KIND,
         config=settings,
@@ -67,5 +64,6 @@ def collect_images(
     return rows
 
 
-def _render(item: tuple[str, int, int, int, int, float, int]) -> dict:
-    return render_chunk(*item)
+def _render(item: tuple[str, int, ImagesConfig]) -> dict:
+    run_dir, chunk, c = item
+    return render_chunk(run_dir, c.seed, chunk, c.chunk, c.samples, c.p_elsewhere, c.views)
