@@ -1,6 +1,6 @@
 """f_p in the loop: the robot's belief of where the objects are, from the fixed cameras' images.
 
-The observer is given what a real robot has (`sim.observer.Look`): the images, the cameras'
+The observer is given what a real robot has (`sim.sensing.Look`): the images, the cameras'
 calibration, the arm's joints and what it knows of its own hand; and, when an episode starts,
 the goal's object names (their types follow from them). Nothing else: no staged pose, no
 simulated scene. Every look runs the pose estimator and names what it found. The goal names

@@ -7,7 +7,7 @@ RGB image from the fixed camera) is in `info["observation"]`: what the env's obs
 (`sim.observer`, the ground truth by default) makes of the scene, with the true symbols beside
 it to judge by. The reward is 1 on the step where the goal truly holds.
 
-With a camera observer (`sim.observer.CameraObserver`) the robot knows only its belief: every
+With a camera observer (`sim.sensing.CameraObserver`) the robot knows only its belief: every
 primitive is planned in the model of that belief (`sim.belief_world`) and the simulated scene
 runs its joint motions; a step's outcome is judged on what the gripper feels and on the belief
 before and after it (a new look), and before acting on an object the belief is unsure of the
