@@ -70,24 +70,20 @@ class Goal:
         for o in self.objects:
             by_type.setdefault(split_instance(o)[0], []).append(o)
         groups = [names for names in by_type.values() if len(names) > 1]
-        out = []
-        for orders in itertools.product(*(itertools.permutations(g) for g in groups)):
-            mapping = {
-                a: b
-                for g, order in zip(groups, orders, strict=True)
-                for a, b in zip(g, order, strict=True)
-            }
-            out.append(
-                Goal(
-                    frozenset(
-                        Literal(
-                            lit.predicate, tuple(mapping.get(a, a) for a in lit.args), lit.positive
-                        )
-                        for lit in self.literals
-                    )
-                )
+        names = [o for g in groups for o in g]
+        return [
+            self.renamed(dict(zip(names, itertools.chain(*orders), strict=True)))
+            for orders in itertools.product(*(itertools.permutations(g) for g in groups))
+        ]
+
+    def renamed(self, names: dict[str, str]) -> Goal:
+        """The goal with each object named in `names` called by its value instead."""
+        return Goal(
+            frozenset(
+                Literal(lit.predicate, tuple(names.get(a, a) for a in lit.args), lit.positive)
+                for lit in self.literals
             )
-        return out
+        )
 
 
 def _snake(name: str) -> str:

@@ -24,6 +24,7 @@ from hsgplan.domain.objects import object_type, type_of
 from hsgplan.domain.world import Kind
 from hsgplan.perception.estimator import Detection, PoseEstimator
 from hsgplan.perception.keypoints import BOX_SYMMETRIES
+from hsgplan.perception.observer import away_from_hand
 from hsgplan.perception.synthetic import VIEWS, ImageSample, render_sample
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -134,10 +135,8 @@ def evaluate_loop(
     out = []
     for scene in loop_scenes(scenes, seed, cameras):
         detections = estimator.detect(scene.images, cameras)
-        if scene.held is not None:  # the robot knows where its hand is: not f_p's to find
-            hand = np.asarray(scene.held.position)
-            far = [np.linalg.norm(np.subtract(d.pose.position, hand)) for d in detections]
-            detections = [d for d, f in zip(detections, far, strict=True) if f > MATCH_DISTANCE]
+        # the robot knows where its hand is: what is there is not f_p's to find
+        detections = away_from_hand(detections, scene.held)
         out.append(score(scene.truth, detections))
         if on_scene:
             on_scene()

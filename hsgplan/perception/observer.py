@@ -73,7 +73,6 @@ class RgbObserver:
         self.cameras = cameras
         self._objects: tuple[str, ...] = ()
         self._last: dict[str, Pose] = {}
-        self._views: dict[str, int] = {}
 
     @staticmethod
     def load(folder: Path) -> RgbObserver:
@@ -81,7 +80,7 @@ class RgbObserver:
 
     def start(self, objects: tuple[str, ...]) -> None:
         self._objects = tuple(objects)
-        self._last, self._views = {}, {}
+        self._last = {}
 
     def look(self, look: Look) -> Seen:
         start = time.perf_counter()
@@ -91,11 +90,8 @@ class RgbObserver:
             # last seen in the hand: it is where the hand let it go, which the robot knows
             name, pose = look.released
             self._last[name] = pose
-        if held is not None and look.held_pose is not None:
-            hand = np.array(look.held_pose.position)
-            detections = [
-                d for d in detections if np.linalg.norm(d.pose.position - hand) > HAND_RADIUS
-            ]
+        if held is not None:
+            detections = away_from_hand(detections, look.held_pose)
         known = {o: p for o, p in self._last.items() if o != held}
         rest = self.estimator.rest if self.estimator.settled else None
         tracks = tracked(detections, known, rest)
@@ -107,9 +103,8 @@ class RgbObserver:
             poses[held] = look.held_pose
             views[held] = len(look.cameras)  # the robot's own knowledge: sure
         self._last = {o: poses[o] for o in self._objects if o in poses}
-        self._views = {o: views.get(o, 0) for o in self._last}
         unknown = tuple(o for o in self._objects if o not in self._last)
-        uncertain = tuple(o for o in self._last if self._views[o] <= 1) + unknown
+        uncertain = tuple(o for o in self._last if views.get(o, 0) <= 1) + unknown
         return Seen(
             GeometricSceneGraph.from_poses(self._last, held=held),
             tracks.unseen,
@@ -117,6 +112,15 @@ class RgbObserver:
             uncertain,
             time.perf_counter() - start,
         )
+
+
+def away_from_hand(detections: list[Detection], hand: Pose | None) -> list[Detection]:
+    """The detections further than `HAND_RADIUS` from the held object's pose `hand` (all of
+    them without one)."""
+    if hand is None:
+        return detections
+    at = np.asarray(hand.position)
+    return [d for d in detections if np.linalg.norm(np.subtract(d.pose.position, at)) > HAND_RADIUS]
 
 
 @dataclass(frozen=True)

@@ -98,10 +98,9 @@ def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFa
 
 def plan_transit(scene: Scene, q_goal: np.ndarray) -> tuple[np.ndarray, ...] | None:
     """A collision-free path of the arm (and what it holds) from where it is to `q_goal`."""
-    q0 = scene.robot.q()
-    held = () if scene.held() is None else (scene.held(),)
+    held = scene.held()
     with scene.robot.preserved():
-        return _path(scene, q0, q_goal, ignore=held)
+        return _path(scene, scene.robot.q(), q_goal, ignore=() if held is None else (held,))
 
 
 def can_pick(scene: Scene, obj: str) -> bool:
