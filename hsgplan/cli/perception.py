@@ -74,6 +74,13 @@ def eval_perception(
     raw: Annotated[
         bool, typer.Option(help="The fused PnP poses, not made to rest on their supports.")
     ] = False,
+    pruned: Annotated[
+        bool,
+        typer.Option(
+            help="Drop what a lone view found that the other views contradict "
+            "(perception/phantoms.py; with the poses made to rest)."
+        ),
+    ] = True,
     as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
     markdown: Annotated[bool, typer.Option(help="Print Markdown tables.")] = False,
     views: Annotated[
@@ -97,7 +104,7 @@ def eval_perception(
     from hsgplan.perception.synthetic import VIEWS, first_views
 
     shown = len(first_views(views)) if views is not None else len(VIEWS)  # before loading
-    estimator = PoseEstimator.load(checkpoint, settled=not raw)
+    estimator = PoseEstimator.load(checkpoint, settled=not raw, pruned=pruned)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         run = evaluate_loop if loop else evaluate

@@ -126,6 +126,25 @@ def _shelf(name: str, x_min: float, x_max: float, y_near: float, y_far: float, p
     return Shelf(name, outer, interior, SHELF_CLEARANCE, top, prepush)
 
 
+@dataclass(frozen=True)
+class Board:
+    """One box of a shelf: its footprint and the heights of its bottom and top faces."""
+
+    rect: Rect
+    z_min: float
+    z_max: float
+
+
+def shelf_boards(shelf: Shelf) -> tuple[Board, ...]:
+    """A shelf's side walls, back wall and top board; the front (low x) is open, the floor is
+    the table."""
+    o, c = shelf.outer, shelf.clearance
+    left = Rect(o.x_min, o.x_max, o.y_max - WALL, o.y_max)
+    right = Rect(o.x_min, o.x_max, o.y_min, o.y_min + WALL)
+    back = Rect(o.x_max - WALL, o.x_max, o.y_min + WALL, o.y_max - WALL)
+    return (*(Board(r, 0.0, c) for r in (left, right, back)), Board(o, c, shelf.top.z))
+
+
 SHELVES: dict[str, Shelf] = {
     "shelf_a": _shelf("shelf_a", 0.38, 0.60, 0.22, 0.54, "prepush_a"),
     "shelf_b": _shelf("shelf_b", 0.38, 0.60, -0.22, -0.54, "prepush_b"),

@@ -9,7 +9,8 @@ names each object's type, among the types of the kind the keypoint network saw w
 fits where the views' rays meet (a box whose centre is a centimetre over the table is no
 popcorn); one whose centroid's pixel another detection hides is named again by the pixels it
 keeps in sight (`perception.visible`). Last, the poses are made to rest on what is under them
-(`perception.settle`), unless asked for raw.
+(`perception.settle`), unless asked for raw, and what a lone view found that the other views
+contradict is dropped (`perception.phantoms`).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ import torch
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.world import OBJECT_TYPES, TABLE, Kind
 from hsgplan.paths import shipped
+from hsgplan.perception import phantoms
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
 from hsgplan.perception.colour import ColourNet, features, load_colour, pixel_vote, type_probs
 from hsgplan.perception.fusion import Seen, grouped, line_of_sight
@@ -103,18 +105,24 @@ class PoseEstimator:
     """
 
     def __init__(
-        self, net: KeypointNet, settled: bool = True, colour: ColourNet | None = None
+        self,
+        net: KeypointNet,
+        settled: bool = True,
+        colour: ColourNet | None = None,
+        pruned: bool = True,
     ) -> None:
         self.net = net
         self.settled = settled
         self.colour = colour
+        self.pruned = pruned
 
     @staticmethod
-    def load(folder: Path, settled: bool = True) -> PoseEstimator:
+    def load(folder: Path, settled: bool = True, pruned: bool = True) -> PoseEstimator:
         """The estimator of a checkpoint folder (the keypoint network, and the colour network
         in its `colour/`)."""
         net = load_perception_net(folder)[0]
-        return PoseEstimator(net, settled, load_colour(shipped(folder) / COLOUR_FOLDER))
+        colour = load_colour(shipped(folder) / COLOUR_FOLDER)
+        return PoseEstimator(net, settled, colour, pruned)
 
     def _typed(self, images: np.ndarray, members: list[Seen]) -> tuple[int, float]:
         """The type of an object its members saw, and its probability: by the colour network
@@ -235,7 +243,8 @@ class PoseEstimator:
         if not self.settled:
             return fused
         fused = self._unstacked(images, cameras, fused)
-        return self.rest([replace(d, measured=d.pose) for d in fused])
+        rested = self.rest([replace(d, measured=d.pose) for d in fused])
+        return phantoms.pruned(rested, found, cameras) if self.pruned else rested
 
     @staticmethod
     def rest(

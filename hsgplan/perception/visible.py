@@ -17,26 +17,69 @@ cuboid, and an estimate is off by a few millimetres; what is left is eroded by a
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
 from hsgplan.domain.objects import object_type
+from hsgplan.domain.world import SHELVES, Board, shelf_boards
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.scene_graph.geometry import Pose
 
 SHRINK = 0.8  # of a cuboid's footprint painted
 
 
-def painted(types: list[str], poses: list[Pose], camera: PinholeCamera) -> np.ndarray:
-    """Which object (its index; -1 for none) each pixel shows, as painted: [H, W] int32."""
+@dataclass(frozen=True)
+class Cuboid:
+    """A box in the world: its pose and its half extents (m)."""
+
+    pose: Pose
+    half: tuple[float, float, float]
+
+    @staticmethod
+    def of_object(type_name: str, pose: Pose, shrink: float = SHRINK) -> Cuboid:
+        """An object's cuboid, its footprint shrunk by `shrink` across."""
+        sx, sy, sz = object_type(type_name).size
+        return Cuboid(pose, (shrink * sx / 2, shrink * sy / 2, sz / 2))
+
+    @staticmethod
+    def of_board(board: Board) -> Cuboid:
+        r = board.rect
+        x, y = r.center
+        centre = (x, y, (board.z_min + board.z_max) / 2)
+        half = (r.width_x / 2, r.width_y / 2, (board.z_max - board.z_min) / 2)
+        return Cuboid(Pose(centre, (0.0, 0.0, 0.0, 1.0)), half)
+
+
+OCCLUDED = -2  # a pixel an occluder shows (`painted`)
+# the shelves' walls and boards: the fixed furniture that hides what stands behind or in it
+FURNITURE = tuple(Cuboid.of_board(b) for s in SHELVES.values() for b in shelf_boards(s))
+
+
+def painted(
+    types: list[str],
+    poses: list[Pose],
+    camera: PinholeCamera,
+    occluders: tuple[Cuboid, ...] = (),
+) -> np.ndarray:
+    """Which object (its index; -1 for none) each pixel shows, as painted: [H, W] int32. The
+    `occluders` (painted as -2) hide what is behind them."""
+    cuboids = [Cuboid.of_object(t, p) for t, p in zip(types, poses, strict=True)]
+    label = paint(cuboids + list(occluders), camera)
+    label[label >= len(cuboids)] = OCCLUDED
+    return label
+
+
+def paint(cuboids: list[Cuboid], camera: PinholeCamera) -> np.ndarray:
+    """Which cuboid (its index; -1 for none) each pixel shows, the far faces painted first:
+    [H, W] int32."""
     label = np.full((camera.height, camera.width), -1, dtype=np.int32)
     faces = []
-    for i, (t, pose) in enumerate(zip(types, poses, strict=True)):
-        sx, sy, sz = object_type(t).size
-        half = np.array([SHRINK * sx / 2, SHRINK * sy / 2, sz / 2])
-        local = np.array(list(itertools.product((-1, 1), repeat=3)), dtype=np.float64) * half
-        m = pose.matrix()
+    for i, cuboid in enumerate(cuboids):
+        local = np.array(list(itertools.product((-1, 1), repeat=3)), dtype=np.float64)
+        local *= np.asarray(cuboid.half)
+        m = cuboid.pose.matrix()
         corners = local @ m[:3, :3].T + m[:3, 3]
         for axis, sign in itertools.product(range(3), (-1, 1)):
             quad = corners[local[:, axis] * sign > 0]

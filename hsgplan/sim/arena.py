@@ -6,7 +6,15 @@ from dataclasses import dataclass
 
 from pybullet_utils.bullet_client import BulletClient
 
-from hsgplan.domain.world import FIXTURE_FRICTION, REGIONS, SHELVES, TABLE, WALL, Rect, Shelf
+from hsgplan.domain.world import (
+    FIXTURE_FRICTION,
+    REGIONS,
+    SHELVES,
+    TABLE,
+    Rect,
+    Shelf,
+    shelf_boards,
+)
 
 TABLE_THICKNESS = 0.05
 TABLE_COLOR = (0.82, 0.74, 0.62, 1.0)
@@ -47,14 +55,8 @@ def _slab(bc: BulletClient, r: Rect, z0: float, z1: float, color, collide=True) 
 
 
 def build_shelf(bc: BulletClient, shelf: Shelf) -> tuple[int, ...]:
-    """Side walls, back wall and top board; the front (low x) is open, the floor is the table."""
-    o, c = shelf.outer, shelf.clearance
-    left = Rect(o.x_min, o.x_max, o.y_max - WALL, o.y_max)
-    right = Rect(o.x_min, o.x_max, o.y_min, o.y_min + WALL)
-    back = Rect(o.x_max - WALL, o.x_max, o.y_min + WALL, o.y_max - WALL)
-    parts = [_slab(bc, r, 0.0, c, SHELF_COLOR) for r in (left, right, back)]
-    parts.append(_slab(bc, o, c, shelf.top.z, SHELF_COLOR))
-    return tuple(parts)
+    """The shelf's boards (`world.shelf_boards`) as fixed boxes."""
+    return tuple(_slab(bc, b.rect, b.z_min, b.z_max, SHELF_COLOR) for b in shelf_boards(shelf))
 
 
 def build_arena(bc: BulletClient) -> Arena:

@@ -1,0 +1,100 @@
+"""What a lone view found, tested against the rest of the look on tiny hand-built looks: found
+again in one space, missed by a view that would show it, doubted by the colour network, or in
+the space of an object several views saw."""
+
+from dataclasses import replace
+
+import numpy as np
+
+from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.perception.estimator import Detection
+from hsgplan.perception.fusion import Seen
+from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
+from hsgplan.perception.phantoms import SURE, overlap, pruned
+from hsgplan.perception.pnp import ViewKeypoints
+from hsgplan.perception.synthetic import VIEWS
+from hsgplan.scene_graph.geometry import Pose
+
+TYPES = list(OBJECT_TYPES)
+OPEN = Pose.from_xyz_yaw(0.45, 0.0, 0.0415, 0.0)  # a soup on the open table, in every view
+INSIDE = Pose.from_xyz_yaw(0.52, 0.38, 0.0415, 0.0)  # a soup deep inside shelf A
+
+
+def _keypoints(name: str, pose: Pose, view: int) -> ViewKeypoints:
+    camera = PinholeCamera.of(VIEWS[view])
+    return ViewKeypoints(camera, view_keypoints(name, pose, camera))
+
+
+def _detection(name: str, pose: Pose, views: tuple[int, ...], confidence: float = 0.9):
+    keypoints = tuple(_keypoints(name, pose, v) for v in views)
+    return Detection(name, pose, 0.8, len(views), 0.0, (), confidence, keypoints)
+
+
+def _instances(name: str, pose: Pose, views: tuple[int, ...]) -> list[Seen]:
+    """What those views found: the object's instance in each."""
+    return [Seen(TYPES.index(name), 0.8, v, _keypoints(name, pose, v), pose) for v in views]
+
+
+def test_a_lone_view_no_other_view_backs_where_every_view_would_show_it_is_dropped():
+    lone = _detection("tomato_soup", OPEN, (0,))
+    assert pruned([lone], _instances("tomato_soup", OPEN, (0,)), VIEWS) == []
+
+
+def test_a_lone_views_detection_stays_where_another_view_found_something_there():
+    lone = _detection("tomato_soup", OPEN, (0,))
+    backed = _instances("tomato_soup", OPEN, (0,)) + _instances("alphabet_soup", OPEN, (1, 2, 3, 4))
+    assert pruned([lone], backed, VIEWS) == [lone]
+
+
+def test_a_lone_views_detection_the_shelf_hides_from_the_others_stays():
+    assert not any(_shows(INSIDE, v) for v in range(1, len(VIEWS)))  # the walls hide it
+    lone = _detection("tomato_soup", INSIDE, (0,))
+    assert pruned([lone], _instances("tomato_soup", INSIDE, (0,)), VIEWS) == [lone]
+
+
+def _shows(pose: Pose, view: int) -> bool:
+    """Whether a view would show a good part of a soup at `pose`, the shelves painted."""
+    from hsgplan.perception.visible import FURNITURE, painted
+
+    camera = PinholeCamera.of(VIEWS[view])
+    alone = (painted(["tomato_soup"], [pose], camera) == 0).sum()
+    shown = (painted(["tomato_soup"], [pose], camera, FURNITURE) == 0).sum()
+    return alone > 0 and shown >= 0.5 * alone
+
+
+def test_one_object_found_again_by_a_lone_view_in_the_same_space_is_kept_once():
+    every = tuple(range(len(VIEWS)))
+    sure = _detection("tomato_soup", OPEN, every)
+    again = _detection("tomato_soup", Pose.from_xyz_yaw(0.455, 0.005, 0.0415, 0.0), (2,))
+    found = _instances("tomato_soup", OPEN, every)
+    assert pruned([again, sure], found, VIEWS) == [sure]
+
+
+def test_a_lone_view_the_colour_network_doubts_is_dropped_and_several_views_are_not():
+    every = tuple(range(len(VIEWS)))
+    found = _instances("tomato_soup", OPEN, every)
+    doubted = _detection("tomato_soup", OPEN, (0,), confidence=SURE / 2)
+    several = _detection("tomato_soup", OPEN, (0, 1), confidence=SURE / 2)
+    assert pruned([doubted], found, VIEWS) == []
+    assert pruned([several], found, VIEWS) == [several]
+
+
+def test_a_lone_views_box_in_a_sure_cans_space_is_dropped_not_in_an_unsure_ones():
+    every = tuple(range(len(VIEWS)))
+    can = _detection("tomato_soup", OPEN, every)
+    box = _detection("butter", Pose.from_xyz_yaw(0.47, 0.01, 0.012, 0.3), (1,))
+    found = _instances("tomato_soup", OPEN, every)
+    assert pruned([can, box], found, VIEWS) == [can]
+    unsure = replace(can, type_confidence=SURE / 2)
+    assert pruned([unsure, box], found, VIEWS) == [unsure, box]
+
+
+def test_cuboids_overlap_in_one_space_not_side_by_side_nor_stacked():
+    a = _detection("butter", Pose.from_xyz_yaw(0.45, 0.0, 0.012, 0.0), (0,))
+    turned = _detection("cream_cheese", Pose.from_xyz_yaw(0.47, 0.02, 0.012, 1.2), (0,))
+    beside = _detection("cream_cheese", Pose.from_xyz_yaw(0.45, 0.12, 0.012, 0.0), (0,))
+    on_it = _detection("cream_cheese", Pose.from_xyz_yaw(0.45, 0.0, 0.036, 0.0), (0,))
+    assert overlap(a, turned) and overlap(turned, a)
+    assert not overlap(a, beside)
+    assert not overlap(a, on_it)
+    assert np.isclose(a.pose.position[2], 0.012)
