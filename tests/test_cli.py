@@ -212,16 +212,15 @@ def test_every_count_and_seed_takes_its_bounds_from_the_one_table():
 
 
 def test_a_commands_defaults_are_its_configurations_defaults():
-    """Where an option sets a configuration's field, its default is the field's: written beside
-    each other (the configurations' modules are too heavy for `--help` to import), held equal
-    here."""
+    """Where an option sets a configuration's field, its default and bounds are the field's
+    (read from it by `cli.common.config_default` and `config_option`)."""
     import dataclasses
 
     import typer.main
 
     from hsgplan.collect.images import ImagesConfig
     from hsgplan.collect.motion import CollectConfig
-    from hsgplan.evaluation.protocol import EvalConfig
+    from hsgplan.evaluation.config import EvalConfig
 
     group = typer.main.get_command(app)
 
@@ -230,11 +229,11 @@ def test_a_commands_defaults_are_its_configurations_defaults():
         for part in path:
             cmd = cmd.commands[part]
         (param,) = [p for p in cmd.params if p.name == name]
-        return param.default
+        return param
 
-    def field_default(config, name: str):
+    def field_of(config, name: str):
         (f,) = [f for f in dataclasses.fields(config) if f.name == name]
-        return f.default
+        return f
 
     pairs = [
         (("collect", "place"), "seed", CollectConfig, "seed"),
@@ -248,6 +247,8 @@ def test_a_commands_defaults_are_its_configurations_defaults():
         (("eval", "world"), "protocol", EvalConfig, "protocol"),
     ]
     for path, name, config, field in pairs:
-        got = option(path, name)
-        got = getattr(got, "value", got)  # an enum's choice
-        assert got == field_default(config, field), (path, name)
+        param, f = option(path, name), field_of(config, field)
+        got = getattr(param.default, "value", param.default)  # an enum's choice
+        assert got == f.default, (path, name)
+        if "lo" in f.metadata:  # a bounded field: the option refuses what the field would
+            assert (param.min, param.max) == (f.metadata["lo"], f.metadata["hi"])

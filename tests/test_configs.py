@@ -7,7 +7,7 @@ from hsgplan.collect.images import ImagesConfig
 from hsgplan.collect.motion import CollectConfig
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
-from hsgplan.evaluation.protocol import EvalConfig
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.motion.train import MotionTrainConfig
 from hsgplan.perception.colour import ColourConfig
 from hsgplan.perception.train import PerceptionTrainConfig

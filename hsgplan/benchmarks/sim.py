@@ -12,8 +12,9 @@ from dataclasses import dataclass
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord, run_episode
-from hsgplan.evaluation.protocol import EvalConfig, episode_specs
+from hsgplan.evaluation.protocol import episode_specs
 from hsgplan.sim.env import KitchenStorageEnv
 
 PRIMITIVES = ("pick", "place", "push")

@@ -23,8 +23,9 @@ from pathlib import Path
 
 from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
+from hsgplan.evaluation.protocol import check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.table1 import TextTable
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim

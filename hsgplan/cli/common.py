@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import sys
 from enum import StrEnum
@@ -60,6 +61,24 @@ def bounded_option(concept: str, help: str, **more) -> typer.models.OptionInfo:
     (`domain.checks.BOUNDS[concept]`)."""
     bounds = BOUNDS[concept]
     return typer.Option(help=help, min=bounds["lo"], max=bounds["hi"], **more)
+
+
+def config_default(config: type, name: str):
+    """The default of a configuration's field: what an option that sets the field defaults to,
+    so that the value is written once, in the configuration."""
+    return _field(config, name).default
+
+
+def config_option(config: type, name: str, help: str, **more) -> typer.models.OptionInfo:
+    """An option that sets a configuration's field, held to the field's bounds
+    (`domain.checks.setting`)."""
+    bounds = _field(config, name).metadata
+    return typer.Option(help=help, min=bounds.get("lo"), max=bounds.get("hi"), **more)
+
+
+def _field(config: type, name: str) -> dataclasses.Field:
+    (found,) = [f for f in dataclasses.fields(config) if f.name == name]
+    return found
 
 
 def shown(value) -> str:

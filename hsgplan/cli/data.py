@@ -14,15 +14,16 @@ from hsgplan.cli.common import (
     RayAddress,
     bounded_option,
     check_ray,
+    config_default,
+    config_option,
     err,
     out,
     out_folder,
     refuses_bad_input,
     shown,
 )
-from hsgplan.domain.checks import (
-    MAX_TASKS_PER_CHUNK,
-)
+from hsgplan.collect.images import ImagesConfig
+from hsgplan.collect.motion import CollectConfig
 from hsgplan.paths import RUNS
 
 app = typer.Typer(no_args_is_help=True, help="Collect datasets (resumable).")
@@ -62,8 +63,10 @@ def _collect_command(primitive: str, default_samples: int):
         samples: Annotated[
             int, bounded_option("samples", "Successful trials to collect.")
         ] = default_samples,
-        workers: CollectWorkers = 2,
-        seed: Annotated[int, bounded_option("seed", "Seed of the scene and parameter stream.")] = 0,
+        workers: CollectWorkers = config_default(CollectConfig, "workers"),
+        seed: Annotated[
+            int, config_option(CollectConfig, "seed", "Seed of the scene and parameter stream.")
+        ] = config_default(CollectConfig, "seed"),
         ray: RayAddress = None,
         out_dir: Annotated[
             Path,
@@ -75,9 +78,8 @@ def _collect_command(primitive: str, default_samples: int):
             ),
         ] = RUNS / "collect-motion",
         tasks_per_chunk: Annotated[
-            int,
-            typer.Option(help="Tasks per unit of work.", min=1, max=MAX_TASKS_PER_CHUNK),
-        ] = 32,
+            int, config_option(CollectConfig, "tasks_per_chunk", "Tasks per unit of work.")
+        ] = config_default(CollectConfig, "tasks_per_chunk"),
     ) -> None:
         check_ray(ray)
         _collect(primitive, samples, workers, seed, ray, out_dir, tasks_per_chunk)
@@ -94,7 +96,7 @@ app.command("push")(_collect_command("push", 8000))
 
 
 def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir: Path, chunk: int):
-    from hsgplan.collect.motion import CollectConfig, collect
+    from hsgplan.collect.motion import collect
     from hsgplan.domain.parameters import MotionPrimitive
 
     config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray, chunk)
@@ -114,18 +116,20 @@ def images(
     samples: Annotated[
         int, bounded_option("samples", "Samples to render (scenes x views).")
     ] = 2000,
-    seed: Annotated[int, bounded_option("seed", "Seed of the scenes and their looks.")] = 0,
+    seed: Annotated[
+        int, config_option(ImagesConfig, "seed", "Seed of the scenes and their looks.")
+    ] = config_default(ImagesConfig, "seed"),
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     out_dir: CollectionFolder = RUNS / "collect-images",
     p_elsewhere: Annotated[
         float,
-        typer.Option(
-            help="Chance that an object starts off the open space (more: more stacks).",
-            min=0.0,
-            max=1.0,
+        config_option(
+            ImagesConfig,
+            "p_elsewhere",
+            "Chance that an object starts off the open space (more: more stacks).",
         ),
-    ] = 0.5,
+    ] = config_default(ImagesConfig, "p_elsewhere"),
     views: Annotated[
         int | None,
         typer.Option(
@@ -135,7 +139,7 @@ def images(
 ) -> None:
     """Synthetic training images for f_p: random scenes from the fixed cameras, domain
     randomised, with every object's pose and cuboid keypoints (format: perception/images.py)."""
-    from hsgplan.collect.images import ImagesConfig, collect_images
+    from hsgplan.collect.images import collect_images
 
     check_ray(ray)
     config = ImagesConfig(samples, seed, p_elsewhere=p_elsewhere)

@@ -20,6 +20,8 @@ from hsgplan.cli.common import (
     RunFolder,
     bounded_option,
     check_ray,
+    config_default,
+    config_option,
     err,
     input_path,
     out,
@@ -30,7 +32,8 @@ from hsgplan.cli.common import (
     shown,
 )
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.recovery import RECOVERING, RecoveryRules
+from hsgplan.domain.recovery import RecoveryRules
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.paths import RUNS, shipped
 from hsgplan.runner.run_folder import check_own
 
@@ -112,7 +115,7 @@ def _print_step(s) -> None:
     )
 
 
-DEFAULT_PROTOCOL = ProtocolName(RECOVERING)
+DEFAULT_PROTOCOL = ProtocolName(config_default(EvalConfig, "protocol"))
 
 
 @refuses_bad_input
@@ -130,8 +133,8 @@ def evaluate(
     goals: Annotated[int, bounded_option("goals", "Random goals per size.")] = 50,
     repeats: Annotated[
         int,
-        bounded_option("repeats", "Episodes per goal, each from its own scene."),
-    ] = 1,
+        config_option(EvalConfig, "repeats", "Episodes per goal, each from its own scene."),
+    ] = config_default(EvalConfig, "repeats"),
     seed: Annotated[int, bounded_option("seed", "Seed of the goals and the episodes.")] = 0,
     goals_file: Annotated[
         Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
@@ -153,7 +156,7 @@ def evaluate(
             help="What the agent sees with, comma-separated: gt (the simulator's poses), rgb "
             "(f_p on the fixed cameras' images); one column each, rgb's named METHOD-rgb."
         ),
-    ] = "gt",
+    ] = config_default(EvalConfig, "perception"),
     perception_checkpoint: PerceptionCheckpoint = None,
     protocol: Annotated[
         ProtocolName,
@@ -188,8 +191,9 @@ def evaluate(
     recovering); writes table1.md, table1.png and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.evaluation.ablation import ablation_table, check_ablation, run_ablation
+    from hsgplan.evaluation.config import EvalConfig
     from hsgplan.evaluation.observers import make_observer
-    from hsgplan.evaluation.protocol import EvalConfig, checkpoints, episode_specs
+    from hsgplan.evaluation.protocol import checkpoints, episode_specs
     from hsgplan.evaluation.table1 import Method, check_table, run_table, tables
 
     planner_name = planner and planner.value
@@ -265,7 +269,7 @@ def _run_name(methods, config) -> str:
     agents = "_".join(
         m.agent + ("" if m.perception == "gt" else f"-{m.perception}") for m in methods
     )
-    protocol = "" if config.protocol == RECOVERING else f"-{config.protocol}"
+    protocol = "" if config.protocol == DEFAULT_PROTOCOL.value else f"-{config.protocol}"
     protocol += "".join(f"-no_{rule}" for rule in config.rules_off)
     return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}"
 

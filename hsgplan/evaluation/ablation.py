@@ -15,8 +15,8 @@ from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import PAPER, PERCEPTION_RULES, RecoveryRules
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import EvalConfig
 from hsgplan.evaluation.table1 import (
     Method,
     TextTable,

@@ -5,15 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from hsgplan.domain.errors import InvalidInputError
+from hsgplan.evaluation.config import check_observer
 from hsgplan.sim.observer import GroundTruth, SceneObserver
-
-OBSERVERS = ("gt", "rgb")
-
-
-def check_observer(name: str) -> None:
-    if name not in OBSERVERS:
-        raise InvalidInputError(f"--perception '{name}': one of {', '.join(OBSERVERS)}")
 
 
 def perception_folder(checkpoint: str | Path | None) -> Path:

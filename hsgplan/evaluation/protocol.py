@@ -19,57 +19,22 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, fields, replace
 from functools import lru_cache, partial
 from pathlib import Path
 
 from hsgplan.domain.checks import (
-    BOUNDS,
-    bounded,
-    check_fields,
     read_json,
-    setting,
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
-from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
+from hsgplan.domain.recovery import PAPER, RECOVERING
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.observers import check_observer, make_observer, perception_folder
+from hsgplan.evaluation.observers import make_observer, perception_folder
 from hsgplan.runner.items import run_items
 from hsgplan.runner.run_folder import CONFIG, add_wall_seconds, check_claim
 from hsgplan.symbolic.generator import random_goals
-
-
-@dataclass(frozen=True)
-class EvalConfig:
-    agent: str
-    sizes: tuple[int, ...]
-    goals: int = field(metadata=bounded(**BOUNDS["goals"]))  # per size (a goal file: unused)
-    seed: int = field(metadata=bounded(**BOUNDS["seed"]))
-    goals_file: str | None = None
-    repeats: int = setting(1, **BOUNDS["repeats"])
-    checkpoint: str | None = None  # the task planner's folder (None: the shipped one)
-    motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
-    perception: str = "gt"  # what the agent sees: "gt" (the simulator's poses) or "rgb" (f_p)
-    perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
-    protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
-    rules_off: tuple[str, ...] = ()  # recovery rules switched off (the recovering protocol)
-
-    def __post_init__(self) -> None:
-        check_fields(self)
-        check_observer(self.perception)
-        if self.protocol not in PROTOCOLS:
-            raise InvalidInputError(f"protocol '{self.protocol}': one of {', '.join(PROTOCOLS)}")
-        object.__setattr__(self, "rules_off", tuple(self.rules_off))
-        if self.protocol == PAPER and self.rules_off:
-            raise InvalidInputError("the paper protocol has no recovery rule to switch off")
-        self.rules()  # an unknown rule's name is refused here
-
-    def rules(self) -> RecoveryRules:
-        """The recovery rules its agent runs under: none under the paper's protocol."""
-        if self.protocol == PAPER:
-            return RecoveryRules.none()
-        return RecoveryRules().without(self.rules_off)
 
 
 @dataclass(frozen=True)

@@ -15,8 +15,9 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from hsgplan.domain.recovery import RECOVERING
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import EvalConfig, check_runs, episode_specs, run_evaluation
+from hsgplan.evaluation.protocol import check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim, read_timing

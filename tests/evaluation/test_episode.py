@@ -9,8 +9,9 @@ from typer.testing import CliRunner
 from hsgplan.agents.registry import make_agent
 from hsgplan.cli import app
 from hsgplan.domain.goals import parse_goal
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import run_episode
-from hsgplan.evaluation.protocol import EvalConfig, episode_specs, run_evaluation
+from hsgplan.evaluation.protocol import episode_specs, run_evaluation
 from hsgplan.evaluation.summary import summarize
 from hsgplan.sim.env import KitchenStorageEnv
 

@@ -10,8 +10,9 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.parameters import PickParams
 from hsgplan.domain.recovery import PERCEPTION_RULES, RecoveryRules
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import run_episode
-from hsgplan.evaluation.protocol import EvalConfig, run_config
+from hsgplan.evaluation.protocol import run_config
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, failure_class
 from hsgplan.sim.env import KitchenStorageEnv
 

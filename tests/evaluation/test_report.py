@@ -8,8 +8,9 @@ from dataclasses import asdict
 import pytest
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord
-from hsgplan.evaluation.protocol import EvalConfig, episode_specs
+from hsgplan.evaluation.protocol import episode_specs
 from hsgplan.evaluation.report import _collapsed, build_report, read_summary, sample_failures
 from hsgplan.evaluation.summary import summarize
 from hsgplan.runner.run_folder import CONFIG, RESULTS

@@ -11,8 +11,9 @@ from dataclasses import replace
 
 import pytest
 
+from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord
-from hsgplan.evaluation.protocol import EvalConfig, episode_specs
+from hsgplan.evaluation.protocol import episode_specs
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, failure_class, summarize
 from hsgplan.evaluation.table1 import PAPER_TABLE1, markdown
 

@@ -1,0 +1,52 @@
+"""What an evaluation runs, as a configuration: its agent, goals, protocol and what the agent
+sees with. Kept apart from running it (`evaluation.protocol`), and light to import: the command
+line takes its options' defaults from here."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from hsgplan.domain.checks import BOUNDS, bounded, check_fields, setting
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
+
+# What an agent sees the simulated world with: `gt` (the simulator's poses) or `rgb` (f_p on
+# the fixed cameras' images); `evaluation.observers` makes them.
+OBSERVERS = ("gt", "rgb")
+
+
+def check_observer(name: str) -> None:
+    if name not in OBSERVERS:
+        raise InvalidInputError(f"--perception '{name}': one of {', '.join(OBSERVERS)}")
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    agent: str
+    sizes: tuple[int, ...]
+    goals: int = field(metadata=bounded(**BOUNDS["goals"]))  # per size (a goal file: unused)
+    seed: int = field(metadata=bounded(**BOUNDS["seed"]))
+    goals_file: str | None = None
+    repeats: int = setting(1, **BOUNDS["repeats"])
+    checkpoint: str | None = None  # the task planner's folder (None: the shipped one)
+    motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
+    perception: str = "gt"  # what the agent sees: "gt" (the simulator's poses) or "rgb" (f_p)
+    perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
+    protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
+    rules_off: tuple[str, ...] = ()  # recovery rules switched off (the recovering protocol)
+
+    def __post_init__(self) -> None:
+        check_fields(self)
+        check_observer(self.perception)
+        if self.protocol not in PROTOCOLS:
+            raise InvalidInputError(f"protocol '{self.protocol}': one of {', '.join(PROTOCOLS)}")
+        object.__setattr__(self, "rules_off", tuple(self.rules_off))
+        if self.protocol == PAPER and self.rules_off:
+            raise InvalidInputError("the paper protocol has no recovery rule to switch off")
+        self.rules()  # an unknown rule's name is refused here
+
+    def rules(self) -> RecoveryRules:
+        """The recovery rules its agent runs under: none under the paper's protocol."""
+        if self.protocol == PAPER:
+            return RecoveryRules.none()
+        return RecoveryRules().without(self.rules_off)
