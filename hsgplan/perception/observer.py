@@ -115,12 +115,18 @@ class RgbObserver:
 
 
 def away_from_hand(detections: list[Detection], hand: Pose | None) -> list[Detection]:
-    """The detections further than `HAND_RADIUS` from the held object's pose `hand` (all of
-    them without one)."""
+    """The detections measured further than `HAND_RADIUS` from the held object's pose `hand`
+    (all of them without one). Where it was measured, not where it was made to rest: the held
+    object's own detection, made to rest on what is under the hand, lands just past the radius
+    (on 100 loop scenes, seed 43, 25 of the 39 detections left matching no object)."""
     if hand is None:
         return detections
     at = np.asarray(hand.position)
-    return [d for d in detections if np.linalg.norm(np.subtract(d.pose.position, at)) > HAND_RADIUS]
+    return [d for d in detections if np.linalg.norm(_measured(d) - at) > HAND_RADIUS]
+
+
+def _measured(d: Detection) -> np.ndarray:
+    return np.asarray((d.measured or d.pose).position)
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,14 @@ from hsgplan.perception.estimator import Detection, PoseEstimator
 from hsgplan.perception.keypoints import PinholeCamera, in_world, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE
-from hsgplan.perception.observer import RgbObserver, assign, first_sight, tracked
+from hsgplan.perception.observer import (
+    HAND_RADIUS,
+    RgbObserver,
+    assign,
+    away_from_hand,
+    first_sight,
+    tracked,
+)
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.env import KitchenStorageEnv
@@ -374,3 +381,13 @@ def test_an_uncertain_object_is_looked_at_again_from_out_of_the_way_unless_the_r
     # and once more before it believes the goal reached, the arm having stopped elsewhere
     assert record.closing_relooks == (1 if relook else 0)
     assert len(observer.looks) == 1 + len(record.steps) + looks + record.closing_relooks
+
+
+def test_what_f_p_measured_at_the_hand_is_no_other_object_wherever_it_was_made_to_rest():
+    hand = Pose.from_xyz_yaw(0.45, 0.0, 0.15, 0.0)
+    rested = Pose.from_xyz_yaw(0.45, 0.0, 0.0415, 0.0)  # dropped onto the table under the hand
+    held = Detection("tomato_soup", rested, 0.9, 5, 0.0, measured=hand)
+    other = Detection("tomato_soup", Pose.from_xyz_yaw(0.45, 0.2, 0.0415, 0.0), 0.9, 5, 0.0)
+    assert math.dist(rested.position, hand.position) > HAND_RADIUS
+    assert away_from_hand([held, other], hand) == [other]
+    assert away_from_hand([held, other], None) == [held, other]
