@@ -56,6 +56,8 @@ def pruned(
     """The detections (made to rest) less those the views contradict (rules 1 to 4 above);
     `instances` are every view's instances behind them, with `Seen.view` indexing `cameras`."""
     kept = _once(detections)
+    if all(d.views > 1 for d in kept):
+        return kept
     pinholes = [PinholeCamera.of(c) for c in cameras]
     labels = [painted(*_types_poses(kept), p, FURNITURE) for p in pinholes]
     kept = [
