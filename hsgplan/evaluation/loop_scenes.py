@@ -25,6 +25,7 @@ from hsgplan.evaluation.episode import run_episode
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.render import Camera
+from hsgplan.sim.sensing import Box
 from hsgplan.symbolic.generator import random_goals
 
 MAX_STEPS_INTO = 10
@@ -37,6 +38,7 @@ class LoopScene:
     held: Pose | None  # the object in the hand, if any
     images: np.ndarray  # [V, H, W, 3]
     step: int  # steps run before it was taken
+    arm: tuple[Box, ...] = ()  # the arm's links (what the robot knows of where its arm is)
 
 
 class _Taken(Exception):
@@ -60,7 +62,8 @@ def loop_scenes(scenes: int, seed: int, cameras: tuple[Camera, ...]) -> Iterator
             poses = scene.poses()
             images = np.stack([c.capture(scene.bc) for c in cameras])
             truth = {o: p for o, p in poses.items() if o != held}
-            yield LoopScene(truth, poses[held] if held else None, images, steps)
+            arm = scene.robot.boxes()
+            yield LoopScene(truth, poses[held] if held else None, images, steps, arm)
     finally:
         env.close()
 

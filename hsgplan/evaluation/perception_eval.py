@@ -134,7 +134,7 @@ def evaluate_loop(
     cameras = first_views(views)
     out = []
     for scene in loop_scenes(scenes, seed, cameras):
-        detections = estimator.detect(scene.images, cameras)
+        detections = estimator.detect(scene.images, cameras, scene.arm)
         # the robot knows where its hand is: what is there is not f_p's to find
         detections = away_from_hand(detections, scene.held)
         out.append(score(scene.truth, detections))

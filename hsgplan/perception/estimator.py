@@ -47,6 +47,7 @@ from hsgplan.perception.settle import (
 from hsgplan.perception.visible import painted, visible_masks
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
+from hsgplan.sim.sensing import Box
 
 TYPES = tuple(OBJECT_TYPES)
 # A free (tilted) fit stands for a toppled object only where its reprojection cost is at most
@@ -225,8 +226,11 @@ class PoseEstimator:
         return out
 
     @torch.inference_mode()
-    def detect(self, images: np.ndarray, cameras: tuple[Camera, ...]) -> list[Detection]:
-        """Objects in the views: images [V, H, W, 3] uint8, taken by `cameras`."""
+    def detect(
+        self, images: np.ndarray, cameras: tuple[Camera, ...], arm: tuple[Box, ...] = ()
+    ) -> list[Detection]:
+        """Objects in the views: images [V, H, W, 3] uint8, taken by `cameras`, with the arm's
+        links at `arm` (`sim.sensing.Box`; they may hide objects from a view)."""
         batch = torch.from_numpy(images).permute(0, 3, 1, 2).float() / 255.0
         beliefs, fields = self.net(batch)[-1]
         found: list[Seen] = []
@@ -244,7 +248,7 @@ class PoseEstimator:
             return fused
         fused = self._unstacked(images, cameras, fused)
         rested = self.rest([replace(d, measured=d.pose) for d in fused])
-        return phantoms.pruned(rested, found, cameras) if self.pruned else rested
+        return phantoms.pruned(rested, found, cameras, arm) if self.pruned else rested
 
     @staticmethod
     def rest(

@@ -84,7 +84,7 @@ class RgbObserver:
 
     def look(self, look: Look) -> Seen:
         start = time.perf_counter()
-        detections = self.estimator.detect(look.images, look.cameras)
+        detections = self.estimator.detect(look.images, look.cameras, look.arm)
         held = look.holding
         if look.released is not None:
             # last seen in the hand: it is where the hand let it go, which the robot knows

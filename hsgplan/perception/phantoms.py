@@ -9,7 +9,8 @@ made to rest, against the rest of the look (`pruned`), in this order:
    rest (`settle.same_place`), is that object again (views whose lines of sight did not meet
    within `fusion.RAY_GAP`, mostly an object inside a shelf, partly hidden).
 2. Missed by a view that should have seen it: painted where it rests, with every other
-   detection and the shelves' boards painted as occluders, another view would show at least
+   detection, the shelves' boards and the arm's links (where the robot's kinematics put them,
+   when it is given them) painted as occluders, another view would show at least
    half of its cuboid (and `MIN_PIXELS`), yet that view found nothing (of any type) whose
    centroid's pixel lies within the cuboid's half-size there.
 3. Of a type the colour network doubts: its probability under `SURE` (the keypoint network saw
@@ -39,6 +40,7 @@ from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.settle import same_place
 from hsgplan.perception.visible import FURNITURE, SHRINK, Cuboid, paint, painted
 from hsgplan.sim.render import Camera
+from hsgplan.sim.sensing import Box
 
 if TYPE_CHECKING:  # the estimator imports this module
     from hsgplan.perception.estimator import Detection
@@ -51,15 +53,20 @@ EDGE_PX = 3  # px of slack around the cuboid's half-size for a view's centroid t
 
 
 def pruned(
-    detections: list[Detection], instances: list[Seen], cameras: tuple[Camera, ...]
+    detections: list[Detection],
+    instances: list[Seen],
+    cameras: tuple[Camera, ...],
+    arm: tuple[Box, ...] = (),
 ) -> list[Detection]:
     """The detections (made to rest) less those the views contradict (rules 1 to 4 above);
-    `instances` are every view's instances behind them, with `Seen.view` indexing `cameras`."""
+    `instances` are every view's instances behind them, with `Seen.view` indexing `cameras`;
+    `arm` the arm's links, which hide what is behind them as the shelves do."""
     kept = _once(detections)
     if all(d.views > 1 for d in kept):
         return kept
     pinholes = [PinholeCamera.of(c) for c in cameras]
-    labels = [painted(*_types_poses(kept), p, FURNITURE) for p in pinholes]
+    occluders = FURNITURE + tuple(Cuboid.of_box(b) for b in arm)
+    labels = [painted(*_types_poses(kept), p, occluders) for p in pinholes]
     kept = [
         d
         for k, d in enumerate(kept)

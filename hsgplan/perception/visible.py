@@ -26,6 +26,7 @@ from hsgplan.domain.objects import object_type
 from hsgplan.domain.world import SHELVES, Board, shelf_boards
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.sensing import Box
 
 SHRINK = 0.8  # of a cuboid's footprint painted
 
@@ -42,6 +43,13 @@ class Cuboid:
         """An object's cuboid, its footprint shrunk by `shrink` across."""
         sx, sy, sz = object_type(type_name).size
         return Cuboid(pose, (shrink * sx / 2, shrink * sy / 2, sz / 2))
+
+    @staticmethod
+    def of_box(box: Box) -> Cuboid:
+        """An axis-aligned box (a link of the arm)."""
+        low, high = np.asarray(box.low), np.asarray(box.high)
+        centre = tuple(map(float, (low + high) / 2))
+        return Cuboid(Pose(centre, (0.0, 0.0, 0.0, 1.0)), tuple(map(float, (high - low) / 2)))
 
     @staticmethod
     def of_board(board: Board) -> Cuboid:

@@ -20,6 +20,7 @@ from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
 from hsgplan.sim.scene import Scene
+from hsgplan.sim.sensing import Box
 
 
 class BeliefWorld:
@@ -49,6 +50,10 @@ class BeliefWorld:
     def follow(self, q: np.ndarray) -> None:
         """The model's arm to the real arm's joints (carrying what it holds)."""
         self.scene.robot.set_q(q)
+
+    def arm(self) -> tuple[Box, ...]:
+        """The model's arm as boxes, link by link (`Panda.boxes`)."""
+        return self.scene.robot.boxes()
 
     def plan(self, params) -> MotionPlan | PlanFailure:
         """A primitive planned at the believed poses; nothing in the model moves."""

@@ -274,13 +274,16 @@ class KitchenStorageEnv(gymnasium.Env):
 
     def _look(self) -> Seen:
         scene, world = self.scene, self.world
+        q = scene.robot.q()
+        world.follow(q)
         look = Look(
             np.stack([c.capture(scene.bc) for c in self.observer.cameras]),
             self.observer.cameras,
-            scene.robot.q(),
+            q,
             world.holding,
             world.held_pose(),
             self._released,
+            world.arm(),
         )
         self._released = None
         seen = self.observer.look(look)

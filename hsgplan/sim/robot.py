@@ -17,6 +17,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from hsgplan.domain.world import GRIPPER_MAX_OPENING
 from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
+from hsgplan.sim.sensing import Box
 
 ARM = tuple(range(7))
 FINGERS = (9, 10)
@@ -68,6 +69,11 @@ class Panda:
         self.hold_position()
 
     # --- state -----------------------------------------------------------------------
+
+    def boxes(self) -> tuple[Box, ...]:
+        """Each link's axis-aligned bounding box where the joints put it (fingers included)."""
+        links = range(-1, self.bc.getNumJoints(self.body))
+        return tuple(Box(*map(tuple, self.bc.getAABB(self.body, j))) for j in links)
 
     def q(self) -> np.ndarray:
         return np.array([s[0] for s in self.bc.getJointStates(self.body, ARM)])

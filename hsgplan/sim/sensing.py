@@ -35,6 +35,15 @@ class Seen:
     seconds: float = 0.0
 
 
+@dataclass(frozen=True)
+class Box:
+    """An axis-aligned box in the world (m): where a part of the arm is, by the robot's own
+    kinematics at its joints."""
+
+    low: tuple[float, float, float]
+    high: tuple[float, float, float]
+
+
 @dataclass(frozen=True, eq=False)
 class Look:
     """Everything a camera observer is given at one look: what a real robot has.
@@ -48,6 +57,8 @@ class Look:
         held_pose: where that object is by the arm's kinematics and the grasp as planned.
         released: the object let go since the last look and where the hand let it go (the
             arm's kinematics and the grasp as planned), if any.
+        arm: the arm's links at `q`, as boxes by the robot's model of itself: what of the
+            scene it may hide from a camera.
     """
 
     images: np.ndarray
@@ -56,6 +67,7 @@ class Look:
     holding: str | None = None
     held_pose: Pose | None = None
     released: tuple[str, Pose] | None = None
+    arm: tuple[Box, ...] = ()
 
 
 @runtime_checkable

@@ -10,7 +10,7 @@ import numpy as np
 from hsgplan.perception.observer import RgbObserver
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
-from hsgplan.sim.sensing import CameraObserver, Look
+from hsgplan.sim.sensing import Box, CameraObserver, Look
 
 BELIEF_SIDE = (
     "hsgplan.perception.observer",
@@ -28,6 +28,7 @@ def test_a_look_carries_images_calibration_joints_and_the_hands_own_record_only(
         str | None,
         Pose | None,
         tuple[str, Pose] | None,
+        tuple[Box, ...],
     }
     assert [f.name for f in dataclasses.fields(Look)] == [
         "images",
@@ -36,6 +37,7 @@ def test_a_look_carries_images_calibration_joints_and_the_hands_own_record_only(
         "holding",
         "held_pose",
         "released",
+        "arm",
     ]
     assert set(hints.values()) <= allowed, hints
 

@@ -177,7 +177,7 @@ def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand()
         def __init__(self, scenes):
             self.scenes = iter(scenes)
 
-        def detect(self, images, cams):
+        def detect(self, images, cams, arm=()):
             s = next(self.scenes)
             found = [Detection(type_of(o), p, 1.0, 2, 0.0) for o, p in s.truth.items()]
             if s.held is not None:

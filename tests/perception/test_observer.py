@@ -206,14 +206,14 @@ def test_tracks_start_from_the_first_look_never_from_a_staged_pose():
     observer.start(("butter", "tomato_soup"))
     soup = Pose.from_xyz_yaw(0.5, 0.1, OBJECT_TYPES["tomato_soup"].size[2] / 2)
     lone = Detection("tomato_soup", soup, 0.9, 1, 1.0)
-    observer.estimator.detect = lambda images, cameras: [lone]
+    observer.estimator.detect = lambda images, cameras, arm: [lone]
     look = Look(np.zeros((1, 2, 2, 3), np.uint8), VIEWS[:1], np.zeros(7))
     seen = observer.look(look)
     assert seen.scene_graph.objects == ("tomato_soup",)
     assert seen.unknown == ("butter",) and set(seen.uncertain) == {"butter", "tomato_soup"}
     butter = Pose.from_xyz_yaw(0.3, -0.2, OBJECT_TYPES["butter"].size[2] / 2)
     both = [replace(lone, views=3), Detection("butter", butter, 0.8, 2, 1.0)]
-    observer.estimator.detect = lambda images, cameras: both
+    observer.estimator.detect = lambda images, cameras, arm: both
     seen = observer.look(look)
     assert seen.unknown == () and seen.uncertain == ()
     assert seen.scene_graph.pose("butter") == butter

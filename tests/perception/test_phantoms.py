@@ -14,6 +14,7 @@ from hsgplan.perception.phantoms import SURE, overlap, pruned
 from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.synthetic import VIEWS
 from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.sensing import Box
 
 TYPES = list(OBJECT_TYPES)
 OPEN = Pose.from_xyz_yaw(0.45, 0.0, 0.0415, 0.0)  # a soup on the open table, in every view
@@ -60,6 +61,19 @@ def _shows(pose: Pose, view: int) -> bool:
     alone = (painted(["tomato_soup"], [pose], camera) == 0).sum()
     shown = (painted(["tomato_soup"], [pose], camera, FURNITURE) == 0).sum()
     return alone > 0 and shown >= 0.5 * alone
+
+
+def test_a_lone_views_detection_the_arm_hides_from_the_others_stays():
+    lone = _detection("tomato_soup", OPEN, (0,))
+    arm = tuple(  # a link between each other camera and the soup, as the kinematics put it
+        Box(tuple(p - 0.05 for p in point), tuple(p + 0.05 for p in point))
+        for point in (
+            np.asarray(OPEN.position) + 0.4 * (np.asarray(c.eye) - OPEN.position) for c in VIEWS[1:]
+        )
+    )
+    found = _instances("tomato_soup", OPEN, (0,))
+    assert pruned([lone], found, VIEWS) == []
+    assert pruned([lone], found, VIEWS, arm) == [lone]
 
 
 def test_one_object_found_again_by_a_lone_view_in_the_same_space_is_kept_once():
