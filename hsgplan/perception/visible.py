@@ -1,5 +1,6 @@
 """Which pixels of a view show which detected object: the detections' cuboids painted far to
-near (the painter's algorithm), face by face.
+near (the painter's algorithm), face by face, with occluders (the shelves' boards, the arm's
+links) painted among them where asked (`perception.phantoms`).
 
 The colour network names a type from the colour around the centroid's pixel. Where another
 object stands on or in front of the detected one, that pixel shows the other object: a cream
