@@ -18,6 +18,7 @@ from hsgplan.sim.sensing import Box
 
 TYPES = list(OBJECT_TYPES)
 OPEN = Pose.from_xyz_yaw(0.45, 0.0, 0.0415, 0.0)  # a soup on the open table, in every view
+EVERY = tuple(range(len(VIEWS)))
 INSIDE = Pose.from_xyz_yaw(0.52, 0.38, 0.0415, 0.0)  # a soup deep inside shelf A
 
 
@@ -77,16 +78,14 @@ def test_a_lone_views_detection_the_arm_hides_from_the_others_stays():
 
 
 def test_one_object_found_again_by_a_lone_view_in_the_same_space_is_kept_once():
-    every = tuple(range(len(VIEWS)))
-    sure = _detection("tomato_soup", OPEN, every)
+    sure = _detection("tomato_soup", OPEN, EVERY)
     again = _detection("tomato_soup", Pose.from_xyz_yaw(0.455, 0.005, 0.0415, 0.0), (2,))
-    found = _instances("tomato_soup", OPEN, every)
+    found = _instances("tomato_soup", OPEN, EVERY)
     assert pruned([again, sure], found, VIEWS) == [sure]
 
 
 def test_a_lone_view_the_colour_network_doubts_is_dropped_and_several_views_are_not():
-    every = tuple(range(len(VIEWS)))
-    found = _instances("tomato_soup", OPEN, every)
+    found = _instances("tomato_soup", OPEN, EVERY)
     doubted = _detection("tomato_soup", OPEN, (0,), confidence=SURE / 2)
     several = _detection("tomato_soup", OPEN, (0, 1), confidence=SURE / 2)
     assert pruned([doubted], found, VIEWS) == []
@@ -94,10 +93,9 @@ def test_a_lone_view_the_colour_network_doubts_is_dropped_and_several_views_are_
 
 
 def test_a_lone_views_box_in_a_sure_cans_space_is_dropped_not_in_an_unsure_ones():
-    every = tuple(range(len(VIEWS)))
-    can = _detection("tomato_soup", OPEN, every)
+    can = _detection("tomato_soup", OPEN, EVERY)
     box = _detection("butter", Pose.from_xyz_yaw(0.47, 0.01, 0.012, 0.3), (1,))
-    found = _instances("tomato_soup", OPEN, every)
+    found = _instances("tomato_soup", OPEN, EVERY)
     assert pruned([can, box], found, VIEWS) == [can]
     unsure = replace(can, type_confidence=SURE / 2)
     assert pruned([unsure, box], found, VIEWS) == [unsure, box]
