@@ -1,9 +1,8 @@
 """Detections the views contradict: what a lone view found that the others say is not there.
 
-Most of what f_p reports that matches no object was found by one view only (on 40 tuning
-scenes, seed 31: 69 of 75 single-view detections matched no object, against 10 of 306 seen by
-several views). A lone view's depth is its weak axis, so its detection is tested where it was
-made to rest, against the rest of the look (`pruned`), in this order:
+Most of what f_p reports that matches no object was found by one view only, while most
+objects are found by several. A lone view's depth is its weak axis, so its detection is tested
+where it was made to rest, against the rest of the look (`pruned`), in this order:
 
 1. Found once more: a detection of the type of one already kept, in the same space once both
    rest (`settle.same_place`), is that object again (views whose lines of sight did not meet
