@@ -55,10 +55,7 @@ class Cuboid:
     @staticmethod
     def of_board(board: Board) -> Cuboid:
         r = board.rect
-        x, y = r.center
-        centre = (x, y, (board.z_min + board.z_max) / 2)
-        half = (r.width_x / 2, r.width_y / 2, (board.z_max - board.z_min) / 2)
-        return Cuboid(Pose(centre, (0.0, 0.0, 0.0, 1.0)), half)
+        return Cuboid.of_box(Box((r.x_min, r.y_min, board.z_min), (r.x_max, r.y_max, board.z_max)))
 
 
 OCCLUDED = -2  # a pixel an occluder shows (`painted`)

@@ -228,7 +228,6 @@ class KitchenStorageEnv(gymnasium.Env):
         self._released = world.executed(plan, holds)
         if world.holding is not None and not holds:
             world.dropped()
-        world.follow(self.scene.robot.q())
         seconds = time.perf_counter() - start - watch.seconds + plan_seconds
         if isinstance(params, PickParams) and not holds:
             detail = f"the fingers closed on nothing where '{params.obj}' was believed"
@@ -268,11 +267,12 @@ class KitchenStorageEnv(gymnasium.Env):
         if path is None:
             return 0
         run_path(self.scene, path, on_frame)
-        self.world.follow(self.scene.robot.q())
         self._seen = self._look()
         return 1
 
     def _look(self) -> Seen:
+        """A look at the scene as it stands; the model's arm is brought to the real joints
+        first, since the look carries its links."""
         scene, world = self.scene, self.world
         q = scene.robot.q()
         world.follow(q)
