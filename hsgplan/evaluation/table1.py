@@ -265,7 +265,7 @@ def _times(report: dict) -> TextTable:
                     (label(m), str(n), str(v["episodes"]), f"{task_ms:.1f}", f"{motion_s:.2f}", "")
                 )
         episodes = sum(v["episodes"] for v in s["by_size"].values())
-        workers = "/".join(str(w) for w in sorted({x["workers"] for x in s["sessions"]}))
+        workers = "/".join(str(w) for w in sorted({x["workers"] for x in s["sittings"]}))
         wall = f"{s['wall_seconds'] / 60:.1f} ({workers or '?'} workers)"
         rows.append((label(m), "all", str(episodes), "", "", wall))
     title = (

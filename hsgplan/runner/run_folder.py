@@ -101,20 +101,22 @@ def logged_rows(run_dir: Path) -> list[dict]:
 
 def add_wall_seconds(run_dir: Path, seconds: float, workers: int) -> None:
     """Add one sitting's wall-clock seconds to the folder's timing (`timing.json`, a list
-    `sessions` of them), with the workers it ran and the cores of the machine: a run
+    `sittings` of them), with the workers it ran and the cores of the machine: a run
     interrupted and resumed is timed over all its sittings."""
     timing = read_timing(run_dir)
     timing["wall_seconds"] = round(timing["wall_seconds"] + seconds, 3)
-    timing["sessions"].append(
+    timing["sittings"].append(
         {"seconds": round(seconds, 3), "workers": workers, "cores": os.cpu_count()}
     )
     write_atomically(run_dir / TIMING, json.dumps(timing) + "\n")
 
 
 def read_timing(run_dir: Path) -> dict:
-    """`{"wall_seconds": total, "sessions": [...]}` (nothing recorded: 0 and none)."""
+    """`{"wall_seconds": total, "sittings": [...]}` (nothing recorded: 0 and none). Folders
+    written before the list was named `sittings` call it `sessions`; both are read."""
     try:
         timing = json.loads((run_dir / TIMING).read_text())
-        return {"wall_seconds": float(timing["wall_seconds"]), "sessions": list(timing["sessions"])}
+        sittings = timing["sittings"] if "sittings" in timing else timing["sessions"]
+        return {"wall_seconds": float(timing["wall_seconds"]), "sittings": list(sittings)}
     except (OSError, json.JSONDecodeError, KeyError, TypeError, ValueError):
-        return {"wall_seconds": 0.0, "sessions": []}
+        return {"wall_seconds": 0.0, "sittings": []}

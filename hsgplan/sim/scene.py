@@ -185,7 +185,7 @@ class Scene:
     def restore(self, state: int) -> None:
         self.bc.restoreState(state)
 
-    # --- planning helpers --------------------------------------------------------------------
+    # --- planning queries --------------------------------------------------------------------
 
     def obstacles(self, ignore: Iterable[str] = ()) -> tuple[int, ...]:
         """The arena's bodies and every object's but those ignored."""

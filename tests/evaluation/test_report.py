@@ -34,7 +34,7 @@ def _run_folder(tmp_path, method: str, records: list[EpisodeRecord], config: Eva
     (folder / RESULTS).write_text("".join(json.dumps(row) + "\n" for row in rows))
     summary = {
         "methods": {
-            method: {"agent": config.agent, "wall_seconds": 1.0, "sessions": []}
+            method: {"agent": config.agent, "wall_seconds": 1.0, "sittings": []}
             | summarize(records)
         },
         "goals": config.goals,

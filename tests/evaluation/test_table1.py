@@ -94,10 +94,10 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
             "gnn": {
                 "agent": "regression+gnn",
                 "wall_seconds": 90.0,
-                "sessions": [{"seconds": 90.0, "workers": 2, "cores": 2}],
+                "sittings": [{"seconds": 90.0, "workers": 2, "cores": 2}],
             }
             | by_size,
-            "sampler": {"agent": "regression", "wall_seconds": 1.0, "sessions": []} | by_size,
+            "sampler": {"agent": "regression", "wall_seconds": 1.0, "sittings": []} | by_size,
         },
         "goals": 2,
         "goals_file": None,
