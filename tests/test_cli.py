@@ -211,6 +211,28 @@ def test_every_count_and_seed_takes_its_bounds_from_the_one_table():
     assert checked >= 20  # seeds, goals, workers, samples, ... across the commands
 
 
+def test_every_command_list_shows_each_command_in_one_paragraph():
+    """A group's command list summarises each command by its docstring's first paragraph,
+    with the docstring's line breaks joined (`cli.common.Summaries`)."""
+    import typer.main
+
+    def groups(group):
+        yield group
+        for name in group.list_commands(None):
+            cmd = group.get_command(None, name)
+            if hasattr(cmd, "list_commands"):  # typer ships its own click: no isinstance
+                yield from groups(cmd)
+
+    seen = 0
+    for group in groups(typer.main.get_command(app)):
+        for name in group.list_commands(None):
+            cmd = group.get_command(None, name)
+            first = cmd.help.split("\n\n")[0]
+            assert cmd.short_help == " ".join(first.split()), name
+            seen += "\n" in first
+    assert seen >= 5  # docstrings that wrap their first paragraph are among them
+
+
 def test_a_commands_defaults_are_its_configurations_defaults():
     """Where an option sets a configuration's field, its default and bounds are the field's
     (read from it by `cli.common.config_default` and `config_option`)."""

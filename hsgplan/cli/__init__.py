@@ -13,7 +13,7 @@ import sys
 import typer
 
 from hsgplan.cli import bench, data, learn, motion, perception, symbolic, world
-from hsgplan.cli.common import OneLineErrors
+from hsgplan.cli.common import OneLineErrors, Summaries
 
 app = typer.Typer(
     cls=OneLineErrors,
@@ -22,6 +22,7 @@ app = typer.Typer(
     help="Hierarchical planning with geometric and symbolic scene graphs (kitchen storage).",
 )
 eval_app = typer.Typer(
+    cls=Summaries,
     no_args_is_help=True,
     help="Evaluate: the agent in the world (Table 1), the task planner, f_reach, the motion "
     "generators, f_p.",

@@ -13,6 +13,7 @@ from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
 from hsgplan.cli.common import (
     PerceptionCheckpoint,
     RunFolder,
+    Summaries,
     bounded_option,
     choice,
     err,
@@ -27,7 +28,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.paths import RUNS, TASK_CHECKPOINT
 
-app = typer.Typer(no_args_is_help=True, help="Measure speed (medians over one run).")
+app = typer.Typer(cls=Summaries, no_args_is_help=True, help="Measure speed (medians over one run).")
 SearchName = choice("SearchName", SEARCH_BASELINES)
 DEFAULT_SEARCH_NAME = SearchName(DEFAULT_SEARCH)
 

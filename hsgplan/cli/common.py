@@ -25,7 +25,18 @@ out = Console()
 err = Console(stderr=True)
 
 
-class OneLineErrors(TyperGroup):
+class Summaries(TyperGroup):
+    """A group whose command list gives each command's first paragraph as one line: Rich keeps
+    the docstring's line breaks there, which broke the list into ragged lines."""
+
+    def get_command(self, ctx, cmd_name):
+        command = super().get_command(ctx, cmd_name)
+        if command is not None and command.short_help is None and command.help:
+            command.short_help = " ".join(command.help.split("\n\n")[0].split())
+        return command
+
+
+class OneLineErrors(Summaries):
     """The top-level group: a usage error (an unknown choice, a malformed number) is one line on
     stderr and exit code 2, like every other refusal, instead of click's framed box; so is an
     older spelling of a command or option (`cli/renamed.py`), with the new one."""

@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     CollectWorkers,
     RayAddress,
+    Summaries,
     bounded_option,
     check_ray,
     config_default,
@@ -26,7 +27,7 @@ from hsgplan.collect.images import ImagesConfig
 from hsgplan.collect.motion import CollectConfig
 from hsgplan.paths import RUNS
 
-app = typer.Typer(no_args_is_help=True, help="Collect datasets (resumable).")
+app = typer.Typer(cls=Summaries, no_args_is_help=True, help="Collect datasets (resumable).")
 CollectionFolder = Annotated[
     Path,
     typer.Option("--out", help="Collection folder (resumed if it exists).", parser=out_folder),

@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     PlannerName,
     RunFolder,
+    Summaries,
     bounded_option,
     dash,
     err,
@@ -27,7 +28,9 @@ from hsgplan.cli.common import (
 from hsgplan.domain.checks import resolve
 from hsgplan.paths import REACH_HELD_OUT, RUNS, TASK_CHECKPOINT
 
-train_app = typer.Typer(no_args_is_help=True, help="Train the learned models (resumable).")
+train_app = typer.Typer(
+    cls=Summaries, no_args_is_help=True, help="Train the learned models (resumable)."
+)
 REGRESSION = PlannerName("regression")
 
 
