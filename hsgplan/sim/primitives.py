@@ -77,25 +77,20 @@ def run_plan(scene: Scene, plan: MotionPlan, on_frame: Frame | None = None, blin
 
 def run_path(scene: Scene, path, on_frame: Frame | None = None) -> None:
     """Move the arm along a planned path (what it holds goes with it)."""
-    _follow(scene, path, on_frame)
-
-
-def _follow(scene: Scene, path, on_frame: Frame | None) -> None:
     # Setting joints moves nothing else and steps no physics: unwatched, only the last counts.
     if on_frame is None:
         scene.robot.set_q(path[-1])
         return
     for q in densify(list(path)):
         scene.robot.set_q(q)
-        if on_frame:
-            on_frame()
+        on_frame()
 
 
 def _run_pick(scene: Scene, plan: MotionPlan, on_frame, blind: bool = False) -> None:
     robot = scene.robot
     robot.set_fingers(plan.opening)
-    _follow(scene, plan.path, on_frame)
-    _follow(scene, [plan.q_above, plan.q_at], on_frame)
+    run_path(scene, plan.path, on_frame)
+    run_path(scene, [plan.q_above, plan.q_at], on_frame)
     # The fingers close to the object's width, then a fixed constraint makes the grasp firm.
     robot.set_fingers(plan.grip)
     if not blind:
@@ -104,24 +99,24 @@ def _run_pick(scene: Scene, plan: MotionPlan, on_frame, blind: bool = False) -> 
         robot.attach(body)
     else:
         robot.set_fingers(0.0)  # closed on nothing
-    _follow(scene, [plan.q_at, plan.q_above], on_frame)
+    run_path(scene, [plan.q_at, plan.q_above], on_frame)
 
 
 def _run_place(scene: Scene, plan: MotionPlan, on_frame) -> None:
     robot = scene.robot
-    _follow(scene, plan.path, on_frame)
-    _follow(scene, [plan.q_above, plan.q_at], on_frame)
+    run_path(scene, plan.path, on_frame)
+    run_path(scene, [plan.q_above, plan.q_at], on_frame)
     robot.detach()
     robot.set_fingers(GRIPPER_MAX_OPENING)
     scene.settle()
-    _follow(scene, [plan.q_at, plan.q_above], on_frame)
+    run_path(scene, [plan.q_at, plan.q_above], on_frame)
 
 
 def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> None:
     robot = scene.robot
     robot.set_fingers(0.0)
-    _follow(scene, plan.path, on_frame)
-    _follow(scene, [plan.q_above, plan.q_at], on_frame)
+    run_path(scene, plan.path, on_frame)
+    run_path(scene, [plan.q_above, plan.q_at], on_frame)
     # Only the pushed object moves unless it is pushed into another, which that wakes.
     with scene.asleep(awake=[plan.params.obj]):
         for q in plan.line:
@@ -130,6 +125,6 @@ def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> None:
                 on_frame()
         # Back out the way it came (joints checked against the shelves while planning; the
         # object is ahead of the fingers now), then up to where the approach began.
-        _follow(scene, [robot.q(), *reversed(plan.line), plan.q_at, plan.q_above], on_frame)
+        run_path(scene, [robot.q(), *reversed(plan.line), plan.q_at, plan.q_above], on_frame)
         scene.settle()
     robot.set_fingers(GRIPPER_MAX_OPENING)
