@@ -30,7 +30,7 @@ from hsgplan.paths import shipped
 from hsgplan.perception import phantoms
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
 from hsgplan.perception.colour import ColourNet, features, load_colour, pixel_vote, type_probs
-from hsgplan.perception.fusion import Seen, grouped, line_of_sight
+from hsgplan.perception.fusion import Seen, along_ray_near, grouped, line_of_sight
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
@@ -70,7 +70,6 @@ TOPPLED_COST = 0.5
 # blob of seed 1's scene 96 was found at 1.29 box heights.
 STACK_BAND = (0.75, 1.75)
 THIN = 0.03  # m: a box no taller than this is a thin one (butter, cream cheese)
-NEAR_RAY = 0.05  # m from a lone view's line of sight to a prior pose, for `along_ray_near`
 
 
 @dataclass(frozen=True)
@@ -271,22 +270,6 @@ class PoseEstimator:
         poses = settle(types, measured, rays, costs, fixed)
         out = [replace(d, pose=p) for d, p in zip(found, poses, strict=True)]
         return [d for d in out if not _inside_table(d.pose)]
-
-
-def along_ray_near(ray: Ray, measured: Pose, before: Pose) -> Pose:
-    """A lone view's estimate moved along its line of sight to the point nearest where its
-    object was believed before, if the line passes within `NEAR_RAY` of it; else as measured.
-    Its depth is what PnP from one view gets worst: a butter under a soup on a shelf's top, a
-    strip of it seen by one view, was put on the table along that view's ray 13 cm off, the soup
-    was seen sunk onto the shelf, and the agent tried to pick the butter under it until the step
-    limit (Table 1 rgb, seed 1050086). Where several resting places lie on the ray, the one at
-    the object's last pose is the likeliest; a moved object's ray passes far from it."""
-    origin, direction = ray
-    depth = float((np.asarray(before.position) - origin) @ direction)
-    point = origin + depth * direction
-    if depth <= 0 or np.linalg.norm(point - np.asarray(before.position)) >= NEAR_RAY:
-        return measured
-    return Pose(tuple(map(float, point)), measured.orientation)
 
 
 def _inside_table(pose: Pose) -> bool:
