@@ -20,7 +20,7 @@ from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
 from hsgplan.files import write_atomically
-from hsgplan.runner.run_folder import check_claim, claim, read_timing
+from hsgplan.runner.run_folder import check_claim, claim, read_timing, sittings
 
 # Table 1 of the paper (success rate, subgoal completion), by motion generator and size.
 PAPER_TABLE1: dict[str, dict[int, tuple[float, float]]] = {
@@ -265,7 +265,7 @@ def _times(report: dict) -> TextTable:
                     (label(m), str(n), str(v["episodes"]), f"{task_ms:.1f}", f"{motion_s:.2f}", "")
                 )
         episodes = sum(v["episodes"] for v in s["by_size"].values())
-        workers = "/".join(str(w) for w in sorted({x["workers"] for x in s["sittings"]}))
+        workers = "/".join(str(w) for w in sorted({x["workers"] for x in sittings(s)}))
         wall = f"{s['wall_seconds'] / 60:.1f} ({workers or '?'} workers)"
         rows.append((label(m), "all", str(episodes), "", "", wall))
     title = (

@@ -112,11 +112,16 @@ def add_wall_seconds(run_dir: Path, seconds: float, workers: int) -> None:
 
 
 def read_timing(run_dir: Path) -> dict:
-    """`{"wall_seconds": total, "sittings": [...]}` (nothing recorded: 0 and none). Folders
-    written before the list was named `sittings` call it `sessions`; both are read."""
+    """`{"wall_seconds": total, "sittings": [...]}` (nothing recorded: 0 and none)."""
     try:
         timing = json.loads((run_dir / TIMING).read_text())
-        sittings = timing["sittings"] if "sittings" in timing else timing["sessions"]
-        return {"wall_seconds": float(timing["wall_seconds"]), "sittings": list(sittings)}
+        return {"wall_seconds": float(timing["wall_seconds"]), "sittings": sittings(timing)}
     except (OSError, json.JSONDecodeError, KeyError, TypeError, ValueError):
         return {"wall_seconds": 0.0, "sittings": []}
+
+
+def sittings(timing: dict) -> list[dict]:
+    """The timed sittings a timing (or an eval summary's method, which carries one) lists.
+    Folders and summaries written before the list was named `sittings` call it `sessions`."""
+    older = "sessions" in timing and "sittings" not in timing
+    return list(timing["sessions"] if older else timing["sittings"])

@@ -3,7 +3,9 @@
 import json
 import os
 
-from hsgplan.runner.run_folder import TIMING, add_wall_seconds, read_timing
+import pytest
+
+from hsgplan.runner.run_folder import TIMING, add_wall_seconds, read_timing, sittings
 
 
 def test_sittings_add_up(tmp_path):
@@ -29,3 +31,11 @@ def test_folder_written_with_the_older_key_still_reads(tmp_path):
 def test_unreadable_timing_counts_as_none(tmp_path):
     (tmp_path / TIMING).write_text("{not json")
     assert read_timing(tmp_path) == {"wall_seconds": 0.0, "sittings": []}
+
+
+def test_a_summary_written_with_the_older_key_lists_its_sittings():
+    method = {"agent": "regression+gnn", "wall_seconds": 9.0, "sessions": [{"workers": 2}]}
+    assert sittings(method) == [{"workers": 2}]
+    assert sittings({"sittings": [], "sessions": [{"workers": 1}]}) == []
+    with pytest.raises(KeyError, match="sittings"):  # named as the page refusing it says
+        sittings({"wall_seconds": 1.0})
