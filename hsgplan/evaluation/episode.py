@@ -1,9 +1,9 @@
 """One closed-loop episode: observe, decide, execute, until the goal holds or it cannot go on.
 
-The agent acts on what the env's observer makes of the scene, and stops when the goal holds
-there; the episode is judged on the truth (the simulator's poses): a goal the agent believes
-reached that does not truly hold is a failure (`MISPERCEIVED`), and a toppled or fallen object
-ends the episode whether the observer saw it or not. With the ground truth as observer the two
+The agent acts on what the env's observer makes of the scene, and the episode ends on what it
+senses: the goal seen reached, a toppled or fallen object seen, the step limit. It is judged
+on the truth (the simulator's poses) once, at the end: a goal the agent believes reached that
+does not truly hold is a failure (`MISPERCEIVED`). With the ground truth as observer the two
 are one.
 
 Under the paper's protocol (`end_at_failure`) a primitive that fails (refused while planning,
@@ -25,6 +25,7 @@ from hsgplan.domain.goals import Goal
 from hsgplan.evaluation.failures import Failure
 from hsgplan.scene_graph.symbol_mapping import AnomalyKind
 from hsgplan.sim.env import KitchenStorageEnv, Observation, ResetOptions
+from hsgplan.sim.outcome import Disturbance
 
 _FATAL = {AnomalyKind.TOPPLED: Failure.KNOCKED_OVER, AnomalyKind.OFF_TABLE: Failure.OFF_TABLE}
 
@@ -41,6 +42,8 @@ class StepRecord:
     motion_seconds: float
     execution_seconds: float
     relooks: int = 0  # looks taken before the primitive, from out of the cameras' way
+    # objects the primitive truly moved besides its own (the simulator's poses), and how far
+    disturbed: tuple[Disturbance, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -82,7 +85,12 @@ class EpisodeRecord:
 
     @staticmethod
     def from_json(d: dict) -> EpisodeRecord:
-        return EpisodeRecord(**{**d, "steps": tuple(StepRecord(**s) for s in d["steps"])})
+        return EpisodeRecord(**{**d, "steps": tuple(_step(s) for s in d["steps"])})
+
+
+def _step(d: dict) -> StepRecord:
+    moved = tuple(Disturbance(**m) for m in d.get("disturbed", ()))
+    return StepRecord(**{**d, "disturbed": moved})
 
 
 def params_text(params) -> str:
@@ -123,7 +131,8 @@ def run_episode(
             obs, closing = again, closing + 1
             unseen += len(obs.unseen)
             continue
-        fatal = [a for a in obs.true_symbols.anomalies if a.kind in _FATAL]
+        # what the robot sees: seeing through f_p, a fall its cameras missed goes on
+        fatal = [a for a in obs.symbols.anomalies if a.kind in _FATAL]
         if fatal:
             failure = _FATAL[fatal[0].kind]
             break
@@ -156,6 +165,7 @@ def run_episode(
             d.motion_seconds,
             outcome.seconds,
             outcome.relooks,
+            info["disturbed"],
         )
         records.append(record)
         if on_step:

@@ -22,7 +22,8 @@ import numpy as np
 
 from hsgplan.domain.objects import object_type, type_of
 from hsgplan.domain.world import Kind
-from hsgplan.perception.estimator import Detection, PoseEstimator
+from hsgplan.perception.detection import Detection
+from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.keypoints import BOX_SYMMETRIES
 from hsgplan.perception.observer import away_from_hand
 from hsgplan.perception.synthetic import VIEWS, ImageSample, render_sample

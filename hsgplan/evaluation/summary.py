@@ -82,6 +82,9 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "overstep_after_failures": sum(
             1 for r, c in classed if c[0] == OVERSTEP and failed_steps(r)
         ),
+        # primitives that truly moved an object besides their own (physics: a swept arm, a
+        # carried object, a push), whatever their status
+        "disturbing_steps": sum(1 for r in rs for s in r.steps if s.disturbed),
         # looks taken again before a primitive or the goal's end, seeing through f_p (`relook`)
         "relooks": sum(s.relooks for r in rs for s in r.steps) + sum(r.closing_relooks for r in rs),
         "median_steps": statistics.median(len(r.steps) for r in rs),

@@ -233,15 +233,20 @@ def _failures(report: dict) -> TextTable:
                     + ((_kinds(fc.get(PERCEPTION, {})),) if seen else ())
                     # a summary from before these counts existed has none
                     + tuple(
-                        str(v.get(k, "—")) for k in ("failed_primitives", "overstep_after_failures")
+                        str(v.get(k, "—"))
+                        for k in (
+                            "failed_primitives",
+                            "overstep_after_failures",
+                            "disturbing_steps",
+                        )
                     )
                     + ((str(v.get("relooks", "—")),) if seen else ())
                 )
     title = (
         f"Failures ({_protocol(report)}), by what ended the episode: execution (a failed "
         "primitive; by the fatal anomaly or its status) and overstep (the step limit, or "
-        "nothing reachable); failed primitives over all episodes, and overstep episodes that "
-        "had some"
+        "nothing reachable); failed primitives over all episodes, overstep episodes that "
+        "had some, and primitives that moved another object than their own (disturbing)"
     )
     if seen:
         title += (
@@ -250,7 +255,7 @@ def _failures(report: dict) -> TextTable:
         )
     header = ("method", "objects", "episodes", "failed", "execution", "overstep")
     header += (PERCEPTION,) if seen else ()
-    header += ("failed primitives", "overstep after failures")
+    header += ("failed primitives", "overstep after failures", "disturbing steps")
     header += ("relooks",) if seen else ()
     return TextTable(title, header, tuple(rows))
 

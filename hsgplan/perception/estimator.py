@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
@@ -30,6 +30,7 @@ from hsgplan.paths import shipped
 from hsgplan.perception import phantoms
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
 from hsgplan.perception.colour import ColourNet, features, load_colour, pixel_vote, type_probs
+from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen, along_ray_near, grouped, line_of_sight
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
@@ -70,30 +71,6 @@ TOPPLED_COST = 0.5
 # blob of seed 1's scene 96 was found at 1.29 box heights.
 STACK_BAND = (0.75, 1.75)
 THIN = 0.03  # m: a box no taller than this is a thin one (butter, cream cheese)
-
-
-@dataclass(frozen=True)
-class Detection:
-    """An object the cameras saw: its type, pose, and the views and keypoints behind it.
-
-    Attributes:
-        rays: each view's line of sight through the object's centroid, (origin, unit
-            direction) in the world; where two or more views saw it, `pose` sits where they
-            meet.
-    """
-
-    type_name: str
-    pose: Pose
-    score: float
-    views: int
-    reprojection_px: float
-    rays: tuple[Ray, ...] = ()
-    # the colour network's probability of the type, among every type (1: no colour network, or
-    # no member view's centroid patch in its image: then it wins `_apart` over measured ones)
-    type_confidence: float = 1.0
-    keypoints: tuple[ViewKeypoints, ...] = ()  # each view's keypoints behind it
-    stacked: bool = False  # one of two thin boxes that the views saw as one (`STACK_BAND`)
-    measured: Pose | None = None  # the pose before it was made to rest (`PoseEstimator.rest`)
 
 
 class PoseEstimator:

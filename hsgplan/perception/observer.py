@@ -34,7 +34,8 @@ from scipy.optimize import linear_sum_assignment
 from hsgplan.domain.objects import object_type, type_of
 from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.perception.cameras import VIEWS
-from hsgplan.perception.estimator import Detection, PoseEstimator
+from hsgplan.perception.detection import Detection
+from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera

@@ -29,20 +29,16 @@ and symbolic match 0.990 unchanged (`hsgplan eval perception --loop --seed 43 [-
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from hsgplan.domain.objects import object_type
+from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.settle import same_place
 from hsgplan.perception.visible import FURNITURE, SHRINK, Cuboid, paint, painted
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sensing import Box
-
-if TYPE_CHECKING:  # the estimator imports this module
-    from hsgplan.perception.estimator import Detection
 
 SURE = 0.5  # the colour network's probability of a detection's type that it agrees with
 MIN_PIXELS = 30  # a cuboid showing fewer pixels in a view is not something it must have found

@@ -5,7 +5,10 @@ Actions are parametrised primitives: the `Dict` of `Discrete`s in `gym_spaces`, 
 Gymnasium; the typed one (the geometric scene graph, its symbols and, when rendering is on, an
 RGB image from the fixed camera) is in `info["observation"]`: what the env's observer
 (`sim.observer`, the ground truth by default) makes of the scene, with the true symbols beside
-it to judge by. The reward is 1 on the step where the goal truly holds.
+it to judge by. The reward is 1, and the episode terminates, on the step where the goal holds
+in what the observer sees (with a camera observer, the robot's belief); whether it truly
+holds is `info["goal_truly_holds"]`, and what a step truly moved besides its object is
+`info["disturbed"]`.
 
 With a camera observer (`sim.sensing.CameraObserver`) the robot knows only its belief: every
 primitive is planned in the model of that belief (`sim.belief_world`) and the simulated scene
@@ -28,13 +31,14 @@ from hsgplan.domain.parameters import PickParams, PrimitiveParams
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
+from hsgplan.sim.actuation import holds_something
 from hsgplan.sim.belief_world import BeliefWorld
 from hsgplan.sim.gym_spaces import action_space, decode, encode, observation_space
 from hsgplan.sim.lookahead import Lookahead
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive, plan_transit
 from hsgplan.sim.observer import CameraObserver, GroundTruth, Look, SceneObserver, Seen
-from hsgplan.sim.outcome import Outcome, Status, compare
-from hsgplan.sim.primitives import Watch, execute, run_path, run_plan
+from hsgplan.sim.outcome import Outcome, Status, compare, disturbances
+from hsgplan.sim.primitives import Watch, execute, run_path, run_plan, stopped_outcome
 from hsgplan.sim.render import Camera
 from hsgplan.sim.robot import REST
 from hsgplan.sim.sampler import sample_scene
@@ -122,7 +126,8 @@ class KitchenStorageEnv(gymnasium.Env):
         self.scene: Scene | None = None
         self.goal: Goal | None = None
         self.steps = 0
-        self._checked: dict[PrimitiveParams, tuple[MotionPlan, float]] = {}
+        # dry runs' plans, each with the state of the scene it was made in (`_state`)
+        self._checked: dict[PrimitiveParams, tuple[MotionPlan, float, tuple]] = {}
         # dry runs (as a feasibility check) and trials of whole plans, for agents that look ahead
         self.lookahead = Lookahead(self._planning_scene, self.check)
 
@@ -158,21 +163,30 @@ class KitchenStorageEnv(gymnasium.Env):
         params = (
             action if isinstance(action, PrimitiveParams) else decode(self.goal.objects, action)
         )
+        true_before = self.scene.poses()
         if isinstance(params, str):  # nothing to execute: a step spent, nothing moved
             outcome = Outcome(Status.INVALID, params, 0.0)
         elif self.believing:
             outcome = self._step_believed(params, on_frame)
         else:
-            plan, plan_seconds = self._checked.get(params, (None, 0.0))
+            plan, plan_seconds = self._checked_plan(params)
             outcome = execute(self.scene, params, on_frame, plan)
             # A plan from a dry run is part of this primitive's cost: its time is added back.
             outcome = Outcome(outcome.status, outcome.detail, outcome.seconds + plan_seconds)
         self._checked.clear()
         self.steps += 1
         typed = self._observe()
-        done = self.goal.satisfied_by(typed.true_symbols.state)
+        # the robot's own verdict: what it sees (the truth only with the ground truth observer)
+        done = self.goal.satisfied_by(typed.symbols.state)
         truncated = not done and self.steps >= self.max_steps
-        info = {"outcome": outcome, "observation": typed}
+        acted_on = params if isinstance(params, str) else params.obj
+        info = {
+            "outcome": outcome,
+            "observation": typed,
+            # what the primitive truly moved besides its object: the record's, not the agent's
+            "disturbed": disturbances(true_before, self.scene.poses(), acted_on),
+            "goal_truly_holds": self.goal.satisfied_by(typed.true_symbols.state),
+        }
         return self._encode(typed), float(done), done, truncated, info
 
     def check(self, action: PrimitiveParams) -> bool:
@@ -182,8 +196,20 @@ class KitchenStorageEnv(gymnasium.Env):
         plan = plan_primitive(self._planning_scene(), action)
         if isinstance(plan, PlanFailure):
             return False
-        self._checked[action] = (plan, time.perf_counter() - start)
+        self._checked[action] = (plan, time.perf_counter() - start, self._state())
         return True
+
+    def _state(self) -> tuple:
+        """What a plan is made from: the arm's joints, and every object's pose in the scene
+        it is planned in (a trial of a plan ahead may have left a dry run behind it)."""
+        scene = self._planning_scene()
+        poses = tuple(p.position + p.orientation for p in scene.poses().values())
+        return tuple(scene.robot.q()), poses, scene.held()
+
+    def _checked_plan(self, params: PrimitiveParams) -> tuple[MotionPlan | None, float]:
+        """A dry run's plan for `params` if it was made in the scene as it is now."""
+        plan, seconds, state = self._checked.pop(params, (None, 0.0, None))
+        return (plan, seconds) if state == self._state() else (None, 0.0)
 
     def render(self, camera: Camera | None = None) -> np.ndarray | None:
         """An RGB image from `camera` (default: the env's fixed camera)."""
@@ -209,7 +235,7 @@ class KitchenStorageEnv(gymnasium.Env):
         start = time.perf_counter()
         watch = Watch(on_frame)
         on_frame = watch.frame
-        plan, plan_seconds = self._checked.pop(params, (None, 0.0))
+        plan, plan_seconds = self._checked_plan(params)
         relooks = 0
         if self.relook and self._unsure_of(params):
             relooks = self._look_again(on_frame)
@@ -223,8 +249,8 @@ class KitchenStorageEnv(gymnasium.Env):
         if isinstance(plan, PlanFailure):
             seconds = time.perf_counter() - start - watch.seconds + plan_seconds
             return Outcome(plan.status, plan.detail, seconds, relooks)
-        run_plan(self.scene, plan, on_frame, blind=True)
-        holds = self.scene.robot.held_body is not None
+        stopped = run_plan(self.scene, plan, on_frame)
+        holds = holds_something(self.scene.robot)  # the gripper's width
         self._released = world.executed(plan, holds)
         if world.holding is not None and not holds:
             world.dropped()
@@ -235,6 +261,8 @@ class KitchenStorageEnv(gymnasium.Env):
         # the look that judges the step is the next observation's: made once
         self._seen = self._judged = self._look()
         status, detail = compare(before, self._seen.scene_graph, params.obj, plan.expected)
+        # the joints' encoders tell whether the arm got where it was driven
+        status, detail = stopped_outcome(status, detail, stopped)
         return Outcome(status, detail, seconds, relooks)
 
     def look_again(self, objects: tuple[str, ...]) -> Observation | None:

@@ -56,18 +56,23 @@ LINE_IK_EVERY = 8  # push waypoints (PUSH_STEP apart) per inverse kinematics alo
 # solved as with a tenth of a millimetre, in a third of the time.
 LINE_IK_TOL = 1e-3
 MAX_JOINT_JUMP = 0.3  # rad between IK solutions along a push line: more means a branch flip
+# Poses solved between the approach's ends: the hand then strays under 1 mm from the line.
+DESCENT_POINTS = 3
 
 
 @dataclass(frozen=True)
 class MotionPlan:
-    """Everything execution needs: the path to `q_above`, the straight approach to `q_at`,
-    and for a push the joints along the push line. `grip` is the finger opening to close to."""
+    """Everything execution needs: the path to `q_above`, the straight approach to `q_at`
+    (through the joints of `descent`, which keep the hand on the straight line: a straight
+    line in joint space bows the hand sideways by as much as a finger's clearance), and for a
+    push the joints along the push line. `grip` is the finger opening to close to."""
 
     params: PrimitiveParams
     expected: Literal
     path: tuple[np.ndarray, ...]
     q_above: np.ndarray
     q_at: np.ndarray
+    descent: tuple[np.ndarray, ...] = ()
     line: tuple[np.ndarray, ...] = ()
     grip: float = 0.0
     opening: float = GRIPPER_MAX_OPENING
@@ -128,9 +133,32 @@ def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
         if q_above is None or near.collides(q_above):
             continue
         q_at = robot.ik(target, scene.rng, seeds=[q_above], restarts=0)
-        if q_at is not None and near.segment_free(q_above, q_at):
-            return q_above, q_at
+        if q_at is None:
+            continue
+        descent = _descent(scene, above, target, q_above)
+        chain = [q_above, *(descent or ()), q_at]
+        if descent is not None and all(
+            near.segment_free(a, b) for a, b in zip(chain, chain[1:], strict=False)
+        ):
+            return q_above, q_at, descent
     return None
+
+
+def _descent(scene: Scene, above: Pose, target: Pose, q_above: np.ndarray):
+    """Joints at DESCENT_POINTS evenly spaced poses strictly between `above` and `target`,
+    each solved from the last, or None where one cannot be reached without a branch flip."""
+    robot, qs = scene.robot, [q_above]
+    a, b = np.array(above.position), np.array(target.position)
+    for k in range(1, DESCENT_POINTS + 1):
+        f = k / (DESCENT_POINTS + 1)
+        pose = Pose(tuple(a + (b - a) * f), target.orientation)
+        q = robot.ik(
+            pose, scene.rng, seeds=[qs[-1]], restarts=0, rest_fallback=False, threshold=LINE_IK_TOL
+        )
+        if q is None or np.max(np.abs(q - qs[-1])) > MAX_JOINT_JUMP:
+            return None
+        qs.append(q)
+    return tuple(qs[1:])
 
 
 def _path(scene: Scene, q0: np.ndarray, q_goal: np.ndarray, ignore=()):

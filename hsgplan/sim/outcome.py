@@ -7,10 +7,14 @@ from enum import StrEnum
 
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import AnomalyKind, map_symbols
 
 # Another object that moves further than this (horizontally) was disturbed by the primitive.
 DISTURB_TOL = 0.02
+# Any object but the one acted on that moves further than this during a primitive is recorded
+# as disturbed by it (the record's, not the status's: nudges under DISTURB_TOL are recorded).
+DISTURB_RECORD = 0.005
 
 
 class Status(StrEnum):
@@ -23,6 +27,7 @@ class Status(StrEnum):
     OFF_TABLE = "off_table"  # some object fell off the table
     DISTURBED = "disturbed"  # another object was moved out of place
     EFFECT_NOT_REACHED = "effect_not_reached"  # the intended predicate does not hold
+    BLOCKED = "blocked"  # the arm was stopped short by what it met, and the effect not reached
     # Motion data only (`hsgplan.data.motion_trials`): the place reached its effect but left an
     # object on that surface, or the placed one, that can no longer be taken up.
     BLOCKS_PICK = "blocks_pick"
@@ -42,6 +47,27 @@ class Outcome:
     @property
     def ok(self) -> bool:
         return self.status is Status.SUCCESS
+
+
+@dataclass(frozen=True)
+class Disturbance:
+    """An object a primitive moved that it was not acting on, and how far (m)."""
+
+    obj: str
+    moved: float
+
+
+def disturbances(
+    before: dict[str, Pose], after: dict[str, Pose], acted_on: str
+) -> tuple[Disturbance, ...]:
+    """The objects other than `acted_on` that moved more than DISTURB_RECORD between two sets
+    of poses (the simulator's: what a primitive truly did, for the episode's record)."""
+    moved = (
+        Disturbance(o, round(before[o].distance(after[o]), 4))
+        for o in sorted(before)
+        if o != acted_on and o in after
+    )
+    return tuple(d for d in moved if d.moved > DISTURB_RECORD)
 
 
 def verify(scene, before: GeometricSceneGraph, obj: str, expected: Literal) -> tuple[Status, str]:

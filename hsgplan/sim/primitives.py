@@ -1,10 +1,11 @@
 """pick, place and push with the paper's parametrisation, each returning a typed outcome.
 
-Execution replays a `MotionPlan`: the planned transit or transfer path, the straight approach,
-the contact phase, and the retreat. The contact phase of a push runs under physics with the arm
-position-controlled along the push line; grasps are made firm by a fixed constraint once the
-fingers have closed (`Panda.attach`). Nothing here raises for a failed motion: every failure is
-an `Outcome` with a `Status`.
+Execution replays a `MotionPlan` under physics (`sim.actuation`): the planned transit or
+transfer path, the straight approach, the contact phase, and the retreat, every one driven by
+joint position control with the simulation stepped, so the arm and what it holds push, topple
+or are stopped by what they meet. A pick closes the fingers until they stop and holds what they
+hold; a push drives the hand along its line. Nothing here raises for a failed motion: every
+failure is an `Outcome` with a `Status`.
 """
 
 from __future__ import annotations
@@ -14,10 +15,10 @@ from collections.abc import Callable
 
 from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams
 from hsgplan.domain.world import GRIPPER_MAX_OPENING
-from hsgplan.sim.motion import densify
+from hsgplan.sim.actuation import body_in_grasp, drive_fingers, drive_path
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
-from hsgplan.sim.outcome import Outcome, verify
-from hsgplan.sim.scene import Scene
+from hsgplan.sim.outcome import Outcome, Status, verify
+from hsgplan.sim.scene import TIME_STEP, Scene
 
 PUSH_SUBSTEPS = 3  # physics steps per 5 mm of push: 0.4 m/s (see README "Decisions")
 
@@ -26,7 +27,7 @@ Frame = Callable[[], None]
 
 class Watch:
     """`on_frame` with the time it takes kept apart: pictures are no part of a primitive's
-    cost (the arm is then moved through every waypoint, which is)."""
+    cost."""
 
     def __init__(self, on_frame: Frame | None) -> None:
         self.on_frame = on_frame
@@ -48,7 +49,7 @@ def execute(
     """Plan (unless a plan made for this scene is given) and run one primitive.
 
     `on_frame` is called along the way, for pictures; the time it takes is not counted in the
-    outcome's seconds (the arm is then moved through every waypoint, which is).
+    outcome's seconds.
     """
     start = time.perf_counter()
     watch = Watch(on_frame)
@@ -56,75 +57,95 @@ def execute(
     planned = plan if plan is not None else plan_primitive(scene, params)
     if isinstance(planned, PlanFailure):
         return Outcome(planned.status, planned.detail, time.perf_counter() - start)
-    run_plan(scene, planned, watch.frame)
+    stopped = run_plan(scene, planned, watch.frame)
     status, detail = verify(scene, before, params.obj, planned.expected)
+    status, detail = stopped_outcome(status, detail, stopped)
     return Outcome(status, detail, time.perf_counter() - start - watch.seconds)
 
 
-def run_plan(scene: Scene, plan: MotionPlan, on_frame: Frame | None = None, blind: bool = False):
-    """Run a planned primitive's joint motions in the scene; physics does the rest.
-
-    `blind`: the plan was made in the robot's model of the scene, not in this one (a camera
-    observer's belief): a pick then holds whatever body its closed fingers touch, if any,
-    rather than the one it was planned for (whose true pose the robot does not know)."""
-    if isinstance(plan.params, PickParams):
-        _run_pick(scene, plan, on_frame, blind)
-    elif isinstance(plan.params, PlaceParams):
-        _run_place(scene, plan, on_frame)
-    else:
-        _run_push(scene, plan, on_frame)
+def stopped_outcome(status: Status, detail: str, stopped: str | None) -> tuple[Status, str]:
+    """A primitive whose arm was stopped short and whose effect does not hold failed because
+    it was stopped (unless something fell or toppled, which says more)."""
+    if stopped is None or status in (Status.SUCCESS, Status.KNOCKED_OVER, Status.OFF_TABLE):
+        return status, detail
+    return Status.BLOCKED, stopped
 
 
-def run_path(scene: Scene, path, on_frame: Frame | None = None) -> None:
-    """Move the arm along a planned path (what it holds goes with it)."""
-    # Setting joints moves nothing else and steps no physics: unwatched, only the last counts.
-    if on_frame is None:
-        scene.robot.set_q(path[-1])
-        return
-    for q in densify(list(path)):
-        scene.robot.set_q(q)
-        on_frame()
+def run_plan(scene: Scene, plan: MotionPlan, on_frame: Frame | None = None) -> str | None:
+    """Run a planned primitive's joint motions in the scene under physics.
+
+    The plan may have been made in the robot's model of the scene rather than in this one (a
+    camera observer's belief): a pick holds whatever its closing fingers hold, if anything.
+    Returns None, or why the arm was stopped short of where the plan took it.
+
+    Objects at rest sleep meanwhile, which costs the solver nothing (measured: 6 resting
+    objects quadruple a physics step), until something touches them, which wakes them."""
+    held = scene.held()
+    with scene.asleep(awake=() if held is None else (held,)):
+        if isinstance(plan.params, PickParams):
+            return _run_pick(scene, plan, on_frame)
+        if isinstance(plan.params, PlaceParams):
+            return _run_place(scene, plan, on_frame)
+        return _run_push(scene, plan, on_frame)
 
 
-def _run_pick(scene: Scene, plan: MotionPlan, on_frame, blind: bool = False) -> None:
+def run_path(scene: Scene, path, on_frame: Frame | None = None) -> bool:
+    """Drive the arm along a planned path under physics (what it holds goes with it);
+    whether it got to the end."""
+    return drive_path(scene.robot, path, TIME_STEP, on_frame).reached
+
+
+def _approach(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
+    if not run_path(scene, plan.path, on_frame):
+        return "the arm was stopped on its way by something it met"
+    down = [scene.robot.q(), plan.q_above, *plan.descent, plan.q_at]
+    if not run_path(scene, down, on_frame):
+        return "the arm was stopped on its final approach by something it met"
+    return None
+
+
+def _retreat(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
+    if not run_path(scene, [scene.robot.q(), *reversed(plan.descent), plan.q_above], on_frame):
+        return "the arm was stopped on its retreat by something it met"
+    return None
+
+
+def _run_pick(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
     robot = scene.robot
-    robot.set_fingers(plan.opening)
-    run_path(scene, plan.path, on_frame)
-    run_path(scene, [plan.q_above, plan.q_at], on_frame)
-    # The fingers close to the object's width, then a fixed constraint makes the grasp firm.
-    robot.set_fingers(plan.grip)
-    if not blind:
-        robot.attach(scene.bodies[plan.params.obj])
-    elif (body := robot.between_fingers(tuple(scene.bodies.values()))) is not None:
+    drive_fingers(robot, plan.opening)
+    if stopped := _approach(scene, plan, on_frame):
+        _retreat(scene, plan, on_frame)  # the fingers stay open: nothing is taken up
+        return stopped
+    # The fingers close until they stop; what they hold from opposite sides is held.
+    drive_fingers(robot, 0.0)
+    if (body := body_in_grasp(robot, tuple(scene.bodies.values()))) is not None:
         robot.attach(body)
-    else:
-        robot.set_fingers(0.0)  # closed on nothing
-    run_path(scene, [plan.q_at, plan.q_above], on_frame)
+    return _retreat(scene, plan, on_frame)
 
 
-def _run_place(scene: Scene, plan: MotionPlan, on_frame) -> None:
+def _run_place(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
     robot = scene.robot
-    run_path(scene, plan.path, on_frame)
-    run_path(scene, [plan.q_above, plan.q_at], on_frame)
+    if stopped := _approach(scene, plan, on_frame):
+        return stopped
     robot.detach()
-    robot.set_fingers(GRIPPER_MAX_OPENING)
+    drive_fingers(robot, GRIPPER_MAX_OPENING)
     scene.settle()
-    run_path(scene, [plan.q_at, plan.q_above], on_frame)
+    return _retreat(scene, plan, on_frame)
 
 
-def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> None:
+def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
     robot = scene.robot
-    robot.set_fingers(0.0)
-    run_path(scene, plan.path, on_frame)
-    run_path(scene, [plan.q_above, plan.q_at], on_frame)
-    # Only the pushed object moves unless it is pushed into another, which that wakes.
-    with scene.asleep(awake=[plan.params.obj]):
-        for q in plan.line:
-            robot.drive_to(q, PUSH_SUBSTEPS)
-            if on_frame:
-                on_frame()
-        # Back out the way it came (joints checked against the shelves while planning; the
-        # object is ahead of the fingers now), then up to where the approach began.
-        run_path(scene, [robot.q(), *reversed(plan.line), plan.q_at, plan.q_above], on_frame)
-        scene.settle()
-    robot.set_fingers(GRIPPER_MAX_OPENING)
+    drive_fingers(robot, 0.0)
+    if stopped := _approach(scene, plan, on_frame):
+        return stopped
+    for q in plan.line:
+        robot.drive_to(q, PUSH_SUBSTEPS)
+        if on_frame:
+            on_frame()
+    # Back out the way it came (joints checked against the shelves while planning; the
+    # object is ahead of the fingers now), then up to where the approach began.
+    back = [robot.q(), *reversed(plan.line), plan.q_at, *reversed(plan.descent), plan.q_above]
+    stopped = None if run_path(scene, back, on_frame) else "stopped backing out of a push"
+    scene.settle()
+    drive_fingers(robot, GRIPPER_MAX_OPENING)
+    return stopped

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from pybullet_utils.bullet_client import BulletClient
+
+if TYPE_CHECKING:  # a camera's calibration is for perception too, which never sees PyBullet
+    from pybullet_utils.bullet_client import BulletClient
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,8 @@
 """The Franka Panda from `pybullet_data`: kinematics, inverse kinematics, gripper, grasp.
 
-Arm motion is kinematic (joint states are set along a collision-checked path) and contact-rich
-phases (settling, pushing) run under physics with position-controlled motors. A grasp is made
-firm by a fixed constraint between the hand and the object once the fingers have closed on it.
+Joint states are set directly only for queries (inverse kinematics, collision checks, a
+model's arm); the real arm is driven under physics by `sim.actuation`. A grasp is made firm by
+a fixed constraint between the hand and the object where the fingers hold it (`attach`).
 """
 
 from __future__ import annotations
@@ -59,6 +59,9 @@ class Panda:
         self.lower = np.array([i[8] for i in info])
         self.upper = np.array([i[9] for i in info])
         self.grasp_constraint: int | None = None
+        # whether the fingers were last told to close (`sim.actuation.drive_fingers`): a closed
+        # gripper's width then says whether it holds something
+        self.closing = False
         self.held_body: int | None = None
         self.held_offset: Pose | None = None
         # The last object let go and its pose as the hand let it go (the arm's kinematics and
@@ -140,11 +143,16 @@ class Panda:
     def preserved(self) -> Iterator[None]:
         """Checks and IK move the arm and fingers; this puts them (and what is held) back after."""
         q, opening = self.q(), self.finger_opening()
+        held = self.held_body
+        # where physics holds it, which the grasp's constraint keeps within a hair of nominal
+        held_at = None if held is None else self.bc.getBasePositionAndOrientation(held)
         try:
             yield
         finally:
             self.set_fingers(opening)
             self.set_q(q)
+            if held is not None and held == self.held_body:
+                self.bc.resetBasePositionAndOrientation(held, *held_at)
 
     # --- kinematics --------------------------------------------------------------------
 
@@ -210,6 +218,7 @@ class Panda:
         obj = Pose(*self.bc.getBasePositionAndOrientation(body))
         self.held_offset = obj.relative_to(self.tcp())
         self.held_body = body
+        self.closing = True
         self.grasp_constraint = self.bc.createConstraint(
             self.body,
             TCP,
@@ -222,22 +231,6 @@ class Panda:
             self.held_offset.orientation,
         )
         self.bc.changeConstraint(self.grasp_constraint, maxForce=200.0)
-
-    def between_fingers(self, bodies: tuple[int, ...], reach: float = 0.01) -> int | None:
-        """The body both fingers touch (within `reach`), if any: what closing them on it
-        holds. Of several, the one the fingers are nearest."""
-        touching = []
-        for body in bodies:
-            gaps = [
-                min(
-                    (c[8] for c in self.bc.getClosestPoints(self.body, body, reach, f, -1)),
-                    default=None,
-                )
-                for f in FINGERS
-            ]
-            if None not in gaps:
-                touching.append((sum(gaps), body))
-        return min(touching)[1] if touching else None
 
     def detach(self) -> None:
         if self.held_body is not None and self.held_offset is not None:

@@ -183,7 +183,17 @@ class Scene:
         return self.bc.saveState()
 
     def restore(self, state: int) -> None:
-        self.bc.restoreState(state)
+        """Back to a snapshot; the motors, which a snapshot does not hold, hold still there.
+        A restored body's collision shape is put where the state puts it: restoring leaves
+        it where it was, which a body asleep meanwhile keeps (measured: closing fingers went
+        through an object there)."""
+        bc = self.bc
+        bc.restoreState(state)
+        self.robot.hold_position()
+        for b in self.bodies.values():
+            pose, velocity = bc.getBasePositionAndOrientation(b), bc.getBaseVelocity(b)
+            bc.resetBasePositionAndOrientation(b, *pose)
+            bc.resetBaseVelocity(b, *velocity)
 
     # --- planning queries --------------------------------------------------------------------
 

@@ -229,16 +229,16 @@ def data_loss_cases() -> list[Case]:
     return [
         case(
             "collect place",
-            "default --out over the shipped dataset (--samples 60)",
-            "collect place --samples 60 --workers 1",
+            "default --out over the shipped dataset (--samples 20)",
+            "collect place --samples 20 --workers 1 --tasks-per-chunk 4",
             *home,
             own_home=True,
             keep=SHIPPED,
         ),
         case(
             "collect push",
-            "default --out over the shipped dataset (--samples 60)",
-            "collect push --samples 60 --workers 1",
+            "default --out over the shipped dataset (--samples 20)",
+            "collect push --samples 20 --workers 1 --tasks-per-chunk 4",
             *home,
             own_home=True,
             keep=SHIPPED,

@@ -12,7 +12,8 @@ from scipy.spatial.transform import Rotation
 from hsgplan.domain.objects import type_of
 from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.evaluation.perception_eval import rotation_error, score_scene, summary
-from hsgplan.perception.estimator import Detection, PoseEstimator, _apart, _fitted, _of_kind
+from hsgplan.perception.detection import Detection
+from hsgplan.perception.estimator import PoseEstimator, _apart, _fitted, _of_kind
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE

@@ -18,7 +18,8 @@ from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.failures import Failure
 from hsgplan.perception.cameras import VIEWS
-from hsgplan.perception.estimator import Detection, PoseEstimator
+from hsgplan.perception.detection import Detection
+from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.keypoints import PinholeCamera, in_world, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE

@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 
 from hsgplan.domain.world import OBJECT_TYPES
-from hsgplan.perception.estimator import Detection
+from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.phantoms import SURE, overlap, pruned

@@ -10,7 +10,8 @@ import torch
 
 from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.perception.colour import MIN_REGION, features, pixel_vote
-from hsgplan.perception.estimator import Detection, PoseEstimator
+from hsgplan.perception.detection import Detection
+from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.synthetic import VIEWS

@@ -40,7 +40,7 @@ def test_a_pick_planned_in_the_belief_takes_up_the_true_object_near_it():
             world.believe(GeometricSceneGraph.from_poses({"butter": off}))
             plan = world.plan(PickParams("butter"))
             assert isinstance(plan, MotionPlan)
-            run_plan(scene, plan, blind=True)
+            run_plan(scene, plan)
             assert scene.held() == "butter"
             world.executed(plan, gripper_holds=scene.robot.held_body is not None)
             assert world.holding == "butter"
