@@ -89,7 +89,7 @@ def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFa
     """Plan a primitive from the scene as it is; the scene is left unchanged."""
     # Checks move the arm: every query below starts from these joints, not from wherever the
     # last check left it.
-    q0 = scene.robot.q()
+    q0 = scene.robot.q_in_limits()
     try:
         with scene.robot.preserved():
             if isinstance(params, PickParams):
@@ -105,7 +105,8 @@ def plan_transit(scene: Scene, q_goal: np.ndarray) -> tuple[np.ndarray, ...] | N
     """A collision-free path of the arm (and what it holds) from where it is to `q_goal`."""
     held = scene.held()
     with scene.robot.preserved():
-        return _path(scene, scene.robot.q(), q_goal, ignore=() if held is None else (held,))
+        q0 = scene.robot.q_in_limits()
+        return _path(scene, q0, q_goal, ignore=() if held is None else (held,))
 
 
 def can_pick(scene: Scene, obj: str) -> bool:

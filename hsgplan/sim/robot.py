@@ -81,6 +81,12 @@ class Panda:
     def q(self) -> np.ndarray:
         return np.array([s[0] for s in self.bc.getJointStates(self.body, ARM)])
 
+    def q_in_limits(self) -> np.ndarray:
+        """The joints clipped to their limits, where planning starts: a joint driven to its
+        limit under physics may end a hair past it, which OMPL takes for an invalid start
+        (measured: 2e-5 rad past, every path refused)."""
+        return np.clip(self.q(), self.lower, self.upper)
+
     def set_q(self, q: np.ndarray) -> None:
         """Set the arm's joints directly; a held object is carried along."""
         for j, v in zip(ARM, q, strict=True):

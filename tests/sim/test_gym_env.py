@@ -116,3 +116,38 @@ def test_registered_with_gymnasium():
         assert env.unwrapped.goal.size == 2
     finally:
         env.close()
+
+
+def test_reward_and_termination_are_what_the_observer_sees_and_the_truth_is_in_info():
+    from hsgplan.domain.objects import object_type
+    from hsgplan.domain.world import surface_rect
+    from hsgplan.scene_graph.geometric import GeometricSceneGraph
+    from hsgplan.scene_graph.geometry import Pose
+    from hsgplan.sim.observer import Seen
+
+    top = surface_rect("shelf_a")
+    on_top = ((top.x_min + top.x_max) / 2, (top.y_min + top.y_max) / 2)
+    on_top += (top.z + object_type("butter").height / 2,)
+
+    class Fooled:  # sees the butter on shelf A's top, wherever it is
+        name = "fooled"
+
+        def reset(self, scene) -> None:
+            pass
+
+        def observe(self, scene) -> Seen:
+            sg = scene.scene_graph()
+            poses = {n.name: n.pose for n in sg.nodes}
+            poses["butter"] = Pose(on_top, poses["butter"].orientation)
+            return Seen(GeometricSceneGraph.from_poses(poses, held=sg.held))
+
+    env = KitchenStorageEnv(observer=Fooled())
+    try:
+        goal = parse_goal("On(butter, shelf_a) & On(cherries, open_space)")
+        env.reset(seed=4, options=ResetOptions(goal))
+        _, reward, terminated, truncated, info = env.step(PickParams("alphabet_soup"))
+        assert info["outcome"].status.value == "invalid"  # not in the scene: nothing moved
+        assert (reward, terminated, truncated) == (1.0, True, False)
+        assert info["goal_truly_holds"] is False
+    finally:
+        env.close()
