@@ -194,3 +194,19 @@ def test_a_column_seeing_with_f_p_is_labelled_so():
 
     assert label("gnn-rgb") == "GNN (rgb)" and label("gnn") == "GNN"
     assert label("forward_gnn") == "forward_gnn"
+
+
+def test_steps_that_truly_moved_another_object_are_counted_and_read_back():
+    from hsgplan.sim.outcome import Disturbance
+
+    nudged = replace(_step("success"), disturbed=(Disturbance("cherries", 0.031),))
+    record = replace(_record(True), steps=(nudged, _step("success", 2)))
+    again = EpisodeRecord.from_json(json.loads(json.dumps(record.to_json())))
+    assert again == record
+    by_size = summarize([record, _record(True)])
+    assert by_size["by_size"]["2"]["disturbing_steps"] == 1
+    gnn = {"agent": "regression+gnn", "wall_seconds": 1.0, "sittings": []}
+    report = {"methods": {"gnn": gnn | by_size}, "goals": 2, "goals_file": None}
+    text = markdown(report | {"repeats": 1, "seed": 0, "run": "x", "protocol": "paper"})
+    assert "| disturbing steps |" in text
+    assert "| GNN | 2 | 2 | 0 | 0 | 0 | 0 | 0 | 1 |" in text

@@ -140,3 +140,15 @@ def test_fingers_both_on_top_of_a_can_are_no_grasp():
         ]
         assert touching == [True, True]  # both fingers touch it, from the same side
         assert body_in_grasp(robot, (scene.bodies[CAN],)) is None
+
+
+def test_a_stopped_arm_is_the_failure_unless_the_effect_holds_or_something_fell():
+    from hsgplan.sim.outcome import Status
+    from hsgplan.sim.primitives import stopped_outcome
+
+    why = "the arm was stopped on its way by something it met"
+    assert stopped_outcome(Status.DROPPED, "nothing held", why) == (Status.BLOCKED, why)
+    assert stopped_outcome(Status.SUCCESS, "", why) == (Status.SUCCESS, "")
+    fell = (Status.KNOCKED_OVER, "'butter' toppled")
+    assert stopped_outcome(*fell, why) == fell
+    assert stopped_outcome(Status.DROPPED, "nothing held", None) == (Status.DROPPED, "nothing held")
