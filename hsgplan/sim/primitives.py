@@ -13,6 +13,8 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+import numpy as np
+
 from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams
 from hsgplan.domain.world import GRIPPER_MAX_OPENING
 from hsgplan.sim.actuation import body_in_grasp, drive_fingers, drive_path
@@ -143,8 +145,13 @@ def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
         if on_frame:
             on_frame()
     # Back out the way it came (joints checked against the shelves while planning; the
-    # object is ahead of the fingers now), then up to where the approach began.
-    back = [robot.q(), *reversed(plan.line), plan.q_at, *reversed(plan.descent), plan.q_above]
+    # object is ahead of the fingers now), then up to where the approach began: from the
+    # line's point the hand got to, since it lags behind the line's end and catching up
+    # would strike the object (measured: a can struck at 1.3 m/s slid to the shelf's back).
+    q = robot.q()
+    reached = int(np.argmin([np.max(np.abs(p - q)) for p in plan.line]))
+    line = plan.line[: reached + 1]
+    back = [q, *reversed(line), plan.q_at, *reversed(plan.descent), plan.q_above]
     stopped = None if run_path(scene, back, on_frame) else "stopped backing out of a push"
     scene.settle()
     drive_fingers(robot, GRIPPER_MAX_OPENING)
