@@ -27,10 +27,11 @@ class Status(StrEnum):
     OFF_TABLE = "off_table"  # some object fell off the table
     DISTURBED = "disturbed"  # another object was moved out of place
     EFFECT_NOT_REACHED = "effect_not_reached"  # the intended predicate does not hold
-    BLOCKED = "blocked"  # the arm was stopped short by what it met, and the effect not reached
     # Motion data only (`hsgplan.data.motion_trials`): the place reached its effect but left an
     # object on that surface, or the placed one, that can no longer be taken up.
     BLOCKS_PICK = "blocks_pick"
+    # New statuses go last: stored motion data holds a status as its index in this order.
+    BLOCKED = "blocked"  # the arm was stopped short by what it met, and the effect not reached
 
 
 @dataclass(frozen=True)
