@@ -65,10 +65,16 @@ def _command(robot: Panda, q: np.ndarray, velocity: np.ndarray) -> None:
     )
 
 
-def _halt(robot: Panda, target: np.ndarray) -> Driven:
-    """Hold the joints where they are now: the motion towards `target` was stopped."""
+def _hold_here(robot: Panda) -> np.ndarray:
+    """Hold the joints where they are now; returns them."""
     q = robot.q()
     _command(robot, q, np.zeros(len(ARM)))
+    return q
+
+
+def _halt(robot: Panda, target: np.ndarray) -> Driven:
+    """The motion towards `target` was stopped: the arm holds where it is."""
+    q = _hold_here(robot)
     return Driven(False, float(np.max(np.abs(q - target))))
 
 
@@ -118,7 +124,7 @@ def drive_fingers(robot: Panda, opening: float, force: float = FINGER_FORCE) -> 
     robot.closing = opening == 0.0
     if not robot.closing and abs(robot.finger_opening() - opening) < FINGER_THERE:
         return robot.finger_opening()
-    _command(robot, robot.q(), np.zeros(len(ARM)))  # the arm stays where it is meanwhile
+    _hold_here(robot)  # the arm stays where it is meanwhile
     bc.setJointMotorControlArray(
         robot.body,
         FINGERS,

@@ -179,7 +179,7 @@ class KitchenStorageEnv(gymnasium.Env):
         # the robot's own verdict: what it sees (the truth only with the ground truth observer)
         done = self.goal.satisfied_by(typed.symbols.state)
         truncated = not done and self.steps >= self.max_steps
-        acted_on = params if isinstance(params, str) else params.obj
+        acted_on = getattr(params, "obj", "")  # an undecodable action acts on nothing
         info = {
             "outcome": outcome,
             "observation": typed,
@@ -208,7 +208,9 @@ class KitchenStorageEnv(gymnasium.Env):
 
     def _checked_plan(self, params: PrimitiveParams) -> tuple[MotionPlan | None, float]:
         """A dry run's plan for `params` if it was made in the scene as it is now."""
-        plan, seconds, state = self._checked.pop(params, (None, 0.0, None))
+        if params not in self._checked:  # most steps: no dry run, no state to compare
+            return None, 0.0
+        plan, seconds, state = self._checked.pop(params)
         return (plan, seconds) if state == self._state() else (None, 0.0)
 
     def render(self, camera: Camera | None = None) -> np.ndarray | None:
