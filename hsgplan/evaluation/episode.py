@@ -44,6 +44,8 @@ class StepRecord:
     relooks: int = 0  # looks taken before the primitive, from out of the cameras' way
     # objects the primitive truly moved besides its own (the simulator's poses), and how far
     disturbed: tuple[Disturbance, ...] = ()
+    # the largest move (m) its observer saw of an object besides its own, look before to after
+    seen_moved: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -166,6 +168,7 @@ def run_episode(
             outcome.seconds,
             outcome.relooks,
             info["disturbed"],
+            round(info["seen_moved"], 4),
         )
         records.append(record)
         if on_step:

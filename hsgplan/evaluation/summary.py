@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.failures import Failure
-from hsgplan.sim.outcome import Status
+from hsgplan.sim.outcome import DISTURB_TOL, SEEN_DISTURB_TOL, Status
 
 EXECUTION = "execution"
 OVERSTEP = "overstep"
@@ -85,6 +85,7 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         # primitives that truly moved an object besides their own (physics: a swept arm, a
         # carried object, a push), whatever their status
         "disturbing_steps": sum(1 for r in rs for s in r.steps if s.disturbed),
+        "still_seen_moved": still_seen_moved(rs),
         # looks taken again before a primitive or the goal's end, seeing through f_p (`relook`)
         "relooks": sum(s.relooks for r in rs for s in r.steps) + sum(r.closing_relooks for r in rs),
         "median_steps": statistics.median(len(r.steps) for r in rs),
@@ -92,6 +93,22 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "median_task_seconds": statistics.median(r.task_seconds for r in rs),
         # the motion level per episode: choosing parameters and executing them
         "median_motion_seconds": statistics.median(r.motion_seconds for r in rs),
+    }
+
+
+def still_seen_moved(rs: Sequence[EpisodeRecord]) -> dict:
+    """How far the observer saw other objects move in the steps that truly moved none of them
+    (none by DISTURB_RECORD): its spread between looks, which a step judged on the belief must
+    tell from a disturbance (`sim.outcome.SEEN_DISTURB_TOL`). Zero under the ground truth."""
+    moves = sorted(s.seen_moved for r in rs for s in r.steps if not s.disturbed)
+    if not moves:
+        return {"steps": 0}
+    return {
+        "steps": len(moves),
+        "p99": moves[min(len(moves) - 1, int(0.99 * len(moves)))],
+        "max": moves[-1],
+        "beyond_2cm": sum(m > DISTURB_TOL for m in moves),
+        "beyond_tolerance": sum(m > SEEN_DISTURB_TOL for m in moves),
     }
 
 

@@ -37,7 +37,14 @@ from hsgplan.sim.gym_spaces import action_space, decode, encode, observation_spa
 from hsgplan.sim.lookahead import Lookahead
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive, plan_transit
 from hsgplan.sim.observer import CameraObserver, GroundTruth, Look, SceneObserver, Seen
-from hsgplan.sim.outcome import Outcome, Status, compare, disturbances
+from hsgplan.sim.outcome import (
+    SEEN_DISTURB_TOL,
+    Outcome,
+    Status,
+    compare,
+    disturbances,
+    largest_move,
+)
 from hsgplan.sim.primitives import Watch, execute, run_path, run_plan, stopped_outcome
 from hsgplan.sim.render import Camera
 from hsgplan.sim.robot import REST
@@ -123,6 +130,7 @@ class KitchenStorageEnv(gymnasium.Env):
         self._seen: Seen | None = None  # the belief's last look
         self._judged: Seen | None = None  # the look that judged the last step, if one did
         self._released = None
+        self._judged_from: Seen | Observation | None = None  # the last observation
         self.scene: Scene | None = None
         self.goal: Goal | None = None
         self.steps = 0
@@ -175,6 +183,7 @@ class KitchenStorageEnv(gymnasium.Env):
             outcome = Outcome(outcome.status, outcome.detail, outcome.seconds + plan_seconds)
         self._checked.clear()
         self.steps += 1
+        before = self._judged_from  # the look the step is judged from (after any relook)
         typed = self._observe()
         # the robot's own verdict: what it sees (the truth only with the ground truth observer)
         done = self.goal.satisfied_by(typed.symbols.state)
@@ -185,6 +194,11 @@ class KitchenStorageEnv(gymnasium.Env):
             "observation": typed,
             # what the primitive truly moved besides its object: the record's, not the agent's
             "disturbed": disturbances(true_before, self.scene.poses(), acted_on),
+            # the largest move the robot saw of an object besides its own, of those it was
+            # sure of before and after (its observer's)
+            "seen_moved": largest_move(
+                before.scene_graph, typed.scene_graph, acted_on, _sure(before, typed)
+            ),
             "goal_truly_holds": self.goal.satisfied_by(typed.true_symbols.state),
         }
         return self._encode(typed), float(done), done, truncated, info
@@ -243,7 +257,7 @@ class KitchenStorageEnv(gymnasium.Env):
             relooks = self._look_again(on_frame)
             if relooks:  # a dry run's plan was made on the older belief: planned again
                 plan, plan_seconds = None, 0.0
-        before = self._seen.scene_graph
+        before = self._judged_from = self._seen
         world = self.world
         world.follow(self.scene.robot.q())
         if plan is None:
@@ -259,10 +273,19 @@ class KitchenStorageEnv(gymnasium.Env):
         seconds = time.perf_counter() - start - watch.seconds + plan_seconds
         if isinstance(params, PickParams) and not holds:
             detail = f"the fingers closed on nothing where '{params.obj}' was believed"
-            return Outcome(Status.DROPPED, detail, seconds, relooks)
+            status, detail = stopped_outcome(Status.DROPPED, detail, stopped)
+            return Outcome(status, detail, seconds, relooks)
         # the look that judges the step is the next observation's: made once
         self._seen = self._judged = self._look()
-        status, detail = compare(before, self._seen.scene_graph, params.obj, plan.expected)
+        after = self._seen
+        status, detail = compare(
+            before.scene_graph,
+            after.scene_graph,
+            params.obj,
+            plan.expected,
+            SEEN_DISTURB_TOL,
+            _sure(before, after),
+        )
         # the joints' encoders tell whether the arm got where it was driven
         status, detail = stopped_outcome(status, detail, stopped)
         return Outcome(status, detail, seconds, relooks)
@@ -333,7 +356,7 @@ class KitchenStorageEnv(gymnasium.Env):
             true_symbols = symbols
         else:
             true_symbols = map_symbols(self.scene.scene_graph())
-        return Observation(
+        self._judged_from = Observation(
             seen.scene_graph,
             symbols,
             rgb,
@@ -342,6 +365,7 @@ class KitchenStorageEnv(gymnasium.Env):
             seen.unknown,
             seen.uncertain,
         )
+        return self._judged_from
 
     def _encode(self, typed: Observation) -> dict:
         return encode(self.goal.objects, typed.scene_graph, typed.symbols.state)
@@ -362,3 +386,11 @@ def _options(options: ResetOptions | dict | None, objects: int, seed: int) -> Re
 
 
 gymnasium.register(id=ENV_ID, entry_point="hsgplan.sim.env:KitchenStorageEnv")
+
+
+def _sure(before: Seen | Observation, after: Seen | Observation) -> frozenset[str]:
+    """The objects a look before and a look after a step were both sure of (seen by several
+    views): only their poses are compared by distance; a single view's depth is compared by
+    the symbolic location it gives."""
+    unsure = set(before.uncertain) | set(after.uncertain)
+    return frozenset(after.scene_graph.objects) - unsure

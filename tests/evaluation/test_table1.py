@@ -210,3 +210,18 @@ def test_steps_that_truly_moved_another_object_are_counted_and_read_back():
     text = markdown(report | {"repeats": 1, "seed": 0, "run": "x", "protocol": "paper"})
     assert "| disturbing steps |" in text
     assert "| GNN | 2 | 2 | 0 | 0 | 0 | 0 | 0 | 1 |" in text
+
+
+def test_what_the_observer_saw_move_is_summed_over_steps_that_truly_moved_nothing():
+    from hsgplan.sim.outcome import Disturbance
+
+    jitter = [replace(_step("success", k), seen_moved=m) for k, m in enumerate((0.01, 0.025), 1)]
+    # a step that truly moved another object is not the observer's spread
+    nudged = replace(_step("success", 3), seen_moved=0.2, disturbed=(Disturbance("cherries", 0.2),))
+    record = replace(_record(True), steps=(*jitter, nudged))
+    again = EpisodeRecord.from_json(json.loads(json.dumps(record.to_json())))
+    assert again == record
+    still = summarize([record])["by_size"]["2"]["still_seen_moved"]
+    assert still == {"steps": 2, "p99": 0.025, "max": 0.025, "beyond_2cm": 1, "beyond_tolerance": 0}
+    no_steps = summarize([replace(_record(True), steps=())])["by_size"]["2"]
+    assert no_steps["still_seen_moved"] == {"steps": 0}

@@ -4,12 +4,12 @@ import pytest
 
 from hsgplan.domain.parameters import PickParams
 from hsgplan.domain.predicates import in_grasp, on
-from hsgplan.domain.world import OBJECT_TYPES, TABLE
+from hsgplan.domain.world import OBJECT_TYPES, REGIONS, TABLE
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.belief_world import BeliefWorld
 from hsgplan.sim.motion_plans import MotionPlan
-from hsgplan.sim.outcome import Status, compare
+from hsgplan.sim.outcome import SEEN_DISTURB_TOL, Status, compare, largest_move
 from hsgplan.sim.primitives import run_plan
 from hsgplan.sim.scene import Scene
 
@@ -66,3 +66,41 @@ def test_a_step_is_judged_on_the_belief_before_and_after_it():
     alone = GeometricSceneGraph.from_poses({"butter": butter})
     status, detail = compare(alone, before, "butter", on("butter", "open_space"))
     assert status is Status.SUCCESS, detail
+
+
+def _soup_seen_at(dy: float) -> tuple[GeometricSceneGraph, GeometricSceneGraph]:
+    """The belief before and after a pick of the butter, the soup seen `dy` m off."""
+    butter, soup = _on_table("butter", 0.5, 0.1), _on_table("tomato_soup", 0.5, -0.15)
+    lifted = Pose((0.5, 0.1, 0.3), butter.orientation)
+    moved = Pose((0.5, -0.15 + dy, soup.position[2]), soup.orientation)
+    return (
+        GeometricSceneGraph.from_poses({"butter": butter, "tomato_soup": soup}),
+        GeometricSceneGraph.from_poses({"butter": lifted, "tomato_soup": moved}, held="butter"),
+    )
+
+
+def test_a_belief_judges_only_moves_beyond_its_own_spread_and_of_what_it_is_sure_of():
+    before, after = _soup_seen_at(0.025)
+    pick = in_grasp("butter")
+    assert compare(before, after, "butter", pick)[0] is Status.DISTURBED  # the truth's 2 cm
+    assert compare(before, after, "butter", pick, SEEN_DISTURB_TOL)[0] is Status.SUCCESS
+    before, after = _soup_seen_at(SEEN_DISTURB_TOL + 0.01)
+    sure = frozenset({"butter", "tomato_soup"})
+    status, detail = compare(before, after, "butter", pick, SEEN_DISTURB_TOL, sure)
+    assert status is Status.DISTURBED and "tomato_soup" in detail
+    # a single view saw it (unsure): its depth is judged by the symbolic location it gives
+    unsure = frozenset({"butter"})
+    assert compare(before, after, "butter", pick, SEEN_DISTURB_TOL, unsure)[0] is Status.SUCCESS
+    # seen in another region now: moved out of place, sure of it or not
+    elsewhere = _on_table("tomato_soup", *REGIONS["prepush_b"].center)
+    onto = GeometricSceneGraph.from_poses(
+        {"butter": after.pose("butter"), "tomato_soup": elsewhere}, held="butter"
+    )
+    assert compare(before, onto, "butter", pick, SEEN_DISTURB_TOL, unsure)[0] is Status.DISTURBED
+
+
+def test_the_largest_move_seen_leaves_out_the_object_acted_on_and_the_unsure():
+    before, after = _soup_seen_at(0.04)
+    assert largest_move(before, after, "butter") == pytest.approx(0.04)
+    assert largest_move(before, after, "tomato_soup") > 0.2  # the butter, lifted
+    assert largest_move(before, after, "butter", frozenset({"butter"})) == 0.0
