@@ -4,6 +4,7 @@ through one of them."""
 
 from __future__ import annotations
 
+import itertools
 import multiprocessing
 import os
 import queue
@@ -11,6 +12,7 @@ import socket
 import sys
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 
 from hsgplan.domain.errors import InvalidInputError
@@ -27,30 +29,97 @@ def one_core() -> None:
         sys.modules["torch"].set_num_threads(1)
 
 
+# Times a work item is run again after the process running it died (killed, out of memory)
+# before the job gives up on it: an item that kills its worker every time is not retried
+# forever.
+RETRIES = 3
+
+
+class WorkerLostError(InvalidInputError):
+    """A work item's worker died more often than RETRIES allows, or Ray lost the node or the
+    cluster: one line, and the run resumes where it stopped when started again."""
+
+
+def _lost(what: str) -> WorkerLostError:
+    return WorkerLostError(
+        f"{what}; every result finished before is kept: run the same command again to go on"
+    )
+
+
+def call(fn: Callable, *args):
+    """`fn(*args)` in a worker, on one core (Ray's workers run no pool initializer)."""
+    one_core()
+    return fn(*args)
+
+
 class LocalEngine:
     """A process pool (spawned: children forked from a process with torch loaded hang), one
-    core per worker."""
+    core per worker. A worker that dies (killed, out of memory) breaks the pool: a new pool
+    runs every unfinished item again, each at most RETRIES times more."""
 
     def __init__(self, workers: int) -> None:
-        context = multiprocessing.get_context("spawn")
-        self.pool = ProcessPoolExecutor(workers, mp_context=context, initializer=one_core)
+        self.workers = workers
+        self.pool = self._new_pool()
         # finished futures in the order they finished: waiting on thousands of pending ones
         # at every step would cost time quadratic in the job's size
         self.finished: queue.SimpleQueue[Future] = queue.SimpleQueue()
+        self.jobs: dict[int, tuple[Callable, tuple]] = {}  # handle: its work, until done
+        self.futures: dict[Future, int] = {}
+        self.retries: dict[int, int] = {}
+        self.count = itertools.count()
 
-    def submit(self, fn: Callable, *args) -> Future:
+    def _new_pool(self) -> ProcessPoolExecutor:
+        context = multiprocessing.get_context("spawn")
+        return ProcessPoolExecutor(self.workers, mp_context=context, initializer=one_core)
+
+    def submit(self, fn: Callable, *args) -> int:
+        handle = next(self.count)
+        self.jobs[handle] = (fn, args)
+        self._start(handle)
+        return handle
+
+    def _start(self, handle: int) -> None:
+        fn, args = self.jobs[handle]
         future = self.pool.submit(fn, *args)
+        self.futures[future] = handle
         future.add_done_callback(self.finished.put)
-        return future
 
     def next_done(self, handles: set) -> tuple[object, object]:
         while True:
-            handle = self.finished.get()
-            if handle in handles:
-                return handle, handle.result()
+            future = self.finished.get()
+            handle = self.futures.pop(future, None)  # None: a future of a pool given up
+            if handle not in handles:
+                continue
+            try:
+                result = future.result()
+            except BrokenProcessPool:
+                self._restart(handle)
+                continue
+            del self.jobs[handle]
+            return handle, result
+
+    def _restart(self, broken: int) -> None:
+        """A worker died, which breaks the pool: every unfinished item runs again in a new
+        one, in the order submitted (the pool's order). Those that were running, the first
+        `workers` of them, are counted as retried."""
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        self.pool = self._new_pool()
+        kept = {f: h for f, h in self.futures.items() if _succeeded(f)}
+        lost = sorted({broken, *(h for h in self.futures.values() if h not in kept.values())})
+        self.futures = kept
+        for h in lost[: self.workers]:
+            self.retries[h] = self.retries.get(h, 0) + 1
+            if self.retries[h] > RETRIES:
+                raise _lost(f"a worker died each of the {RETRIES + 1} times it ran one item")
+        for h in lost:
+            self._start(h)
 
     def close(self) -> None:
         self.pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _succeeded(future: Future) -> bool:
+    return future.done() and not future.cancelled() and future.exception() is None
 
 
 RAY_CONNECT_SECONDS = 3.0
@@ -101,16 +170,21 @@ class RayEngine:
             raise InvalidInputError(
                 f"--ray '{address}': could not start or join Ray ({first})"
             ) from None
-        self.remote = {}
+        self.task = ray.remote(max_retries=RETRIES)(call)
 
     def submit(self, fn: Callable, *args):
-        if fn not in self.remote:
-            self.remote[fn] = self.ray.remote(fn)
-        return self.remote[fn].remote(*args)
+        # One remote function for every job: `fn` travels as its argument (a plain function
+        # or a functools.partial alike, which ray.remote itself refuses).
+        return self.task.remote(fn, *args)
 
     def next_done(self, handles: set) -> tuple[object, object]:
         ready, _ = self.ray.wait(list(handles), num_returns=1)
-        return ready[0], self.ray.get(ready[0])
+        try:
+            return ready[0], self.ray.get(ready[0])
+        except self.ray.exceptions.RayTaskError as e:  # the work's own error, as raised
+            raise e.as_instanceof_cause() from None
+        except self.ray.exceptions.RayError as e:  # a worker, a node or the cluster lost
+            raise _lost(f"Ray lost a worker or a node ({type(e).__name__})") from None
 
     def close(self) -> None:
         self.ray.shutdown()

@@ -1,0 +1,68 @@
+"""Work items survive a worker that dies: each is logged once, and one that kills its worker
+every time ends the job in one line. The work functions live here so spawned workers import
+them."""
+
+import functools
+import json
+import os
+import signal
+from pathlib import Path
+
+import pytest
+
+from hsgplan.runner.engines import RETRIES, WorkerLostError
+from hsgplan.runner.items import run_items
+from hsgplan.runner.run_folder import RESULTS
+
+
+def square_or_die(marks: str, item: int) -> int:
+    """Kills its own worker the first time it runs item 3 (a mark file remembers)."""
+    mark = Path(marks) / f"died-{item}"
+    if item == 3 and not mark.exists():
+        mark.touch()
+        os.kill(os.getpid(), signal.SIGKILL)
+    return item * item
+
+
+def always_die(item: int) -> int:
+    if item == 1:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return item
+
+
+def test_an_item_whose_worker_is_killed_runs_again_and_is_logged_once(tmp_path):
+    marks, run = tmp_path / "marks", tmp_path / "run"
+    marks.mkdir()
+    work = functools.partial(square_or_die, str(marks))
+    items = list(range(8))
+    got = run_items(work, items, key=str, run_dir=run, kind="test", workers=2)
+    assert got == [i * i for i in items]
+    assert (marks / "died-3").exists()  # the worker did die
+    keys = [json.loads(line)["key"] for line in (run / RESULTS).read_text().splitlines()]
+    assert sorted(keys) == sorted(str(i) for i in items)  # each exactly once
+
+
+def test_an_item_that_kills_every_worker_ends_the_job_in_one_line(tmp_path):
+    run = tmp_path / "run"
+    with pytest.raises(WorkerLostError, match=f"died each of the {RETRIES + 1} times"):
+        run_items(always_die, [0, 1, 2], key=str, run_dir=run, kind="test", workers=1)
+    # what finished before is kept: run again, item 0 is not repeated
+    keys = [json.loads(line)["key"] for line in (run / RESULTS).read_text().splitlines()]
+    assert keys == ["0"]
+
+
+def test_ray_runs_a_partial_and_survives_a_killed_worker(tmp_path):
+    import ray  # noqa: F401  (installed by the test set-up: `make test` installs .[dev,ray])
+
+    marks = tmp_path / "marks"
+    marks.mkdir()
+    work = functools.partial(square_or_die, str(marks))
+    got = run_items(
+        work, list(range(6)), key=str, run_dir=tmp_path / "run", kind="test", ray="local"
+    )
+    assert got == [i * i for i in range(6)]
+    assert (marks / "died-3").exists()
+    keys = [
+        json.loads(line)["key"] for line in (tmp_path / "run" / RESULTS).read_text().splitlines()
+    ]
+    assert sorted(keys) == [str(i) for i in range(6)]
