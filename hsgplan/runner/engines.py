@@ -147,6 +147,25 @@ def check_ray_address(address: str | None) -> None:
         ) from None
 
 
+# Left out of the checkout a cluster's workers are sent: history, environments, run folders.
+CLUSTER_EXCLUDES = [".git", ".venv", "venv", "**/__pycache__", "runs", "*.egg-info"]
+
+
+def cluster_env() -> dict:
+    """What the workers of a cluster joined with `--ray ADDRESS` are given: this checkout
+    (the package, `checkpoints/` and `data/`, less CLUSTER_EXCLUDES) as their working folder,
+    which Ray uploads once and unpacks on every node, so no node needs a checkout of its own;
+    their dependencies (torch, pybullet, ...) must be installed on each. Run from an installed
+    package rather than a checkout, nothing is sent: each node needs the package installed."""
+    from hsgplan.paths import home
+
+    env = {"env_vars": {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}}
+    root = home()
+    if (root / "hsgplan" / "__init__.py").is_file():
+        env |= {"working_dir": str(root), "excludes": CLUSTER_EXCLUDES}
+    return env
+
+
 class RayEngine:
     """The same work on a Ray cluster: `address` as `ray.init` takes it ("auto", "ray://...",
     or "local" to start a private instance on this machine)."""
@@ -164,7 +183,7 @@ class RayEngine:
             if address == "local":
                 ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
             else:
-                ray.init(address=address, log_to_driver=False)
+                ray.init(address=address, log_to_driver=False, runtime_env=cluster_env())
         except Exception as e:  # no cluster there, a bad address: one line, not a traceback
             first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
             raise InvalidInputError(

@@ -66,3 +66,17 @@ def test_ray_runs_a_partial_and_survives_a_killed_worker(tmp_path):
         json.loads(line)["key"] for line in (tmp_path / "run" / RESULTS).read_text().splitlines()
     ]
     assert sorted(keys) == [str(i) for i in range(6)]
+
+
+def test_a_cluster_is_sent_the_checkout_and_nothing_from_an_installed_package(
+    monkeypatch, tmp_path
+):
+    from hsgplan.paths import HOME_VARIABLE
+    from hsgplan.runner.engines import CLUSTER_EXCLUDES, cluster_env
+
+    env = cluster_env()
+    assert (Path(env["working_dir"]) / "checkpoints").is_dir()
+    assert {".git", ".venv", "runs"} <= set(env["excludes"]) == set(CLUSTER_EXCLUDES)
+    assert env["env_vars"]["OMP_NUM_THREADS"] == "1"
+    monkeypatch.setenv(HOME_VARIABLE, str(tmp_path))  # a home holding no package
+    assert "working_dir" not in cluster_env()
