@@ -65,6 +65,17 @@ def _command(robot: Panda, q: np.ndarray, velocity: np.ndarray) -> None:
     )
 
 
+def press_towards(robot: Panda, q: np.ndarray, steps: int) -> None:
+    """The push line's stroke: the joints driven towards `q` for `steps` physics steps by the
+    motors' own position control (its gains, no feed-forward velocity), whatever stands in
+    the way: the push is meant to move what it meets."""
+    robot.bc.setJointMotorControlArray(
+        robot.body, ARM, robot.bc.POSITION_CONTROL, targetPositions=q, forces=[MOTOR_FORCE] * 7
+    )
+    for _ in range(steps):
+        robot.bc.stepSimulation()
+
+
 def _hold_here(robot: Panda) -> np.ndarray:
     """Hold the joints where they are now; returns them."""
     q = robot.q()

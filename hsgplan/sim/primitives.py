@@ -17,7 +17,7 @@ import numpy as np
 
 from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams
 from hsgplan.domain.world import GRIPPER_MAX_OPENING
-from hsgplan.sim.actuation import body_in_grasp, drive_fingers, drive_path
+from hsgplan.sim.actuation import body_in_grasp, drive_fingers, drive_path, press_towards
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
 from hsgplan.sim.outcome import Outcome, Status, verify
 from hsgplan.sim.scene import TIME_STEP, Scene
@@ -141,7 +141,7 @@ def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
     if stopped := _approach(scene, plan, on_frame):
         return stopped
     for q in plan.line:
-        robot.drive_to(q, PUSH_SUBSTEPS)
+        press_towards(robot, q, PUSH_SUBSTEPS)
         if on_frame:
             on_frame()
     # Back out the way it came (joints checked against the shelves while planning; the

@@ -137,14 +137,6 @@ class Panda:
             forces=[40.0] * 2,
         )
 
-    def drive_to(self, q: np.ndarray, steps: int) -> None:
-        """Position-control the arm towards q for a number of physics steps."""
-        self.bc.setJointMotorControlArray(
-            self.body, ARM, self.bc.POSITION_CONTROL, targetPositions=q, forces=[MOTOR_FORCE] * 7
-        )
-        for _ in range(steps):
-            self.bc.stepSimulation()
-
     @contextlib.contextmanager
     def preserved(self) -> Iterator[None]:
         """Checks and IK move the arm and fingers; this puts them (and what is held) back after."""
