@@ -14,10 +14,10 @@ from hsgplan.scene_graph.symbol_mapping import AnomalyKind, map_symbols
 DISTURB_TOL = 0.02
 # The same judged on what the robot sees (f_p's looks before and after the step), of objects
 # both looks saw from several views: a move the looks cannot tell from their own spread is none.
-# Between two such looks, objects a step truly left still (none moved 5 mm) seemed to move up
-# to 2.6 cm on the tuning seeds (`still_seen_moved` in an eval run's summary.json;
-# docs/decisions.md, "A step judged on the belief").
-SEEN_DISTURB_TOL = 0.03
+# On the tuning seeds (`eval world --perception rgb --protocol paper --sizes 4-6 --goals 30
+# --seed 900`), objects a step truly left still (none moved 5 mm) seemed to move up to 5.2 cm
+# between two looks, beyond 2 cm in 13 of 825 steps (`still_seen_moved` in summary.json).
+SEEN_DISTURB_TOL = 0.06
 # Any object but the one acted on that moves further than this during a primitive is recorded
 # as disturbed by it (the record's, not the status's: nudges under DISTURB_TOL are recorded).
 DISTURB_RECORD = 0.005
