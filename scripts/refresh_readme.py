@@ -1,10 +1,12 @@
 """Replace a results block with what a command prints, so no table is typed by hand.
 
-Usage: python scripts/refresh_readme.py NAME -- hsgplan bench symbolic --markdown
+Usage: python scripts/refresh_readme.py NAME [--saved FILE] -- hsgplan bench symbolic --markdown
 
 The block is the text between `<!-- BEGIN NAME -->` and `<!-- END NAME -->`, in the README or in
 one of the pages under docs/; it becomes the command's standard output followed by a line naming
-the command, the date and the machine.
+the command, the date and the machine. With `--saved FILE`, the command is not run again: FILE
+is its standard output, saved when it ran (`COMMAND > FILE`), for runs that take long and keep
+no run folder to read back.
 """
 
 from __future__ import annotations
@@ -23,6 +25,9 @@ PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 
 
 def main(argv: list[str]) -> int:
+    saved = None
+    if len(argv) > 2 and argv[1] == "--saved":
+        saved, argv = Path(argv[2]), [argv[0], *argv[3:]]
     if len(argv) < 3 or argv[1] != "--":
         print(__doc__.strip().splitlines()[2], file=sys.stderr)
         return 2
@@ -34,15 +39,19 @@ def main(argv: list[str]) -> int:
     if page is None:
         print(f"no page (README.md, docs/*.md) has a block named '{name}'", file=sys.stderr)
         return 2
-    result = subprocess.run(command, capture_output=True, text=True, check=False)
-    if result.returncode != 0:
-        print(result.stderr, file=sys.stderr)
-        return result.returncode
+    if saved is not None:
+        output = saved.read_text()
+    else:
+        result = subprocess.run(command, capture_output=True, text=True, check=False)
+        if result.returncode != 0:
+            print(result.stderr, file=sys.stderr)
+            return result.returncode
+        output = result.stdout
     stamp = (
         f"\n_Produced by `{shlex.join(command)}` on {datetime.date.today()} "
         f"({platform.machine()}, {os.cpu_count()} cores)._\n"
     )
-    block = result.stdout.strip() + "\n" + stamp
+    block = output.strip() + "\n" + stamp
     # read again: the page may have changed while the command ran (another refresh, an edit)
     text = page.read_text()
     page.write_text(pattern.sub(lambda m: m.group(1) + block + m.group(2), text))
