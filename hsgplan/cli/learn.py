@@ -10,10 +10,13 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import (
+    CollectWorkers,
     PlannerName,
+    RayAddress,
     RunFolder,
     Summaries,
     bounded_option,
+    check_ray,
     dash,
     err,
     input_path,
@@ -86,7 +89,8 @@ def eval_task(
     checkpoint: Annotated[
         Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
     ] = TASK_CHECKPOINT,
-    workers: Annotated[int, bounded_option("workers", "Episodes run side by side.")] = 2,
+    workers: CollectWorkers = 2,
+    ray: RayAddress = None,
     run_dir: RunFolder = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
@@ -105,6 +109,7 @@ def eval_task(
     source = goals_file.stem if goals_file else f"g{goals}"
     tag = "" if checkpoint == TASK_CHECKPOINT else f"-{resolve(checkpoint).name}"
     run_dir = run_dir or RUNS / f"eval-task-{planner}{tag}-{sizes}-{source}-seed{seed}"
+    check_ray(ray)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(f"{planner} episodes", total=total)
         episodes = evaluate_task(
@@ -117,6 +122,7 @@ def eval_task(
             workers,
             lambda e: progress.advance(task),
             run_dir,
+            ray,
         )
     report = summarize_task(episodes) | {"planner": planner, "seed": seed}
     if as_json:

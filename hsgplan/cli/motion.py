@@ -12,7 +12,10 @@ import typer
 from rich.progress import Progress
 
 from hsgplan.cli.common import (
+    CollectWorkers,
+    RayAddress,
     bounded_option,
+    check_ray,
     err,
     input_path,
     out,
@@ -99,7 +102,8 @@ def eval_motion(
     motion_checkpoints: Annotated[
         Path, typer.Option(help="Folder of motion checkpoints.", parser=input_path)
     ] = MOTION_CHECKPOINTS,
-    workers: Annotated[int, bounded_option("workers", "Processes.")] = 2,
+    workers: CollectWorkers = 2,
+    ray: RayAddress = None,
     run_dir: Annotated[
         Path | None,
         typer.Option(
@@ -120,10 +124,18 @@ def eval_motion(
     kinds = [p.strip() for p in primitives.split(",")]
     if "" in kinds or len(set(kinds)) != len(kinds):
         raise InvalidInputError(f"--primitives '{primitives}': name place, push or both, each once")
+    check_ray(ray)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("scenes", total=trials * len(kinds))
         report = evaluate_motion(
-            kinds, trials, seed, motion_checkpoints, workers, lambda: progress.advance(bar), run_dir
+            kinds,
+            trials,
+            seed,
+            motion_checkpoints,
+            workers,
+            lambda: progress.advance(bar),
+            run_dir,
+            ray,
         )
     if as_json:
         print(json.dumps(report, indent=2))

@@ -131,6 +131,7 @@ def evaluate_motion(
     workers: int,
     progress: Callable[[], None] | None = None,
     run_dir: Path | None = None,
+    ray: str | None = None,
 ) -> dict:
     """`{primitive: {model: {"success_rate", "trials", "by_crowding", ...}}}` over the first
     `trials` tasks of the evaluation stream (scenes that could not be staged are skipped).
@@ -171,6 +172,7 @@ def evaluate_motion(
             ),
         },
         workers=workers,
+        ray=ray,
         on_result=on_chunk,
     )
     report = {}

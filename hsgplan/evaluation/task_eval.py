@@ -122,6 +122,7 @@ def evaluate_task(
     workers: int = 2,
     on_episode: Callable[[TaskEpisode], None] | None = None,
     run_dir: Path | None = None,
+    ray: str | None = None,
 ) -> list[TaskEpisode]:
     """Every episode, `workers` at a time. With `run_dir`, finished episodes are appended to
     its `episodes.jsonl` as they finish, and a run started again skips them."""
@@ -156,6 +157,7 @@ def evaluate_task(
             "fingerprint": fingerprint([*learned, *([goals_file] if goals_file else [])]),
         },
         workers=workers,
+        ray=ray,
         on_result=on_episode and (lambda row: on_episode(_episode(row))),
     )
     return [_episode(row) for row in rows]

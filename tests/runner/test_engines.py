@@ -80,3 +80,13 @@ def test_a_cluster_is_sent_the_checkout_and_nothing_from_an_installed_package(
     assert env["env_vars"]["OMP_NUM_THREADS"] == "1"
     monkeypatch.setenv(HOME_VARIABLE, str(tmp_path))  # a home holding no package
     assert "working_dir" not in cluster_env()
+
+
+def test_eval_task_and_eval_motion_take_a_ray_address_checked_at_the_door():
+    from typer.testing import CliRunner
+
+    from hsgplan.cli import app
+
+    for command in (["eval", "task"], ["eval", "motion"]):
+        result = CliRunner().invoke(app, [*command, "--ray", "127.0.0.1:1"])
+        assert result.exit_code == 2 and "--ray '127.0.0.1:1'" in result.output
