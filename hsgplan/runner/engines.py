@@ -105,7 +105,7 @@ class LocalEngine:
         self.pool.shutdown(wait=False, cancel_futures=True)
         self.pool = self._new_pool()
         kept = {f: h for f, h in self.futures.items() if _succeeded(f)}
-        lost = sorted({broken, *(h for h in self.futures.values() if h not in kept.values())})
+        lost = sorted({broken, *self.futures.values()} - set(kept.values()))
         self.futures = kept
         for h in lost[: self.workers]:
             self.retries[h] = self.retries.get(h, 0) + 1
