@@ -153,25 +153,40 @@ def _check_progress(progress: Path, data: str) -> dict:
 def resume(folder: Path, model: torch.nn.Module, optim: torch.optim.Optimizer, data: str) -> int:
     """Load the saved progress, if any, into model and optimiser; the epoch to start from.
     Progress made on other training data (`data`, a fingerprint) is refused, never mixed."""
+    return resume_with(folder, model, optim, data)[0]
+
+
+def resume_with(
+    folder: Path, model: torch.nn.Module, optim: torch.optim.Optimizer, data: str
+) -> tuple[int, dict]:
+    """`resume`, and what the trainer saved beside the weights (`save_progress`'s `extra`)."""
     progress = folder / PROGRESS
     if not progress.exists():
-        return 0
+        return 0, {}
     state = _check_progress(progress, data)
     try:
         model.load_state_dict(state["model"])
         optim.load_state_dict(state["optim"])
         epoch = int(state["epoch"])
+        extra = state.get("extra") or {}
+        if not isinstance(extra, dict):
+            raise TypeError("extra: not a mapping")
     except Exception as e:  # another network's progress: one line, and nothing is touched
         raise _unusable(progress, e) from None
     if non_finite(model.state_dict()):
         raise InvalidInputError(f"'{progress}' holds NaN or infinite weights; delete it")
-    return epoch
+    return epoch, extra
 
 
-def save_progress(folder: Path, model, optim, epoch: int, data: str) -> None:
-    """The last finished epoch, written whole (a crash mid-write leaves the last good one)."""
+def save_progress(
+    folder: Path, model, optim, epoch: int, data: str, extra: dict | None = None
+) -> None:
+    """The last finished epoch, written whole (a crash mid-write leaves the last good one);
+    `extra` (tensors, numbers, text) comes back from `resume_with`."""
     tensors: dict[str, torch.Tensor] = {}
     state = {"model": model.state_dict(), "optim": optim.state_dict(), "epoch": epoch}
+    if extra:
+        state["extra"] = extra
     meta = json.dumps(_encode(state | {"data": data}, "state", tensors))
     write_atomically(folder / PROGRESS, save(tensors, metadata={_STATE: meta}))
 

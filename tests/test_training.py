@@ -27,6 +27,20 @@ def test_progress_is_saved_and_resumed(tmp_path):
             assert torch.equal(loaded["state"][k][name], value)
 
 
+def test_what_a_trainer_keeps_beside_the_weights_comes_back(tmp_path):
+    """A trainer choosing its epoch keeps the best weights so far and the losses of every
+    epoch: an interrupted training resumes with them."""
+    model, optim = _model_and_optim()
+    best = {k: v + 1 for k, v in model.state_dict().items()}
+    history = [{"epoch": 1, "loss": 0.5, "validation_loss": 0.75}]
+    training.save_progress(tmp_path, model, optim, 1, "data-a", {"best": best, "history": history})
+    other, other_optim = _model_and_optim()
+    epoch, extra = training.resume_with(tmp_path, other, other_optim, "data-a")
+    assert epoch == 1 and extra["history"] == history
+    assert all(torch.equal(extra["best"][k], v) for k, v in best.items())
+    assert training.resume_with(tmp_path / "none", other, other_optim, "data-a") == (0, {})
+
+
 def test_progress_is_data_not_a_pickle(tmp_path):
     from safetensors import safe_open
 

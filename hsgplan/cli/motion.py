@@ -160,3 +160,22 @@ def eval_motion(
         rows,
         markdown,
     )
+    trained = [
+        (
+            kind,
+            m,
+            f"{r['parameters']:,}",
+            f"{r['training_examples']:,}",
+            f"{r['validation_examples']:,}",
+            str(r["chosen_epoch"]),
+        )
+        for kind, by_model in report.items()
+        for m, r in by_model.items()
+        if "parameters" in r
+    ]
+    print_table(
+        "What each network learnt from: its examples, those held out to choose its epoch",
+        ("primitive", "model", "parameters", "examples", "held out", "epoch kept"),
+        trained,
+        markdown,
+    )

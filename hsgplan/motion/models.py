@@ -22,6 +22,7 @@ from hsgplan.motion.layers import GroundedConv, mlp
 from hsgplan.scene_graph.grounding import EDGE_DIM, NODE_DIM, QUERY_DIM, SUBGOAL_DIM, TYPES
 
 MODELS = ("gnn", "mlp")
+REFERENCE_A = NODE_DIM - 6  # a node's reference-A position: three features from here
 HEADS = ("mlp", "bins")
 
 
@@ -39,17 +40,17 @@ class MotionNetConfig:
     edge_dim: int = EDGE_DIM
     subgoal_dim: int = SUBGOAL_DIM
     slots: int = len(TYPES)  # the MLP's fixed input: one node slot per object type
-    # The GNN's head: "mlp", the paper's (the embeddings, concatenated, through an MLP onto
-    # every bin), or "bins" (beyond the paper): each bin is a query that reads every node
-    # from where that bin would put the object (see `BinQueryHead`).
+    # The head: "mlp", the paper's (the embeddings, concatenated, through an MLP onto every
+    # bin), or "bins" (beyond the paper): each bin is scored from where it would put the
+    # object (the GNN: `BinQueryHead`; the MLP: `FlatBinHead`, the same inputs in slots).
     head: str = "mlp"
     query_dim: int = QUERY_DIM
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:
             raise InvalidInputError(f"model '{self.model}': one of {', '.join(MODELS)}")
-        if self.head not in HEADS or (self.model == "mlp" and self.head != "mlp"):
-            raise InvalidInputError(f"head '{self.head}': mlp, or bins for the gnn")
+        if self.head not in HEADS:
+            raise InvalidInputError(f"head '{self.head}': one of {', '.join(HEADS)}")
         for name in ("hidden", "embed", "rounds"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
@@ -111,9 +112,24 @@ class FlatMotionNet(nn.Module):
         c = config
         self.slots = c.slots
         flat = c.slots * c.node_dim + c.slots * (c.slots - 1) * c.edge_dim
-        self.graph_embed = mlp([flat, c.hidden, c.hidden, c.embed])
         self.subgoal_embed = mlp([c.subgoal_dim, c.hidden, c.embed])
-        self.head = mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
+        if c.head == "bins":
+            self.graph_embed = mlp([flat, c.hidden, c.hidden])
+            self.head = FlatBinHead(c.hidden, c.embed, c.query_dim, c.slots, c.hidden)
+        else:
+            self.graph_embed = mlp([flat, c.hidden, c.hidden, c.embed])
+            self.head = mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
+
+    def _slot_positions(self, batch) -> tuple[torch.Tensor, torch.Tensor]:
+        """Each slot's reference-A position [B, slots, 3] and whether its type is present
+        [B, slots]."""
+        kind = batch.x[:, : self.slots].argmax(dim=1)
+        b = int(batch.u.shape[0])
+        positions = batch.x.new_zeros(b, self.slots, 3)
+        positions[batch.batch, kind] = batch.x[:, REFERENCE_A : REFERENCE_A + 3]
+        present = torch.zeros(b, self.slots, dtype=torch.bool, device=batch.x.device)
+        present[batch.batch, kind] = True
+        return positions, present
 
     def flatten(self, batch) -> torch.Tensor:
         s = self.slots
@@ -130,6 +146,10 @@ class FlatMotionNet(nn.Module):
 
     def forward(self, batch, only: torch.Tensor | None = None) -> torch.Tensor:
         graph = self.graph_embed(self.flatten(batch))
+        if isinstance(self.head, FlatBinHead):
+            positions, present = self._slot_positions(batch)
+            subgoal = self.subgoal_embed(batch.u)
+            return self.head(torch.relu(graph), positions, present, batch, subgoal, only)
         return _pick(self.head(torch.cat([graph, self.subgoal_embed(batch.u)], dim=-1)), only)
 
 
@@ -164,8 +184,7 @@ class BinQueryHead(nn.Module):
         self, h: torch.Tensor, batch, subgoal: torch.Tensor, only: torch.Tensor | None = None
     ) -> torch.Tensor:
         nodes, mask = to_dense_batch(h, batch.batch)  # [B, N, hidden]
-        start = NODE_DIM - 6  # reference A: the three features after the first nine geometric
-        pos, _ = to_dense_batch(batch.x[:, start : start + 3], batch.batch)
+        pos, _ = to_dense_batch(batch.x[:, REFERENCE_A : REFERENCE_A + 3], batch.batch)
         b, n = mask.shape
         query = batch.query.view(b, -1, batch.query.shape[-1])  # [B, bins, query_dim]
         if only is not None:
@@ -178,6 +197,51 @@ class BinQueryHead(nn.Module):
         seen = seen.masked_fill(~mask[:, None, :, None], float("-inf")).amax(dim=2)
         wide = subgoal[:, None, :].expand(b, bins, -1)
         return self.score(torch.cat([seen, query, wide], dim=-1)).squeeze(-1)
+
+
+class FlatBinHead(nn.Module):
+    """The MLP's bin head, given what `BinQueryHead` reads but in fixed slots: each bin is
+    scored by a three-layer network from the scene's flat embedding, every slot's offset
+    from where the bin would put the moved object (zeros for an absent type), the bin's own
+    features and the subgoal embedding. No pooling over nodes: that is the graph's share.
+
+    Args:
+        hidden: width of the flat scene embedding; embed: subgoal embedding width;
+        query_dim: features per bin; slots: object types; width: the head's hidden units.
+
+    Shapes:
+        scene [B, hidden], positions [B, slots, 3], present [B, slots] bool,
+        batch.query [B * bins, query_dim], subgoal [B, embed] -> [B, bins];
+        with `only` [B] -> [B, 1].
+    """
+
+    def __init__(self, hidden: int, embed: int, query_dim: int, slots: int, width: int) -> None:
+        super().__init__()
+        self.score = mlp([hidden + 3 * slots + query_dim + embed, width, width, 1])
+
+    def forward(
+        self,
+        scene: torch.Tensor,
+        positions: torch.Tensor,
+        present: torch.Tensor,
+        batch,
+        subgoal: torch.Tensor,
+        only: torch.Tensor | None = None,
+    ) -> torch.Tensor:
+        b = scene.shape[0]
+        query = batch.query.view(b, -1, batch.query.shape[-1])  # [B, bins, query_dim]
+        if only is not None:
+            query = query[torch.arange(b), only.view(-1)].unsqueeze(1)
+        bins = query.shape[1]
+        offset = positions[:, None, :, :] - query[:, :, None, :3]  # [B, bins, slots, 3]
+        offset = offset * present[:, None, :, None]
+        inputs = [
+            scene[:, None].expand(b, bins, -1),
+            offset.flatten(2),
+            query,
+            subgoal[:, None].expand(b, bins, -1),
+        ]
+        return self.score(torch.cat(inputs, dim=-1)).squeeze(-1)
 
 
 def build(config: MotionNetConfig) -> nn.Module:

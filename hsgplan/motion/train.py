@@ -6,11 +6,14 @@ every trial, failures included, teaches the logit of its own bin pair whether it
 the network estimates each bin's chance of success from more than twice the data. The
 checkpoint is a folder: `train_config.json`, `config.json` (the network's), `model.safetensors`;
 `progress.safetensors` holds the last finished epoch while training runs, so
-that a run started again with the same configuration continues from there.
+that a run started again with the same configuration continues from there. With a
+validation share, `training.json` says how many examples trained it, how many chose its
+epoch, the loss of every epoch and the epoch kept.
 """
 
 from __future__ import annotations
 
+import json
 import random
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -27,14 +30,17 @@ from hsgplan.domain.checks import (
     BOUNDS,
     check_fields,
     from_settings,
+    read_json,
     setting,
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import BINS, MotionPrimitive
 from hsgplan.domain.predicates import inside, on
+from hsgplan.files import write_atomically
 from hsgplan.motion.models import MotionNetConfig, build
 from hsgplan.paths import MOTION_DATA, shipped
 from hsgplan.scene_graph.grounding import ground
+from hsgplan.training import TRAIN_CONFIG
 
 
 @dataclass(frozen=True)
@@ -56,7 +62,10 @@ class MotionTrainConfig:
     # than 1 (they fight the simulation workers for the cores).
     threads: int = setting(1, **BOUNDS["workers"])
     loss: str = "ce"  # "ce" (successes, the paper's) or "bce" (every trial)
-    head: str = "mlp"  # the GNN's head: "mlp" (the paper's) or "bins" (`models.BinQueryHead`)
+    head: str = "mlp"  # "mlp" (the paper's) or "bins" (`models.BinQueryHead`, `FlatBinHead`)
+    # The share of the training scenes held out to choose the epoch: the weights kept are
+    # those of the epoch with the lowest loss on them (0: train on all, keep the last epoch).
+    validation: float = setting(0.0, lo=0, hi=0.5)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -121,6 +130,27 @@ def grounded_examples(data: MotionData) -> list[Data]:
     return out
 
 
+SELECTION = "training.json"  # the examples and the epoch kept, beside a checkpoint
+
+
+def split_tasks(data: MotionData, share: float, seed: int) -> np.ndarray:
+    """Which rows are held out: every trial of `share` of the tasks (scenes), drawn with
+    `seed`, so that no held-out scene was also trained on."""
+    tasks = np.unique(data.task)
+    count = int(round(share * len(tasks)))
+    held = np.random.default_rng(seed).permutation(tasks)[:count]
+    return np.isin(data.task, held)
+
+
+def _mean_loss(kind: str, model: torch.nn.Module, examples: list[Data], size: int) -> float:
+    total = 0.0
+    with torch.no_grad():
+        for i in range(0, len(examples), size):
+            batch = Batch.from_data_list(examples[i : i + size])
+            total += _loss(kind, model, batch).item() * batch.num_graphs
+    return total / len(examples)
+
+
 def train_motion(
     config: MotionTrainConfig,
     out: Path,
@@ -136,13 +166,16 @@ def train_motion(
     training.claim(out, asdict(config), data=data)
     if training.finished(out):
         return  # finished earlier
-    examples = grounded_examples(rows)
+    held = split_tasks(rows, config.validation, config.seed)
+    examples = grounded_examples(rows.take(~held))
+    checking = grounded_examples(rows.take(held))
     torch.set_num_threads(config.threads)
     torch.manual_seed(config.seed)
     net_config = config.net_config()
     model = build(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
-    start = training.resume(out, model, optim, data)
+    start, kept = training.resume_with(out, model, optim, data)
+    history: list[dict] = list(kept.get("history", []))
     for epoch in range(start, config.epochs):
         order = list(range(len(examples)))
         random.Random(f"{config.seed}-{epoch}").shuffle(order)
@@ -155,8 +188,54 @@ def train_motion(
             optim.step()
             total += loss.detach().item() * batch.num_graphs
         training.check_loss(total, f"the {config.model} {config.primitive} network", epoch + 1)
+        row = {"epoch": epoch + 1, "loss": total / len(examples)}
+        if checking:
+            row["validation_loss"] = _mean_loss(config.loss, model, checking, 512)
+            best = min((h["validation_loss"] for h in history), default=float("inf"))
+            if row["validation_loss"] < best:
+                kept["best"] = {k: v.clone() for k, v in model.state_dict().items()}
+        history.append(row)
         if on_epoch:
-            on_epoch(epoch + 1, total / len(examples))
+            on_epoch(epoch + 1, row["loss"])
         if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
-            training.save_progress(out, model, optim, epoch + 1, data)
+            extra = {"history": history, **({"best": kept["best"]} if "best" in kept else {})}
+            training.save_progress(out, model, optim, epoch + 1, data, extra)
+    if checking:
+        model.load_state_dict(kept["best"])
+        chosen = min(history, key=lambda h: h["validation_loss"])["epoch"]
+        selection = {
+            "training_examples": len(examples),
+            "validation_examples": len(checking),
+            "chosen_epoch": chosen,
+            "rule": "the epoch of lowest validation loss",
+            "epochs": history,
+        }
+        write_atomically(out / SELECTION, json.dumps(selection, indent=2) + "\n")
     training.finish(out, model, net_config.to_json())
+
+
+@dataclass(frozen=True)
+class TrainingRecord:
+    """What a motion checkpoint was trained on: its examples, the examples that chose its
+    epoch, and the epoch kept (the last, where none were held out)."""
+
+    parameters: int
+    training_examples: int
+    validation_examples: int
+    chosen_epoch: int
+
+    @staticmethod
+    def of(folder: Path, model: torch.nn.Module) -> TrainingRecord:
+        parameters = sum(p.numel() for p in model.parameters())
+        if (folder / SELECTION).is_file():
+            saved = read_json(folder / SELECTION, "training record")
+            return TrainingRecord(
+                parameters,
+                int(saved["training_examples"]),
+                int(saved["validation_examples"]),
+                int(saved["chosen_epoch"]),
+            )
+        config = MotionTrainConfig.from_json(
+            read_json(folder / TRAIN_CONFIG, "training configuration")
+        )
+        return TrainingRecord(parameters, len(_training_rows(config)), 0, config.epochs)

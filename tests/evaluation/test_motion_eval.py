@@ -7,9 +7,10 @@ from typer.testing import CliRunner
 
 from hsgplan.cli import app
 from hsgplan.collect.motion import CollectConfig, collect
+from hsgplan.data.motion_store import load_dataset
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.evaluation.motion_eval import evaluate_motion
-from hsgplan.motion.train import MotionTrainConfig, train_motion
+from hsgplan.motion.train import MotionTrainConfig, split_tasks, train_motion
 
 runner = CliRunner()
 
@@ -18,20 +19,35 @@ runner = CliRunner()
 def checkpoints(tmp_path_factory):
     root = tmp_path_factory.mktemp("motion")
     collect(CollectConfig(MotionPrimitive.PLACE, 6, workers=1, tasks_per_chunk=2), root / "data")
-    # as shipped: the GNN learns from every trial (bce), the MLP from the successes (ce)
-    for model, head, loss in (("gnn", "bins", "bce"), ("mlp", "mlp", "ce")):
+    # as shipped: the GNN and the fair MLP learn from every trial (bce), their epoch chosen on
+    # held-out scenes; the paper's MLP from the successes (ce), its last epoch kept
+    for model, folder, head, loss, held in (
+        ("gnn", "gnn", "bins", "bce", 0.34),
+        ("mlp", "mlp", "bins", "bce", 0.34),
+        ("mlp", "mlp-paper", "mlp", "ce", 0.0),
+    ):
         config = MotionTrainConfig(
-            model=model, head=head, loss=loss, data=str(root / "data"), epochs=2, hidden=16, embed=8
-        )
-        train_motion(config, root / "ck" / f"place-{model}")
+            model=model, head=head, loss=loss, data=str(root / "data"), epochs=2, hidden=16,
+            embed=8, validation=held,
+        )  # fmt: skip
+        train_motion(config, root / "ck" / f"place-{folder}")
     return root / "ck"
+
+
+def test_held_out_scenes_are_whole_tasks(checkpoints):
+    trials = load_dataset(checkpoints.parent / "data" / "place_trials.npz", MotionPrimitive.PLACE)
+    held = split_tasks(trials, 0.34, 0)
+    assert held.any() and not held.all()
+    assert not set(trials.task[held]) & set(trials.task[~held])
+    assert (split_tasks(trials, 0.34, 0) == held).all()  # the seed draws the same split
+    assert not split_tasks(trials, 0.0, 0).any()
 
 
 @pytest.mark.slow
 def test_every_model_is_tried_once_in_the_same_scenes(checkpoints):
     report = evaluate_motion(["place"], 3, 0, checkpoints, workers=1)
     place = report["place"]
-    assert set(place) == {"gnn", "mlp", "random"}  # no paper-head checkpoint here
+    assert set(place) == {"gnn", "mlp", "mlp_paper", "random"}  # no paper-head GNN here
     trials = {name: entry["trials"] for name, entry in place.items()}
     assert len(set(trials.values())) == 1 and 1 <= trials["gnn"] <= 3
     for entry in place.values():
@@ -51,7 +67,15 @@ def test_eval_motion_cli_prints_json(checkpoints):
          str(checkpoints), "--workers", "1", "--json"],
     )  # fmt: skip
     assert r.exit_code == 0, r.output
-    assert set(json.loads(r.stdout)["place"]) >= {"gnn", "mlp", "random"}
+    place = json.loads(r.stdout)["place"]
+    assert set(place) >= {"gnn", "mlp", "random"}
+    gnn, mlp, paper = place["gnn"], place["mlp"], place["mlp_paper"]
+    # the fair MLP learnt from the GNN's examples, its epoch chosen by the same rule
+    assert gnn["training_examples"] == mlp["training_examples"] > 0
+    assert gnn["validation_examples"] == mlp["validation_examples"] > 0
+    assert {gnn["chosen_epoch"], mlp["chosen_epoch"]} <= {1, 2}
+    assert paper["validation_examples"] == 0 and paper["chosen_epoch"] == 2
+    assert "parameters" not in place["random"] and paper["parameters"] > 0
 
 
 @pytest.mark.parametrize(

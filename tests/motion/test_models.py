@@ -6,7 +6,7 @@ from torch_geometric.data import Batch
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.predicates import inside, on
-from hsgplan.motion.models import FlatMotionNet, GraphMotionNet, MotionNetConfig, build
+from hsgplan.motion.models import FlatMotionNet, MotionNetConfig, build
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.grounding import ground
@@ -30,7 +30,7 @@ def _permuted_pair():
     return a, b
 
 
-MODELS = [("gnn", "mlp"), ("gnn", "bins"), ("mlp", "mlp")]
+MODELS = [("gnn", "mlp"), ("gnn", "bins"), ("mlp", "mlp"), ("mlp", "bins")]
 
 
 @pytest.mark.parametrize("model,head", MODELS)
@@ -70,9 +70,10 @@ def test_object_order_does_not_matter(model, head):
     assert torch.allclose(out_a, out_b, atol=1e-5)
 
 
-def test_the_gnn_reads_the_other_objects():
+@pytest.mark.parametrize("model,head", MODELS)
+def test_every_model_reads_the_other_objects(model, head):
     torch.manual_seed(0)
-    net = GraphMotionNet(MotionNetConfig("gnn", "place", (10, 10), hidden=32, embed=8)).eval()
+    net = build(MotionNetConfig(model, "place", (10, 10), hidden=32, embed=8, head=head)).eval()
     a, _ = _permuted_pair()
     moved = a.clone()
     moved.x = a.x.clone()
@@ -88,10 +89,19 @@ def test_the_mlp_flattens_by_type_slot():
     )
 
 
+def test_the_mlp_bin_head_reads_each_type_slot_and_knows_the_absent_ones():
+    net = FlatMotionNet(MotionNetConfig("mlp", "place", (10, 10), hidden=16, embed=8, head="bins"))
+    a, b = _permuted_pair()
+    positions, present = net._slot_positions(Batch.from_data_list([a, b]))
+    assert torch.equal(positions[0], positions[1])  # by type, whatever the node order
+    assert present.sum(dim=1).tolist() == [4, 4]  # four of the six types in the scene
+    assert positions[~present].abs().sum() == 0
+
+
 def test_bad_configurations_are_refused():
     with pytest.raises(InvalidInputError, match="model 'cnn'"):
         MotionNetConfig("cnn", "place", (10, 10))
-    with pytest.raises(InvalidInputError, match="head 'bins'"):
-        MotionNetConfig("mlp", "place", (10, 10), head="bins")
+    with pytest.raises(InvalidInputError, match="head 'query'"):
+        MotionNetConfig("mlp", "place", (10, 10), head="query")
     with pytest.raises(InvalidInputError, match="hidden"):
         MotionNetConfig("gnn", "place", (10, 10), hidden=0)
