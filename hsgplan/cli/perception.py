@@ -21,6 +21,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
+from hsgplan.evaluation.seeds import marked
 from hsgplan.paths import PERCEPTION_CHECKPOINT, RUNS
 
 
@@ -138,6 +139,7 @@ def eval_perception(
         f"{report['precision']:.3f} ({report['unmatched_detections']} matched none), "
         f"symbolic scene graph equal {report['symbolic_match_rate']:.3f}"
     )
+    title = marked(title, seed, perception=True)
     print_table(
         title,
         ("type", "objects", "translation cm (median)", "rotation deg (median)"),

@@ -18,6 +18,7 @@ from hsgplan.domain.recovery import RECOVERING
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import check_runs, episode_specs, run_evaluation
+from hsgplan.evaluation.seeds import is_tuning, marked
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim, read_timing, sittings
@@ -110,6 +111,7 @@ def run_table(
         "goals_file": config.goals_file,
         "repeats": config.repeats,
         "seed": config.seed,
+        "tuning_seed": is_tuning(config.seed),
         "run": str(out),
     }
     write_atomically(out / "summary.json", json.dumps(report, indent=2) + "\n")
@@ -211,6 +213,7 @@ def _results(report: dict) -> TextTable:
         f"{report['repeats']} times (± the standard deviation of the success rate over the "
         f"repeats), seed {report['seed']}"
     )
+    title = marked(title, report["seed"])
     return TextTable(title, tuple(header), tuple(rows))
 
 

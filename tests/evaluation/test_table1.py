@@ -113,6 +113,8 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
     assert "| GNN | 2 | 2 | 1 | 0 | 1 (step limit 1) | 1 | 1 |" in text
     assert "(recovering protocol)" in text  # a report without a protocol predates the paper's
     assert "1.5 (2 workers)" in text
+    assert "tuning seed" not in text
+    assert "(a tuning seed: for choosing rules, not a result)" in markdown(report | {"seed": 901})
 
 
 def test_repeats_run_each_goal_from_scenes_of_their_own():
