@@ -274,3 +274,10 @@ def test_a_commands_defaults_are_its_configurations_defaults():
         assert got == f.default, (path, name)
         if "lo" in f.metadata:  # a bounded field: the option refuses what the field would
             assert (param.min, param.max) == (f.metadata["lo"], f.metadata["hi"])
+
+
+def test_version_is_the_installed_packages():
+    from importlib.metadata import version
+
+    r = runner.invoke(app, ["--version"])
+    assert r.exit_code == 0 and r.stdout.strip() == f"hsgplan {version('hsgplan')}"

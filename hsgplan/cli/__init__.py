@@ -9,6 +9,8 @@ spellings.
 from __future__ import annotations
 
 import sys
+from importlib.metadata import version
+from typing import Annotated
 
 import typer
 
@@ -42,6 +44,26 @@ app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
 app.add_typer(bench.app, name="bench")
 learn.train_app.command("motion")(motion.train_motion)
+
+
+def _print_version(given: bool) -> None:
+    if given:
+        print(f"hsgplan {version('hsgplan')}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    show_version: Annotated[
+        bool,
+        typer.Option(
+            "--version", help="Print the version and exit.", callback=_print_version, is_eager=True
+        ),
+    ] = False,
+) -> None:
+    """Hierarchical planning with geometric and symbolic scene graphs (kitchen storage)."""
+
+
 learn.train_app.command("perception")(perception.train_perception)
 
 
