@@ -117,9 +117,11 @@ def run_timing(
     workers: int = 1,
     on_episode: Callable[[EpisodeRecord], None] | None = None,
     search: str = DEFAULT_SEARCH,
+    ray: str | None = None,
 ) -> dict:
-    """Both agents' episodes into `out/AGENT/`; the summary, also written as `summary.json`,
-    `table2.md` and `table2.png` in `out`.
+    """Both agents' episodes into `out/AGENT/` (on Ray at `ray`, one core an episode as on
+    the local pool); the summary, also written as `summary.json`, `table2.md` and
+    `table2.png` in `out`.
 
     `{"by_size": {"2": {"ours": {"task_s", "motion_s", "success_rate", ...}, "search": {...}}},
     "search": "search", ...}`: the baseline's entries are under its name (`search` or
@@ -129,7 +131,7 @@ def run_timing(
     table, refusal = check_timing_folder(sizes, goals, seed, out, search)
     claim(out, TIMING_KIND, table, refusal)
     records = {
-        key: run_evaluation(replace(config, agent=agent), out / key, workers, on_episode)
+        key: run_evaluation(replace(config, agent=agent), out / key, workers, on_episode, ray)
         for key, agent in timing_agents(search).items()
     }
     report = {

@@ -12,9 +12,11 @@ from rich.progress import Progress
 from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
 from hsgplan.cli.common import (
     PerceptionCheckpoint,
+    RayAddress,
     RunFolder,
     Summaries,
     bounded_option,
+    check_ray,
     choice,
     err,
     input_path,
@@ -177,6 +179,7 @@ def bench_timing(
             "streams) or search (Fast Downward's abstract plan, refined by trials)."
         ),
     ] = DEFAULT_SEARCH_NAME,
+    ray: RayAddress = None,
     run_dir: RunFolder = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
     markdown: Annotated[
@@ -203,13 +206,21 @@ def bench_timing(
     folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}{which}"
     # cheap refusals before the agents load
     check_timing_folder(size_list, goals, seed, folder, baseline)
+    check_ray(ray)
     for agent in agents.values():  # a missing checkpoint is refused before any work
         make_agent(agent)
     with Progress(console=err, transient=True) as progress:
         total = total_episodes(size_list, goals, seed)
         task = progress.add_task(f"ours, {baseline}", total=total)
         report = run_timing(
-            size_list, goals, seed, folder, workers, lambda r: progress.advance(task), baseline
+            size_list,
+            goals,
+            seed,
+            folder,
+            workers,
+            lambda r: progress.advance(task),
+            baseline,
+            ray,
         )
     if as_json:
         print(json.dumps(report, indent=2))

@@ -82,11 +82,29 @@ def test_a_cluster_is_sent_the_checkout_and_nothing_from_an_installed_package(
     assert "working_dir" not in cluster_env()
 
 
-def test_eval_task_and_eval_motion_take_a_ray_address_checked_at_the_door():
+def test_eval_task_eval_motion_and_bench_timing_take_a_ray_address_checked_at_the_door(
+    tmp_path,
+):
     from typer.testing import CliRunner
 
     from hsgplan.cli import app
 
-    for command in (["eval", "task"], ["eval", "motion"]):
+    timing = ["bench", "timing", "--sizes", "2", "--goals", "1", "--out", str(tmp_path / "t")]
+    for command in (["eval", "task"], ["eval", "motion"], timing):
         result = CliRunner().invoke(app, [*command, "--ray", "127.0.0.1:1"])
         assert result.exit_code == 2 and "--ray '127.0.0.1:1'" in result.output
+    assert not (tmp_path / "t").exists()  # refused before any run folder is made
+
+
+def test_bench_timing_hands_its_ray_address_to_its_runs(monkeypatch, tmp_path):
+    from hsgplan.benchmarks import timing
+
+    class Handed(Exception):
+        pass
+
+    def run_evaluation(config, out, workers, on_episode, ray):
+        raise Handed(ray)
+
+    monkeypatch.setattr(timing, "run_evaluation", run_evaluation)
+    with pytest.raises(Handed, match="local"):
+        timing.run_timing([2], 1, 0, tmp_path / "t", ray="local")
