@@ -228,6 +228,7 @@ def print_table(title: str, header: tuple[str, ...], rows: list[tuple[str, ...]]
         print("|" + "---:|" * len(header))
         for row in rows:
             print("| " + " | ".join(row) + " |")
+        print()  # a table ends at a blank line: the next title is not one of its rows
         return
     table = Table(title=title)
     for col in header:
