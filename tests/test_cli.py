@@ -1,6 +1,7 @@
 """The command line: output shapes, and bad input refused with one line and exit code 2."""
 
 import json
+import re
 
 import pytest
 from typer.testing import CliRunner
@@ -206,7 +207,8 @@ def test_every_count_and_seed_takes_its_bounds_from_the_one_table():
             if param.name not in BOUNDS or param.min is None:
                 continue
             expected = (BOUNDS[param.name]["lo"], BOUNDS[param.name]["hi"])
-            assert (param.min, param.max) == expected, (path, param.name)
+            # the upper bound is checked by the option's callback (`cli.common.at_most`)
+            assert (param.min, param.callback.hi) == expected, (path, param.name)
             checked += 1
     assert checked >= 20  # seeds, goals, workers, samples, ... across the commands
 
@@ -273,7 +275,7 @@ def test_a_commands_defaults_are_its_configurations_defaults():
         got = getattr(param.default, "value", param.default)  # an enum's choice
         assert got == f.default, (path, name)
         if "lo" in f.metadata:  # a bounded field: the option refuses what the field would
-            assert (param.min, param.max) == (f.metadata["lo"], f.metadata["hi"])
+            assert (param.min, param.callback.hi) == (f.metadata["lo"], f.metadata["hi"])
 
 
 def test_version_is_the_installed_packages():
@@ -281,3 +283,33 @@ def test_version_is_the_installed_packages():
 
     r = runner.invoke(app, ["--version"])
     assert r.exit_code == 0 and r.stdout.strip() == f"hsgplan {version('hsgplan')}"
+
+
+def _help_at_80_columns(path: list[str], monkeypatch) -> str:
+    monkeypatch.setenv("COLUMNS", "80")
+    monkeypatch.setenv("TERM", "dumb")
+    r = runner.invoke(app, [*path, "--help"], env={"COLUMNS": "80"})
+    assert r.exit_code == 0, r.output
+    return r.output
+
+
+def test_help_reads_at_80_columns(monkeypatch):
+    """Every option name whole, and eval world's descriptions at least 30 characters wide."""
+    import typer.main
+
+    def commands(group, path=()):
+        for name, cmd in group.commands.items():
+            if hasattr(cmd, "commands"):
+                yield from commands(cmd, (*path, name))
+            else:
+                yield [*path, name]
+
+    option = re.compile(r"^│\s+(?:\*\s+)?(--[\w-]+)(…?)")
+    for path in commands(typer.main.get_command(app)):
+        text = _help_at_80_columns(path, monkeypatch)
+        assert max(len(line) for line in text.splitlines()) <= 80, path
+        found = [m.groups() for m in map(option.match, text.splitlines()) if m]
+        assert found and not [name for name, cut in found if cut], path
+    text = _help_at_80_columns(["eval", "world"], monkeypatch)
+    seed = next(line for line in text.splitlines() if option.match(line) and "--seed " in line)
+    assert len(seed) - 2 - seed.index("Seed of the goals") >= 30

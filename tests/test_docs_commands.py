@@ -70,3 +70,17 @@ def test_a_quoted_command_line_names_what_the_cli_takes(where, rest):
     for token in tokens:
         for option in re.findall(r"(?<![\w-])--[a-z][a-z0-9-]*", token):
             assert any(option in _options(c) for c in commands), f"{where}: no {option}"
+
+
+def test_every_choice_the_cli_offers_is_explained_in_the_cli_reference():
+    from hsgplan.agents.registry import (
+        AGENT_NAMES,
+        MOTION_GENERATORS,
+        SEARCH_BASELINES,
+        TASK_PLANNERS,
+    )
+
+    page = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
+    agents = page.split("## Agents", 1)[1].split("\n## ", 1)[0]
+    for name in (*AGENT_NAMES, *TASK_PLANNERS, *MOTION_GENERATORS, *SEARCH_BASELINES):
+        assert f"`{name}`" in agents, name

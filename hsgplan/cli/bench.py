@@ -42,7 +42,8 @@ def bench_sim(
     episodes: Annotated[int, bounded_option("episodes", "Oracle episodes per size.")] = 5,
     seed: Annotated[int, bounded_option("seed", "Random seed.")] = 0,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """Median seconds per primitive (motion planning included) and per oracle episode."""
@@ -76,9 +77,10 @@ def bench_symbolic(
             help="Largest size the optimal search is timed on (0: none).", min=0, max=MAX_OBJECTS
         ),
     ] = 8,
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """Fast Downward plan time per size: median over the goals, both search configurations."""
@@ -118,9 +120,10 @@ def bench_task(
     checkpoint: Annotated[
         Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
     ] = TASK_CHECKPOINT,
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """Task-planning time: the learned regression planner against Fast Downward, one core."""
@@ -173,17 +176,18 @@ def bench_timing(
     search: Annotated[
         SearchName,
         typer.Option(
-            help="The search baseline: stream (PDDLStream's incremental algorithm over poses), "
-            "stream-focused (its focused algorithm: optimistic outputs, then only the streams "
-            "a plan uses), stream-goal and stream-focused-goal (the same with goal-directed "
-            "streams) or search (Fast Downward's abstract plan, refined by trials)."
+            help=f"The search baseline: {', '.join(SearchName)} (docs/cli.md, Agents).",
+            metavar="SEARCH",
         ),
     ] = DEFAULT_SEARCH_NAME,
     ray: RayAddress = None,
     run_dir: RunFolder = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object.", metavar="")
+    ] = False,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """The paper's Table 2: task-planning and motion seconds per episode, ours (regression +
@@ -237,9 +241,10 @@ def bench_collect(
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
     samples: Annotated[int, bounded_option("samples", "Successful samples per primitive.")] = 300,
     workers: Annotated[int, bounded_option("workers", "Processes.")] = 2,
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """Successful motion samples per second of the collector (wall time, start-up included)."""
@@ -280,9 +285,10 @@ def bench_observe(
     scenes: Annotated[int, bounded_option("scenes", "Scenes staged, rendered and seen.")] = 30,
     seed: Annotated[int, bounded_option("seed", "Seed of the scenes.")] = 100,
     checkpoint: PerceptionCheckpoint = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.", metavar="")] = False,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """Seconds per observation through f_p (rendering timed apart and excluded): the keypoint

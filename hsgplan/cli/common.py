@@ -71,7 +71,26 @@ def bounded_option(concept: str, help: str, **more) -> typer.models.OptionInfo:
     """An option for a count or a seed, its bounds those the configurations hold it to
     (`domain.checks.BOUNDS[concept]`)."""
     bounds = BOUNDS[concept]
-    return typer.Option(help=help, min=bounds["lo"], max=bounds["hi"], **more)
+    return _bounded(help, bounds["lo"], bounds["hi"], "SEED" if concept == "seed" else "N", more)
+
+
+def _bounded(help: str, lo, hi, metavar: str, more: dict) -> typer.models.OptionInfo:
+    """An option held to [lo, hi]. `--help` shows the lower bound only: the upper ones (up to
+    2**32 - 1 for a seed) would take the width of the descriptions at 80 columns; a value
+    above is refused in the parser's own words."""
+    return typer.Option(help=help, min=lo, metavar=metavar, callback=at_most(hi), **more)
+
+
+def at_most(hi):
+    """A parser callback refusing a value above `hi` (None: no bound); `.hi` tells the bound."""
+
+    def check(value):
+        if hi is not None and value is not None and value > hi:
+            raise typer.BadParameter(f"Input should be less than or equal to {hi}")
+        return value
+
+    check.hi = hi
+    return check
 
 
 def config_default(config: type, name: str):
@@ -84,7 +103,7 @@ def config_option(config: type, name: str, help: str, **more) -> typer.models.Op
     """An option that sets a configuration's field, held to the field's bounds
     (`domain.checks.setting`)."""
     bounds = _field(config, name).metadata
-    return typer.Option(help=help, min=bounds.get("lo"), max=bounds.get("hi"), **more)
+    return _bounded(help, bounds.get("lo"), bounds.get("hi"), "N", more)
 
 
 def _field(config: type, name: str) -> dataclasses.Field:

@@ -92,9 +92,12 @@ def eval_task(
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     run_dir: RunFolder = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object.", metavar="")
+    ] = False,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
@@ -168,9 +171,12 @@ def eval_reach(
             help="Held-out executed primitives (`hsgplan collect reach`).", parser=input_path
         ),
     ] = REACH_HELD_OUT,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object.", metavar="")
+    ] = False,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """f_reach against the simulated world: precision and recall of "reachable" on held-out

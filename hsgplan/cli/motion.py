@@ -42,10 +42,10 @@ class Model(StrEnum):
 @refuses_bad_input
 def train_motion(
     primitive: Annotated[
-        Primitive | None, typer.Option(help="place or push [default: the config's, or place].")
+        Primitive | None, typer.Option(help="place or push (default: the config's, or place).")
     ] = None,
     model: Annotated[
-        Model | None, typer.Option(help="gnn or mlp [default: the config's, or gnn].")
+        Model | None, typer.Option(help="gnn or mlp (default: the config's, or gnn).")
     ] = None,
     config: Annotated[
         Path | None, typer.Option(help="Training configuration (JSON).", parser=input_path)
@@ -112,9 +112,12 @@ def eval_motion(
             parser=out_folder,
         ),
     ] = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object.", metavar="")
+    ] = False,
     markdown: Annotated[
-        bool, typer.Option(help="Print a Markdown table (for the README).")
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
     """Single-shot success of the GNN, the MLP and Random on fresh random scenes (never the

@@ -73,7 +73,10 @@ def eval_perception(
     scenes: Annotated[int, bounded_option("scenes", "Fresh scenes.")] = 100,
     seed: Annotated[int, bounded_option("seed", "Seed of the scenes (training's is 0).")] = 1,
     raw: Annotated[
-        bool, typer.Option(help="The fused PnP poses, not made to rest on their supports.")
+        bool,
+        typer.Option(
+            "--raw", metavar="", help="The fused PnP poses, not made to rest on their supports."
+        ),
     ] = False,
     pruned: Annotated[
         bool,
@@ -82,8 +85,12 @@ def eval_perception(
             "(perception/phantoms.py; with the poses made to rest)."
         ),
     ] = True,
-    as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
-    markdown: Annotated[bool, typer.Option(help="Print Markdown tables.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the summary as JSON.", metavar="")
+    ] = False,
+    markdown: Annotated[
+        bool, typer.Option("--markdown", help="Print Markdown tables.", metavar="")
+    ] = False,
     views: Annotated[
         int | None,
         typer.Option(
@@ -94,8 +101,10 @@ def eval_perception(
     loop: Annotated[
         bool,
         typer.Option(
+            "--loop",
+            metavar="",
             help="Scenes from inside the loop (the oracle part way through a random goal, the "
-            "scene's own look) instead of synthetic ones."
+            "scene's own look) instead of synthetic ones.",
         ),
     ] = False,
 ) -> None:

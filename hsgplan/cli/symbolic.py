@@ -85,7 +85,9 @@ def plan(
             "fast: weighted A*; auto: optimal up to 6 objects."
         ),
     ] = Search.auto,
-    as_json: Annotated[bool, typer.Option("--json", help="Print the plan as JSON.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the plan as JSON.", metavar="")
+    ] = False,
 ) -> None:
     """Plan a goal with Fast Downward and show the symbolic state after each step."""
     from hsgplan.planning.fast_downward import FastDownwardPlanner

@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.agents.registry import AGENTS, WHOLE_AGENTS, agent_name, agent_parts
+from hsgplan.agents.registry import agent_name, agent_parts
 from hsgplan.cli.common import (
     AgentName,
     MotionName,
@@ -37,18 +37,23 @@ from hsgplan.evaluation.config import EvalConfig
 from hsgplan.paths import RUNS, shipped
 from hsgplan.runner.run_folder import check_own
 
-AGENT_HELP = "A registered agent: " + "; ".join(
-    [f"{name} ({planner} + {motion})" for name, (planner, motion) in AGENTS.items()]
-    + [f"{name} ({what})" for name, what in WHOLE_AGENTS.items()]
-)
+# what each agent is: docs/cli.md, "Agents" (a test holds the two to the same names)
+AGENT_HELP = f"{', '.join(AgentName)}: what each is in docs/cli.md."
 ORACLE = AgentName("oracle")
 PAPER = AgentName("paper")
-AgentOption = Annotated[AgentName, typer.Option(help=AGENT_HELP)]
+AgentOption = Annotated[AgentName, typer.Option(help=AGENT_HELP, metavar="AGENT")]
 PlannerOption = Annotated[
-    PlannerName | None, typer.Option(help="Task planner in place of the agent's.")
+    PlannerName | None,
+    typer.Option(
+        help=f"Task planner in place of the agent's: {', '.join(PlannerName)}.", metavar="PLANNER"
+    ),
 ]
 MotionOption = Annotated[
-    MotionName | None, typer.Option(help="Motion generator in place of the agent's.")
+    MotionName | None,
+    typer.Option(
+        help=f"Motion generator in place of the agent's: {', '.join(MotionName)}.",
+        metavar="MOTION",
+    ),
 ]
 
 
@@ -161,8 +166,9 @@ def evaluate(
     protocol: Annotated[
         ProtocolName,
         typer.Option(
-            help="paper: no recovery rule, the first failed primitive ends the episode; "
-            "recovering: a failed primitive costs its step and the loop goes on."
+            help="paper: the first failed primitive ends the episode; recovering: it costs "
+            "its step.",
+            metavar="PROTOCOL",
         ),
     ] = DEFAULT_PROTOCOL,
     rules_off: Annotated[
@@ -176,15 +182,21 @@ def evaluate(
     ablate_rules: Annotated[
         bool,
         typer.Option(
+            "--ablate-rules",
+            metavar="",
             help="Run the table with every recovery rule on, then with each off in turn "
-            "(one folder each), and print what each buys."
+            "(one folder each), and print what each buys.",
         ),
     ] = False,
     workers: Annotated[int, bounded_option("workers", "Episodes run side by side.")] = 2,
     run_dir: RunFolder = None,
     ray: RayAddress = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
-    markdown: Annotated[bool, typer.Option(help="Print Markdown tables (for the README).")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object.", metavar="")
+    ] = False,
+    markdown: Annotated[
+        bool, typer.Option("--markdown", help="Print Markdown tables (for the README).", metavar="")
+    ] = False,
 ) -> None:
     """Success rate and subgoal completion per problem size and method, beside the paper's
     Table 1, with the failure taxonomy and the time per level, under a protocol (paper or
