@@ -134,7 +134,8 @@ def images(
     views: Annotated[
         int | None,
         typer.Option(
-            help="The first this many fixed views (3: the shoulder and front views; default: all).", min=1
+            help="The first this many fixed views (3: the shoulder and front views; default: all).",
+            min=1,
         ),
     ] = None,
 ) -> None:
