@@ -37,18 +37,26 @@ def failed_steps(record: EpisodeRecord) -> list[str]:
     return [s.status for s in record.steps if s.status != Status.SUCCESS]
 
 
+def class_of(failure: Failure) -> str:
+    """The class of the taxonomy an episode ended by `failure` is counted in."""
+    if failure in _ENDED_BY_PERCEPTION:
+        return PERCEPTION
+    if failure in _ENDED_BY_EXECUTION or failure == Failure.FAILED_PRIMITIVE:
+        return EXECUTION
+    return OVERSTEP
+
+
 def failure_class(record: EpisodeRecord) -> tuple[str, str] | None:
     """(class, kind) of a failed episode, None for a success."""
     if record.success:
         return None
-    if record.failure in _ENDED_BY_PERCEPTION:
-        return PERCEPTION, str(record.failure)
-    if record.failure in _ENDED_BY_EXECUTION:
-        return EXECUTION, str(record.failure)
+    kind = str(record.failure)
     if record.failure == Failure.FAILED_PRIMITIVE:
         failed = failed_steps(record)
-        return EXECUTION, failed[-1] if failed else str(record.failure)
-    return OVERSTEP, "step limit" if record.failure == Failure.OVERSTEP else str(record.failure)
+        kind = failed[-1] if failed else kind
+    elif record.failure == Failure.OVERSTEP:
+        kind = "step limit"
+    return class_of(Failure(record.failure)), kind
 
 
 def _spread(values_by_repeat: dict[int, list[float]]) -> float | None:

@@ -1,0 +1,60 @@
+"""The names a results table prints, each said once: a primitive's statuses and the ends of an
+episode, read from their enums, so the reference (`docs/failures.md`, made by `python -m
+hsgplan.evaluation.glossary`) cannot drift from the code. A test holds the page to it."""
+
+from __future__ import annotations
+
+from hsgplan.evaluation.failures import Failure
+from hsgplan.evaluation.summary import class_of
+from hsgplan.sim.outcome import DISTURB_TOL, SEEN_DISTURB_TOL, Status
+
+STATUSES = {
+    Status.SUCCESS: "the primitive did what it was for.",
+    Status.INVALID: "its parameters cannot apply to the scene as it is (a place with nothing "
+    "in the hand); nothing moved.",
+    Status.NO_IK: "no collision-free arm configuration for a pose it needs (a shelf cell so "
+    "crowded that no grasp of the can fits); refused before the arm moves.",
+    Status.NO_PATH: "the motion planner found no path to it, or a push line left the arm's "
+    "reach; refused before the arm moves.",
+    Status.DROPPED: "the gripper holds nothing after a pick (it closed where the object was "
+    "believed to be), or lost the object on the way.",
+    Status.KNOCKED_OVER: "an object toppled (a can put down on a box's edge).",
+    Status.OFF_TABLE: "an object fell off the table.",
+    Status.DISTURBED: f"another object moved: more than {100 * DISTURB_TOL:.0f} cm in the "
+    "simulator, or its place changed; seeing through f_p, seen in another place, or, seen by "
+    f"several views both times, more than {100 * SEEN_DISTURB_TOL:.0f} cm away.",
+    Status.EFFECT_NOT_REACHED: "the primitive ran but its intended literal does not hold (a "
+    "push too short to bring the can into the shelf).",
+    Status.BLOCKS_PICK: "motion data only: the place reached its effect but left an object "
+    "there that can no longer be taken up.",
+    Status.BLOCKED: "the arm was stopped short by what it met, and the effect does not hold.",
+}
+
+ENDINGS = {
+    Failure.OVERSTEP: "the step limit came first (tables show it as `step limit`).",
+    Failure.NO_SUBGOAL: "the task planner found nothing reachable to do next.",
+    Failure.NO_PARAMETERS: "every choice of parameters for the next action had failed "
+    "(recovering protocol).",
+    Failure.FAILED_PRIMITIVE: "paper protocol: a primitive failed, which ends the episode; "
+    "tables show its status (`no_ik 4`: four episodes ended by a refused arm configuration).",
+    Failure.KNOCKED_OVER: "an object toppled.",
+    Failure.OFF_TABLE: "an object fell off the table.",
+    Failure.MISPERCEIVED: "the robot saw its goal reached where it truly was not.",
+    Failure.NEVER_SEEN: "an object of the goal that no view had found when the robot had to "
+    "decide.",
+}
+
+
+def glossary() -> str:
+    """The two tables of `docs/failures.md`, in Markdown."""
+    lines = ["A primitive's status (each step's `status` in `episodes.jsonl`):", ""]
+    lines += ["| status | meaning |", "|---|---|"]
+    lines += [f"| `{s}` | {STATUSES[s]} |" for s in Status]
+    lines += ["", "What ended a failed episode (its `failure`), and the class tables count it in:"]
+    lines += ["", "| failure | class | meaning |", "|---|---|---|"]
+    lines += [f"| `{f}` | {class_of(f)} | {ENDINGS[f]} |" for f in Failure]
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    print(glossary(), end="")
