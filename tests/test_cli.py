@@ -129,6 +129,8 @@ BAD = [
     (["collect", "images", "--samples", "1", "--views", "9"], "views 9: there are 1 to 5"),
     (["collect", "images", "--samples", "1", "--views", "0"], "greater than or equal to 1"),
     (["eval", "perception", "--scenes", "1", "--views", "6"], "views 6: there are 1 to 5"),
+    ([*WORLD, "--tables", "success,plots"], "no table 'plots'"),
+    (["eval", "world", "--goals", "100001"], "less than or equal to 100000"),
 ]
 
 

@@ -33,7 +33,7 @@ from hsgplan.cli.common import (
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import RecoveryRules
-from hsgplan.evaluation.config import EvalConfig
+from hsgplan.evaluation.config import TABLES, EvalConfig
 from hsgplan.paths import RUNS, shipped
 from hsgplan.runner.run_folder import check_own
 
@@ -197,13 +197,20 @@ def evaluate(
     markdown: Annotated[
         bool, typer.Option("--markdown", help="Print Markdown tables (for the README).", metavar="")
     ] = False,
+    shown_tables: Annotated[
+        str,
+        typer.Option(
+            "--tables",
+            help=f"The tables printed, comma-separated: {', '.join(TABLES)} (all are written).",
+        ),
+    ] = ",".join(TABLES),
 ) -> None:
     """Success rate and subgoal completion per problem size and method, beside the paper's
     Table 1, with the failure taxonomy and the time per level, under a protocol (paper or
     recovering); writes table1.md, table1.png and summary.json into the run folder."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.evaluation.ablation import ablation_table, check_ablation, run_ablation
-    from hsgplan.evaluation.config import EvalConfig
+    from hsgplan.evaluation.config import TABLES, EvalConfig
     from hsgplan.evaluation.observers import make_observer
     from hsgplan.evaluation.protocol import checkpoints, episode_specs
     from hsgplan.evaluation.table1 import Method, check_table, run_table, tables
@@ -245,6 +252,9 @@ def evaluate(
     total = len(episode_specs(config)) * len(methods)
     folder = run_dir or RUNS / (_run_name(methods, config) + ("-ablation" if ablate_rules else ""))
     check_ray(ray)
+    which = _names(shown_tables, "--tables", "table")
+    if unknown := sorted(set(which) - set(TABLES)):
+        raise InvalidInputError(f"--tables: no table '{unknown[0]}' ({', '.join(TABLES)})")
     if ablate_rules:  # the cheap refusals first: loading agents takes seconds
         total *= len(check_ablation(methods, config, folder))
     else:
@@ -258,7 +268,7 @@ def evaluate(
     if as_json:
         print(json.dumps(report, indent=2))
         return
-    for t in [ablation_table(report)] if ablate_rules else tables(report):
+    for t in [ablation_table(report)] if ablate_rules else tables(report, which):
         print_table(t.title, t.header, [list(r) for r in t.rows], markdown)
         print()
     if not markdown and not ablate_rules:

@@ -20,6 +20,10 @@ def check_observer(name: str) -> None:
         raise InvalidInputError(f"--perception '{name}': one of {', '.join(OBSERVERS)}")
 
 
+# the tables of an `eval world` run (`table1.tables`), in their order
+TABLES = ("success", "failures", "time")
+
+
 @dataclass(frozen=True)
 class EvalConfig:
     agent: str

@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from hsgplan.domain.recovery import RECOVERING
-from hsgplan.evaluation.config import EvalConfig
+from hsgplan.evaluation.config import TABLES, EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.seeds import is_tuning, marked
@@ -172,9 +172,11 @@ class TextTable:
         )
 
 
-def tables(report: dict) -> list[TextTable]:
-    """Results beside the paper's, the failure taxonomy, the time per level."""
-    return [_results(report), _failures(report), _times(report)]
+def tables(report: dict, which: tuple[str, ...] = TABLES) -> list[TextTable]:
+    """Results beside the paper's, the failure taxonomy, the time per level (those `which`
+    names)."""
+    made = {"success": _results, "failures": _failures, "time": _times}
+    return [made[name](report) for name in TABLES if name in which]
 
 
 def markdown(report: dict) -> str:

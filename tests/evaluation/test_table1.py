@@ -15,7 +15,7 @@ from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord
 from hsgplan.evaluation.protocol import episode_specs
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, failure_class, summarize
-from hsgplan.evaluation.table1 import PAPER_TABLE1, markdown
+from hsgplan.evaluation.table1 import PAPER_TABLE1, markdown, tables
 
 
 def _step(status: str, k: int = 1) -> StepRecord:
@@ -114,6 +114,10 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
     assert "(recovering protocol)" in text  # a report without a protocol predates the paper's
     assert "1.5 (2 workers)" in text
     assert "tuning seed" not in text
+    assert [t.title for t in tables(report, ("time", "success"))] == [
+        t.title
+        for t in tables(report)[::2]  # in the tables' own order
+    ]
     assert "(a tuning seed: for choosing rules, not a result)" in markdown(report | {"seed": 901})
 
 
