@@ -270,7 +270,8 @@ def evaluate(
         return
     for t in [ablation_table(report)] if ablate_rules else tables(report, which):
         print_table(t.title, t.header, [list(r) for r in t.rows], markdown)
-        print()
+        if not markdown:  # a Markdown table ends with its own blank line
+            print()
     if not markdown and not ablate_rules:
         out.print(f"wrote {shown(folder)}/table1.md, table1.png, summary.json", highlight=False)
 
