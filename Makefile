@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/hsgplan demo --agent paper
+	$(BIN)/hsgplan demo --agent learned
 
 # The whole suite, in a random order (pytest-randomly), on both cores; what CI runs.
 test: lint

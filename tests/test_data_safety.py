@@ -119,7 +119,7 @@ def test_one_commands_run_folder_is_refused_by_another(tmp_path):
     folder.mkdir()
     (folder / "config.json").write_text(json.dumps({"kind": "eval-task", "planner": "fd"}))
     r = run("eval", "motion", "--trials", "1", "--out", folder)
-    _refused(r, "is not a eval-motion run folder (it holds a eval-task run)")
+    _refused(r, "is not an eval-motion run folder (it holds an eval-task run)")
     r = run("collect", "reach", "--states", "1", "--out", folder)
     _refused(r, "is not a reach run folder")
 

@@ -1,7 +1,8 @@
 """Agents, task planners and motion generators by name, as the CLI offers them.
 
 An agent is a task planner and a motion generator (`HierarchicalAgent`). The registered agents
-are named pairs; any other pair is asked for as `PLANNER+MOTION` (`regression+gnn`). The
+are named pairs; any other pair is named `PLANNER+MOTION` (`regression+mlp`: the CLI's
+`--planner` and `--motion`). The
 search-based baselines plan both levels together and are agents of their own (`search`;
 `stream`, PDDLStream's incremental algorithm; `stream-goal`, the same with goal-directed
 streams; `stream-focused` and `stream-focused-goal`, PDDLStream's focused algorithm).
@@ -87,7 +88,7 @@ MOTION_GENERATORS: dict[str, Callable[[Path, RecoveryRules], MotionGenerator]] =
 AGENTS: dict[str, tuple[str, str]] = {
     "oracle": ("fd", "sampler"),  # the rules and geometry: the ceiling the learned agents meet
     "regression": ("regression", "sampler"),  # the learned task level alone
-    "paper": ("regression", "gnn"),  # the paper's system: both levels learned
+    "learned": ("regression", "gnn"),  # the paper's system as we build it: both levels learned
 }
 
 # agents that are not a task planner beside a motion generator: name -> what it is

@@ -60,7 +60,7 @@ def timing_agents(search: str = DEFAULT_SEARCH) -> dict[str, str]:
         raise InvalidInputError(
             f"--search '{search}': the search baseline is one of {', '.join(SEARCH_BASELINES)}"
         )
-    return {"ours": "paper", search: search}
+    return {"ours": "learned", search: search}
 
 
 def _quartiles(values: list[float]) -> dict[str, float]:

@@ -39,8 +39,7 @@ from hsgplan.runner.run_folder import check_own
 
 # what each agent is: docs/cli.md, "Agents" (a test holds the two to the same names)
 AGENT_HELP = f"{', '.join(AgentName)}: what each is in docs/cli.md."
-ORACLE = AgentName("oracle")
-PAPER = AgentName("paper")
+LEARNED = AgentName("learned")
 AgentOption = Annotated[AgentName, typer.Option(help=AGENT_HELP, metavar="AGENT")]
 PlannerOption = Annotated[
     PlannerName | None,
@@ -59,7 +58,7 @@ MotionOption = Annotated[
 
 @refuses_bad_input
 def demo(
-    agent: AgentOption = PAPER,
+    agent: AgentOption = LEARNED,
     planner: PlannerOption = None,
     motion: MotionOption = None,
     goal: Annotated[
@@ -125,7 +124,7 @@ DEFAULT_PROTOCOL = ProtocolName(config_default(EvalConfig, "protocol"))
 
 @refuses_bad_input
 def evaluate(
-    agent: AgentOption = ORACLE,
+    agent: AgentOption = LEARNED,
     planner: PlannerOption = None,
     motion: Annotated[
         str | None,

@@ -16,3 +16,8 @@ class GoalSyntaxError(InvalidInputError):
 
 class InfeasibleError(InvalidInputError):
     """Literals that contradict each other or that no physical scene can satisfy."""
+
+
+def a(noun: str) -> str:
+    """`noun` behind its indefinite article, as a message reads it ("an eval-task run")."""
+    return f"{'an' if noun[:1].lower() in 'aeiou' else 'a'} {noun}"

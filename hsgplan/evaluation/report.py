@@ -16,15 +16,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from hsgplan.domain.checks import read_json
-from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.errors import InvalidInputError, a
 from hsgplan.domain.goals import parse_goal
+from hsgplan.evaluation.ablation import ABLATION_KIND
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer
-from hsgplan.evaluation.protocol import PAPER, checkpoints, read_eval_config
+from hsgplan.evaluation.protocol import EVAL_KIND, PAPER, checkpoints, read_eval_config
 from hsgplan.evaluation.summary import FAILED_EXECUTION, failure_class
-from hsgplan.evaluation.table1 import label, tables
+from hsgplan.evaluation.table1 import TABLE_KIND, label, tables
 from hsgplan.files import write_atomically
-from hsgplan.runner.run_folder import logged_rows
+from hsgplan.runner.run_folder import CONFIG, logged_rows
 from hsgplan.viz.html_page import heading, image, page, paragraph, table
 
 REPORT = "report.html"
@@ -58,12 +59,22 @@ class Rollout:
         return a.success == b.success and a.failure == b.failure and statuses
 
 
+def _not_a_world_run(run_dir: Path) -> str:
+    """Why a folder without summary.json has no page: another command's run, or an eval world
+    run not finished yet."""
+    saved = run_dir / CONFIG
+    kind = read_json(saved, "run configuration").get("kind") if saved.is_file() else None
+    if isinstance(kind, str) and kind not in (EVAL_KIND, TABLE_KIND, ABLATION_KIND):
+        return f"holds {a(kind)} run; report makes a page of an 'eval world' run folder"
+    return "holds no summary.json: not a finished 'eval world' run (run it again to finish it)"
+
+
 def read_summary(run_dir: Path) -> dict:
     path = run_dir / "summary.json"
     if not run_dir.is_dir():
         raise InvalidInputError(f"'{run_dir}' is not a folder")
     if not path.exists():
-        raise InvalidInputError(f"'{run_dir}' holds no summary.json: not a finished eval run")
+        raise InvalidInputError(f"'{run_dir}' {_not_a_world_run(run_dir)}")
     summary = read_json(path, "eval summary")
     if not isinstance(summary.get("methods"), dict):
         raise InvalidInputError(f"'{path}' is not an eval summary (no methods)")

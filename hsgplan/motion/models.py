@@ -17,7 +17,7 @@ from torch_geometric.nn import global_max_pool
 from torch_geometric.utils import to_dense_batch
 
 from hsgplan.checkpoint import load_trained
-from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.errors import InvalidInputError, a
 from hsgplan.motion.layers import GroundedConv, mlp
 from hsgplan.scene_graph.grounding import EDGE_DIM, NODE_DIM, QUERY_DIM, SUBGOAL_DIM, TYPES
 
@@ -261,7 +261,7 @@ def load_motion_net(
     ):
         if asked is not None and asked != found:
             raise InvalidInputError(
-                f"'{folder}' holds a {found} network where a {asked} one belongs ({what})"
+                f"'{folder}' holds {a(found)} network where {a(asked)} one belongs ({what})"
             )
     model.config = config
     return model

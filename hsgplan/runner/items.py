@@ -17,6 +17,7 @@ from collections.abc import Callable, Hashable, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
+from hsgplan.domain.errors import a
 from hsgplan.runner.engines import engine
 from hsgplan.runner.run_folder import RESULTS, claim, logged_rows
 
@@ -50,7 +51,7 @@ def run_items(
             run_dir,
             kind,
             config or {},
-            f"'{run_dir}' holds a {kind} run with another configuration or other checkpoints; "
+            f"'{run_dir}' holds {a(kind)} run with another configuration or other checkpoints; "
             "use another --out",
         )
         for row in logged_rows(run_dir):

@@ -13,7 +13,7 @@ import os
 from pathlib import Path
 
 from hsgplan.domain.checks import read_json
-from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.errors import InvalidInputError, a
 from hsgplan.files import write_atomically
 from hsgplan.runner.lock import LOCK, hold_folder
 
@@ -43,9 +43,9 @@ def check_claim(run_dir: Path, kind: str, config: dict, refusal: str) -> bool:
     if saved.exists() or saved.is_symlink():
         other = read_json(saved, "run configuration")
         if other.get("kind") != kind:
-            what = f"a {other['kind']} run" if isinstance(other.get("kind"), str) else "no run"
+            what = f"{a(other['kind'])} run" if isinstance(other.get("kind"), str) else "no run"
             raise InvalidInputError(
-                f"'{run_dir}' is not a {kind} run folder (it holds {what}); use another --out"
+                f"'{run_dir}' is not {a(kind)} run folder (it holds {what}); use another --out"
             )
         if other != config:
             raise InvalidInputError(refusal)

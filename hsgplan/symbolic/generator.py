@@ -32,7 +32,8 @@ MIN_OBJECTS = 2
 def check_size(n: int) -> None:
     if not MIN_OBJECTS <= n <= MAX_OBJECTS:
         raise InvalidInputError(
-            f"{n} objects: a goal names between {MIN_OBJECTS} and {MAX_OBJECTS} objects"
+            f"{n} object{'' if n == 1 else 's'}: a goal names between {MIN_OBJECTS} and "
+            f"{MAX_OBJECTS} objects"
         )
 
 

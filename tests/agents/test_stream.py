@@ -96,7 +96,7 @@ def test_without_the_world_offers_nothing():
 
 def test_is_a_registered_agent_and_a_table2_baseline():
     assert isinstance(make_agent("stream"), StreamAgent)
-    assert timing_agents("stream") == {"ours": "paper", "stream": "stream"}
+    assert timing_agents("stream") == {"ours": "learned", "stream": "stream"}
     with pytest.raises(InvalidInputError, match="search baseline"):
         timing_agents("wizard")
     row = {"task_s": 2.0, "task_q1": 1.0, "task_q3": 3.0, "success_rate": 1.0}

@@ -104,7 +104,7 @@ def test_demo_writes_pictures_and_a_record(tmp_path):
     assert first.shape[0] >= 480 and first.shape[1] >= 640  # two 640 x 480 views, a caption
     record = json.loads((out / "episode.json").read_text())
     assert record["seed"] == 1 and record["size"] == 2
-    assert record["agent"] == "paper"  # the paper's agent: regression planner, motion GNN
+    assert record["agent"] == "learned"  # regression planner, motion GNN
     # every decision printed with its subgoal, parameters and outcome
     lines = r.stdout.splitlines()
     for s in record["steps"]:

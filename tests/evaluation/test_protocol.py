@@ -53,16 +53,16 @@ def test_a_recovering_episode_out_of_steps_after_failures_is_overstep():
 
 
 def test_the_paper_protocol_runs_without_any_recovery_rule():
-    assert EvalConfig("paper", (2,), 1, 0, protocol="paper").rules() == RecoveryRules.none()
-    assert EvalConfig("paper", (2,), 1, 0).rules() == RecoveryRules()
-    some = EvalConfig("paper", (2,), 1, 0, rules_off=("failed_bins", "least_taken"))
+    assert EvalConfig("learned", (2,), 1, 0, protocol="paper").rules() == RecoveryRules.none()
+    assert EvalConfig("learned", (2,), 1, 0).rules() == RecoveryRules()
+    some = EvalConfig("learned", (2,), 1, 0, rules_off=("failed_bins", "least_taken"))
     assert some.rules().off() == ("failed_bins", "least_taken")
     with pytest.raises(InvalidInputError, match="unknown recovery rule"):
-        EvalConfig("paper", (2,), 1, 0, rules_off=("wizard",))
+        EvalConfig("learned", (2,), 1, 0, rules_off=("wizard",))
     with pytest.raises(InvalidInputError, match="no recovery rule"):
-        EvalConfig("paper", (2,), 1, 0, protocol="paper", rules_off=("failed_bins",))
+        EvalConfig("learned", (2,), 1, 0, protocol="paper", rules_off=("failed_bins",))
     with pytest.raises(InvalidInputError, match="protocol 'x'"):
-        EvalConfig("paper", (2,), 1, 0, protocol="x")
+        EvalConfig("learned", (2,), 1, 0, protocol="x")
 
 
 def test_a_run_folder_names_its_protocol_unless_it_is_the_default():
@@ -77,7 +77,7 @@ def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
     from hsgplan.evaluation.summary import summarize
     from tests.evaluation.test_table1 import _record
 
-    config = EvalConfig("paper", (2,), 1, 0)
+    config = EvalConfig("learned", (2,), 1, 0)
     found = variants(config)
     assert list(found)[0] == "all-rules" and found["all-rules"].rules_off == ()
     rules = [r for r in RecoveryRules.names() if r not in PERCEPTION_RULES]
@@ -85,7 +85,7 @@ def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
     seeing = variants(config, seeing=True)  # relook acts only through the cameras
     assert [v.rules_off for v in list(seeing.values())[1:]] == [(r,) for r in RecoveryRules.names()]
     with pytest.raises(InvalidInputError, match="ablate-rules"):
-        variants(EvalConfig("paper", (2,), 1, 0, protocol="paper"))
+        variants(EvalConfig("learned", (2,), 1, 0, protocol="paper"))
     run = {"goals": 1, "goals_file": None, "repeats": 1, "seed": 0}
     ok, failed = summarize([_record(True)]), summarize([_record(False, "overstep", ("no_ik",))])
     report = {

@@ -2,6 +2,7 @@
 real headless browser (Debian's chromium, which `.ci/run` installs)."""
 
 import json
+import re
 import shutil
 from dataclasses import asdict
 
@@ -20,7 +21,7 @@ CHROMIUM = shutil.which("chromium")
 
 def _record(seed: int, failure: str | None, status="success", size=2, goal="On(butter, shelf_a)"):
     step = StepRecord(1, "InGrasp(butter)", "pick(butter)", "pick(obj=butter)", status, "", 0, 0, 0)
-    return EpisodeRecord(seed, "paper", goal, size, failure is None, 0.5, failure, (step,), 1.0)
+    return EpisodeRecord(seed, "learned", goal, size, failure is None, 0.5, failure, (step,), 1.0)
 
 
 def _run_folder(tmp_path, method: str, records: list[EpisodeRecord], config: EvalConfig):
@@ -55,7 +56,7 @@ def test_the_sample_takes_each_kind_of_failure_in_turn(tmp_path):
         _record(5, None),
         _record(6, "overstep"),
     ]
-    _run_folder(tmp_path, "gnn", records, EvalConfig("paper", (2,), 6, 0))
+    _run_folder(tmp_path, "gnn", records, EvalConfig("learned", (2,), 6, 0))
     sample = sample_failures(tmp_path, ["gnn"], 4)
     # the commonest kind first, then one of every other kind, then the commonest again
     assert [r.seed for _, r in sample] == [1, 4, 6, 2]
@@ -78,12 +79,25 @@ def test_refuses_what_is_not_a_finished_eval_run(tmp_path):
         read_summary(tmp_path)
 
 
+@pytest.mark.parametrize(
+    ("kind", "says"),
+    [
+        ("eval-task", "holds an eval-task run; report makes a page of an 'eval world' run"),
+        ("eval-table", "not a finished 'eval world' run (run it again to finish it)"),
+    ],
+)
+def test_a_folder_without_summary_is_told_apart_by_its_kind(tmp_path, kind, says):
+    (tmp_path / "config.json").write_text(json.dumps({"kind": kind}))
+    with pytest.raises(InvalidInputError, match=re.escape(says)):
+        read_summary(tmp_path)
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed here")
 def test_the_page_loads_in_a_browser_with_every_image_and_no_console_error(tmp_path):
     from playwright.sync_api import sync_playwright
 
-    config = EvalConfig("paper", (2,), 1, 0)
+    config = EvalConfig("learned", (2,), 1, 0)
     spec = episode_specs(config)[0]
     # logged as failed: re-simulated, the page shows the rollout (and says if it ended otherwise)
     _run_folder(tmp_path, "gnn", [_record(spec.seed, "overstep", goal=spec.goal)], config)

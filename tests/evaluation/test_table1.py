@@ -122,12 +122,12 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
 
 
 def test_repeats_run_each_goal_from_scenes_of_their_own():
-    specs = episode_specs(EvalConfig("paper", (3,), goals=2, seed=0, repeats=3))
+    specs = episode_specs(EvalConfig("learned", (3,), goals=2, seed=0, repeats=3))
     assert len(specs) == 6 and len({s.seed for s in specs}) == 6
     assert [s.goal for s in specs[:3]] == [specs[0].goal] * 3
     assert [s.repeat for s in specs[:3]] == [0, 1, 2]
     # the first repeat is the episode a single-repeat run has
-    single = episode_specs(EvalConfig("paper", (3,), goals=2, seed=0))
+    single = episode_specs(EvalConfig("learned", (3,), goals=2, seed=0))
     assert [s.seed for s in single] == [s.seed for s in specs if s.repeat == 0]
 
 

@@ -22,7 +22,7 @@ def test_moving_the_true_objects_after_a_look_changes_neither_belief_nor_decisio
         obs = info["observation"]
 
         def decide():
-            agent = make_agent("paper")
+            agent = make_agent("learned")
             agent.reset(GOAL, SEED)
             return agent.decide(obs.scene_graph, obs.symbols.state, GOAL, feasible=env.lookahead)
 

@@ -113,7 +113,7 @@ def state_cases() -> list[Case]:
     for command, args, which in [
         (
             "eval",
-            base("eval", "--agent paper --out run --motion-checkpoints mk"),
+            base("eval", "--agent learned --out run --motion-checkpoints mk"),
             motion_damage[:2] + motion_damage[4:],
         ),
         ("eval motion", base("eval motion", "--motion-checkpoints mk"), motion_damage),
@@ -207,7 +207,7 @@ def cross_cases() -> list[Case]:
         case(
             "eval",
             "--motion-checkpoints a task checkpoint",
-            base("eval", "--agent paper --motion-checkpoints ck --out run"),
+            base("eval", "--agent learned --motion-checkpoints ck --out run"),
             ck,
         ),
         case(

@@ -274,14 +274,15 @@ def test_eval_sees_through_the_shipped_f_p_beside_the_ground_truth(tmp_path):
 
     r = CliRunner().invoke(
         app,
-        ["eval", "world", "--agent", "paper", "--sizes", "2", "--goals", "1", "--workers", "1"]
+        ["eval", "world", "--agent", "learned", "--sizes", "2", "--goals", "1", "--workers", "1"]
         + ["--perception", "gt,rgb", "--json", "--out", str(tmp_path / "run")],
     )
     assert r.exit_code == 0, r.output
     methods = json.loads(r.stdout)["methods"]
-    assert methods["paper"]["perception"] == "gt" and methods["paper-rgb"]["perception"] == "rgb"
-    assert methods["paper-rgb"]["by_size"]["2"]["episodes"] == 1
-    (line,) = (tmp_path / "run" / "paper-rgb" / "episodes.jsonl").read_text().splitlines()
+    assert methods["learned"]["perception"] == "gt"
+    assert methods["learned-rgb"]["perception"] == "rgb"
+    assert methods["learned-rgb"]["by_size"]["2"]["episodes"] == 1
+    (line,) = (tmp_path / "run" / "learned-rgb" / "episodes.jsonl").read_text().splitlines()
     assert json.loads(line)["result"]["observer"] == "rgb"
 
 
