@@ -172,6 +172,8 @@ def test_refused_command_leaves_an_existing_file_alone(tmp_path):
         (["eval", "reach", "--trials", "x"], "'hsgplan eval reach --trials' is now '--data'"),
         (["eval", "motion", "--checkpoints", "m"], "is now '--motion-checkpoints'"),
         (["collect", "images", "--count", "1"], "is now '--samples'"),
+        (["demo", "--agent", "paper"], "'--agent paper' is now '--agent learned'"),
+        ([*WORLD, "--agent=paper"], "'--agent paper' is now '--agent learned'"),
     ],
 )
 def test_older_spellings_are_refused_with_the_new_one(args, hint):
@@ -189,6 +191,7 @@ def test_the_new_spellings_are_not_mistaken_for_older_ones():
     assert hint(["eval", "--help"]) is None
     assert hint(["eval", "task", "--checkpoints", "x"]) is None  # the option is eval motion's
     assert hint([]) is None
+    assert hint([*WORLD, "--protocol", "paper"]) is None  # the protocol keeps its name
 
 
 def test_every_count_and_seed_takes_its_bounds_from_the_one_table():

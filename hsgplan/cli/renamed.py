@@ -20,6 +20,8 @@ OPTIONS: dict[tuple[str, str], str] = {
     ("eval reach", "--trials"): "--data",
     ("eval motion", "--checkpoints"): "--motion-checkpoints",
 }
+# (option, value) once typed -> the value now
+VALUES: dict[tuple[str, str], str] = {("--agent", "paper"): "learned"}
 EVAL_TOPICS = ("world", "task", "reach", "motion", "perception")
 
 
@@ -43,4 +45,8 @@ def hint(argv: Sequence[str]) -> str | None:
             continue
         if any(a == old or a.startswith(old + "=") for a in argv[len(command) :]):
             return f"'hsgplan {words} {old}' is now '{new}'"
+    for (option, old), new in VALUES.items():
+        pairs = zip(argv, argv[1:], strict=False)
+        if f"{option}={old}" in argv or any(a == option and b == old for a, b in pairs):
+            return f"'{option} {old}' is now '{option} {new}'"
     return None
