@@ -315,6 +315,7 @@ def test_help_reads_at_80_columns(monkeypatch):
         assert max(len(line) for line in text.splitlines()) <= 80, path
         found = [m.groups() for m in map(option.match, text.splitlines()) if m]
         assert found and not [name for name, cut in found if cut], path
+        assert not re.search(r"<(?:str|bool|int|float|Path)>", text), path  # Typer's own words
     text = _help_at_80_columns(["eval", "world"], monkeypatch)
     seed = next(line for line in text.splitlines() if option.match(line) and "--seed " in line)
     assert len(seed) - 2 - seed.index("Seed of the goals") >= 30

@@ -33,7 +33,41 @@ class Summaries(TyperGroup):
         command = super().get_command(ctx, cmd_name)
         if command is not None and command.short_help is None and command.help:
             command.short_help = " ".join(command.help.split("\n\n")[0].split())
+        if command is not None:
+            plain_metavars(command)
         return command
+
+
+# what `--help` shows for a value of each Python type (Typer's default is `<str>`, `<Path>`)
+METAVARS = {str: "TEXT", Path: "PATH", int: "N", float: "X"}
+
+
+def plain_metavars(command) -> None:
+    """Give every option without a metavar of its own a plain one: a flag (and `--help`)
+    none, a value its type's word in capitals."""
+    for param in command.params:
+        if isinstance(param, typer.core.TyperArgument):  # its name says it (RUN_DIR)
+            param.metavar = param.metavar or param.name.upper()
+            param.display_type_rich = lambda ctx: None
+            continue
+        if param.metavar is not None:
+            continue
+        if getattr(param, "is_flag", False):
+            param.metavar = ""
+            continue
+        annotation = getattr(getattr(param, "type_descriptor", None), "annotation", None)
+        word = METAVARS.get(annotation)
+        if word is not None:
+            param.metavar = word
+    help_option = command.get_help_option
+
+    def quiet_help(ctx):
+        option = help_option(ctx)
+        if option is not None:
+            option.metavar = ""
+        return option
+
+    command.get_help_option = quiet_help
 
 
 class OneLineErrors(Summaries):
@@ -50,6 +84,7 @@ class OneLineErrors(Summaries):
             if standalone_mode:
                 sys.exit(2)
             return 2
+        plain_metavars(self)
         try:
             code = super().main(args, *rest, standalone_mode=False, **kwargs)
         except typer.TyperException as e:  # click's exceptions, as typer ships them
