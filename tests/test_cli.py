@@ -319,3 +319,12 @@ def test_help_reads_at_80_columns(monkeypatch):
     text = _help_at_80_columns(["eval", "world"], monkeypatch)
     seed = next(line for line in text.splitlines() if option.match(line) and "--seed " in line)
     assert len(seed) - 2 - seed.index("Seed of the goals") >= 30
+
+
+def test_a_piped_table_keeps_its_headers_whole(capsys):
+    from hsgplan.cli.common import print_table
+
+    header = tuple(f"header number {i}" for i in range(9))  # wider than 80 columns
+    print_table("t", header, [tuple("1" for _ in header)], markdown=False)
+    text = capsys.readouterr().out
+    assert all(h in text for h in header) and "…" not in text

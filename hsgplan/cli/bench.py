@@ -284,7 +284,7 @@ def bench_collect(
 def bench_observe(
     scenes: Annotated[int, bounded_option("scenes", "Scenes staged, rendered and seen.")] = 30,
     seed: Annotated[int, bounded_option("seed", "Seed of the scenes.")] = 100,
-    checkpoint: PerceptionCheckpoint = None,
+    perception_checkpoint: PerceptionCheckpoint = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.", metavar="")] = False,
     markdown: Annotated[
         bool,
@@ -299,7 +299,10 @@ def bench_observe(
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         rows = run(
-            perception_folder(checkpoint), scenes, seed, on_scene=lambda: progress.advance(task)
+            perception_folder(perception_checkpoint),
+            scenes,
+            seed,
+            on_scene=lambda: progress.advance(task),
         )
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))

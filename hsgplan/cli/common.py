@@ -23,6 +23,7 @@ from hsgplan.domain.recovery import PROTOCOLS
 
 out = Console()
 err = Console(stderr=True)
+PIPED_WIDTH = 200
 
 
 class Summaries(TyperGroup):
@@ -289,7 +290,8 @@ def print_table(title: str, header: tuple[str, ...], rows: list[tuple[str, ...]]
         table.add_column(col, justify="right")
     for row in rows:
         table.add_row(*row)
-    out.print(table)
+    # piped into a file or a pager, a table keeps its headers whole rather than fit 80 columns
+    (out if out.is_terminal else Console(width=PIPED_WIDTH)).print(table)
 
 
 # f_p's checkpoint, where a command can see with it (--perception rgb)

@@ -81,7 +81,7 @@ def train_task(
 def eval_task(
     planner: Annotated[PlannerName, typer.Option(help="Task planner.")] = REGRESSION,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
-    goals: Annotated[int, bounded_option("goals", "Random goals per size.")] = 500,
+    goals: Annotated[int, bounded_option("goals", "Random goals per size.")] = 100,
     seed: Annotated[int, bounded_option("seed", "Seed of the goals and start states.")] = 0,
     goals_file: Annotated[
         Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)

@@ -67,11 +67,13 @@ def train_perception(
 
 @refuses_bad_input
 def eval_perception(
-    checkpoint: Annotated[
-        Path, typer.Option(help="Keypoint network checkpoint.", parser=input_path)
+    perception_checkpoint: Annotated[
+        Path, typer.Option(help="f_p's checkpoint (default: the shipped one).", parser=input_path)
     ] = PERCEPTION_CHECKPOINT,
     scenes: Annotated[int, bounded_option("scenes", "Fresh scenes.")] = 100,
-    seed: Annotated[int, bounded_option("seed", "Seed of the scenes (training's is 0).")] = 1,
+    seed: Annotated[
+        int, bounded_option("seed", "Seed of the scenes (not a tuning seed: docs/perception.md).")
+    ] = 6,
     raw: Annotated[
         bool,
         typer.Option(
@@ -114,7 +116,7 @@ def eval_perception(
     from hsgplan.perception.synthetic import VIEWS, first_views
 
     shown = len(first_views(views)) if views is not None else len(VIEWS)  # before loading
-    estimator = PoseEstimator.load(checkpoint, settled=not raw, pruned=pruned)
+    estimator = PoseEstimator.load(perception_checkpoint, settled=not raw, pruned=pruned)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         run = evaluate_loop if loop else evaluate

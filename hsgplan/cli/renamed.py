@@ -19,6 +19,8 @@ OPTIONS: dict[tuple[str, str], str] = {
     ("collect images", "--count"): "--samples",
     ("eval reach", "--trials"): "--data",
     ("eval motion", "--checkpoints"): "--motion-checkpoints",
+    ("eval perception", "--checkpoint"): "--perception-checkpoint",
+    ("bench observe", "--checkpoint"): "--perception-checkpoint",
 }
 # (option, value) once typed -> the value now
 VALUES: dict[tuple[str, str], str] = {("--agent", "paper"): "learned"}

@@ -106,6 +106,10 @@ def ablation_table(report: dict) -> TextTable:
     source = first["goals_file"] or f"{first['goals']} random goals per size"
     title = (
         f"Success rate with each recovery rule off in turn (recovering protocol): {source}, "
-        f"each run {first['repeats']} times, seed {first['seed']}"
+        f"each run {_times(first['repeats'])}, seed {first['seed']}"
     )
     return TextTable(title, tuple(header), tuple(rows))
+
+
+def _times(repeats: int) -> str:
+    return "once" if repeats == 1 else f"{repeats} times"

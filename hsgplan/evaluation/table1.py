@@ -210,10 +210,15 @@ def _results(report: dict) -> TextTable:
                 row.append(f"{paper[0]:.2f} / {paper[1]:.2f}" if paper else "—")
         rows.append(tuple(row))
     source = report["goals_file"] or f"{report['goals']} random goals per size"
+    repeats = (
+        f", each run {report['repeats']} times (± the standard deviation of the success rate "
+        "over the repeats)"
+        if report["repeats"] > 1
+        else ", each run once"
+    )
     title = (
-        f"Success rate / subgoal completion ({_protocol(report)}): {source}, each run "
-        f"{report['repeats']} times (± the standard deviation of the success rate over the "
-        f"repeats), seed {report['seed']}"
+        f"Success rate / subgoal completion ({_protocol(report)}): {source}{repeats}, "
+        f"seed {report['seed']}"
     )
     title = marked(title, report["seed"])
     return TextTable(title, tuple(header), tuple(rows))
@@ -266,21 +271,21 @@ def _failures(report: dict) -> TextTable:
 
 
 def _times(report: dict) -> TextTable:
-    rows = []
+    rows, walls = [], []
     for m, s in report["methods"].items():
         for n in _sizes(report["methods"]):
             if v := s["by_size"].get(str(n)):
                 task_ms, motion_s = v["median_task_seconds"] * 1000, v["median_motion_seconds"]
                 rows.append(
-                    (label(m), str(n), str(v["episodes"]), f"{task_ms:.1f}", f"{motion_s:.2f}", "")
+                    (label(m), str(n), str(v["episodes"]), f"{task_ms:.1f}", f"{motion_s:.2f}")
                 )
-        episodes = sum(v["episodes"] for v in s["by_size"].values())
         workers = "/".join(str(w) for w in sorted({x["workers"] for x in sittings(s)}))
-        wall = f"{s['wall_seconds'] / 60:.1f} ({workers or '?'} workers)"
-        rows.append((label(m), "all", str(episodes), "", "", wall))
+        walls.append(f"{label(m)} {s['wall_seconds'] / 60:.1f} min ({workers or '?'} workers)")
+    # the whole run's wall clock is one number per method: in the title, not a column of blanks
     title = (
         f"Time per episode ({_protocol(report)}, medians): the task level's, and the motion "
-        "level's (choosing parameters and executing them); wall clock of each method's whole run"
+        "level's (choosing parameters and executing them); wall clock of each method's whole "
+        f"run: {', '.join(walls)}"
     )
-    header = ("method", "objects", "episodes", "task ms", "motion s", "wall min")
+    header = ("method", "objects", "episodes", "task ms", "motion s")
     return TextTable(title, header, tuple(rows))

@@ -26,9 +26,9 @@ def test_times_per_episode_are_sums_over_steps_with_quartiles():
 
 @pytest.mark.slow
 def test_run_writes_both_agents_on_the_same_goals(tmp_path):
-    report = run_timing([2], goals=1, seed=0, out=tmp_path)
+    report = run_timing([2], goals=1, seed=0, out=tmp_path)  # the strongest baseline unless told
     row = report["by_size"]["2"]
-    assert set(row) == {"ours", "search"}
+    assert set(row) == {"ours", "stream-goal"}
     for v in row.values():
         assert v["episodes"] == 1 and v["task_s"] >= 0 and v["motion_s"] > 0
     episodes = {
@@ -36,10 +36,10 @@ def test_run_writes_both_agents_on_the_same_goals(tmp_path):
             json.loads(line)["result"]
             for line in (tmp_path / agent / "episodes.jsonl").read_text().splitlines()
         ]
-        for agent in ("ours", "search")
+        for agent in ("ours", "stream-goal")
     }
     assert [(r["goal"], r["seed"]) for r in episodes["ours"]] == [
-        (r["goal"], r["seed"]) for r in episodes["search"]
+        (r["goal"], r["seed"]) for r in episodes["stream-goal"]
     ]
     assert json.loads((tmp_path / "summary.json").read_text()) == report
     text = (tmp_path / "table2.md").read_text()

@@ -291,7 +291,7 @@ eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --percepti
 eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --perception '[red]x'
 eval           | eval world --sizes 2 --goals 1 --out run --perception rgb --perception-checkpoint .
 demo           | demo --perception ''
-bench observe  | bench observe --scenes 1 --checkpoint .
+bench observe  | bench observe --scenes 1 --perception-checkpoint .
 demo           | demo --perception rgb --perception-checkpoint .
 eval motion    | eval motion --trials 1 --workers 1 --primitives ''
 eval motion    | eval motion --trials 1 --workers 1 --primitives wizard
