@@ -8,6 +8,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 from hsgplan.files import atomic  # noqa: E402
 
@@ -54,6 +55,7 @@ def plot_success_by_size(
                 label=f"{method} (paper)",
             )
     ax.set_xlabel("objects in the goal")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # no tick at 2.5 objects
     ax.set_ylabel("success rate")
     ax.set_ylim(0, 1.02)
     ax.grid(alpha=0.3)
@@ -87,6 +89,7 @@ def plot_times_by_size(series: dict[str, dict[str, dict[int, float]]], path: Pat
             )
         ax.set_yscale("log")
         ax.set_xlabel("objects in the goal")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_title(f"{level} seconds per episode")
         ax.grid(alpha=0.3, which="both")
     axes[0].set_ylabel("seconds (log scale)")
