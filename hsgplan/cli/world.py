@@ -20,6 +20,7 @@ from hsgplan.cli.common import (
     RunFolder,
     bounded_option,
     check_ray,
+    choice,
     config_default,
     config_option,
     err,
@@ -33,13 +34,15 @@ from hsgplan.cli.common import (
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import RecoveryRules
-from hsgplan.evaluation.config import TABLES, EvalConfig
+from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
 from hsgplan.paths import RUNS, shipped
 from hsgplan.runner.run_folder import check_own
 
 # what each agent is: docs/cli.md, "Agents" (a test holds the two to the same names)
 AGENT_HELP = f"{', '.join(AgentName)}: what each is in docs/cli.md."
 LEARNED = AgentName("learned")
+PerceptionName = choice("PerceptionName", OBSERVERS)
+GT = PerceptionName("gt")
 AgentOption = Annotated[AgentName, typer.Option(help=AGENT_HELP, metavar="AGENT")]
 PlannerOption = Annotated[
     PlannerName | None,
@@ -70,12 +73,13 @@ def demo(
         Path, typer.Option("--out", help="Folder for the pictures.", parser=out_folder)
     ] = RUNS / "demo",
     perception: Annotated[
-        str,
+        PerceptionName,
         typer.Option(
             help="What the agent sees with: gt (the simulator's poses) or rgb (f_p on the "
-            "fixed cameras' images; its estimate drawn on the views as cuboids)."
+            "fixed cameras' images; its estimate drawn on the views as cuboids).",
+            metavar="PERCEPTION",
         ),
-    ] = "gt",
+    ] = GT,
     perception_checkpoint: PerceptionCheckpoint = None,
 ) -> None:
     """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record."""
@@ -87,7 +91,9 @@ def demo(
 
     agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
     make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
-    observer = make_observer(perception, perception_checkpoint and shipped(perception_checkpoint))
+    observer = make_observer(
+        perception.value, perception_checkpoint and shipped(perception_checkpoint)
+    )
     if goal is None:
         check_size(objects)
     g = parse_goal(goal) if goal else demo_goal(objects, seed)
