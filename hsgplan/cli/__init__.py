@@ -34,6 +34,7 @@ eval_app.command("task")(learn.eval_task)
 eval_app.command("reach")(learn.eval_reach)
 eval_app.command("motion")(motion.eval_motion)
 eval_app.command("perception")(perception.eval_perception)
+eval_app.command("compare")(world.compare)
 
 app.command()(symbolic.plan)
 app.command()(symbolic.goals)

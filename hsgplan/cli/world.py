@@ -328,3 +328,28 @@ def report(
         )
     size = path.stat().st_size / 1e6
     out.print(f"wrote {shown(path)} ({size:.1f} MB)", highlight=False)
+
+
+@refuses_bad_input
+def compare(
+    runs: Annotated[
+        list[Path],
+        typer.Argument(help="Finished eval world run folders, one row each.", parser=input_path),
+    ],
+    names: Annotated[
+        str | None,
+        typer.Option(help="The rows' names, comma-separated (default: the folders' names)."),
+    ] = None,
+    method: Annotated[str, typer.Option(help="The column compared (gnn, mlp, ...).")] = "gnn",
+    markdown: Annotated[
+        bool, typer.Option("--markdown", help="Print a Markdown table.", metavar="")
+    ] = False,
+) -> None:
+    """One method's success per size across eval world runs, one row each: a ladder from one
+    recipe to another, one change per row. The runs must be like for like (protocol, goals,
+    repeats, seed, sizes); only their checkpoints may differ."""
+    from hsgplan.evaluation.compare import compare as compare_runs
+
+    row_names = _names(names, "--names", "run") if names else tuple(r.name for r in runs)
+    t = compare_runs(runs, row_names, method)
+    print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

@@ -139,7 +139,7 @@ def total_episodes(methods: list[Method], config: EvalConfig) -> int:
     return len(methods) * len(episode_specs(config))
 
 
-def _cell(v: dict) -> str:
+def cell(v: dict) -> str:
     sr, sc = f"{v['success_rate']:.2f}", f"{v['subgoal_completion']:.2f}"
     if v.get("success_std") is not None:
         sr += f" ± {v['success_std']:.2f}"
@@ -187,7 +187,7 @@ def _sizes(methods: dict) -> list[int]:
     return sorted({int(n) for s in methods.values() for n in s["by_size"]})
 
 
-def _protocol(report: dict) -> str:
+def protocol_name(report: dict) -> str:
     """The protocol's name as the tables say it, with any recovery rule switched off."""
     protocol = report.get("protocol", RECOVERING)
     off = report.get("rules_off") or []
@@ -204,7 +204,7 @@ def _results(report: dict) -> TextTable:
         row = [str(n)]
         for m, s in methods.items():
             v = s["by_size"].get(str(n))
-            row.append(_cell(v) if v else "—")
+            row.append(cell(v) if v else "—")
             if m in PAPER_TABLE1:
                 paper = PAPER_TABLE1[m].get(n)
                 row.append(f"{paper[0]:.2f} / {paper[1]:.2f}" if paper else "—")
@@ -217,7 +217,7 @@ def _results(report: dict) -> TextTable:
         else ", each run once"
     )
     title = (
-        f"Success rate / subgoal completion ({_protocol(report)}): {source}{repeats}, "
+        f"Success rate / subgoal completion ({protocol_name(report)}): {source}{repeats}, "
         f"seed {report['seed']}"
     )
     title = marked(title, report["seed"])
@@ -253,7 +253,7 @@ def _failures(report: dict) -> TextTable:
                     + ((str(v.get("relooks", "—")),) if seen else ())
                 )
     title = (
-        f"Failures ({_protocol(report)}), by what ended the episode: execution (a failed "
+        f"Failures ({protocol_name(report)}), by what ended the episode: execution (a failed "
         "primitive; by the fatal anomaly or its status) and overstep (the step limit, or "
         "nothing reachable); failed primitives over all episodes, overstep episodes that "
         "had some, and primitives that moved another object than their own (disturbing)"
@@ -283,7 +283,7 @@ def _times(report: dict) -> TextTable:
         walls.append(f"{label(m)} {s['wall_seconds'] / 60:.1f} min ({workers or '?'} workers)")
     # the whole run's wall clock is one number per method: in the title, not a column of blanks
     title = (
-        f"Time per episode ({_protocol(report)}, medians): the task level's, and the motion "
+        f"Time per episode ({protocol_name(report)}, medians): the task level's, and the motion "
         "level's (choosing parameters and executing them); wall clock of each method's whole "
         f"run: {', '.join(walls)}"
     )

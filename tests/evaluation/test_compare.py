@@ -1,0 +1,81 @@
+"""Runs side by side: rows like for like, refused in one line where they are not."""
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from hsgplan.cli import app
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.evaluation.compare import compare
+from hsgplan.evaluation.episode import EpisodeRecord, StepRecord
+from hsgplan.evaluation.summary import summarize
+from hsgplan.runner.run_folder import CONFIG
+
+
+def _record(seed: int, size: int, success: bool) -> EpisodeRecord:
+    status = "success" if success else "no_ik"
+    step = StepRecord(1, "InGrasp(butter)", "pick(butter)", "pick(obj=butter)", status, "", 0, 0, 0)
+    failure = None if success else "failed_primitive"
+    return EpisodeRecord(
+        seed, "learned", "On(butter, shelf_a)", size, success, 0.5, failure, (step,), 1.0
+    )
+
+
+def _run(folder, wins: dict[int, tuple[bool, ...]], seed=0, protocol="paper", motion="m"):
+    """A finished table folder whose `gnn` column won `wins[size]`."""
+    folder.mkdir(parents=True)
+    records = [_record(k, n, won) for n, outcomes in wins.items() for k, won in enumerate(outcomes)]
+    settings = {"kind": "eval-table", "goals": len(next(iter(wins.values()))), "seed": seed}
+    settings |= {"protocol": protocol, "rules_off": [], "repeats": 1, "goals_file": None}
+    settings |= {"sizes": sorted(wins), "motion_checkpoints": motion}
+    (folder / CONFIG).write_text(json.dumps(settings))
+    summary = {
+        "protocol": protocol,
+        "rules_off": [],
+        "methods": {
+            "gnn": {"agent": "learned", "wall_seconds": 1.0, "sittings": []} | summarize(records)
+        },
+        "goals": settings["goals"],
+        "goals_file": None,
+        "repeats": 1,
+        "seed": seed,
+        "run": str(folder),
+    }
+    (folder / "summary.json").write_text(json.dumps(summary))
+    return folder
+
+
+def test_each_run_is_a_row_of_its_success_per_size_and_the_paper_is_the_last(tmp_path):
+    a = _run(tmp_path / "a", {2: (True, False), 3: (False, False)}, motion="ladder/a")
+    b = _run(tmp_path / "b", {2: (True, True), 3: (True, False)}, motion="ladder/b")
+    table = compare([a, b], ["theirs", "ours"], "gnn")
+    assert table.header == ("run", "2 objects", "3 objects")
+    assert [r[0] for r in table.rows] == ["theirs", "ours", "GNN (paper)"]
+    assert table.rows[0][1].startswith("0.50") and table.rows[1][1].startswith("1.00")
+    assert table.rows[1][2].startswith("0.50") and table.rows[2][1] == "0.92 / 0.95"
+    assert "paper protocol" in table.title and "each run once" in table.title
+
+
+@pytest.mark.parametrize(
+    ("other", "says"),
+    [
+        ({"seed": 1}, "differ in seed"),
+        ({"protocol": "recovering"}, "differ in protocol"),
+    ],
+)
+def test_runs_that_are_not_like_for_like_are_refused(tmp_path, other, says):
+    a = _run(tmp_path / "a", {2: (True,)})
+    b = _run(tmp_path / "b", {2: (True,)}, **other)
+    with pytest.raises(InvalidInputError, match=says):
+        compare([a, b], ["a", "b"], "gnn")
+
+
+def test_a_missing_method_or_a_name_short_is_one_line_exit_2(tmp_path):
+    a = _run(tmp_path / "a", {2: (True,)})
+    with pytest.raises(InvalidInputError, match="holds no method 'mlp'"):
+        compare([a], ["a"], "mlp")
+    r = CliRunner().invoke(app, ["eval", "compare", str(a), str(a), "--names", "x"])
+    assert r.exit_code == 2 and "2 runs and 1 names" in r.stderr
+    r = CliRunner().invoke(app, ["eval", "compare", str(a), "--markdown"])
+    assert r.exit_code == 0 and "| a | 1.00 / " in r.stdout
