@@ -1,0 +1,25 @@
+"""The motion ladder's rows change only what they name: the head and the loss."""
+
+import json
+
+import pytest
+
+from hsgplan.motion.train import MotionTrainConfig
+from hsgplan.paths import MOTION_CHECKPOINTS, home
+
+LADDER = home() / "configs" / "ladder"
+ROWS = {
+    "paper-head-ce": {"head": "mlp", "loss": "ce"},
+    "bin-inputs-ce": {"head": "bins", "loss": "ce"},
+}
+
+
+@pytest.mark.parametrize("row", sorted(ROWS))
+@pytest.mark.parametrize("kind", ["place", "push"])
+def test_a_row_differs_from_the_shipped_gnn_in_its_head_and_loss_only(row, kind):
+    config = json.loads((LADDER / row / f"{kind}-gnn.json").read_text())
+    shipped = json.loads((MOTION_CHECKPOINTS / f"{kind}-gnn" / "train_config.json").read_text())
+    MotionTrainConfig.from_json(config)  # a configuration training takes
+    assert {k for k in shipped if config[k] != shipped[k]} <= {"head", "loss"}
+    assert {k: config[k] for k in ROWS[row]} == ROWS[row]
+    assert set(config) == set(shipped)
