@@ -122,7 +122,7 @@ def eval_motion(
 ) -> None:
     """Single-shot success of the GNN, the MLP and Random on fresh random scenes (never the
     training scenes), per primitive and crowding level; every model sees the same scenes."""
-    from hsgplan.evaluation.motion_eval import MODELS, evaluate_motion
+    from hsgplan.evaluation.motion_eval import LABELS, MODELS, evaluate_motion
 
     kinds = [p.strip() for p in primitives.split(",")]
     if "" in kinds or len(set(kinds)) != len(kinds):
@@ -159,14 +159,14 @@ def eval_motion(
             rows.append((kind, label, str(n), *cells))
     print_table(
         f"Single-shot motion success on fresh scenes, seed {seed}",
-        ("primitive", "crowding", "scenes", *MODELS),
+        ("primitive", "crowding", "scenes", *(LABELS[m] for m in MODELS)),
         rows,
         markdown,
     )
     trained = [
         (
             kind,
-            m,
+            LABELS[m],
             f"{r['parameters']:,}",
             f"{r['training_examples']:,}",
             f"{r['validation_examples']:,}",

@@ -36,6 +36,16 @@ FOLDERS = {
     "mlp_paper": "mlp-paper",
     "mlp_bce": "mlp-bce",
 }
+# a model's name in the tables: a column headed "(paper)" anywhere holds the paper's numbers,
+# so networks trained by the paper's recipe are named for the recipe
+LABELS = {
+    "gnn": "GNN",
+    "gnn_paper": "GNN, paper's recipe",
+    "mlp": "MLP",
+    "mlp_paper": "MLP, paper's recipe",
+    "mlp_bce": "MLP, BCE",
+    "random": "Random",
+}
 EVAL_STREAM = 1_000_000  # collection streams use small seeds; evaluation never meets them
 CHUNK = 8
 CROWDED = 2  # a shelf top with this many of its 4 cells taken counts as crowded
