@@ -113,7 +113,7 @@ BAD = [
         [*WORLD, "--sizes", "2", "--perception", "rgb", "--perception-checkpoint", "/no/f_p"],
         "/no/f_p",
     ),
-    (["demo", "--perception", "sonar"], "--perception 'sonar': one of gt, rgb"),
+    (["demo", "--perception", "sonar"], "'sonar' is not one of 'gt', 'rgb'"),
     (["demo", "--perception", "rgb", "--perception-checkpoint", "/no/f_p"], "/no/f_p"),
     (["bench", "sim", "--episodes", "0"], "greater than or equal to 1"),
     (["plan", "--goal", "On(cherries, shelf_a) &"], "ends with '&'"),

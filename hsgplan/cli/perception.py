@@ -68,7 +68,12 @@ def train_perception(
 @refuses_bad_input
 def eval_perception(
     perception_checkpoint: Annotated[
-        Path, typer.Option(help="f_p's checkpoint (default: the shipped one).", parser=input_path)
+        Path,
+        typer.Option(
+            help="f_p's checkpoint (default: the shipped one).",
+            parser=input_path,
+            show_default=False,
+        ),
     ] = PERCEPTION_CHECKPOINT,
     scenes: Annotated[int, bounded_option("scenes", "Fresh scenes.")] = 100,
     seed: Annotated[
@@ -80,13 +85,15 @@ def eval_perception(
             "--raw", metavar="", help="The fused PnP poses, not made to rest on their supports."
         ),
     ] = False,
-    pruned: Annotated[
+    unpruned: Annotated[
         bool,
         typer.Option(
-            help="Drop what a lone view found that the other views contradict "
-            "(perception/phantoms.py; with the poses made to rest)."
+            "--no-pruned",
+            metavar="",
+            help="Keep what a lone view found that the other views contradict (dropped unless "
+            "told: perception/phantoms.py).",
         ),
-    ] = True,
+    ] = False,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the summary as JSON.", metavar="")
     ] = False,
@@ -116,7 +123,7 @@ def eval_perception(
     from hsgplan.perception.synthetic import VIEWS, first_views
 
     shown = len(first_views(views)) if views is not None else len(VIEWS)  # before loading
-    estimator = PoseEstimator.load(perception_checkpoint, settled=not raw, pruned=pruned)
+    estimator = PoseEstimator.load(perception_checkpoint, settled=not raw, pruned=not unpruned)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         run = evaluate_loop if loop else evaluate

@@ -85,7 +85,8 @@ def test_evaluation_resumes_without_repeating_work(tmp_path):
 def test_eval_cli_json_shape(tmp_path):
     r = CliRunner().invoke(
         app,
-        ["eval", "world", "--sizes", "2", "--goals", "1", "--json", "--out", str(tmp_path / "run")],
+        [*["eval", "world", "--agent", "oracle", "--sizes", "2", "--goals", "1", "--json"]]
+        + ["--out", str(tmp_path / "run")],
     )
     assert r.exit_code == 0, r.output
     report = json.loads(r.stdout)
@@ -126,6 +127,8 @@ def test_json_output_of_the_real_command_is_pure_json(tmp_path):
             "hsgplan.cli",
             "eval",
             "world",
+            "--agent",
+            "oracle",
             "--sizes",
             "2",
             "--goals",

@@ -112,7 +112,7 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
     assert f"| 2 | 0.50 / 0.75 | {paper[0]:.2f} / {paper[1]:.2f} | 0.50 / 0.75 |" in text
     assert "| GNN | 2 | 2 | 1 | 0 | 1 (step limit 1) | 1 | 1 |" in text
     assert "(recovering protocol)" in text  # a report without a protocol predates the paper's
-    assert "1.5 (2 workers)" in text
+    assert "whole run: GNN 1.5 min (2 workers), sampler 0.0 min (? workers)" in text
     assert "tuning seed" not in text
     assert [t.title for t in tables(report, ("time", "success"))] == [
         t.title

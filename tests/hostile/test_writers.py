@@ -13,7 +13,20 @@ from tests.hostile.case import TINY_MOTION, tiny_config
 from tests.hostile.harness import child_env, launch
 
 pytestmark = pytest.mark.slow
-EVAL = ["eval", "world", "--sizes", "2-3", "--goals", "2", "--workers", "1", "--out", "run"]
+EVAL = [
+    "eval",
+    "world",
+    "--agent",
+    "oracle",
+    "--sizes",
+    "2-3",
+    "--goals",
+    "2",
+    "--workers",
+    "1",
+    "--out",
+    "run",
+]
 
 
 def _temporary_files(folder):
