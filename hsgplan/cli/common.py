@@ -45,7 +45,11 @@ METAVARS = {str: "TEXT", Path: "PATH", int: "N", float: "X"}
 
 def plain_metavars(command) -> None:
     """Give every option without a metavar of its own a plain one: a flag (and `--help`)
-    none, a value its type's word in capitals."""
+    none, a value its type's word in capitals. Once per command: a group hands the same
+    command out on every lookup."""
+    if getattr(command, "plain_metavars", False):
+        return
+    command.plain_metavars = True
     for param in command.params:
         if isinstance(param, typer.core.TyperArgument):  # its name says it (RUN_DIR)
             param.metavar = param.metavar or param.name.upper()
