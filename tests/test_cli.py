@@ -114,6 +114,7 @@ BAD = [
         "/no/f_p",
     ),
     (["demo", "--perception", "sonar"], "'sonar' is not one of 'gt', 'rgb'"),
+    (["demo", "--rerun", "episode.mp4"], "a recording's file ends in .rrd"),
     (["demo", "--perception", "rgb", "--perception-checkpoint", "/no/f_p"], "/no/f_p"),
     (["bench", "sim", "--episodes", "0"], "greater than or equal to 1"),
     (["plan", "--goal", "On(cherries, shelf_a) &"], "ends with '&'"),
@@ -328,3 +329,15 @@ def test_a_piped_table_keeps_its_headers_whole(capsys):
     print_table("t", header, [tuple("1" for _ in header)], markdown=False)
     text = capsys.readouterr().out
     assert all(h in text for h in header) and "…" not in text
+
+
+@pytest.mark.parametrize(
+    "args", [["demo", "--rerun", "x/episode.rrd"], ["report", "/no/run", "--rerun"]]
+)
+def test_a_recording_without_rerun_installed_is_refused_in_one_line(args, monkeypatch, tmp_path):
+    monkeypatch.setattr("hsgplan.evaluation.recording.available", lambda: False)
+    monkeypatch.chdir(tmp_path)
+    r = run(*args)
+    assert r.exit_code == 2, r.output
+    assert "--rerun needs rerun-sdk" in r.output and "Traceback" not in r.output
+    assert list(tmp_path.iterdir()) == []  # nothing written

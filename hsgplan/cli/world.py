@@ -26,6 +26,7 @@ from hsgplan.cli.common import (
     err,
     input_path,
     out,
+    out_file,
     out_folder,
     parse_sizes,
     print_table,
@@ -81,8 +82,17 @@ def demo(
         ),
     ] = GT,
     perception_checkpoint: PerceptionCheckpoint = None,
+    rerun: Annotated[
+        Path | None,
+        typer.Option(
+            help="Also write the episode as a rerun recording (.rrd): the true scene and the "
+            "belief side by side, the cameras, every decision. Needs the rerun extra.",
+            parser=out_file,
+        ),
+    ] = None,
 ) -> None:
-    """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record."""
+    """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record;
+    with --rerun, a 3D recording for rerun's viewer."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.domain.goals import parse_goal
     from hsgplan.evaluation.demo import demo_goal, run_demo
@@ -98,18 +108,37 @@ def demo(
         check_size(objects)
     g = parse_goal(goal) if goal else demo_goal(objects, seed)
     check_own(out_dir, "episode.json", "demo")
+    if rerun is not None:
+        check_recording(rerun)
     out.print(
         f"[bold]goal[/] ({g.size} objects, seed {seed}, agent {agent}): {g}",
         highlight=False,
         soft_wrap=True,
     )
-    record = run_demo(agent, g, seed, out_dir, on_step=_print_step, observer=observer)
+    record = run_demo(
+        agent, g, seed, out_dir, on_step=_print_step, observer=observer, recording=rerun
+    )
     verdict = "[green]success[/]" if record.success else f"[red]failed: {shown(record.failure)}[/]"
     out.print(
         f"{verdict} in {len(record.steps)} steps ({record.seconds:.0f} s with the pictures); "
         f"subgoal completion {record.subgoal_completion:.2f}"
     )
     out.print(f"wrote {shown(out_dir)}/episode.gif, graphs/, episode.json")
+    if rerun is not None:
+        out.print(f"wrote {shown(rerun)}: open it with `rerun {shown(rerun)}`", highlight=False)
+
+
+def check_recording(path: Path) -> None:
+    """A recording is asked for where rerun-sdk is installed, into a `.rrd` file."""
+    from hsgplan.evaluation.recording import available
+
+    if path.suffix != ".rrd":
+        raise InvalidInputError(f"--rerun {shown(path)}: a recording's file ends in .rrd")
+    if not available():
+        raise InvalidInputError(NO_RERUN)
+
+
+NO_RERUN = "--rerun needs rerun-sdk: pip install -e '.[rerun]' (make installs it)"
 
 
 def _print_step(s) -> None:
@@ -312,11 +341,24 @@ def report(
         int,
         bounded_option("failures", "Failed episodes re-simulated and shown, GIF and graphs."),
     ] = 6,
+    rerun: Annotated[
+        bool,
+        typer.Option(
+            "--rerun",
+            help="Also write each re-simulated episode as a rerun recording (episode.rrd). "
+            "Needs the rerun extra.",
+            metavar="",
+        ),
+    ] = False,
 ) -> None:
     """One self-contained HTML page for an eval run: its tables and plot, and failed episodes
     re-simulated from their seeds (a GIF with each decision, the scene graphs around the
-    failing step). Writes RUN_DIR/report.html."""
+    failing step; with --rerun, a 3D recording). Writes RUN_DIR/report.html."""
+    from hsgplan.evaluation.recording import available
     from hsgplan.evaluation.report import build_report
+
+    if rerun and not available():
+        raise InvalidInputError(NO_RERUN)
 
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("re-simulating failed episodes", total=None)
@@ -325,6 +367,7 @@ def report(
             failures,
             on_rollout=lambda r: progress.advance(task),
             on_sample=lambda n: progress.update(task, total=n),
+            recordings=rerun,
         )
     size = path.stat().st_size / 1e6
     out.print(f"wrote {shown(path)} ({size:.1f} MB)", highlight=False)

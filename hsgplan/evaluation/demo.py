@@ -1,6 +1,7 @@
 """One episode with pictures: a GIF from two cameras with the current step and subgoal written
 on every frame, a drawing of the symbolic scene graph at every step, and `episode.json` (seed,
-goal, every decision with its subgoal, parameters, outcome and timings)."""
+goal, every decision with its subgoal, parameters, outcome and timings); asked for, a rerun
+recording (`evaluation.recording`)."""
 
 from __future__ import annotations
 
@@ -44,6 +45,7 @@ def run_demo(
     frame_every: int = FRAME_EVERY,
     observer: SceneObserver | CameraObserver | None = None,
     end_at_failure: bool = False,
+    recording: Path | None = None,
 ) -> EpisodeRecord:
     """Run the episode and write its pictures and record into `out`; `on_step` sees every
     step as soon as it has been executed; `end_at_failure` as `run_episode` takes it.
@@ -54,11 +56,20 @@ def run_demo(
         frame_every: arm waypoints between two frames.
         observer: what the agent sees with (default: the ground truth). Another observer's
             estimate, as of its last observation, is drawn on the views as cuboids.
+        recording: also write the episode as a rerun recording there (`.rrd`; needs the
+            `rerun` extra): the true scene and the belief, the cameras, every decision.
     """
     one_core()  # beside other busy processes, two threads make each planner call 20x slower
     out.mkdir(parents=True, exist_ok=True)
     graphs = out / "graphs"
     graphs.mkdir(exist_ok=True)
+    rec = None
+    if recording is not None:
+        from hsgplan.evaluation.recording import EpisodeRecording, RecordedLooks
+
+        rec = EpisodeRecording(recording, str(goal), seed)
+        if isinstance(observer, CameraObserver):
+            observer = RecordedLooks(observer, rec)
     env = KitchenStorageEnv(observer=observer)
     seeing = observer is not None and observer.name != "gt"
     believed: dict = {}
@@ -82,6 +93,8 @@ def run_demo(
     def on_frame() -> None:
         nonlocal waypoints
         waypoints += 1
+        if rec is not None:
+            rec.on_frame()
         if waypoints % frame_every == 0:
             frames.append(snapshot())
 
@@ -91,6 +104,8 @@ def run_demo(
             f"subgoal: {d.subgoal}",
             f"goal: {goal}",
         ]
+        if rec is not None:
+            rec.decide(step, d, params_text(d.params))
 
     def on_step_done(record, obs) -> None:
         believed.clear()
@@ -104,12 +119,22 @@ def run_demo(
         k = 0 if record is None else record.step
         title = "start" if record is None else f"step {k}: {record.params} -> {record.status}"
         draw_symbolic(obs.symbols.state, graphs / f"step_{k:02d}.png", title, goal)
+        if rec is not None and record is None:
+            rec.start(env, obs)
+        elif rec is not None:
+            rec.stepped(record, obs)
         if record is not None and on_step:
             on_step(record)
 
     if isinstance(agent, str):
         agent = make_agent(agent)
-    record = run_episode(env, agent, goal, seed, on_frame, on_step_done, on_decide, end_at_failure)
+    try:
+        record = run_episode(
+            env, agent, goal, seed, on_frame, on_step_done, on_decide, end_at_failure
+        )
+    finally:
+        if rec is not None:
+            rec.close()
     with atomic(out / "episode.gif") as tmp:
         iio.imwrite(tmp, frames, duration=90, loop=0)
     write_atomically(out / "episode.json", json.dumps(record.to_json(), indent=2) + "\n")

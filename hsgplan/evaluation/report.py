@@ -3,8 +3,10 @@
 The page holds the run's tables (results beside the paper's, the failure taxonomy, the time
 per level), its plot, and for a sample of failed episodes a GIF of the rollout, re-simulated
 from the episode's seed with each decision written on the frame, with the symbolic scene
-graphs before and after the failing step. Rollouts are kept in `RUN_DIR/report/` as they are
-made: a report interrupted and started again makes only those still missing.
+graphs before and after the failing step; asked for, a rerun recording of each rollout
+(`episode.rrd`: the true scene and the belief, the cameras, every decision). Rollouts are kept
+in `RUN_DIR/report/` as they are made: a report interrupted and started again makes only those
+still missing.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ REPORT = "report.html"
 ROLLOUTS = "report"
 GIF_SCALE = 0.5  # the rollouts' frames at half the demo's size: the page stays small
 FRAME_EVERY = 24
+RECORDING = "episode.rrd"
 
 
 @dataclass(frozen=True)
@@ -117,14 +120,17 @@ def _round_robin(lists: list[list]) -> list:
     return [x[i] for i in range(max(map(len, lists), default=0)) for x in lists if i < len(x)]
 
 
-def rollout(run_dir: Path, method: str, agent: str, record: EpisodeRecord) -> Rollout:
-    """The episode re-simulated with the method's agent and checkpoints (made once, kept)."""
+def rollout(
+    run_dir: Path, method: str, agent: str, record: EpisodeRecord, recording: bool = False
+) -> Rollout:
+    """The episode re-simulated with the method's agent and checkpoints (made once, kept;
+    made again where a `recording` is asked for and the kept one has none)."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.evaluation.demo import run_demo
 
     folder = run_dir / ROLLOUTS / f"{method}-{record.size}-{record.seed}"
     done = folder / "episode.json"
-    if not done.exists():
+    if not done.exists() or (recording and not (folder / RECORDING).exists()):
         config = read_eval_config(run_dir / method)
         partial = folder.with_name(folder.name + ".partial")
         shutil.rmtree(partial, ignore_errors=True)
@@ -137,7 +143,9 @@ def rollout(run_dir: Path, method: str, agent: str, record: EpisodeRecord) -> Ro
             frame_every=FRAME_EVERY,
             observer=make_observer(config.perception, config.perception_checkpoint),
             end_at_failure=config.protocol == PAPER,
+            recording=partial / RECORDING if recording else None,
         )
+        shutil.rmtree(folder, ignore_errors=True)
         partial.rename(folder)
     rerun = EpisodeRecord.from_json(json.loads(done.read_text()))
     return Rollout(method, record, rerun, folder)
@@ -148,9 +156,11 @@ def build_report(
     failures: int = 6,
     on_rollout: Callable[[Rollout], None] | None = None,
     on_sample: Callable[[int], None] | None = None,
+    recordings: bool = False,
 ) -> Path:
     """Write `RUN_DIR/report.html` (written whole or not at all) and return its path;
-    `on_sample` hears how many failed episodes will be re-simulated, `on_rollout` each one."""
+    `on_sample` hears how many failed episodes will be re-simulated, `on_rollout` each one;
+    with `recordings`, each rollout is also a rerun recording, linked from the page."""
     summary = read_summary(run_dir)
     methods = list(summary["methods"])
     parts = [
@@ -173,8 +183,9 @@ def build_report(
     if not sample:
         parts.append(paragraph("No episode of this run failed."))
     for method, record in sample:
-        r = rollout(run_dir, method, summary["methods"][method]["agent"], record)
-        parts.append(_episode(r))
+        agent = summary["methods"][method]["agent"]
+        r = rollout(run_dir, method, agent, record, recordings)
+        parts.append(_episode(r, run_dir))
         if on_rollout:
             on_rollout(r)
     path = run_dir / REPORT
@@ -182,7 +193,7 @@ def build_report(
     return path
 
 
-def _episode(r: Rollout) -> str:
+def _episode(r: Rollout, run_dir: Path) -> str:
     rec = r.logged
     cls, kind = failure_class(rec) or ("", "")
     k = r.failing_step
@@ -202,6 +213,11 @@ def _episode(r: Rollout) -> str:
             )
         )
     parts.append(image(r.folder / "episode.gif", f"rollout of seed {rec.seed}"))
+    if (r.folder / RECORDING).exists():
+        where = (r.folder / RECORDING).relative_to(run_dir)
+        parts.append(
+            paragraph(f"3D recording: {where} in the run folder (open it with `rerun FILE`)")
+        )
     parts.append(
         table(
             ("step", "subgoal", "primitive", "outcome", "why", "task ms"),

@@ -74,6 +74,8 @@ class RgbObserver:
         self.cameras = cameras
         self._objects: tuple[str, ...] = ()
         self._last: dict[str, Pose] = {}
+        # the last look's detections, the hand's left out: what a recording shows of f_p
+        self.detections: tuple[Detection, ...] = ()
 
     @staticmethod
     def load(folder: Path) -> RgbObserver:
@@ -82,6 +84,7 @@ class RgbObserver:
     def start(self, objects: tuple[str, ...]) -> None:
         self._objects = tuple(objects)
         self._last = {}
+        self.detections = ()
 
     def look(self, look: Look) -> Seen:
         start = time.perf_counter()
@@ -93,6 +96,7 @@ class RgbObserver:
             self._last[name] = pose
         if held is not None:
             detections = away_from_hand(detections, look.held_pose)
+        self.detections = tuple(detections)
         known = {o: p for o, p in self._last.items() if o != held}
         rest = self.estimator.rest if self.estimator.settled else None
         tracks = tracked(detections, known, rest)

@@ -134,6 +134,8 @@ class KitchenStorageEnv(gymnasium.Env):
         self.scene: Scene | None = None
         self.goal: Goal | None = None
         self.steps = 0
+        # the last step's plan, if one was made (for recordings of the episode)
+        self.last_plan: MotionPlan | None = None
         # dry runs' plans, each with the state of the scene it was made in (`_state`)
         self._checked: dict[PrimitiveParams, tuple[MotionPlan, float, tuple]] = {}
         # dry runs (as a feasibility check) and trials of whole plans, for agents that look ahead
@@ -172,14 +174,21 @@ class KitchenStorageEnv(gymnasium.Env):
             action if isinstance(action, PrimitiveParams) else decode(self.goal.objects, action)
         )
         true_before = self.scene.poses()
+        self.last_plan = None
         if isinstance(params, str):  # nothing to execute: a step spent, nothing moved
             outcome = Outcome(Status.INVALID, params, 0.0)
         elif self.believing:
             outcome = self._step_believed(params, on_frame)
         else:
             plan, plan_seconds = self._checked_plan(params)
+            if plan is None:
+                start = time.perf_counter()
+                plan = plan_primitive(self.scene, params)
+                plan_seconds = time.perf_counter() - start
+            if isinstance(plan, MotionPlan):
+                self.last_plan = plan
             outcome = execute(self.scene, params, on_frame, plan)
-            # A plan from a dry run is part of this primitive's cost: its time is added back.
+            # The plan is part of this primitive's cost: its time is added back.
             outcome = Outcome(outcome.status, outcome.detail, outcome.seconds + plan_seconds)
         self._checked.clear()
         self.steps += 1
@@ -265,6 +274,7 @@ class KitchenStorageEnv(gymnasium.Env):
         if isinstance(plan, PlanFailure):
             seconds = time.perf_counter() - start - watch.seconds + plan_seconds
             return Outcome(plan.status, plan.detail, seconds, relooks)
+        self.last_plan = plan
         stopped = run_plan(self.scene, plan, on_frame)
         holds = holds_something(self.scene.robot)  # the gripper's width
         self._released = world.executed(plan, holds)

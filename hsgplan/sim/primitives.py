@@ -46,9 +46,10 @@ def execute(
     scene: Scene,
     params: PrimitiveParams,
     on_frame: Frame | None = None,
-    plan: MotionPlan | None = None,
+    plan: MotionPlan | PlanFailure | None = None,
 ) -> Outcome:
-    """Plan (unless a plan made for this scene is given) and run one primitive.
+    """Plan (unless a plan made for this scene, or its failure, is given) and run one
+    primitive.
 
     `on_frame` is called along the way, for pictures; the time it takes is not counted in the
     outcome's seconds.

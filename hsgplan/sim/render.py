@@ -40,11 +40,12 @@ class Camera:
 
 # The demo's two views, 640 x 480 each: between them every object is in sight whatever the arm
 # does. Facing the robot from beyond the table, the arm stays behind the objects: shelf tops,
-# the open space and what stands on them (shelf B on the left). From behind the robot and
-# low, under the shelves' top boards: their interiors and the prepush regions.
+# the open space and what stands on them (shelf B on the left). Low in front of the robot's
+# base, under the shelves' top boards and wide: both shelves' interiors and the prepush
+# regions, with the arm above the view except where it reaches down into them.
 FRONT = Camera(640, 480, (1.3, 0.0, 1.25), (0.38, 0.0, 0.0), 52.0)
-ROBOT_SIDE = Camera(640, 480, (-0.45, 0.0, 0.62), (0.5, 0.0, 0.05), 65.0)
+LOW = Camera(640, 480, (0.12, 0.0, 0.30), (0.5, 0.0, 0.05), 95.0)
 DEMO_VIEWS: tuple[tuple[str, Camera], ...] = (
     ("facing the robot: shelf tops, open space", FRONT),
-    ("behind the robot: shelf interiors, prepush regions", ROBOT_SIDE),
+    ("low, in front of the robot: shelf interiors, prepush regions", LOW),
 )

@@ -49,7 +49,8 @@ def test_a_learned_planner_decides_without_the_rules(kind):
     checkpoint = shipped(TASK_CHECKPOINT)
     for text in GOALS:
         goal = parse_goal(text)
-        for seed in range(2):
+        # the forward planner searches with f_reach at every node: one seed is its budget
+        for seed in range(2 if kind == "regression" else 1):
             calls: list[str] = []
             if kind == "regression":
                 planner = RegressionPlanner(checkpoint, seed=seed)

@@ -1,6 +1,7 @@
 """The HTML report: which failed episodes it shows, its refusals, and the page itself in a
 real headless browser (Debian's chromium, which `.ci/run` installs)."""
 
+import importlib.util
 import json
 import re
 import shutil
@@ -92,6 +93,9 @@ def test_a_folder_without_summary_is_told_apart_by_its_kind(tmp_path, kind, says
         read_summary(tmp_path)
 
 
+RERUN = importlib.util.find_spec("rerun") is not None
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed here")
 def test_the_page_loads_in_a_browser_with_every_image_and_no_console_error(tmp_path):
@@ -101,8 +105,12 @@ def test_the_page_loads_in_a_browser_with_every_image_and_no_console_error(tmp_p
     spec = episode_specs(config)[0]
     # logged as failed: re-simulated, the page shows the rollout (and says if it ended otherwise)
     _run_folder(tmp_path, "gnn", [_record(spec.seed, "overstep", goal=spec.goal)], config)
-    path = build_report(tmp_path, failures=1)
-    assert (tmp_path / "report" / f"gnn-2-{spec.seed}" / "episode.gif").exists()
+    path = build_report(tmp_path, failures=1, recordings=RERUN)
+    rollout = tmp_path / "report" / f"gnn-2-{spec.seed}"
+    assert (rollout / "episode.gif").exists()
+    if RERUN:  # the rollout's 3D recording, named on the page
+        assert (rollout / "episode.rrd").stat().st_size > 0
+        assert f"report/gnn-2-{spec.seed}/episode.rrd" in path.read_text()
     errors: list[str] = []
     with sync_playwright() as p:
         browser = p.chromium.launch(

@@ -160,6 +160,7 @@ def test_the_evaluation_sees_from_the_first_views_asked_for():
         assert all(r.found == 0 and not r.symbolic_match for r in results)
 
 
+@pytest.mark.slow
 def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand():
     from hsgplan.evaluation.loop_scenes import loop_scenes
     from hsgplan.evaluation.perception_eval import evaluate_loop
