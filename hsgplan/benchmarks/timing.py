@@ -25,6 +25,7 @@ from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
+from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.protocol import check_runs, episode_specs, run_evaluation
 from hsgplan.evaluation.table1 import TextTable
 from hsgplan.files import write_atomically
@@ -71,7 +72,16 @@ def _quartiles(values: list[float]) -> dict[str, float]:
 
 
 def timing_summary(records: Sequence[EpisodeRecord]) -> dict:
-    """Medians and quartiles of an agent's seconds per episode, and its success rate."""
+    """Medians and quartiles of an agent's seconds per episode, and its success rate, over the
+    episodes whose start scene could be sampled (the others are counted apart)."""
+    tried = [r for r in records if r.failure != Failure.UNSAMPLED]
+    if not tried:
+        raise InvalidInputError(
+            f"no start scene could be sampled for any of {len(records)} goals of "
+            f"{records[0].size} objects"
+        )
+    unsampled = len(records) - len(tried)
+    records = tried
     task = [r.task_seconds for r in records]
     motion = [r.motion_seconds for r in records]
     t, m = _quartiles(task), _quartiles(motion)
@@ -84,6 +94,7 @@ def timing_summary(records: Sequence[EpisodeRecord]) -> dict:
         "motion_q3": m["q3"],
         "success_rate": sum(r.success for r in records) / len(records),
         "episodes": len(records),
+        "unsampled_scenes": unsampled,
     }
 
 

@@ -18,6 +18,11 @@ class InfeasibleError(InvalidInputError):
     """Literals that contradict each other or that no physical scene can satisfy."""
 
 
+class UnsampledSceneError(InvalidInputError):
+    """No start scene could be drawn for a goal's objects within the sampler's attempts: the
+    world's limit, not an agent's failure (an evaluation records it and goes on)."""
+
+
 def a(noun: str) -> str:
     """`noun` behind its indefinite article, as a message reads it ("an eval-task run")."""
     return f"{'an' if noun[:1].lower() in 'aeiou' else 'a'} {noun}"

@@ -21,6 +21,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 from hsgplan.agents.base import Agent, Decision
+from hsgplan.domain.errors import UnsampledSceneError
 from hsgplan.domain.goals import Goal
 from hsgplan.evaluation.failures import Failure
 from hsgplan.scene_graph.symbol_mapping import AnomalyKind
@@ -95,6 +96,14 @@ def _step(d: dict) -> StepRecord:
     return StepRecord(**{**d, "disturbed": moved})
 
 
+def unsampled(seed: int, agent: str, goal: Goal, observer: str) -> EpisodeRecord:
+    """The record of an episode whose start scene could not be sampled: nothing was tried."""
+    failure = str(Failure.UNSAMPLED)
+    return EpisodeRecord(
+        seed, agent, str(goal), goal.size, False, 0.0, failure, (), 0.0, observer=observer
+    )
+
+
 def params_text(params) -> str:
     fields = ", ".join(f"{k}={v}" for k, v in asdict(params).items() if v is not None)
     return f"{type(params).__name__.removesuffix('Params').lower()}({fields})"
@@ -114,7 +123,10 @@ def run_episode(
     executed, `on_step` the start (record None) and every step after it. With
     `end_at_failure` (the paper's protocol) the first failed primitive ends it."""
     start = time.perf_counter()
-    _, info = env.reset(seed=seed, options=ResetOptions(goal))
+    try:
+        _, info = env.reset(seed=seed, options=ResetOptions(goal))
+    except UnsampledSceneError:
+        return unsampled(seed, agent.name, goal, env.observer.name)
     obs: Observation = info["observation"]
     agent.reset(goal, seed)
     if on_step:

@@ -24,6 +24,7 @@ from hsgplan.sim.outcome import DISTURB_TOL, SEEN_DISTURB_TOL, Status
 EXECUTION = "execution"
 OVERSTEP = "overstep"
 PERCEPTION = "perception"  # the goal seen reached where it truly was not, or an object never seen
+UNSAMPLED = "unsampled"  # no start scene: left out of every rate, counted apart
 _ENDED_BY_PERCEPTION = {Failure.MISPERCEIVED, Failure.NEVER_SEEN}
 # statuses of a primitive that failed in execution (an inapplicable one is the task level's)
 FAILED_EXECUTION = frozenset(s.value for s in Status) - {Status.SUCCESS, Status.INVALID}
@@ -39,6 +40,8 @@ def failed_steps(record: EpisodeRecord) -> list[str]:
 
 def class_of(failure: Failure) -> str:
     """The class of the taxonomy an episode ended by `failure` is counted in."""
+    if failure == Failure.UNSAMPLED:
+        return UNSAMPLED
     if failure in _ENDED_BY_PERCEPTION:
         return PERCEPTION
     if failure in _ENDED_BY_EXECUTION or failure == Failure.FAILED_PRIMITIVE:
@@ -121,6 +124,11 @@ def still_seen_moved(rs: Sequence[EpisodeRecord]) -> dict:
 
 
 def summarize(records: Sequence[EpisodeRecord]) -> dict:
-    """`{"by_size": {"2": {"success_rate", "subgoal_completion", "episodes", ...}, ...}}`."""
-    sizes = sorted({r.size for r in records})
-    return {"by_size": {str(n): size_summary([r for r in records if r.size == n]) for n in sizes}}
+    """`{"by_size": {"2": {"success_rate", "subgoal_completion", "episodes", ...}, ...},
+    "unsampled_scenes": {"12": 1, ...}}`. Episodes whose start scene could not be sampled are
+    the world's, not the agent's: left out of every rate and counted apart, by size."""
+    unsampled = Counter(str(r.size) for r in records if r.failure == Failure.UNSAMPLED)
+    tried = [r for r in records if r.failure != Failure.UNSAMPLED]
+    sizes = sorted({r.size for r in tried})
+    by_size = {str(n): size_summary([r for r in tried if r.size == n]) for n in sizes}
+    return {"by_size": by_size, "unsampled_scenes": dict(sorted(unsampled.items()))}

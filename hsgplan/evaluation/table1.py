@@ -220,8 +220,19 @@ def _results(report: dict) -> TextTable:
         f"Success rate / subgoal completion ({protocol_name(report)}): {source}{repeats}, "
         f"seed {report['seed']}"
     )
+    if unsampled := _unsampled(report):
+        title += (
+            f"; {unsampled} episode(s) whose start scene could not be sampled are left out "
+            "(the failure table)"
+        )
     title = marked(title, report["seed"])
     return TextTable(title, tuple(header), tuple(rows))
+
+
+def _unsampled(report: dict) -> int:
+    """Episodes of every method whose start scene could not be sampled (summaries from before
+    this count existed have none)."""
+    return sum(sum(s.get("unsampled_scenes", {}).values()) for s in report["methods"].values())
 
 
 def _failures(report: dict) -> TextTable:
@@ -231,11 +242,13 @@ def _failures(report: dict) -> TextTable:
         for s in report["methods"].values()
         for v in s["by_size"].values()
     )
+    unsampled = _unsampled(report) > 0
     rows = []
     for m, s in report["methods"].items():
         for n in _sizes(report["methods"]):
             if v := s["by_size"].get(str(n)):
                 failed = v["episodes"] - round(v["success_rate"] * v["episodes"])
+                skipped = s.get("unsampled_scenes", {}).get(str(n), 0)
                 fc = v["failure_classes"]
                 rows.append(
                     (label(m), str(n), str(v["episodes"]), str(failed))
@@ -251,6 +264,7 @@ def _failures(report: dict) -> TextTable:
                         )
                     )
                     + ((str(v.get("relooks", "—")),) if seen else ())
+                    + ((str(skipped),) if unsampled else ())
                 )
     title = (
         f"Failures ({protocol_name(report)}), by what ended the episode: execution (a failed "
@@ -267,6 +281,12 @@ def _failures(report: dict) -> TextTable:
     header += (PERCEPTION,) if seen else ()
     header += ("failed primitives", "overstep after failures", "disturbing steps")
     header += ("relooks",) if seen else ()
+    if unsampled:
+        title += (
+            "; unsampled: goals whose start scene could not be sampled (the world's limit, "
+            "not the agent's failure), left out of every column before it"
+        )
+        header += ("unsampled",)
     return TextTable(title, header, tuple(rows))
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import random
 
-from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.errors import UnsampledSceneError
 from hsgplan.domain.objects import EntityKind, kind_of, object_type
 from hsgplan.domain.parameters import place_inset
 from hsgplan.domain.predicates import Predicate
@@ -51,7 +51,7 @@ def sample_scene(
             scene.robot.hold_position()
             return scene, state
     scene.close()
-    raise InvalidInputError(
+    raise UnsampledSceneError(
         f"no collision-free arrangement of {len(objects)} objects found in {ATTEMPTS} attempts "
         f"(seed {seed})"
     )
