@@ -8,7 +8,9 @@ Playwright), its window saved as a PNG once the recording has loaded.
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -58,6 +60,7 @@ def main() -> None:
         ],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
+        start_new_session=True,  # `rerun` starts the viewer's own binary: both end together
     )
     width, height = (int(v) for v in args.size.split("x"))
     try:
@@ -71,7 +74,7 @@ def main() -> None:
             page.screenshot(path=str(args.out))
             browser.close()
     finally:
-        server.terminate()
+        os.killpg(server.pid, signal.SIGTERM)
         server.wait()
     print(f"wrote {args.out}")
 

@@ -12,6 +12,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import imageio.v3 as iio
+import numpy as np
 
 from hsgplan.agents.base import Agent, Decision
 from hsgplan.agents.registry import make_agent
@@ -77,17 +78,22 @@ def run_demo(
     waypoints = 0
     caption = ["start", "", f"goal: {goal}"]
 
-    cameras = [
-        replace(c, width=round(c.width * scale), height=round(c.height * scale))
-        for _, c in DEMO_VIEWS
+    panels = [
+        [replace(c, width=round(c.width * scale), height=round(c.height * scale)) for c in cams]
+        for _, cams in DEMO_VIEWS
     ]
 
-    def snapshot():
-        views = [env.render(camera) for camera in cameras]
+    def view(camera):
+        image = env.render(camera)
         if seeing:
             from hsgplan.perception.draw import draw_cuboids
 
-            views = [draw_cuboids(v, c, believed) for v, c in zip(views, cameras, strict=True)]
+            image = draw_cuboids(image, camera, believed)
+        return image
+
+    def snapshot():
+        # a panel of several cameras stacks their pictures, top to bottom
+        views = [np.vstack([view(c) for c in cams]) for cams in panels]
         return compose(views, [name for name, _ in DEMO_VIEWS], caption, scale)
 
     def on_frame() -> None:

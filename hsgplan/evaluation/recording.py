@@ -33,7 +33,7 @@ from hsgplan.domain.world import Kind
 from hsgplan.perception.draw import EDGES
 from hsgplan.perception.keypoints import PinholeCamera, in_world
 from hsgplan.scene_graph.geometry import Pose
-from hsgplan.sim.render import DEMO_VIEWS, Camera
+from hsgplan.sim.render import DEMO_CAMERAS, Camera
 from hsgplan.sim.scene import Scene
 from hsgplan.sim.sensing import CameraObserver, Look, Seen
 from hsgplan.sim.visuals import BOX, CYLINDER, SPHERE, VisualPart, link_pose, links_of, visual_parts
@@ -45,7 +45,6 @@ if TYPE_CHECKING:
 APP = "hsgplan"
 EVERY = 3  # arm waypoints between two recorded frames
 UNSURE = (255, 140, 0, 255)
-DEMO_NAMES = ("demo_front", "demo_low")
 JPEG = 85
 
 
@@ -159,8 +158,8 @@ class EpisodeRecording:
         for j, part in enumerate(parts):
             path = f"robot/links/link_{part.link}/part_{j}"
             self._log(path, _transform(part.local), _shape(part), static=True)
-        for name, camera in zip(DEMO_NAMES, (c for _, c in DEMO_VIEWS), strict=True):
-            self._camera(name, camera)
+        for name, camera in DEMO_CAMERAS.items():
+            self._camera(f"demo_{name}", camera)
         if isinstance(env.observer, CameraObserver):
             for k, camera in enumerate(env.observer.cameras):
                 self._camera(f"view_{k}", camera)
@@ -283,9 +282,9 @@ class EpisodeRecording:
             rr.GraphNodes(node_ids=nodes, labels=nodes),
             rr.GraphEdges(edges=edges, graph_type="directed"),
         )
-        for name, (_, camera) in zip(DEMO_NAMES, DEMO_VIEWS, strict=True):
+        for name, camera in DEMO_CAMERAS.items():
             image = self.env.render(camera)
-            self._log(f"cameras/{name}/image", rr.Image(image).compress(jpeg_quality=JPEG))
+            self._log(f"cameras/demo_{name}/image", rr.Image(image).compress(jpeg_quality=JPEG))
 
     def _path(self) -> None:
         """The hand's planned path for the step just run, by the arm's kinematics."""
@@ -320,7 +319,10 @@ def blueprint():
             ),
             rrb.Horizontal(
                 rrb.Spatial2DView(name="front", origin="cameras/demo_front/image"),
-                rrb.Spatial2DView(name="low", origin="cameras/demo_low/image"),
+                rrb.Vertical(
+                    rrb.Spatial2DView(name="shelf A's side", origin="cameras/demo_side_a/image"),
+                    rrb.Spatial2DView(name="shelf B's side", origin="cameras/demo_side_b/image"),
+                ),
                 rrb.GraphView(name="symbolic scene graph", origin="plan/graph"),
                 rrb.Vertical(
                     rrb.TextDocumentView(name="subgoal", origin="plan/subgoal"),

@@ -29,6 +29,22 @@ def one_core() -> None:
         sys.modules["torch"].set_num_threads(1)
 
 
+def worker_start(parent: int) -> None:
+    """A pool worker's first act: one core (`one_core`), and on Linux an end with its parent:
+    a job killed however it was (SIGTERM, SIGKILL) takes its workers with it, where they would
+    otherwise go on running the items queued to them."""
+    one_core()
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+    import signal
+
+    pr_set_pdeathsig = 1
+    ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGTERM)
+    if os.getppid() != parent:  # the parent died before the signal was asked for
+        os._exit(1)
+
+
 # Times a work item is run again after the process running it died (killed, out of memory)
 # before the job gives up on it: an item that kills its worker every time is not retried
 # forever.
@@ -70,7 +86,9 @@ class LocalEngine:
 
     def _new_pool(self) -> ProcessPoolExecutor:
         context = multiprocessing.get_context("spawn")
-        return ProcessPoolExecutor(self.workers, mp_context=context, initializer=one_core)
+        return ProcessPoolExecutor(
+            self.workers, mp_context=context, initializer=worker_start, initargs=(os.getpid(),)
+        )
 
     def submit(self, fn: Callable, *args) -> int:
         handle = next(self.count)

@@ -38,14 +38,21 @@ class Camera:
         return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3]
 
 
-# The demo's two views, 640 x 480 each: between them every object is in sight whatever the arm
-# does. Facing the robot from beyond the table, the arm stays behind the objects: shelf tops,
-# the open space and what stands on them (shelf B on the left). Low in front of the robot's
-# base, under the shelves' top boards and wide: both shelves' interiors and the prepush
-# regions, with the arm above the view except where it reaches down into them.
+# The demo's two panels, 640 x 480 each: between them every object is in sight whatever the
+# arm does. Facing the robot from beyond the table, the arm stays behind the objects: shelf
+# tops, the open space and what stands on them (shelf B on the left). From each side of the
+# table, low, one shelf's interior through its open front and its prepush region (shelf A's
+# above, shelf B's below): the arm is seen from the side, never between the view and the shelf
+# (from behind the robot, or in front of its base, it filled the view).
 FRONT = Camera(640, 480, (1.3, 0.0, 1.25), (0.38, 0.0, 0.0), 52.0)
-LOW = Camera(640, 480, (0.12, 0.0, 0.30), (0.5, 0.0, 0.05), 95.0)
-DEMO_VIEWS: tuple[tuple[str, Camera], ...] = (
-    ("facing the robot: shelf tops, open space", FRONT),
-    ("low, in front of the robot: shelf interiors, prepush regions", LOW),
+SIDE_A = Camera(640, 240, (0.0, 0.80, 0.24), (0.47, 0.36, 0.08), 30.0)
+SIDE_B = Camera(640, 240, (0.0, -0.80, 0.24), (0.47, -0.36, 0.08), 30.0)
+DEMO_VIEWS: tuple[tuple[str, tuple[Camera, ...]], ...] = (
+    ("facing the robot: shelf tops, open space", (FRONT,)),
+    (
+        "from the sides, low: shelf A's interior and prepush region, then shelf B's",
+        (SIDE_A, SIDE_B),
+    ),
 )
+# each camera of the demo by name, as a recording logs them
+DEMO_CAMERAS: dict[str, Camera] = {"front": FRONT, "side_a": SIDE_A, "side_b": SIDE_B}

@@ -78,7 +78,7 @@ def test_an_episode_recorded_holds_truth_belief_robot_cameras_and_every_step(tmp
     assert any("Transform3D:translation" in entities[e] for e in links)  # and where they are
     assert "LineStrips3D:strips" in entities["/robot/path"]
     assert "EncodedImage:blob" in entities["/cameras/demo_front/image"]
-    assert "Pinhole:image_from_camera" in entities["/cameras/demo_low/image"]
+    assert "Pinhole:image_from_camera" in entities["/cameras/demo_side_b/image"]
     assert "GraphEdges:edges" in entities["/plan/graph"]
     # one log line for the start and one for every step, on the step timeline
     assert _steps(rrd, "/log/steps") == list(range(len(recorded.steps) + 1))

@@ -17,9 +17,9 @@ from hsgplan.perception.keypoints import (
 )
 from hsgplan.perception.pnp import ViewKeypoints, estimate_pose
 from hsgplan.scene_graph.geometry import Pose
-from hsgplan.sim.render import FRONT, LOW, Camera
+from hsgplan.sim.render import FRONT, SIDE_A, Camera
 
-VIEWS = [PinholeCamera.of(FRONT), PinholeCamera.of(LOW)]
+VIEWS = [PinholeCamera.of(FRONT), PinholeCamera.of(SIDE_A)]
 
 
 def _pose(rng: np.random.Generator, obj: str) -> Pose:

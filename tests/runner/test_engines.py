@@ -6,6 +6,9 @@ import functools
 import json
 import os
 import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -28,6 +31,54 @@ def always_die(item: int) -> int:
     if item == 1:
         os.kill(os.getpid(), signal.SIGKILL)
     return item
+
+
+def sleep_and_tell(folder: str, item: int) -> int:
+    """Writes its worker's pid, then works for a long while."""
+    (Path(folder) / f"worker-{os.getpid()}").touch()
+    time.sleep(60)
+    return item
+
+
+PARENT = """
+import functools, sys
+from hsgplan.runner.engines import LocalEngine
+sys.path.insert(0, {tests!r})
+from runner.test_engines import sleep_and_tell
+pool = LocalEngine(2)
+for item in range(4):
+    pool.submit(functools.partial(sleep_and_tell, {folder!r}), item)
+pool.next_done({{0}})
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux's parent-death signal")
+def test_a_job_killed_with_sigkill_takes_its_workers_with_it(tmp_path):
+    tests = str(Path(__file__).resolve().parents[1])
+    code = PARENT.format(tests=tests, folder=str(tmp_path))
+    parent = subprocess.Popen([sys.executable, "-c", code])
+    try:
+        deadline = time.monotonic() + 60
+        while len(list(tmp_path.glob("worker-*"))) < 2:
+            assert parent.poll() is None and time.monotonic() < deadline
+            time.sleep(0.1)
+    finally:
+        parent.kill()
+        parent.wait()
+    workers = [int(p.name.removeprefix("worker-")) for p in tmp_path.glob("worker-*")]
+    deadline = time.monotonic() + 20
+    while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(_alive(pid) for pid in workers)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    with open(f"/proc/{pid}/stat") as f:  # a zombie awaiting its reaper is no worker
+        return f.read().split()[2] != "Z"
 
 
 def test_an_item_whose_worker_is_killed_runs_again_and_is_logged_once(tmp_path):
