@@ -30,8 +30,8 @@ import numpy as np
 from hsgplan.agents.base import Decision
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.world import Kind
-from hsgplan.perception.draw import EDGES
-from hsgplan.perception.keypoints import PinholeCamera, in_world
+from hsgplan.perception.draw import EDGES, cuboid_pixels
+from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import DEMO_CAMERAS, Camera
 from hsgplan.sim.scene import Scene
@@ -64,11 +64,11 @@ def _transform(pose: Pose):
     )
 
 
-def _shape(part: VisualPart, alpha: float = 1.0):
+def _shape(part: VisualPart):
     """The rerun archetype drawing one visual part in its own frame."""
     import rerun as rr
 
-    colour = _rgba((*part.rgba[:3], part.rgba[3] * alpha))
+    colour = _rgba(part.rgba)
     if part.kind == BOX:
         return rr.Boxes3D(
             half_sizes=[np.asarray(part.size) / 2], colors=[colour], fill_mode="solid"
@@ -215,9 +215,8 @@ class EpisodeRecording:
                         seen_px = v.pixels[~np.isnan(v.pixels).any(axis=1)]
                         points.extend(seen_px.tolist())
                         labels.extend([d.type_name] * len(seen_px))
-                corners = in_world(d.type_name, d.pose)
-                if (pinhole.to_camera(corners)[:, 2] > 0).all():
-                    px = pinhole.project(corners)
+                px = cuboid_pixels(d.type_name, d.pose, pinhole)
+                if px is not None:
                     strips.extend([px[a], px[b]] for a, b in EDGES)
             self._log(f"{base}/keypoints", rr.Points2D(points, labels=labels or None, radii=2.0))
             self._log(f"{base}/detections", rr.LineStrips2D(strips, colors=[40, 220, 60]))

@@ -19,6 +19,15 @@ EDGES = tuple(
 COLOR = (40, 220, 60)
 
 
+def cuboid_pixels(obj: str, pose: Pose, pinhole: PinholeCamera) -> np.ndarray | None:
+    """The object's 9 keypoints where `pose` puts it, in `pinhole`'s pixels: [9, 2]; None
+    where any of them is behind the camera."""
+    points = in_world(obj, pose)
+    if (pinhole.to_camera(points)[:, 2] <= 0).any():
+        return None
+    return pinhole.project(points)
+
+
 def draw_cuboids(image: np.ndarray, camera: Camera, poses: dict[str, Pose]) -> np.ndarray:
     """A copy of `image` (taken by `camera`) with each object's cuboid at its pose drawn on it.
 
@@ -29,10 +38,10 @@ def draw_cuboids(image: np.ndarray, camera: Camera, poses: dict[str, Pose]) -> n
     pinhole = PinholeCamera.of(camera)
     thickness = max(1, round(camera.height / 240))
     for obj, pose in poses.items():
-        points = in_world(obj, pose)
-        if (pinhole.to_camera(points)[:, 2] <= 0).any():  # behind the camera
+        projected = cuboid_pixels(obj, pose, pinhole)
+        if projected is None:  # behind the camera
             continue
-        pixels = np.round(pinhole.project(points)).astype(int)
+        pixels = np.round(projected).astype(int)
         for a, b in EDGES:
             cv2.line(out, tuple(pixels[a]), tuple(pixels[b]), COLOR, thickness, cv2.LINE_AA)
         cv2.circle(out, tuple(pixels[-1]), thickness + 1, COLOR, -1, cv2.LINE_AA)
