@@ -39,7 +39,12 @@ def bench_sim(
     records = []
     for spec in specs:
         records.append(
-            run_episode(KitchenStorageEnv(), make_agent("oracle"), parse_goal(spec.goal), spec.seed)
+            run_episode(
+                KitchenStorageEnv(visuals=False),
+                make_agent("oracle"),
+                parse_goal(spec.goal),
+                spec.seed,
+            )
         )
         if on_episode:
             on_episode(records[-1])

@@ -36,7 +36,9 @@ def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
             actions.append(record.action)
         states.append(obs.symbols.state)
 
-    result = run_episode(KitchenStorageEnv(), make_agent("oracle"), goal, seed, on_step=on_step)
+    result = run_episode(
+        KitchenStorageEnv(visuals=False), make_agent("oracle"), goal, seed, on_step=on_step
+    )
     if not result.success or not actions or any(s.status != "success" for s in result.steps):
         return None  # a failure, a detour, or a goal that held from the start shows nothing
     return Demo(

@@ -221,7 +221,7 @@ class ReachItem:
 
 @functools.cache
 def _process_scene() -> Scene:
-    return Scene(())
+    return Scene((), visuals=False)
 
 
 def run_reach_item(item: ReachItem) -> dict:

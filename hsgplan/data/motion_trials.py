@@ -82,7 +82,7 @@ def run_chunk(
     kind = MotionPrimitive(primitive)
     trials: list[Trial] = []
     unstaged = 0
-    with Scene((), seed=seed) as scene:
+    with Scene((), seed=seed, visuals=False) as scene:
         for index in range(chunk * tasks_per_chunk, (chunk + 1) * tasks_per_chunk):
             got = run_task(scene, draw_task(kind, seed, index))
             unstaged += got is None

@@ -81,7 +81,7 @@ def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> l
         for name in generators:
             # A fresh scene per model: a restored physics state still carries the solver's
             # contact caches, so one model's trial would nudge the next one's outcome.
-            with Scene((), seed=seed) as scene:
+            with Scene((), seed=seed, visuals=False) as scene:
                 staged = stage_task(scene, task)
                 if staged is None:
                     break

@@ -157,7 +157,9 @@ def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
     from hsgplan.sim.env import KitchenStorageEnv
 
     agent = _worker_agent(config)
-    env = KitchenStorageEnv(observer=_worker_observer(config), relook=config.rules().relook)
+    env = KitchenStorageEnv(
+        observer=_worker_observer(config), relook=config.rules().relook, visuals=False
+    )
     goal = parse_goal(spec.goal)
     record = run_episode(env, agent, goal, spec.seed, end_at_failure=config.protocol == PAPER)
     return replace(record, repeat=spec.repeat).to_json()

@@ -294,7 +294,7 @@ class EpisodeRecording:
             self._log("robot/path", rr.Clear(recursive=False))
             return
         if self._kinematics is None:
-            self._kinematics = Scene(())
+            self._kinematics = Scene((), visuals=False)
         robot = self._kinematics.robot
         joints = (*plan.path, plan.q_above, *plan.descent, plan.q_at, *plan.line)
         points = []

@@ -30,7 +30,7 @@ class BeliefWorld:
     """
 
     def __init__(self, objects: Iterable[str], seed: int) -> None:
-        self.scene = Scene(objects, seed)
+        self.scene = Scene(objects, seed, visuals=False)  # a model: never pictured
         self.holding: str | None = None
 
     def close(self) -> None:

@@ -99,6 +99,9 @@ class KitchenStorageEnv(gymnasium.Env):
             observer makes the robot act on its belief (see the module).
         relook: with a camera observer, look again from out of the cameras' way before acting
             on an object the belief is unsure of (a recovery rule of perception's, switchable).
+        visuals: load the arm's visual meshes, for pictures of the scene (rendering, a camera
+            observer, a demo's frames); an env nothing pictures resets faster without them,
+            and runs the same episodes.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
@@ -112,6 +115,7 @@ class KitchenStorageEnv(gymnasium.Env):
         render_mode: str | None = None,
         observer: SceneObserver | CameraObserver | None = None,
         relook: bool = True,
+        visuals: bool = True,
     ):
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
@@ -126,6 +130,7 @@ class KitchenStorageEnv(gymnasium.Env):
         self.observer = observer or GroundTruth()
         self.believing = isinstance(self.observer, CameraObserver)
         self.relook = relook
+        self.visuals = visuals or render or render_mode is not None or self.believing
         self.world: BeliefWorld | None = None  # the robot's model, with a camera observer
         self._seen: Seen | None = None  # the belief's last look
         self._judged: Seen | None = None  # the look that judged the last step, if one did
@@ -153,7 +158,9 @@ class KitchenStorageEnv(gymnasium.Env):
         options = _options(options, self.objects, scene_seed)
         self.close()
         self.goal = options.goal
-        self.scene, _ = sample_scene(options.goal.objects, scene_seed, options.p_elsewhere)
+        self.scene, _ = sample_scene(
+            options.goal.objects, scene_seed, options.p_elsewhere, self.visuals
+        )
         self.steps = 0
         self._checked.clear()
         self._seen = self._judged = self._released = None

@@ -35,14 +35,14 @@ STACK_JITTER = 0.005
 
 
 def sample_scene(
-    objects: tuple[str, ...], seed: int, p_elsewhere: float = 0.3
+    objects: tuple[str, ...], seed: int, p_elsewhere: float = 0.3, visuals: bool = True
 ) -> tuple[Scene, SymbolicSceneGraph]:
-    """A settled scene for the objects and the symbolic state it is in.
+    """A settled scene for the objects and the symbolic state it is in (`visuals`: `Scene`'s).
 
     The same seed gives the same scene: every random number comes from `seed`.
     """
     rng = random.Random(f"scene-{seed}")
-    scene = Scene(objects, seed=seed)
+    scene = Scene(objects, seed=seed, visuals=visuals)
     for _ in range(ATTEMPTS):
         state = random_state(objects, rng, p_elsewhere=p_elsewhere)
         for o in objects:
