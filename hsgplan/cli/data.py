@@ -42,15 +42,25 @@ def demos(
         Path,
         typer.Option("--out", help="Dataset folder (resumed if it exists).", parser=out_folder),
     ] = RUNS / "collect-demos",
+    full_scene: Annotated[
+        bool,
+        typer.Option(
+            "--full-scene",
+            help="Record each in a scene of one object of every type, not of the goal's alone.",
+        ),
+    ] = False,
 ) -> None:
     """Record the paper's 18 short demonstrations with the oracle in the simulated world."""
     from hsgplan.collect.demos import collect_demos
     from hsgplan.data.demos import TASKS
 
     command = f"hsgplan collect demos --seed {seed} --out {out_dir}"
+    command += " --full-scene" * full_scene
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("demonstrations", total=len(TASKS))
-        done = collect_demos(out_dir, seed, command, lambda d: progress.advance(task))
+        done = collect_demos(
+            out_dir, seed, command, lambda d: progress.advance(task), full_scene=full_scene
+        )
         progress.update(task, completed=len(TASKS))
     steps = sum(len(d.actions) for d in done)
     out.print(f"{len(done)} demonstrations, {steps} transitions, in {shown(out_dir)}")

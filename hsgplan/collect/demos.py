@@ -1,6 +1,11 @@
 """Recording the demonstrations: oracle episodes in the simulated world, one per task of
 `hsgplan.data.demos.TASKS`, appended to the dataset folder as each finishes (an interrupted
-recording, started again, records only the tasks that are missing)."""
+recording, started again, records only the tasks that are missing).
+
+A demonstration's scene holds the objects its goal names, or, with `full_scene`, one object of
+every type (the paper does not say its demonstrations' scenes hold only the named objects):
+the others rest wherever the sampler puts them, and the oracle moves them when they are in the
+way."""
 
 from __future__ import annotations
 
@@ -13,19 +18,21 @@ from hsgplan.data.demos import DEMOS, FORMAT, META, TASKS, VERSION, Demo, read_d
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.files import write_atomically
 from hsgplan.runner.lock import hold_folder
 from hsgplan.runner.run_folder import check_own
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.sim.env import KitchenStorageEnv
+from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
 
 RETRIES = 5
 
 
-def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
+def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) -> Demo | None:
     """Run the oracle on one task; the demonstration, or None if the episode failed."""
     goal = parse_goal(goal_text)
+    others = tuple(t for t in OBJECT_TYPES if t not in goal.objects) if full_scene else ()
     states: list[SymbolicSceneGraph] = []
     actions: list[str] = []
 
@@ -37,7 +44,12 @@ def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
         states.append(obs.symbols.state)
 
     result = run_episode(
-        KitchenStorageEnv(visuals=False), make_agent("oracle"), goal, seed, on_step=on_step
+        KitchenStorageEnv(visuals=False),
+        make_agent("oracle"),
+        goal,
+        seed,
+        on_step=on_step,
+        others=others,
     )
     if not result.success or not actions or any(s.status != "success" for s in result.steps):
         return None  # a failure, a detour, or a goal that held from the start shows nothing
@@ -45,32 +57,42 @@ def record_demo(task: str, goal_text: str, seed: int) -> Demo | None:
         task,
         goal_text,
         seed,
-        goal.objects,
+        ResetOptions(goal, others=others).objects(),
         tuple(actions),
         tuple(tuple(str(lit) for lit in s.sorted_literals()) for s in states),
     )
 
 
-def _recorded(out: Path, seed: int) -> dict[str, Demo]:
-    """The demonstrations already in `out`, by task; a set made with another seed refused."""
+def _recorded(out: Path, seed: int, full_scene: bool) -> dict[str, Demo]:
+    """The demonstrations already in `out`, by task; a set made with another seed or scene
+    refused."""
     meta_path = out / META
     if meta_path.exists():
         saved = read_json(meta_path, "demonstration metadata")
         if saved.get("seed") != seed or saved.get("version") != VERSION:
             raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
+        if saved.get("full_scene", False) != full_scene:
+            scene = "every object type" if saved.get("full_scene") else "the goal's objects"
+            raise InvalidInputError(f"'{out}' holds demonstrations recorded in {scene} only")
     return {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
 
 
 def collect_demos(
-    out: Path, seed: int, command: str = "", on_demo: Callable[[Demo], None] | None = None
+    out: Path,
+    seed: int,
+    command: str = "",
+    on_demo: Callable[[Demo], None] | None = None,
+    full_scene: bool = False,
 ) -> list[Demo]:
     """Record every task not yet in `out` (appending as each finishes); all demos, in order."""
     check_own(out, META, "demonstration set")  # never into another command's folder
     meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
+    if full_scene:
+        meta["full_scene"] = True
     meta_path = out / META
-    _recorded(out, seed)
+    _recorded(out, seed, full_scene)
     hold_folder(out)  # one writer: a second collection into `out` is refused
-    done = _recorded(out, seed)  # again, now that the folder is ours
+    done = _recorded(out, seed, full_scene)  # again, now that the folder is ours
     if not meta_path.exists():
         write_atomically(meta_path, json.dumps(meta, indent=2) + "\n")
     path = out / DEMOS
@@ -81,7 +103,7 @@ def collect_demos(
         if task in done:
             continue
         for attempt in range(RETRIES):
-            demo = record_demo(task, goal, seed * 1000 + i * RETRIES + attempt)
+            demo = record_demo(task, goal, seed * 1000 + i * RETRIES + attempt, full_scene)
             if demo is not None:
                 break
         else:

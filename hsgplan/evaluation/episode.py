@@ -118,13 +118,15 @@ def run_episode(
     on_step: Callable[[StepRecord | None, Observation], None] | None = None,
     on_decide: Callable[[int, Decision], None] | None = None,
     end_at_failure: bool = False,
+    others: tuple[str, ...] = (),
 ) -> EpisodeRecord:
     """Run one episode; `on_decide` sees each decision (with its step number) before it is
     executed, `on_step` the start (record None) and every step after it. With
-    `end_at_failure` (the paper's protocol) the first failed primitive ends it."""
+    `end_at_failure` (the paper's protocol) the first failed primitive ends it. `others`:
+    objects in the scene that the goal does not name (`ResetOptions`)."""
     start = time.perf_counter()
     try:
-        _, info = env.reset(seed=seed, options=ResetOptions(goal))
+        _, info = env.reset(seed=seed, options=ResetOptions(goal, others=others))
     except UnsampledSceneError:
         return unsampled(seed, agent.name, goal, env.observer.name)
     obs: Observation = info["observation"]

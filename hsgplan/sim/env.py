@@ -27,6 +27,7 @@ import gymnasium
 import numpy as np
 
 from hsgplan.domain.goals import Goal, parse_goal
+from hsgplan.domain.objects import sort_objects
 from hsgplan.domain.parameters import PickParams, PrimitiveParams
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -76,10 +77,16 @@ class Observation:
 
 @dataclass(frozen=True)
 class ResetOptions:
-    """What an episode is about: the goal (the scene holds exactly its objects)."""
+    """What an episode is about: the goal, and the scene's objects: the goal's, and `others`
+    (objects no goal literal names, placed by the same sampler: the full scene a demonstration
+    may be recorded in)."""
 
     goal: Goal
     p_elsewhere: float = 0.3
+    others: tuple[str, ...] = ()
+
+    def objects(self) -> tuple[str, ...]:
+        return sort_objects({*self.goal.objects, *self.others})
 
 
 class KitchenStorageEnv(gymnasium.Env):
@@ -159,14 +166,14 @@ class KitchenStorageEnv(gymnasium.Env):
         self.close()
         self.goal = options.goal
         self.scene, _ = sample_scene(
-            options.goal.objects, scene_seed, options.p_elsewhere, self.visuals
+            options.objects(), scene_seed, options.p_elsewhere, self.visuals
         )
         self.steps = 0
         self._checked.clear()
         self._seen = self._judged = self._released = None
         if self.believing:
-            self.world = BeliefWorld(options.goal.objects, scene_seed)
-            self.observer.start(options.goal.objects)
+            self.world = BeliefWorld(options.objects(), scene_seed)
+            self.observer.start(options.objects())
         else:
             self.observer.reset(self.scene)
         typed = self._observe()
@@ -178,7 +185,7 @@ class KitchenStorageEnv(gymnasium.Env):
         if self.scene is None or self.goal is None:
             raise RuntimeError("call reset() before step()")
         params = (
-            action if isinstance(action, PrimitiveParams) else decode(self.goal.objects, action)
+            action if isinstance(action, PrimitiveParams) else decode(self.scene.objects, action)
         )
         true_before = self.scene.poses()
         self.last_plan = None
@@ -385,7 +392,7 @@ class KitchenStorageEnv(gymnasium.Env):
         return self._judged_from
 
     def _encode(self, typed: Observation) -> dict:
-        return encode(self.goal.objects, typed.scene_graph, typed.symbols.state)
+        return encode(self.scene.objects, typed.scene_graph, typed.symbols.state)
 
 
 def _options(options: ResetOptions | dict | None, objects: int, seed: int) -> ResetOptions:

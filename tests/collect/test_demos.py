@@ -82,3 +82,28 @@ def test_cli_refuses_a_dataset_made_with_another_seed(tmp_path):
     )
     r = CliRunner().invoke(app, ["collect", "demos", "--seed", "0", "--out", str(tmp_path)])
     assert r.exit_code == 2 and "another seed" in r.stderr
+
+
+FULL_SCENE = SHIPPED.parent / "full-scene"
+
+
+def test_full_scene_demos_hold_every_type_and_replay_in_the_transition_model():
+    from hsgplan.domain.world import OBJECT_TYPES
+
+    demos = load_demos(FULL_SCENE)
+    assert [d.task for d in demos] == [t for t, _ in TASKS]
+    assert json.loads((FULL_SCENE / "meta.json").read_text())["full_scene"] is True
+    for d in demos:
+        assert sorted(d.objects) == sorted(OBJECT_TYPES), d.task
+        states, actions = d.symbolic_states(), d.symbolic_actions()
+        assert d.goal_literals().satisfied_by(states[-1])
+        for before, action, after in zip(states[:-1], actions, states[1:], strict=True):
+            assert apply(before, action) == after, (d.task, str(action))
+
+
+def test_a_full_scene_collection_is_not_resumed_as_a_goal_objects_one(tmp_path, monkeypatch):
+    monkeypatch.setattr(record_demos, "TASKS", TASKS[:1])
+    (demo,) = collect_demos(tmp_path, seed=3, full_scene=True)
+    assert len(demo.objects) == 6 and len(demo.goal_literals().objects) == 1
+    with pytest.raises(InvalidInputError, match="every object type"):
+        collect_demos(tmp_path, seed=3)

@@ -56,6 +56,22 @@ def test_paper_reach_labels_come_from_demonstrated_changes_and_their_alterations
         assert ex.mask.any() and ex.target[ex.mask].max() <= 1
 
 
+def test_predicate_only_alterations_keep_the_edge_and_change_its_predicate():
+    from hsgplan.planning.regression.encoding import Slots
+
+    demo = next(d for d in load_demos(DEMOS) if d.task == "inside-cherries-shelf_a")
+    examples = paper_reach_examples([demo], singles=1, predicates_only=True)
+    negatives, positives = set(), set()
+    for ex in examples:
+        slots = Slots(tuple(ex.data.names))
+        for e, p in ex.mask.nonzero().tolist():
+            (positives if ex.target[e, p] else negatives).add(slots.literal(e, p))
+    assert {in_grasp("cherries"), inside("cherries", "shelf_a")} <= positives
+    # In(cherries, shelf_a) as On: the one alteration that does not hold already (Clear,
+    # InGrasp's other predicate, held before the pick); no other subject or target
+    assert negatives == {on("cherries", "shelf_a")}
+
+
 def test_world_labels_are_what_the_executed_action_made_hold():
     from hsgplan.data.world_trials import WorldTrial
 

@@ -136,6 +136,21 @@ def _alterations(lit: Literal, state: SymbolicSceneGraph) -> set[Literal]:
     return out
 
 
+def _other_predicates(lit: Literal, state: SymbolicSceneGraph) -> set[Literal]:
+    """The paper's words taken narrowly ("altering predicates of edges"): the same edge or
+    node under each other predicate (On for In and, towards a shelf, In for On; InGrasp for
+    Clear and Clear for InGrasp). The subject and target stay."""
+    if lit.predicate.arity == 2:
+        a, x = lit.args
+        out = {Literal(Predicate.ON, (a, x))}
+        if kind_of(x) is EntityKind.SHELF:
+            out.add(Literal(Predicate.IN, (a, x)))
+    else:
+        out = {Literal(p, lit.args) for p in (Predicate.IN_GRASP, Predicate.CLEAR)}
+    out.discard(lit)
+    return out
+
+
 def _labelled(state: SymbolicSceneGraph, labels: dict[Literal, bool]) -> Example:
     data = encode(state, labels)
     slots = Slots(tuple(data.names))
@@ -166,18 +181,26 @@ def demonstrated_reach(traj: Trajectory | Demo) -> list[tuple[SymbolicSceneGraph
     return out
 
 
-def paper_reach_examples(demos: list[Trajectory] | list[Demo], seed: int = 0, singles: int = 12):
+def paper_reach_examples(
+    demos: list[Trajectory] | list[Demo],
+    seed: int = 0,
+    singles: int = 12,
+    predicates_only: bool = False,
+):
     """The paper's f_reach labels: what each demonstrated step changed is reachable from the
     state before it; the alterations of what it made true are not (the paper labels them all
     unreachable, though some are: placing on another free surface is one primitive too).
-    Every label at once, and up to `singles` of each class alone."""
+    Alterations change the subject, the target or the predicate, or with `predicates_only` the
+    predicate alone (`_other_predicates`). Every label at once, and up to `singles` of each
+    class alone."""
     rng = random.Random(f"reach-{seed}")
+    alter = _other_predicates if predicates_only else _alterations
     out = []
     for traj in demos:
         for state, changed in demonstrated_reach(traj):
             labels = dict.fromkeys(changed, True)
             for lit in [c for c in changed if c.positive]:
-                for alt in _alterations(lit, state) - changed:
+                for alt in alter(lit, state) - changed:
                     if not state.holds(alt):
                         labels[alt] = False
             pos = sorted(c for c, y in labels.items() if y)

@@ -43,7 +43,9 @@ from hsgplan.planning.regression.gnn import (
 )
 
 NETWORKS = {"preimage": 3, "reach": 2, "forward": 3}
-REACH_SOURCES = ("world", "alterations")
+# f_reach's labels: "world" (executed primitives), "alterations" (the demonstrated changes and
+# their alterations in subject, target or predicate), "predicates" (in the predicate alone)
+REACH_SOURCES = ("world", "alterations", "predicates")
 
 
 @dataclass(frozen=True)
@@ -65,9 +67,9 @@ class TaskTrainConfig:
     # copies of each demonstration with added objects (`augment.py`); 0: none
     copies: int = setting(20, lo=0, hi=1000)
     vary: bool = True  # f_preimage also asked from varied states (`augment.varied`)
-    reach: str = "world"  # f_reach's labels: "world" (executed primitives) or "alterations"
+    reach: str = "world"  # f_reach's labels: one of REACH_SOURCES
     world_trials: str = str(REACH_DATA)  # the executed primitives, for reach = "world"
-    # alterations asked alone per state and label (reach = "alterations")
+    # alterations asked alone per state and label (reach = "alterations" or "predicates")
     reach_singles: int = setting(12, lo=1, hi=1000)
     # f_reach sees the max-pooled graph context (`gnn.RelationalLayer`): whether the hand is
     # full is news from an object nothing relates. f_preimage and the forward baseline do not:
@@ -89,6 +91,12 @@ def _examples(name: str, demos, trajs, config: TaskTrainConfig) -> dict[str, lis
     """A network's training examples by where their labels come from."""
     n = len(demos)  # the demonstrations come first, then copy after copy
     if name == "reach":
+        if config.reach == "predicates":
+            return {
+                "demonstrated changes and their other predicates": paper_reach_examples(
+                    demos, config.seed, config.reach_singles, predicates_only=True
+                )
+            }
         if config.reach == "alterations":
             return {
                 "demonstrated changes and their alterations": paper_reach_examples(
