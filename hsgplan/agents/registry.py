@@ -31,6 +31,12 @@ def _regression(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     return RegressionPlanner(checkpoint, rules=rules)
 
 
+def _regression_paper(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
+    from hsgplan.planning.regression.paper_loop import PaperRegressionPlanner
+
+    return PaperRegressionPlanner(checkpoint)
+
+
 def _forward(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     from hsgplan.planning.regression.planner import ForwardPlanner
 
@@ -47,6 +53,7 @@ def _fast_downward(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
 # recovery rules in force (the forward baseline and Fast Downward keep their own ways)
 TASK_PLANNERS: dict[str, Callable[[Path, RecoveryRules], TaskPlanner]] = {
     "regression": _regression,
+    "regression-paper": _regression_paper,  # the paper's loop (`paper_loop.py`), no rules
     "forward": _forward,
     "fd": _fast_downward,
 }
@@ -156,7 +163,7 @@ def agent_parts(name: str) -> tuple[str, str]:
     return AGENTS[name]
 
 
-LEARNED_PLANNERS = ("regression", "forward")
+LEARNED_PLANNERS = ("regression", "regression-paper", "forward")
 LEARNED_MOTION = ("gnn", "mlp")
 
 

@@ -10,6 +10,7 @@ import pytest
 from hsgplan.domain.goals import parse_goal
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT, shipped
+from hsgplan.planning.regression.paper_loop import PaperRegressionPlanner
 from hsgplan.planning.regression.planner import ForwardPlanner, RegressionPlanner
 from tests.forbidden_calls import rules_forbidden
 
@@ -44,7 +45,7 @@ def test_the_profiler_catches_a_call_into_the_transition_model():
     assert any("applicable_actions" in c for c in calls)
 
 
-@pytest.mark.parametrize("kind", ["regression", "forward"])
+@pytest.mark.parametrize("kind", ["regression", "regression-paper", "forward"])
 def test_a_learned_planner_decides_without_the_rules(kind):
     checkpoint = shipped(TASK_CHECKPOINT)
     for text in GOALS:
@@ -54,6 +55,8 @@ def test_a_learned_planner_decides_without_the_rules(kind):
             calls: list[str] = []
             if kind == "regression":
                 planner = RegressionPlanner(checkpoint, seed=seed)
+            elif kind == "regression-paper":
+                planner = PaperRegressionPlanner(checkpoint, seed=seed)
             else:
                 planner = ForwardPlanner(checkpoint)
             planner.reset(goal, seed)
