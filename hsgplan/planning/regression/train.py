@@ -76,6 +76,9 @@ class TaskTrainConfig:
     # a preimage is local, and with the pool f_preimage let crowded shelf tops elsewhere change
     # a push's preimage (measured: On(x, prepush_a) dropped from In(x, shelf_a)'s).
     reach_pool: bool = True
+    # f_reach's epochs where they differ from `epochs`: world-labelled f_reach has two hundred
+    # times the examples of the demonstrations alone
+    reach_epochs: int | None = setting(None, lo=1, hi=10_000)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -175,7 +178,8 @@ def _train_one(
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start = training.resume(folder, model, optim, data)
     graphs = [e.as_data() for e in examples]
-    for epoch in range(start, config.epochs):
+    epochs = config.reach_epochs if name == "reach" and config.reach_epochs else config.epochs
+    for epoch in range(start, epochs):
         rng = random.Random(f"{config.seed}-{name}-{epoch}")
         order = list(range(len(graphs)))
         rng.shuffle(order)
@@ -190,6 +194,6 @@ def _train_one(
         training.check_loss(total, name, epoch + 1)
         if on_epoch:
             on_epoch(name, epoch + 1, total / len(graphs))
-        if (epoch + 1) % config.save_every == 0 and epoch + 1 < config.epochs:
+        if (epoch + 1) % config.save_every == 0 and epoch + 1 < epochs:
             training.save_progress(folder, model, optim, epoch + 1, data)
     training.finish(folder, model, net_config.to_json())
