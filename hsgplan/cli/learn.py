@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     CollectWorkers,
     PlannerName,
+    ProtocolName,
     RayAddress,
     RunFolder,
     Summaries,
@@ -77,6 +78,33 @@ def train_task(
     out.print(f"trained f_preimage, f_reach and the forward baseline into {shown(out_dir)}")
 
 
+@train_app.command("combine")
+@refuses_bad_input
+def combine_task(
+    preimage: Annotated[
+        Path,
+        typer.Option(
+            help="Task checkpoint whose f_preimage (and forward) is taken.", parser=input_path
+        ),
+    ],
+    reach: Annotated[
+        Path, typer.Option(help="Task checkpoint whose f_reach is taken.", parser=input_path)
+    ],
+    out_dir: Annotated[
+        Path, typer.Option("--out", help="Checkpoint folder to write.", parser=out_folder)
+    ],
+) -> None:
+    """A task checkpoint of one checkpoint's f_preimage and another's f_reach, copied, nothing
+    trained (the f_preimage x f_reach grid); combined.json names the sources."""
+    from hsgplan.planning.regression.combine import combine
+
+    combine(preimage, reach, out_dir)
+    out.print(f"f_preimage of {shown(preimage)}, f_reach of {shown(reach)}: {shown(out_dir)}")
+
+
+RECOVERING_PROTOCOL = ProtocolName("recovering")
+
+
 @refuses_bad_input
 def eval_task(
     planner: Annotated[PlannerName, typer.Option(help="Task planner.")] = REGRESSION,
@@ -92,6 +120,14 @@ def eval_task(
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     run_dir: RunFolder = None,
+    protocol: Annotated[
+        ProtocolName,
+        typer.Option(
+            help="paper: the first inapplicable action ends the episode and the planner has no "
+            "recovery rule; recovering: it costs its step.",
+            metavar="PROTOCOL",
+        ),
+    ] = RECOVERING_PROTOCOL,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
@@ -102,8 +138,8 @@ def eval_task(
 ) -> None:
     """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
     wasted (inapplicable) actions per episode, milliseconds per decision. Episodes are kept in
-    the run folder (by default runs/eval-task-PLANNER[-CHECKPOINT]-SIZES-gGOALS-seedSEED) as
-    they finish."""
+    the run folder (by default
+    runs/eval-task-PLANNER[-CHECKPOINT]-SIZES-gGOALS-seedSEED[-paper]) as they finish."""
     from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
 
     planner = planner.value
@@ -111,7 +147,8 @@ def eval_task(
     total = goals * len(size_list) if goals_file is None else None
     source = goals_file.stem if goals_file else f"g{goals}"
     tag = "" if checkpoint == TASK_CHECKPOINT else f"-{resolve(checkpoint).name}"
-    run_dir = run_dir or RUNS / f"eval-task-{planner}{tag}-{sizes}-{source}-seed{seed}"
+    paper = "-paper" if protocol.value == "paper" else ""
+    run_dir = run_dir or RUNS / f"eval-task-{planner}{tag}-{sizes}-{source}-seed{seed}{paper}"
     check_ray(ray)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(f"{planner} episodes", total=total)
@@ -126,8 +163,13 @@ def eval_task(
             lambda e: progress.advance(task),
             run_dir,
             ray,
+            protocol.value,
         )
-    report = summarize_task(episodes) | {"planner": planner, "seed": seed}
+    report = summarize_task(episodes) | {
+        "planner": planner,
+        "seed": seed,
+        "protocol": protocol.value,
+    }
     if as_json:
         print(json.dumps(report, indent=2))
         return
@@ -145,7 +187,8 @@ def eval_task(
         for n, v in report["by_size"].items()
     ]
     print_table(
-        f"{planner} in the symbolic loop, {goals} goals per size, seed {seed}",
+        f"{planner} in the symbolic loop, {goals} goals per size, seed {seed}"
+        + (" (paper protocol)" if paper else ""),
         (
             "objects",
             "success",

@@ -4,7 +4,9 @@ Each goal starts from a seeded random state (`random_state`); the planner picks 
 transition model applies it, until the goal holds or 50 steps pass. The transition model is the
 world here, never the planner's: an action whose preconditions fail leaves the state as it was
 and costs its step (a wasted action, counted per episode), as a failed primitive does in the
-simulated world. Plan length is compared
+simulated world under the recovering protocol; under the paper's (`protocol="paper"`) it ends
+the episode (`failed_primitive`), and the planner runs without recovery rules. Plan length is
+compared
 with Fast Downward's plan from the same start (shortest plans up to 6 objects, weighted A*
 beyond), and every decision is timed.
 """
@@ -22,6 +24,7 @@ from hsgplan.agents.registry import LEARNED_PLANNERS, make_planner
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
+from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.protocol import episode_seed
@@ -45,7 +48,11 @@ class TaskEpisode:
     wasted: int = 0
 
 
-def run_task_episode(planner, goal: Goal, seed: int, fd_length: int) -> TaskEpisode:
+def run_task_episode(
+    planner, goal: Goal, seed: int, fd_length: int, end_at_failure: bool = False
+) -> TaskEpisode:
+    """One episode; with `end_at_failure` (the paper's protocol) the first inapplicable action
+    ends it."""
     state = random_state(goal.objects, random.Random(f"task-{seed}"))
     times, failure, steps, wasted = [], None, 0, 0
     while not goal.satisfied_by(state):
@@ -62,6 +69,9 @@ def run_task_episode(planner, goal: Goal, seed: int, fd_length: int) -> TaskEpis
         # costs its step; the planner is told nothing but the state it observes again.
         if why_not(state, decision.action) is not None:
             wasted += 1
+            if end_at_failure:
+                failure = Failure.FAILED_PRIMITIVE
+                break
             continue
         state = apply(state, decision.action)
     done = sum(state.holds(lit) for lit in goal.literals) / len(goal.literals)
@@ -95,6 +105,7 @@ class TaskJob:
     checkpoint: str
     goal: str
     seed: int
+    protocol: str = RECOVERING
 
     @property
     def key(self) -> str:
@@ -107,9 +118,12 @@ def run_task_job(job: TaskJob) -> dict:
 
     torch.set_num_threads(1)  # one core per worker: the pool already fills the machine
     goal = parse_goal(job.goal)
-    planner = make_planner(job.planner, Path(job.checkpoint))
+    paper = job.protocol == PAPER
+    rules = RecoveryRules.none() if paper else RecoveryRules()
+    planner = make_planner(job.planner, Path(job.checkpoint), rules)
     planner.reset(goal, job.seed)
-    return asdict(run_task_episode(planner, goal, job.seed, fd_length(goal, job.seed)))
+    length = fd_length(goal, job.seed)
+    return asdict(run_task_episode(planner, goal, job.seed, length, end_at_failure=paper))
 
 
 def evaluate_task(
@@ -123,9 +137,13 @@ def evaluate_task(
     on_episode: Callable[[TaskEpisode], None] | None = None,
     run_dir: Path | None = None,
     ray: str | None = None,
+    protocol: str = RECOVERING,
 ) -> list[TaskEpisode]:
-    """Every episode, `workers` at a time. With `run_dir`, finished episodes are appended to
-    its `episodes.jsonl` as they finish, and a run started again skips them."""
+    """Every episode, `workers` at a time, under `protocol` (one of PROTOCOLS). With
+    `run_dir`, finished episodes are appended to its `episodes.jsonl` as they finish, and a run
+    started again skips them."""
+    if protocol not in PROTOCOLS:
+        raise InvalidInputError(f"protocol '{protocol}': one of {', '.join(PROTOCOLS)}")
     make_planner(planner, checkpoint)  # a bad name or checkpoint fails here, once
     if goals < 0:
         raise InvalidInputError(f"--goals {goals}: the number of goals cannot be negative")
@@ -147,13 +165,14 @@ def evaluate_task(
     learned = [checkpoint] if planner in LEARNED_PLANNERS else []
     rows = run_items(
         run_task_job,
-        [TaskJob(planner, str(checkpoint), str(g), s) for g, s in jobs],
+        [TaskJob(planner, str(checkpoint), str(g), s, protocol) for g, s in jobs],
         key=lambda job: job.key,
         run_dir=run_dir,
         kind="eval-task",
         config={
             "planner": planner,
             "checkpoint": str(checkpoint),
+            **({"protocol": protocol} if protocol != RECOVERING else {}),
             "fingerprint": fingerprint([*learned, *([goals_file] if goals_file else [])]),
         },
         workers=workers,
