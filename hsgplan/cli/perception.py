@@ -157,6 +157,9 @@ def eval_perception(
         f"{report['precision']:.3f} ({report['unmatched_detections']} matched none), "
         f"symbolic scene graph equal {report['symbolic_match_rate']:.3f}"
     )
+    if report["misreads"]:
+        misreads = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in report["misreads"].items())
+        title += f"; scenes misread by: {misreads}"
     title = marked(title, seed, perception=True)
     print_table(
         title,

@@ -10,17 +10,24 @@ can about its axis, and upside down). A scene's symbolic scene graph from the es
 poses, every object found, for the scene to count as a symbolic match. Recall is the share of
 objects found; precision the share of detections that match an object (a detection matching
 none is a phantom, or an object found twice).
+
+A scene that is no symbolic match is classed by what f_p misread (`MISREADS`, the first that
+applies): an object not found where a detection of another type lies (`look_alike`), an object
+of a stack not found (`stack_missed`), any other object not found (`unseen`: hidden, or never
+found), or every object found and a relation read wrong: between stacked objects
+(`stack_relation`), with a shelf (`shelf_relation`), or another (`other_relation`).
 """
 
 from __future__ import annotations
 
 import math
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.domain.objects import object_type, type_of
+from hsgplan.domain.objects import EntityKind, kind_of, object_type, type_of
 from hsgplan.domain.world import Kind
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
@@ -32,6 +39,15 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 
 MATCH_DISTANCE = 0.10  # m: a detection further than this from every object of its type matched none
+# what a scene that is no symbolic match was misread by, in the order they are tried
+MISREADS = (
+    "look_alike",
+    "stack_missed",
+    "unseen",
+    "stack_relation",
+    "shelf_relation",
+    "other_relation",
+)
 
 
 @dataclass(frozen=True)
@@ -43,6 +59,7 @@ class SceneResult:
     types: tuple[str, ...]  # of the matched objects, in the order of the errors
     symbolic_match: bool
     detections: int = 0  # everything f_p reported, matched or not
+    misread: str | None = None  # one of MISREADS where the scene is no symbolic match
 
 
 def rotation_error(obj: str, truth: Pose, estimate: Pose) -> float:
@@ -86,10 +103,11 @@ def score(truth: dict[str, Pose], detections: list[Detection]) -> SceneResult:
         for o in names
     ]
     rotation = [rotation_error(o, truth[o], matched[o].pose) for o in names]
-    same = len(names) == len(truth) and (
-        map_symbols(GeometricSceneGraph.from_poses(truth)).state
-        == map_symbols(GeometricSceneGraph.from_poses({o: matched[o].pose for o in names})).state
-    )
+    true_state = map_symbols(GeometricSceneGraph.from_poses(truth)).state
+    seen_state = map_symbols(
+        GeometricSceneGraph.from_poses({o: matched[o].pose for o in names})
+    ).state
+    same = len(names) == len(truth) and true_state == seen_state
     return SceneResult(
         len(truth),
         len(names),
@@ -98,7 +116,35 @@ def score(truth: dict[str, Pose], detections: list[Detection]) -> SceneResult:
         tuple(type_of(o) for o in names),
         same,
         len(detections),
+        None if same else misread(truth, detections, matched, true_state, seen_state),
     )
+
+
+def misread(truth, detections, matched, true_state, seen_state) -> str:
+    """What a scene that is no symbolic match was misread by (`MISREADS`)."""
+    missing = [o for o in truth if o not in matched]
+    taken = {id(d) for d in matched.values()}
+    spare = [d for d in detections if id(d) not in taken]
+    for o in missing:
+        near = (np.linalg.norm(np.subtract(d.pose.position, truth[o].position)) for d in spare)
+        if any(distance < MATCH_DISTANCE for distance in near):
+            return "look_alike"
+    if any(true_state.resting_on(o) or _on_object(true_state, o) for o in missing):
+        return "stack_missed"
+    if missing:
+        return "unseen"
+    wrong = set(true_state.literals) ^ set(seen_state.literals)
+    targets = {kind_of(lit.args[-1]) for lit in wrong if lit.predicate.arity == 2}
+    if EntityKind.OBJECT in targets:
+        return "stack_relation"
+    if EntityKind.SHELF in targets:
+        return "shelf_relation"
+    return "other_relation"
+
+
+def _on_object(state, obj: str) -> bool:
+    below = state.location(obj).args[-1]
+    return kind_of(below) is EntityKind.OBJECT
 
 
 def evaluate(
@@ -174,6 +220,8 @@ def summary(results: list[SceneResult]) -> dict:
         "symbolic_match_rate": (
             sum(r.symbolic_match for r in results) / len(results) if results else 0.0
         ),
+        # scenes that are no symbolic match, by what was misread
+        "misreads": dict(Counter(r.misread for r in results if r.misread).most_common()),
         "by_type": {
             t: medians([x for x in rows if x[0] == t]) for t in sorted({x[0] for x in rows})
         },
