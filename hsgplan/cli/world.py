@@ -377,7 +377,10 @@ def report(
 def compare(
     runs: Annotated[
         list[Path],
-        typer.Argument(help="Finished eval world run folders, one row each.", parser=input_path),
+        typer.Argument(
+            help="Finished eval world (or eval task) run folders, one row each.",
+            parser=input_path,
+        ),
     ],
     names: Annotated[
         str | None,
@@ -390,9 +393,14 @@ def compare(
 ) -> None:
     """One method's success per size across eval world runs, one row each: a ladder from one
     recipe to another, one change per row. The runs must be like for like (protocol, goals,
-    repeats, seed, sizes); only their checkpoints may differ."""
+    repeats, seed, sizes); only their checkpoints may differ. Eval task runs (the symbolic
+    loop) are compared the same way, on the same episodes."""
+    from hsgplan.evaluation.compare import all_task_runs, compare_task
     from hsgplan.evaluation.compare import compare as compare_runs
 
     row_names = _names(names, "--names", "run") if names else tuple(r.name for r in runs)
-    t = compare_runs(runs, row_names, method)
+    if all_task_runs(runs):
+        t = compare_task(runs, row_names)
+    else:
+        t = compare_runs(runs, row_names, method)
     print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

@@ -1,9 +1,10 @@
 """Finished `eval world` runs side by side, one row each: a ladder from one recipe to another,
-one change per row.
+one change per row; or finished `eval task` runs (the symbolic loop) the same way.
 
-The runs must be like for like (protocol, goals, repeats, seed, sizes, rules switched off):
-only what the agent reads (its checkpoints) may differ, so a row's gain over the row above is
-the change that row names.
+The runs must be like for like (protocol, goals, repeats, seed, sizes, rules switched off; for
+`eval task` runs, the protocol and the very same episodes): only what the agent reads (its
+checkpoints, and for a ladder its task planner's loop) may differ, so a row's gain over the
+row above is the change that row names.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.report import read_summary
 from hsgplan.evaluation.seeds import marked
 from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable, cell, label, protocol_name
-from hsgplan.runner.run_folder import CONFIG
+from hsgplan.runner.run_folder import CONFIG, logged_rows
 
 # what rows must share; the checkpoints are what a ladder's rows change
 LIKE_FOR_LIKE = ("protocol", "rules_off", "goals", "goals_file", "repeats", "seed", "sizes")
@@ -63,3 +64,56 @@ def compare(runs: Sequence[Path], names: Sequence[str], method: str) -> TextTabl
 
 def _settings(run: Path) -> dict:
     return read_json(run / CONFIG, "run configuration")
+
+
+def all_task_runs(runs: Sequence[Path]) -> bool:
+    """Whether every folder is an `eval task` run (compared by `compare_task`)."""
+    configs = [run / CONFIG for run in runs]
+    return all(
+        c.is_file() and read_json(c, "run configuration").get("kind") == "eval-task"
+        for c in configs
+    )
+
+
+def compare_task(runs: Sequence[Path], names: Sequence[str]) -> TextTable:
+    """One row per `eval task` run folder: success and subgoal completion per size. The runs
+    must hold the same episodes (goals and seeds) under the same protocol."""
+    from hsgplan.evaluation.task_eval import _episode, summarize_task
+
+    if len(names) != len(runs):
+        raise InvalidInputError(f"{len(runs)} runs and {len(names)} names: name each run once")
+    settings = [_settings(run) for run in runs]
+    episodes = []
+    for run, s in zip(runs, settings, strict=True):
+        if s.get("kind") != "eval-task":
+            raise InvalidInputError(f"'{run}' is no eval task run")
+        rows = logged_rows(run)
+        if not rows:
+            raise InvalidInputError(f"'{run}' holds no finished episode")
+        episodes.append({row["key"]: _episode(row["result"]) for row in rows})
+    for run, s, eps in zip(runs, settings, episodes, strict=True):
+        if s.get("protocol") != settings[0].get("protocol") or eps.keys() != episodes[0].keys():
+            what = "protocol" if s.get("protocol") != settings[0].get("protocol") else "episodes"
+            raise InvalidInputError(
+                f"'{run}' and '{runs[0]}' differ in {what}: a comparison's rows must be like "
+                "for like"
+            )
+    summaries = [summarize_task(list(eps.values()))["by_size"] for eps in episodes]
+    sizes = sorted({int(n) for s in summaries for n in s})
+    rows = [
+        (name, *(_task_cell(s.get(str(n))) for n in sizes))
+        for name, s in zip(names, summaries, strict=True)
+    ]
+    protocol = "paper protocol" if settings[0].get("protocol") == "paper" else "recovering"
+    per_size = len(episodes[0]) // len(sizes)
+    title = (
+        f"Success rate / subgoal completion in the symbolic loop by run ({protocol}): "
+        f"{per_size} goals per size"
+    )
+    return TextTable(title, ("run", *(f"{n} objects" for n in sizes)), tuple(rows))
+
+
+def _task_cell(size: dict | None) -> str:
+    if size is None:
+        return "—"
+    return f"{size['success_rate']:.2f} / {size['subgoal_completion']:.2f}"

@@ -1,6 +1,7 @@
 """Runs side by side: rows like for like, refused in one line where they are not."""
 
 import json
+from dataclasses import asdict
 
 import pytest
 from typer.testing import CliRunner
@@ -79,3 +80,34 @@ def test_a_missing_method_or_a_name_short_is_one_line_exit_2(tmp_path):
     assert r.exit_code == 2 and "2 runs and 1 names" in r.stderr
     r = CliRunner().invoke(app, ["eval", "compare", str(a), "--markdown"])
     assert r.exit_code == 0 and "| a | 1.00 / " in r.stdout
+
+
+def _task_run(folder, successes, protocol="paper", seeds=(1, 2)):
+    from hsgplan.evaluation.task_eval import TaskEpisode
+
+    folder.mkdir()
+    config = {"kind": "eval-task", "planner": "regression", "checkpoint": "c"}
+    (folder / "config.json").write_text(json.dumps(config | {"protocol": protocol}))
+    lines = []
+    for seed, ok in zip(seeds, successes, strict=True):
+        goal = "On(cherries, shelf_a) & On(butter, shelf_b)"
+        episode = TaskEpisode(2, seed, goal, ok, None if ok else "no_subgoal", 3, 3, 1.0, (1.0,))
+        lines.append(json.dumps({"key": f"{seed}/{goal}", "result": asdict(episode)}))
+    (folder / "episodes.jsonl").write_text("\n".join(lines) + "\n")
+    return folder
+
+
+def test_task_runs_are_compared_on_the_same_episodes(tmp_path):
+    from hsgplan.evaluation.compare import all_task_runs, compare_task
+
+    a, b = _task_run(tmp_path / "a", (True, False)), _task_run(tmp_path / "b", (True, True))
+    assert all_task_runs([a, b])
+    table = compare_task([a, b], ["theirs", "ours"])
+    assert [row[1].split(" / ")[0] for row in table.rows] == ["0.50", "1.00"]
+    assert "paper protocol" in table.title
+    other = _task_run(tmp_path / "c", (True, True), seeds=(1, 3))
+    with pytest.raises(InvalidInputError, match="differ in episodes"):
+        compare_task([a, other], ["a", "c"])
+    recovering = _task_run(tmp_path / "d", (True, True), protocol="recovering")
+    with pytest.raises(InvalidInputError, match="differ in protocol"):
+        compare_task([a, recovering], ["a", "d"])
