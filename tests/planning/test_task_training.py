@@ -120,6 +120,10 @@ def test_training_writes_checkpoint_folders_and_resumes(tmp_path):
         train_task(config, tmp_path, stop_midway)
     assert (tmp_path / "preimage" / "model.safetensors").exists()
     seen.clear()
+    # saved before f_reach's own epoch count existed: trained with its default, resumed
+    saved = json.loads((tmp_path / "train_config.json").read_text())
+    del saved["reach_epochs"]
+    (tmp_path / "train_config.json").write_text(json.dumps(saved))
     train_task(config, tmp_path, lambda n, e, loss: seen.append((n, e)))
     assert ("preimage", 1) not in seen  # finished before: not trained again
     for name in ("preimage", "reach", "forward"):

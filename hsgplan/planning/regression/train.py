@@ -145,7 +145,8 @@ def train_task(
     demos = load_demos(Path(config.demos))
     sources = [config.demos] + ([config.world_trials] if config.reach == "world" else [])
     data = fingerprint(Path(s) for s in sources)
-    training.claim(out, asdict(config), data=data)
+    # a checkpoint trained before a setting existed was trained with its default
+    training.claim(out, asdict(config), defaults=asdict(TaskTrainConfig()), data=data)
     trajs = trajectories(demos, config.copies, config.seed)
     for name, classes in NETWORKS.items():
         if training.finished(out / name):
