@@ -28,9 +28,10 @@ from hsgplan.planning.regression.planner import (
     MAX_DEPTH,
     RegressionPlanner,
     _decision,
-    _in_order,
+    _goal_holds,
     _Node,
     _order,
+    _unsatisfied,
 )
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -51,9 +52,8 @@ class PaperRegressionPlanner(RegressionPlanner):
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
-        unsatisfied = [lit for lit in _in_order(goal) if not state.holds(lit)]
-        if not unsatisfied:
-            return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
+        if not (unsatisfied := _unsatisfied(state, goal)):
+            return _goal_holds(start)
         for _ in range(TRIES):
             if found := self._descend(state, goal, unsatisfied):
                 return _decision(found[1], found[0], start)

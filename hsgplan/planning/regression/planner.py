@@ -63,6 +63,15 @@ def _inference_networks(checkpoint: str):
     return load_network(folder / "preimage").script(), load_network(folder / "reach").script()
 
 
+def _unsatisfied(state: SymbolicSceneGraph, goal: Goal) -> list[Literal]:
+    """The goal's literals that do not hold, in order."""
+    return [lit for lit in _in_order(goal) if not state.holds(lit)]
+
+
+def _goal_holds(start: float) -> TaskDecision:
+    return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
+
+
 @lru_cache(maxsize=64)
 def _in_order(goal: Goal) -> list[Literal]:
     """A goal's literals, sorted (once per goal: a decision needs them in order)."""
@@ -168,9 +177,8 @@ class RegressionPlanner:
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
-        unsatisfied = [lit for lit in _in_order(goal) if not state.holds(lit)]
-        if not unsatisfied:
-            return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
+        if not (unsatisfied := _unsatisfied(state, goal)):
+            return _goal_holds(start)
         rules = self.rules
         if rules.failed_goal_waits and self._last is not None and self._last[0] == state:
             self._failed_roots.add(self._last[2])
