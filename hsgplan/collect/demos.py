@@ -72,8 +72,8 @@ def _recorded(out: Path, seed: int, full_scene: bool) -> dict[str, Demo]:
         if saved.get("seed") != seed or saved.get("version") != VERSION:
             raise InvalidInputError(f"'{out}' holds demonstrations made with another seed")
         if saved.get("full_scene", False) != full_scene:
-            scene = "every object type" if saved.get("full_scene") else "the goal's objects"
-            raise InvalidInputError(f"'{out}' holds demonstrations recorded in {scene} only")
+            scene = "every object type" if saved.get("full_scene") else "their goal's objects alone"
+            raise InvalidInputError(f"'{out}' holds demonstrations recorded in a scene of {scene}")
     return {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
 
 
