@@ -35,6 +35,7 @@ eval_app.command("reach")(learn.eval_reach)
 eval_app.command("motion")(motion.eval_motion)
 eval_app.command("perception")(perception.eval_perception)
 eval_app.command("compare")(world.compare)
+eval_app.command("curve")(learn.eval_curve)
 
 app.command()(symbolic.plan)
 app.command()(symbolic.goals)

@@ -49,19 +49,33 @@ def demos(
             help="Record each in a scene of one object of every type, not of the goal's alone.",
         ),
     ] = False,
+    rounds: Annotated[
+        int,
+        typer.Option(
+            min=1,
+            max=1000,
+            help="Record the 18 tasks this many times, each in scenes of its own (a larger set "
+            "for a learning curve; the first round is the paper's set).",
+        ),
+    ] = 1,
 ) -> None:
     """Record the paper's 18 short demonstrations with the oracle in the simulated world."""
     from hsgplan.collect.demos import collect_demos
     from hsgplan.data.demos import TASKS
 
     command = f"hsgplan collect demos --seed {seed} --out {out_dir}"
-    command += " --full-scene" * full_scene
+    command += " --full-scene" * full_scene + f" --rounds {rounds}" * (rounds > 1)
     with Progress(console=err, transient=True) as progress:
-        task = progress.add_task("demonstrations", total=len(TASKS))
+        task = progress.add_task("demonstrations", total=len(TASKS) * rounds)
         done = collect_demos(
-            out_dir, seed, command, lambda d: progress.advance(task), full_scene=full_scene
+            out_dir,
+            seed,
+            command,
+            lambda d: progress.advance(task),
+            full_scene=full_scene,
+            rounds=rounds,
         )
-        progress.update(task, completed=len(TASKS))
+        progress.update(task, completed=len(TASKS) * rounds)
     steps = sum(len(d.actions) for d in done)
     out.print(f"{len(done)} demonstrations, {steps} transitions, in {shown(out_dir)}")
 

@@ -22,6 +22,7 @@ from hsgplan.cli.common import (
     err,
     input_path,
     out,
+    out_file,
     out_folder,
     parse_sizes,
     print_table,
@@ -253,3 +254,52 @@ def eval_reach(
         rows,
         markdown,
     )
+
+
+@refuses_bad_input
+def eval_curve(
+    series: Annotated[
+        list[str],
+        typer.Option(
+            "--series",
+            help="NAME=RUN,RUN,...: one curve, its points finished eval task runs of checkpoints "
+            "trained on different numbers of demonstrations (repeat for more curves).",
+        ),
+    ],
+    plot: Annotated[
+        Path | None,
+        typer.Option(help="Also draw the curves into this PNG.", parser=out_file),
+    ] = None,
+    markdown: Annotated[
+        bool,
+        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
+    ] = False,
+) -> None:
+    """Learning curves of the task planner: success in the symbolic loop against how many
+    demonstrations its f_preimage learned from (read from each run's checkpoint), beside the
+    paper's Table 1. Every run must hold the same episodes under the same protocol."""
+    from hsgplan.domain.errors import InvalidInputError
+    from hsgplan.evaluation.curve import curve_points, curve_table
+
+    parsed = []
+    for text in series:
+        name, sep, runs = text.partition("=")
+        folders = [r.strip() for r in runs.split(",") if r.strip()]
+        if not sep or not name.strip() or not folders:
+            raise InvalidInputError(f"--series {text!r}: write NAME=RUN,RUN,...")
+        parsed.append((name.strip(), [Path(r) for r in folders]))
+    if len({name for name, _ in parsed}) < len(parsed):
+        raise InvalidInputError("two --series share a name")
+    title, points = curve_points(parsed)
+    table = curve_table(title, points)
+    print_table(table.title, table.header, [list(r) for r in table.rows], markdown)
+    if plot is not None:
+        from hsgplan.evaluation.table1 import PAPER_TABLE1
+        from hsgplan.viz.plots import plot_learning_curves
+
+        curves: dict[str, dict[int, dict[int, float]]] = {name: {} for name, _ in parsed}
+        for p in points:
+            curves[p.series][p.demonstrations] = p.success
+        paper = {n: v[0] for n, v in PAPER_TABLE1["gnn"].items()}
+        plot_learning_curves(curves, paper, plot)
+        out.print(f"wrote {shown(plot)}", highlight=False)

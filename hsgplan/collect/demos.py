@@ -1,6 +1,8 @@
 """Recording the demonstrations: oracle episodes in the simulated world, one per task of
 `hsgplan.data.demos.TASKS`, appended to the dataset folder as each finishes (an interrupted
-recording, started again, records only the tasks that are missing).
+recording, started again, records only the tasks that are missing). With `rounds` > 1 the 18
+tasks are recorded again in scenes of their own, round after round: the larger sets a learning
+curve trains on (round 1 is the paper's set).
 
 A demonstration's scene holds the objects its goal names, or, with `full_scene`, one object of
 every type (the paper does not say its demonstrations' scenes hold only the named objects):
@@ -27,6 +29,13 @@ from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
 
 RETRIES = 5
+# a later round's scene seeds lie this far apart, clear of the first round's
+ROUND_STRIDE = 1_000_000
+
+
+def round_task(task: str, r: int) -> str:
+    """The name of `task`'s demonstration in round `r` (0: the paper's set, named as before)."""
+    return task if r == 0 else f"{task}@{r + 1}"
 
 
 def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) -> Demo | None:
@@ -83,27 +92,36 @@ def collect_demos(
     command: str = "",
     on_demo: Callable[[Demo], None] | None = None,
     full_scene: bool = False,
+    rounds: int = 1,
 ) -> list[Demo]:
-    """Record every task not yet in `out` (appending as each finishes); all demos, in order."""
+    """Record every task of every round not yet in `out` (appending as each finishes); all
+    demos, round by round in task order."""
+    if rounds < 1:
+        raise InvalidInputError(f"rounds {rounds}: need at least 1")
     check_own(out, META, "demonstration set")  # never into another command's folder
     meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
     if full_scene:
         meta["full_scene"] = True
+    if rounds > 1:
+        meta["rounds"] = rounds
     meta_path = out / META
     _recorded(out, seed, full_scene)
     hold_folder(out)  # one writer: a second collection into `out` is refused
     done = _recorded(out, seed, full_scene)  # again, now that the folder is ours
-    if not meta_path.exists():
+    saved = read_json(meta_path, "demonstration metadata") if meta_path.exists() else {}
+    if saved.get("rounds", 1) < rounds or not saved:  # a set grown by more rounds says so
         write_atomically(meta_path, json.dumps(meta, indent=2) + "\n")
     path = out / DEMOS
     if path.exists() and path.stat().st_size and not path.read_bytes().endswith(b"\n"):
         with open(path, "a") as f:  # a line cut short by an interruption: end it
             f.write("\n")
-    for i, (task, goal) in enumerate(TASKS):
+    order = [(r, i, round_task(t, r), g) for r in range(rounds) for i, (t, g) in enumerate(TASKS)]
+    for r, i, task, goal in order:
         if task in done:
             continue
+        base = seed * 1000 + r * ROUND_STRIDE + i * RETRIES
         for attempt in range(RETRIES):
-            demo = record_demo(task, goal, seed * 1000 + i * RETRIES + attempt, full_scene)
+            demo = record_demo(task, goal, base + attempt, full_scene)
             if demo is not None:
                 break
         else:
@@ -113,4 +131,4 @@ def collect_demos(
         done[task] = demo
         if on_demo:
             on_demo(demo)
-    return [done[t] for t, _ in TASKS]
+    return [done[t] for _, _, t, _ in order]

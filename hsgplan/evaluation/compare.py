@@ -78,10 +78,28 @@ def all_task_runs(runs: Sequence[Path]) -> bool:
 def compare_task(runs: Sequence[Path], names: Sequence[str]) -> TextTable:
     """One row per `eval task` run folder: success and subgoal completion per size. The runs
     must hold the same episodes (goals and seeds) under the same protocol."""
-    from hsgplan.evaluation.task_eval import _episode, summarize_task
-
     if len(names) != len(runs):
         raise InvalidInputError(f"{len(runs)} runs and {len(names)} names: name each run once")
+    protocol, per_size, summaries = task_summaries(runs)
+    sizes = sorted({int(n) for s in summaries for n in s})
+    rows = [
+        (name, *(_task_cell(s.get(str(n))) for n in sizes))
+        for name, s in zip(names, summaries, strict=True)
+    ]
+    title = (
+        f"Success rate / subgoal completion in the symbolic loop by run ({protocol}): "
+        f"{per_size} goals per size"
+    )
+    return TextTable(title, ("run", *(f"{n} objects" for n in sizes)), tuple(rows))
+
+
+def task_summaries(runs: Sequence[Path]) -> tuple[str, int, list[dict]]:
+    """The protocol's name, the goals per size, and each `eval task` run's summary by size.
+
+    Raises InvalidInputError for a folder that is no eval task run or holds no episode, and
+    for runs that differ in protocol or episodes (goals and seeds)."""
+    from hsgplan.evaluation.task_eval import _episode, summarize_task
+
     settings = [_settings(run) for run in runs]
     episodes = []
     for run, s in zip(runs, settings, strict=True):
@@ -99,18 +117,8 @@ def compare_task(runs: Sequence[Path], names: Sequence[str]) -> TextTable:
                 "for like"
             )
     summaries = [summarize_task(list(eps.values()))["by_size"] for eps in episodes]
-    sizes = sorted({int(n) for s in summaries for n in s})
-    rows = [
-        (name, *(_task_cell(s.get(str(n))) for n in sizes))
-        for name, s in zip(names, summaries, strict=True)
-    ]
     protocol = "paper protocol" if settings[0].get("protocol") == "paper" else "recovering"
-    per_size = len(episodes[0]) // len(sizes)
-    title = (
-        f"Success rate / subgoal completion in the symbolic loop by run ({protocol}): "
-        f"{per_size} goals per size"
-    )
-    return TextTable(title, ("run", *(f"{n} objects" for n in sizes)), tuple(rows))
+    return protocol, len(episodes[0]) // len(summaries[0]), summaries
 
 
 def _task_cell(size: dict | None) -> str:

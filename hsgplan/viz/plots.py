@@ -96,3 +96,40 @@ def plot_times_by_size(series: dict[str, dict[str, dict[int, float]]], path: Pat
     axes[1].legend(fontsize=8)
     fig.tight_layout()
     save_figure(fig, path)
+
+
+def plot_learning_curves(
+    series: dict[str, dict[int, dict[int, float]]], paper: dict[int, float], path: Path
+) -> None:
+    """Success rate against the number of demonstrations (log scale), one panel per series and
+    one colour per problem size; the paper's rate at each size as a dashed line.
+
+    Args:
+        series: series name -> demonstrations -> size -> success rate.
+        paper: size -> the paper's success rate (drawn where the series have that size).
+        path: where the PNG goes.
+    """
+    fig, axes = plt.subplots(
+        1, len(series), figsize=(4.4 * len(series), 3.8), dpi=120, sharey=True, squeeze=False
+    )
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for ax, (name, points) in zip(axes[0], series.items(), strict=True):
+        counts = sorted(points)
+        sizes = sorted({n for p in points.values() for n in p})
+        for k, n in enumerate(sizes):
+            colour = colours[k % len(colours)]
+            xs = [c for c in counts if n in points[c]]
+            ax.plot(xs, [points[c][n] for c in xs], color=colour, marker="o", label=f"{n} objects")
+            if n in paper:
+                ax.axhline(paper[n], color=colour, linestyle="--", alpha=0.6)
+        ax.set_xscale("log", base=2)
+        ax.set_xticks(counts, [str(c) for c in counts])
+        ax.minorticks_off()
+        ax.set_xlabel("demonstrations")
+        ax.set_title(name, fontsize=9)
+        ax.set_ylim(0, 1.02)
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel("success rate (dashed: the paper's)")
+    axes[0][-1].legend(fontsize=8)
+    fig.tight_layout()
+    save_figure(fig, path)

@@ -107,3 +107,40 @@ def test_a_full_scene_collection_is_not_resumed_as_a_goal_objects_one(tmp_path, 
     assert len(demo.objects) == 6 and len(demo.goal_literals().objects) == 1
     with pytest.raises(InvalidInputError, match="every object type"):
         collect_demos(tmp_path, seed=3)
+
+
+def _stub_recorder(seeds: list[int]):
+    """A recorder that runs no simulation: one made-up transition per task, its seed noted."""
+
+    def record(task, goal_text, seed, full_scene=False):
+        seeds.append(seed)
+        return record_demos.Demo(task, goal_text, seed, ("butter",), ("a",), (("x",), ("y",)))
+
+    return record
+
+
+def test_rounds_record_every_task_again_in_scenes_of_their_own(tmp_path, monkeypatch):
+    monkeypatch.setattr(record_demos, "TASKS", TASKS[:2])
+    seeds: list[int] = []
+    monkeypatch.setattr(record_demos, "record_demo", _stub_recorder(seeds))
+    (first_round := tmp_path / "one").mkdir()
+    one = collect_demos(first_round, seed=3)
+    three = collect_demos(tmp_path / "three", seed=3, rounds=3)
+    names = [t for t, _ in TASKS[:2]]
+    assert [d.task for d in three] == names + [f"{t}@2" for t in names] + [f"{t}@3" for t in names]
+    assert three[:2] == one  # the first round is the paper's set, seeds and all
+    assert len({d.seed for d in three}) == 6
+    meta = json.loads((tmp_path / "three" / "meta.json").read_text())
+    assert meta["rounds"] == 3
+    seeds.clear()
+    grown = collect_demos(first_round, seed=3, rounds=2)  # a set grows by the missing rounds
+    assert grown == three[:4] and len(seeds) == 2
+    assert json.loads((first_round / "meta.json").read_text())["rounds"] == 2
+    with pytest.raises(InvalidInputError, match="rounds 0"):
+        collect_demos(tmp_path / "none", seed=3, rounds=0)
+
+
+def test_cli_refuses_zero_rounds_in_one_line(tmp_path):
+    r = CliRunner().invoke(app, ["collect", "demos", "--rounds", "0", "--out", str(tmp_path / "d")])
+    assert r.exit_code == 2 and "rounds" in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "d").exists()

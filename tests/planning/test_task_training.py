@@ -258,3 +258,20 @@ def test_bad_training_settings_are_one_line_with_exit_code_2(tmp_path):
         )
         assert r.exit_code == 2, (bad, r.output)
         assert len(r.stderr.strip().splitlines()) == 1 and next(iter(bad)) in r.stderr
+
+
+def test_a_demo_limit_trains_on_the_first_demonstrations_alone(tmp_path):
+    first = tmp_path / "first-three"
+    first.mkdir()
+    (first / "meta.json").write_text((DEMOS / "meta.json").read_text())
+    lines = (DEMOS / "demos.jsonl").read_text().splitlines()
+    (first / "demos.jsonl").write_text("\n".join(lines[:3]) + "\n")
+    tiny = TINY | {"epochs": 1, "copies": 0}
+    train_task(TaskTrainConfig.from_json(tiny | {"demo_limit": 3}), tmp_path / "limited")
+    train_task(TaskTrainConfig.from_json(tiny | {"demos": str(first)}), tmp_path / "cut")
+    for name in ("preimage", "reach", "forward"):
+        limited = json.loads((tmp_path / "limited" / name / "labels.json").read_text())
+        assert limited == json.loads((tmp_path / "cut" / name / "labels.json").read_text())
+    with pytest.raises(InvalidInputError, match="holds 18 demonstrations"):
+        train_task(TaskTrainConfig.from_json(tiny | {"demo_limit": 19}), tmp_path / "more")
+    assert not (tmp_path / "more").exists()

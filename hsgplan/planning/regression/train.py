@@ -56,6 +56,8 @@ class TaskTrainConfig:
     f_reach from primitives executed in the simulated world)."""
 
     demos: str = str(DEMOS)
+    # the first this many demonstrations of the set (a point of a learning curve); None: all
+    demo_limit: int | None = setting(None, lo=1, hi=1_000_000)
     seed: int = setting(0, **BOUNDS["seed"])
     epochs: int = setting(8, lo=1, hi=10_000)
     lr: float = setting(1e-3, above=0, hi=10)
@@ -143,6 +145,13 @@ def train_task(
     from hsgplan.data.demos import load_demos
 
     demos = load_demos(Path(config.demos))
+    if config.demo_limit is not None:
+        if config.demo_limit > len(demos):
+            raise InvalidInputError(
+                f"demo_limit {config.demo_limit}: '{config.demos}' holds {len(demos)} "
+                "demonstrations"
+            )
+        demos = demos[: config.demo_limit]
     sources = [config.demos] + ([config.world_trials] if config.reach == "world" else [])
     data = fingerprint(Path(s) for s in sources)
     # a checkpoint trained before a setting existed was trained with its default
