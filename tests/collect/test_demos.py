@@ -101,6 +101,18 @@ def test_full_scene_demos_hold_every_type_and_replay_in_the_transition_model():
             assert apply(before, action) == after, (d.task, str(action))
 
 
+def test_the_learning_curve_set_starts_with_the_full_scene_set_and_replays():
+    rounds = load_demos(FULL_SCENE.parent / "full-scene-rounds")
+    assert len(rounds) == 8 * len(TASKS)
+    assert rounds[: len(TASKS)] == load_demos(FULL_SCENE)
+    assert len({d.seed for d in rounds}) == len(rounds)
+    for d in rounds[len(TASKS) :]:
+        states, actions = d.symbolic_states(), d.symbolic_actions()
+        assert d.goal_literals().satisfied_by(states[-1]), d.task
+        for before, action, after in zip(states[:-1], actions, states[1:], strict=True):
+            assert apply(before, action) == after, (d.task, str(action))
+
+
 def test_a_full_scene_collection_is_not_resumed_as_a_goal_objects_one(tmp_path, monkeypatch):
     monkeypatch.setattr(record_demos, "TASKS", TASKS[:1])
     (demo,) = collect_demos(tmp_path, seed=3, full_scene=True)
