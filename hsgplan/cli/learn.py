@@ -262,10 +262,14 @@ def eval_curve(
         list[str],
         typer.Option(
             "--series",
-            help="NAME=RUN,RUN,...: one curve, its points finished eval task runs of checkpoints "
-            "trained on different numbers of demonstrations (repeat for more curves).",
+            help="NAME=RUN,RUN,...: one curve, its points finished eval task runs (or eval "
+            "motion runs) of models that learned from different amounts of data (repeat for "
+            "more curves).",
         ),
     ],
+    primitive: Annotated[
+        str, typer.Option(help="The primitive of eval motion runs: place or push.")
+    ] = "place",
     plot: Annotated[
         Path | None,
         typer.Option(help="Also draw the curves into this PNG.", parser=out_file),
@@ -275,12 +279,16 @@ def eval_curve(
         typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
     ] = False,
 ) -> None:
-    """Learning curves of the task planner: success in the symbolic loop against how many
-    demonstrations its f_preimage learned from (read from each run's checkpoint), beside the
-    paper's Table 1. Every run must hold the same episodes under the same protocol."""
+    """Learning curves: success against how much data a model learned from, read from each
+    run's checkpoint. Eval task runs: success in the symbolic loop by size against the
+    demonstrations of f_preimage, beside the paper's Table 1. Eval motion runs: single-shot
+    success of the GNN (and Random) against the GNN's training trials. The points must be
+    like for like (the same episodes, or the same scenes)."""
     from hsgplan.domain.errors import InvalidInputError
-    from hsgplan.evaluation.curve import curve_points, curve_table
+    from hsgplan.evaluation.curve import curve_table, curves
 
+    if primitive not in ("place", "push"):
+        raise InvalidInputError(f"--primitive {primitive!r}: place or push")
     parsed = []
     for text in series:
         name, sep, runs = text.partition("=")
@@ -290,16 +298,15 @@ def eval_curve(
         parsed.append((name.strip(), [Path(r) for r in folders]))
     if len({name for name, _ in parsed}) < len(parsed):
         raise InvalidInputError("two --series share a name")
-    title, points = curve_points(parsed)
-    table = curve_table(title, points)
+    c = curves(parsed, primitive)
+    table = curve_table(c)
     print_table(table.title, table.header, [list(r) for r in table.rows], markdown)
     if plot is not None:
-        from hsgplan.evaluation.table1 import PAPER_TABLE1
         from hsgplan.viz.plots import plot_learning_curves
 
-        curves: dict[str, dict[int, dict[int, float]]] = {name: {} for name, _ in parsed}
-        for p in points:
-            curves[p.series][p.demonstrations] = p.success
-        paper = {n: v[0] for n, v in PAPER_TABLE1["gnn"].items()}
-        plot_learning_curves(curves, paper, plot)
+        drawn: dict[str, dict[int, dict[str, float]]] = {name: {} for name, _ in parsed}
+        for p in c.points:
+            drawn[p.series][p.amount] = p.success
+        paper = {col: rates[0] for col, rates in c.paper.items()}
+        plot_learning_curves(drawn, paper, c.unit, plot)
         out.print(f"wrote {shown(plot)}", highlight=False)

@@ -1,10 +1,14 @@
-"""Learning curves of the task planner: success in the symbolic loop against the number of
-demonstrations its f_preimage learned from (`hsgplan eval curve`).
+"""Learning curves (`hsgplan eval curve`): success against how much data a model learned from.
 
-Each point is a finished `eval task` run; how many demonstrations its checkpoint learned from is
-read from the checkpoint itself (its training configuration's set and `demo_limit`, following a
-combined checkpoint to the one its f_preimage came from), never typed by hand. The points of
-every series must hold the same episodes under the same protocol (`compare.task_summaries`).
+Two kinds of point, each a finished run:
+- an `eval task` run: success in the symbolic loop by problem size, against the number of
+  demonstrations its checkpoint's f_preimage learned from (its training configuration's set
+  and `demo_limit`, following a combined checkpoint to the one its f_preimage came from);
+- an `eval motion` run: single-shot success of each model of one primitive, against the
+  training examples (trials) of its GNN (the checkpoint's training record).
+
+How much data is read from the checkpoints, never typed by hand. Every point of a curve must
+hold the same episodes (task) or the same scenes (motion).
 """
 
 from __future__ import annotations
@@ -17,11 +21,14 @@ from hsgplan.data.demos import load_demos
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.compare import task_summaries
+from hsgplan.evaluation.motion_eval import LABELS, MODELS
 from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable
 from hsgplan.paths import shipped
 from hsgplan.planning.regression.combine import COMBINED
-from hsgplan.runner.run_folder import CONFIG
+from hsgplan.runner.run_folder import CONFIG, logged_rows
 from hsgplan.training import TRAIN_CONFIG
+
+SELECTION = "training.json"  # a motion checkpoint's training record (`motion/train.py`)
 
 
 @dataclass(frozen=True)
@@ -30,15 +37,26 @@ class CurvePoint:
 
     Args:
         series: the curve it belongs to.
-        demonstrations: how many demonstrations its f_preimage learned from.
-        success: problem size -> success rate in the symbolic loop.
-        completion: problem size -> subgoal completion.
+        amount: how much data it learned from (demonstrations, or training trials).
+        success: column (a problem size, or a motion model) -> success rate.
+        completion: column -> subgoal completion (task points), else None.
     """
 
     series: str
-    demonstrations: int
-    success: dict[int, float]
-    completion: dict[int, float]
+    amount: int
+    success: dict[str, float]
+    completion: dict[str, float] | None = None
+
+
+@dataclass(frozen=True)
+class Curves:
+    """Every point, by series and amount, with what the table and the plot say of them."""
+
+    title: str
+    unit: str  # what `amount` counts
+    columns: tuple[str, ...]
+    points: tuple[CurvePoint, ...]
+    paper: dict[str, tuple[float, float]]  # column -> the paper's success and completion
 
 
 def demonstrations_of(checkpoint: Path) -> int:
@@ -56,59 +74,120 @@ def demonstrations_of(checkpoint: Path) -> int:
     return min(held, limit) if isinstance(limit, int) else held
 
 
-def curve_points(series: Sequence[tuple[str, Sequence[Path]]]) -> tuple[str, list[CurvePoint]]:
-    """The points of every series (name, its eval task runs), by demonstrations within a
-    series, and the title line they share. Raises InvalidInputError where the runs are not like
-    for like or two runs of a series learned from as many demonstrations."""
+def trials_of(checkpoints: Path, primitive: str) -> int:
+    """How many training examples (trials) a folder's GNN for `primitive` learned from."""
+    record = shipped(checkpoints) / f"{primitive}-gnn" / SELECTION
+    if not record.is_file():
+        raise InvalidInputError(f"'{record}' does not exist: no trained {primitive} GNN there")
+    examples = read_json(record, "training record").get("training_examples")
+    if not isinstance(examples, int):
+        raise InvalidInputError(f"'{record}' holds no count of training examples")
+    return examples
+
+
+def curves(series: Sequence[tuple[str, Sequence[Path]]], primitive: str = "place") -> Curves:
+    """The points of every series (its name, its runs), by amount within a series. The runs
+    are all `eval task` runs or all `eval motion` runs (of `primitive`). Raises
+    InvalidInputError where they are not like for like, or where two runs of a series learned
+    from as much data."""
     runs = [run for _, rs in series for run in rs]
     if not runs:
         raise InvalidInputError("no run given")
-    protocol, per_size, summaries = task_summaries(runs)
-    points, k = [], 0
+    kinds = {read_json(run / CONFIG, "run configuration").get("kind") for run in runs}
+    if kinds == {"eval-motion"}:
+        made = _motion(runs, primitive)
+    elif kinds == {"eval-task"}:
+        made = _task(runs)
+    else:
+        raise InvalidInputError("a curve's runs are all eval task runs or all eval motion runs")
+    title, unit, columns, by_run, paper = made
+    points = []
     for name, rs in series:
         seen: dict[int, Path] = {}
         for run in rs:
-            checkpoint = read_json(run / CONFIG, "run configuration").get("checkpoint")
-            if not isinstance(checkpoint, str):
-                raise InvalidInputError(f"'{run}' names no task checkpoint")
-            n = demonstrations_of(Path(checkpoint))
-            if n in seen:
-                raise InvalidInputError(
-                    f"'{run}' and '{seen[n]}' both learned from {n} demonstrations"
-                )
-            seen[n] = run
-            by_size = summaries[k]
-            k += 1
-            points.append(
-                CurvePoint(
-                    name,
-                    n,
-                    {int(s): v["success_rate"] for s, v in by_size.items()},
-                    {int(s): v["subgoal_completion"] for s, v in by_size.items()},
-                )
-            )
-    points.sort(key=lambda p: ([s for s, _ in series].index(p.series), p.demonstrations))
+            amount, success, completion = by_run[run]
+            if amount in seen:
+                raise InvalidInputError(f"'{run}' and '{seen[amount]}' both learned from {amount}")
+            seen[amount] = run
+            points.append(CurvePoint(name, amount, success, completion))
+    order = [name for name, _ in series]
+    points.sort(key=lambda p: (order.index(p.series), p.amount))
+    return Curves(title, unit, columns, tuple(points), paper)
+
+
+def _task(runs: Sequence[Path]):
+    protocol, per_size, summaries = task_summaries(runs)
+    by_run = {}
+    for run, by_size in zip(runs, summaries, strict=True):
+        checkpoint = read_json(run / CONFIG, "run configuration").get("checkpoint")
+        if not isinstance(checkpoint, str):
+            raise InvalidInputError(f"'{run}' names no task checkpoint")
+        by_run[run] = (
+            demonstrations_of(Path(checkpoint)),
+            {f"{n} objects": v["success_rate"] for n, v in by_size.items()},
+            {f"{n} objects": v["subgoal_completion"] for n, v in by_size.items()},
+        )
+    sizes = sorted({int(n) for s in summaries for n in s})
+    columns = tuple(f"{n} objects" for n in sizes)
+    paper = {f"{n} objects": rates for n, rates in PAPER_TABLE1["gnn"].items()}
     title = (
         f"Success rate / subgoal completion in the symbolic loop against demonstrations "
         f"({protocol}): {per_size} goals per size"
     )
-    return title, points
+    return title, "demonstrations", columns, by_run, paper
 
 
-def curve_table(title: str, points: Sequence[CurvePoint]) -> TextTable:
-    """One row per point, and the paper's Table 1 (its whole system in its world) below."""
-    sizes = sorted({n for p in points for n in p.success})
-    rows = [
-        (p.series, str(p.demonstrations))
-        + tuple(
-            f"{p.success[n]:.2f} / {p.completion[n]:.2f}" if n in p.success else "—" for n in sizes
-        )
-        for p in points
-    ]
-    paper = PAPER_TABLE1["gnn"]
-    rows.append(
-        ("the paper's Table 1 (GNN, in its world)", "18")
-        + tuple(f"{paper[n][0]:.2f} / {paper[n][1]:.2f}" if n in paper else "—" for n in sizes)
+def _motion(runs: Sequence[Path], primitive: str):
+    by_run: dict[Path, tuple] = {}
+    scenes: tuple = ()
+    for run in runs:
+        config = read_json(run / CONFIG, "run configuration")
+        rows = [
+            r
+            for row in logged_rows(run)
+            if str(row.get("key", "")).startswith(f"{primitive}/")
+            for r in row["result"]
+        ]
+        if not rows:
+            raise InvalidInputError(f"'{run}' holds no finished {primitive} scene")
+        tasks = (config.get("seed"), frozenset(r["task"] for r in rows))
+        if not scenes:
+            scenes = tasks
+        elif tasks != scenes:
+            raise InvalidInputError(
+                f"'{run}' and '{runs[0]}' differ in seed or scenes: a curve's points must be "
+                "like for like"
+            )
+        success = {}
+        for model in MODELS:
+            mine = [r["ok"] for r in rows if r["model"] == model]
+            if mine and model in ("gnn", "random"):  # the curve's model and the floor
+                success[LABELS[model]] = sum(mine) / len(mine)
+        by_run[run] = (trials_of(Path(config["checkpoints"]), primitive), success, None)
+    title = (
+        f"Single-shot {primitive} success on fresh scenes against the GNN's training trials: "
+        f"{len(scenes[1])} scenes, seed {scenes[0]}"
     )
-    header = ("series", "demonstrations", *(f"{n} objects" for n in sizes))
-    return TextTable(title, header, tuple(rows))
+    return title, "training trials", (LABELS["gnn"], LABELS["random"]), by_run, {}
+
+
+def curve_table(c: Curves) -> TextTable:
+    """One row per point, and for task curves the paper's Table 1 (its system, its world)."""
+
+    def cell(p: CurvePoint, col: str) -> str:
+        if col not in p.success:
+            return "—"
+        if p.completion is None:
+            return f"{p.success[col]:.3f}"
+        return f"{p.success[col]:.2f} / {p.completion[col]:.2f}"
+
+    rows = [(p.series, f"{p.amount:,}", *(cell(p, col) for col in c.columns)) for p in c.points]
+    if c.paper:
+        rows.append(
+            ("the paper's Table 1 (GNN, in its world)", "18")
+            + tuple(
+                f"{c.paper[col][0]:.2f} / {c.paper[col][1]:.2f}" if col in c.paper else "—"
+                for col in c.columns
+            )
+        )
+    return TextTable(c.title, ("series", c.unit, *c.columns), tuple(rows))

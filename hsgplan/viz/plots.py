@@ -99,14 +99,15 @@ def plot_times_by_size(series: dict[str, dict[str, dict[int, float]]], path: Pat
 
 
 def plot_learning_curves(
-    series: dict[str, dict[int, dict[int, float]]], paper: dict[int, float], path: Path
+    series: dict[str, dict[int, dict[str, float]]], paper: dict[str, float], unit: str, path: Path
 ) -> None:
-    """Success rate against the number of demonstrations (log scale), one panel per series and
-    one colour per problem size; the paper's rate at each size as a dashed line.
+    """Success rate against how much data (log scale), one panel per series and one colour per
+    column (a problem size, or a model); the paper's rate of a column as a dashed line.
 
     Args:
-        series: series name -> demonstrations -> size -> success rate.
-        paper: size -> the paper's success rate (drawn where the series have that size).
+        series: series name -> amount of data -> column -> success rate.
+        paper: column -> the paper's success rate (drawn where a series has that column).
+        unit: what the amounts count (the x axis' label).
         path: where the PNG goes.
     """
     fig, axes = plt.subplots(
@@ -114,22 +115,22 @@ def plot_learning_curves(
     )
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ax, (name, points) in zip(axes[0], series.items(), strict=True):
-        counts = sorted(points)
-        sizes = sorted({n for p in points.values() for n in p})
-        for k, n in enumerate(sizes):
+        amounts = sorted(points)
+        columns = list(dict.fromkeys(col for a in amounts for col in points[a]))
+        for k, col in enumerate(columns):
             colour = colours[k % len(colours)]
-            xs = [c for c in counts if n in points[c]]
-            ax.plot(xs, [points[c][n] for c in xs], color=colour, marker="o", label=f"{n} objects")
-            if n in paper:
-                ax.axhline(paper[n], color=colour, linestyle="--", alpha=0.6)
+            xs = [a for a in amounts if col in points[a]]
+            ax.plot(xs, [points[a][col] for a in xs], color=colour, marker="o", label=col)
+            if col in paper:
+                ax.axhline(paper[col], color=colour, linestyle="--", alpha=0.6)
         ax.set_xscale("log", base=2)
-        ax.set_xticks(counts, [str(c) for c in counts])
+        ax.set_xticks(amounts, [f"{a:,}" for a in amounts])
         ax.minorticks_off()
-        ax.set_xlabel("demonstrations")
+        ax.set_xlabel(unit)
         ax.set_title(name, fontsize=9)
         ax.set_ylim(0, 1.02)
         ax.grid(alpha=0.3)
-    axes[0][0].set_ylabel("success rate (dashed: the paper's)")
+    axes[0][0].set_ylabel("success rate" + (" (dashed: the paper's)" if paper else ""))
     axes[0][-1].legend(fontsize=8)
     fig.tight_layout()
     save_figure(fig, path)

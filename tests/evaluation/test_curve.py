@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 
 from hsgplan.cli import app
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.evaluation.curve import curve_points, curve_table, demonstrations_of
+from hsgplan.evaluation.curve import curve_table, curves, demonstrations_of
 
 DEMOS = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
 
@@ -47,13 +47,20 @@ def _run(folder: Path, checkpoint: Path, wins: dict[int, int], protocol="paper")
 def test_points_are_ordered_by_the_demonstrations_their_checkpoint_learned_from(tmp_path):
     big = _run(tmp_path / "r18", _checkpoint(tmp_path / "c18", None), {2: 2, 3: 1})
     small = _run(tmp_path / "r6", _checkpoint(tmp_path / "c6", 6), {2: 1, 3: 0})
-    title, points = curve_points([("recipe", [big, small])])
-    assert [p.demonstrations for p in points] == [6, 18]
-    assert points[0].success == {2: 0.5, 3: 0.0} and points[1].completion == {2: 1.0, 3: 0.75}
-    assert "paper protocol" in title and "2 goals per size" in title
-    table = curve_table(title, points)
+    c = curves([("recipe", [big, small])])
+    points = c.points
+    assert [p.amount for p in points] == [6, 18] and c.unit == "demonstrations"
+    assert points[0].success == {"2 objects": 0.5, "3 objects": 0.0}
+    assert points[1].completion == {"2 objects": 1.0, "3 objects": 0.75}
+    assert "paper protocol" in c.title and "2 goals per size" in c.title
+    table = curve_table(c)
     assert table.rows[0] == ("recipe", "6", "0.50 / 0.75", "0.00 / 0.50")
-    assert table.rows[-1][0].startswith("the paper's Table 1")
+    assert table.rows[-1] == (
+        "the paper's Table 1 (GNN, in its world)",
+        "18",
+        "0.92 / 0.95",
+        "0.89 / 0.95",
+    )
 
 
 def test_a_combined_checkpoint_counts_its_f_preimage_demonstrations(tmp_path):
@@ -68,10 +75,10 @@ def test_runs_that_are_not_like_for_like_or_repeat_a_count_are_refused(tmp_path)
     a = _run(tmp_path / "a", _checkpoint(tmp_path / "ca", 6), {2: 1})
     b = _run(tmp_path / "b", _checkpoint(tmp_path / "cb", 6), {2: 2})
     with pytest.raises(InvalidInputError, match="both learned from 6"):
-        curve_points([("s", [a, b])])
+        curves([("s", [a, b])])
     c = _run(tmp_path / "c", _checkpoint(tmp_path / "cc", 12), {2: 1}, protocol="recovering")
     with pytest.raises(InvalidInputError, match="differ in protocol"):
-        curve_points([("s", [a]), ("t", [c])])
+        curves([("s", [a]), ("t", [c])])
 
 
 def test_cli_writes_the_plot_and_refuses_a_bad_series_in_one_line(tmp_path):
@@ -87,3 +94,42 @@ def test_cli_writes_the_plot_and_refuses_a_bad_series_in_one_line(tmp_path):
     for bad in ("s", "=x", "s="):
         r = CliRunner().invoke(app, ["eval", "curve", "--series", bad])
         assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1, bad
+
+
+def _motion_run(folder: Path, trials: int, wins: dict[str, int], scenes: int = 4) -> Path:
+    """An eval motion run over `scenes` place scenes, `wins[model]` of them solved, of a
+    checkpoint folder whose place GNN learned from `trials` examples."""
+    checkpoints = folder / "checkpoints"
+    (checkpoints / "place-gnn").mkdir(parents=True)
+    record = {"training_examples": trials, "validation_examples": 0, "chosen_epoch": 1}
+    (checkpoints / "place-gnn" / "training.json").write_text(json.dumps(record))
+    run = folder / "run"
+    run.mkdir()
+    config = {"kind": "eval-motion", "seed": 0, "checkpoints": str(checkpoints)}
+    (run / "config.json").write_text(json.dumps(config))
+    rows = [
+        {"task": k, "model": model, "crowding": 0, "shelf_top": False, "ok": k < won}
+        for k in range(scenes)
+        for model, won in wins.items()
+    ]
+    (run / "episodes.jsonl").write_text(json.dumps({"key": "place/0", "result": rows}) + "\n")
+    return run
+
+
+def test_motion_points_read_the_gnns_training_trials_and_refuse_other_scenes(tmp_path):
+    more = _motion_run(tmp_path / "more", 800, {"gnn": 4, "random": 1})
+    fewer = _motion_run(tmp_path / "fewer", 100, {"gnn": 2, "random": 1})
+    c = curves([("GNN", [more, fewer])])
+    assert [(p.amount, p.success) for p in c.points] == [
+        (100, {"GNN": 0.5, "Random": 0.25}),
+        (800, {"GNN": 1.0, "Random": 0.25}),
+    ]
+    assert curve_table(c).rows[-1] == ("GNN", "800", "1.000", "0.250")  # no paper row
+    other = _motion_run(tmp_path / "other", 200, {"gnn": 1}, scenes=3)
+    with pytest.raises(InvalidInputError, match="differ in seed or scenes"):
+        curves([("GNN", [more, other])])
+    with pytest.raises(InvalidInputError, match="no finished push scene"):
+        curves([("GNN", [more])], primitive="push")
+    task = _run(tmp_path / "t", _checkpoint(tmp_path / "ct", 6), {2: 1})
+    with pytest.raises(InvalidInputError, match="all eval task runs or all eval motion"):
+        curves([("a", [more]), ("b", [task])])
