@@ -309,4 +309,4 @@ def eval_curve(
             drawn[p.series][p.amount] = p.success
         paper = {col: rates[0] for col, rates in c.paper.items()}
         plot_learning_curves(drawn, paper, c.unit, plot)
-        out.print(f"wrote {shown(plot)}", highlight=False)
+        err.print(f"wrote {shown(plot)}", highlight=False)  # stdout stays the table alone
