@@ -21,7 +21,7 @@ from hsgplan.data.demos import load_demos
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.compare import task_summaries
-from hsgplan.evaluation.motion_eval import LABELS, MODELS
+from hsgplan.evaluation.motion_eval import CROWDED, LABELS
 from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable
 from hsgplan.paths import shipped
 from hsgplan.planning.regression.combine import COMBINED
@@ -159,16 +159,20 @@ def _motion(runs: Sequence[Path], primitive: str):
                 "like for like"
             )
         success = {}
-        for model in MODELS:
-            mine = [r["ok"] for r in rows if r["model"] == model]
-            if mine and model in ("gnn", "random"):  # the curve's model and the floor
-                success[LABELS[model]] = sum(mine) / len(mine)
+        for model in ("gnn", "random"):  # the curve's model and the floor
+            mine = [r for r in rows if r["model"] == model]
+            if mine:
+                success[LABELS[model]] = sum(r["ok"] for r in mine) / len(mine)
+            crowded = [r["ok"] for r in mine if r["shelf_top"] and r["crowding"] >= CROWDED]
+            if crowded:  # where a place is hardest: a shelf top half full or more
+                success[f"{LABELS[model]}, crowded shelf tops"] = sum(crowded) / len(crowded)
         by_run[run] = (trials_of(Path(config["checkpoints"]), primitive), success, None)
     title = (
         f"Single-shot {primitive} success on fresh scenes against the GNN's training trials: "
         f"{len(scenes[1])} scenes, seed {scenes[0]}"
     )
-    return title, "training trials", (LABELS["gnn"], LABELS["random"]), by_run, {}
+    columns = tuple(dict.fromkeys(col for _, success, _ in by_run.values() for col in success))
+    return title, "training trials", columns, by_run, {}
 
 
 def curve_table(c: Curves) -> TextTable:

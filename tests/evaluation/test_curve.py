@@ -108,7 +108,8 @@ def _motion_run(folder: Path, trials: int, wins: dict[str, int], scenes: int = 4
     config = {"kind": "eval-motion", "seed": 0, "checkpoints": str(checkpoints)}
     (run / "config.json").write_text(json.dumps(config))
     rows = [
-        {"task": k, "model": model, "crowding": 0, "shelf_top": False, "ok": k < won}
+        # scene 0 a place on a crowded shelf top, where it is hardest
+        {"task": k, "model": model, "crowding": 2 * (k == 0), "shelf_top": k == 0, "ok": k < won}
         for k in range(scenes)
         for model, won in wins.items()
     ]
@@ -120,11 +121,13 @@ def test_motion_points_read_the_gnns_training_trials_and_refuse_other_scenes(tmp
     more = _motion_run(tmp_path / "more", 800, {"gnn": 4, "random": 1})
     fewer = _motion_run(tmp_path / "fewer", 100, {"gnn": 2, "random": 1})
     c = curves([("GNN", [more, fewer])])
+    crowded = {"GNN, crowded shelf tops": 1.0, "Random, crowded shelf tops": 1.0}
     assert [(p.amount, p.success) for p in c.points] == [
-        (100, {"GNN": 0.5, "Random": 0.25}),
-        (800, {"GNN": 1.0, "Random": 0.25}),
+        (100, {"GNN": 0.5, "Random": 0.25} | crowded),
+        (800, {"GNN": 1.0, "Random": 0.25} | crowded),
     ]
-    assert curve_table(c).rows[-1] == ("GNN", "800", "1.000", "0.250")  # no paper row
+    assert c.columns == ("GNN", "GNN, crowded shelf tops", "Random", "Random, crowded shelf tops")
+    assert curve_table(c).rows[-1] == ("GNN", "800", "1.000", "1.000", "0.250", "1.000")
     other = _motion_run(tmp_path / "other", 200, {"gnn": 1}, scenes=3)
     with pytest.raises(InvalidInputError, match="differ in seed or scenes"):
         curves([("GNN", [more, other])])
