@@ -199,7 +199,14 @@ class RayEngine:
         self.ray = ray
         try:
             if address == "local":
-                ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
+                # "local" starts an instance of our own: without it Ray would join one another
+                # process started on this machine, and refuse the CPU count it was given
+                ray.init(
+                    address="local",
+                    num_cpus=workers,
+                    include_dashboard=False,
+                    log_to_driver=False,
+                )
             else:
                 ray.init(address=address, log_to_driver=False, runtime_env=cluster_env())
         except Exception as e:  # no cluster there, a bad address: one line, not a traceback
