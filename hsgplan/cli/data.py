@@ -74,6 +74,7 @@ def demos(
             lambda d: progress.advance(task),
             full_scene=full_scene,
             rounds=rounds,
+            on_start=lambda n: progress.update(task, completed=n),  # a resumed set starts there
         )
         progress.update(task, completed=len(TASKS) * rounds)
     steps = sum(len(d.actions) for d in done)

@@ -93,9 +93,10 @@ def collect_demos(
     on_demo: Callable[[Demo], None] | None = None,
     full_scene: bool = False,
     rounds: int = 1,
+    on_start: Callable[[int], None] | None = None,
 ) -> list[Demo]:
     """Record every task of every round not yet in `out` (appending as each finishes); all
-    demos, round by round in task order."""
+    demos, round by round in task order. `on_start` hears how many are already recorded."""
     if rounds < 1:
         raise InvalidInputError(f"rounds {rounds}: need at least 1")
     check_own(out, META, "demonstration set")  # never into another command's folder
@@ -116,6 +117,8 @@ def collect_demos(
         with open(path, "a") as f:  # a line cut short by an interruption: end it
             f.write("\n")
     order = [(r, i, round_task(t, r), g) for r in range(rounds) for i, (t, g) in enumerate(TASKS)]
+    if on_start:
+        on_start(sum(task in done for _, _, task, _ in order))
     for r, i, task, goal in order:
         if task in done:
             continue

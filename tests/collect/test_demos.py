@@ -145,8 +145,10 @@ def test_rounds_record_every_task_again_in_scenes_of_their_own(tmp_path, monkeyp
     meta = json.loads((tmp_path / "three" / "meta.json").read_text())
     assert meta["rounds"] == 3
     seeds.clear()
-    grown = collect_demos(first_round, seed=3, rounds=2)  # a set grows by the missing rounds
-    assert grown == three[:4] and len(seeds) == 2
+    started: list[int] = []
+    # a set grows by the missing rounds, and says how many it already holds
+    grown = collect_demos(first_round, seed=3, rounds=2, on_start=started.append)
+    assert grown == three[:4] and len(seeds) == 2 and started == [2]
     assert json.loads((first_round / "meta.json").read_text())["rounds"] == 2
     with pytest.raises(InvalidInputError, match="rounds 0"):
         collect_demos(tmp_path / "none", seed=3, rounds=0)
