@@ -11,6 +11,7 @@ from rich.progress import Progress
 
 from hsgplan.agents.registry import DEFAULT_SEARCH, SEARCH_BASELINES
 from hsgplan.cli.common import (
+    MarkdownFlag,
     PerceptionCheckpoint,
     RayAddress,
     RunFolder,
@@ -41,10 +42,7 @@ def bench_sim(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
     episodes: Annotated[int, bounded_option("episodes", "Oracle episodes per size.")] = 5,
     seed: Annotated[int, bounded_option("seed", "Random seed.")] = 0,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """Median seconds per primitive (motion planning included) and per oracle episode."""
     from hsgplan.benchmarks.sim import bench_sim as run
@@ -78,10 +76,7 @@ def bench_symbolic(
         ),
     ] = 8,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """Fast Downward plan time per size: median over the goals, both search configurations."""
     from hsgplan.benchmarks.symbolic import bench_symbolic as run
@@ -121,10 +116,7 @@ def bench_task(
         Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
     ] = TASK_CHECKPOINT,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """Task-planning time: the learned regression planner against Fast Downward, one core."""
     from hsgplan.benchmarks.task import bench_task as run
@@ -185,10 +177,7 @@ def bench_timing(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """The paper's Table 2: task-planning and motion seconds per episode, ours (regression +
     GNN) against a search-based baseline, on the same goals; writes table2.md, table2.png
@@ -242,10 +231,7 @@ def bench_collect(
     samples: Annotated[int, bounded_option("samples", "Successful samples per primitive.")] = 300,
     workers: Annotated[int, bounded_option("workers", "Processes.")] = 2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """Successful motion samples per second of the collector (wall time, start-up included)."""
     from hsgplan.benchmarks.collect import bench_collect as run
@@ -286,10 +272,7 @@ def bench_observe(
     seed: Annotated[int, bounded_option("seed", "Seed of the scenes.")] = 100,
     perception_checkpoint: PerceptionCheckpoint = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.", metavar="")] = False,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """Seconds per observation through f_p (rendering timed apart and excluded): the keypoint
     network, PnP, fusion, naming and resting, and the tracker; medians over the scenes."""

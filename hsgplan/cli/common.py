@@ -211,6 +211,13 @@ RunFolder = Annotated[
 ]
 
 
+# --markdown of every command that prints a table
+MarkdownFlag = Annotated[
+    bool,
+    typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
+]
+
+
 # --workers and --ray of the jobs that can run on Ray (collections, eval)
 CollectWorkers = Annotated[
     int,

@@ -11,6 +11,7 @@ from rich.progress import Progress
 
 from hsgplan.cli.common import (
     CollectWorkers,
+    MarkdownFlag,
     PlannerName,
     ProtocolName,
     RayAddress,
@@ -132,10 +133,7 @@ def eval_task(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
     wasted (inapplicable) actions per episode, milliseconds per decision. Episodes are kept in
@@ -218,10 +216,7 @@ def eval_reach(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """f_reach against the simulated world: precision and recall of "reachable" on held-out
     executed primitives, by the situation that decides them (hand full, surface full, ...)."""
@@ -274,10 +269,7 @@ def eval_curve(
         Path | None,
         typer.Option(help="Also draw the curves into this PNG.", parser=out_file),
     ] = None,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """Learning curves: success against how much data a model learned from, read from each
     run's checkpoint. Eval task runs: success in the symbolic loop by size against the

@@ -13,6 +13,7 @@ from rich.progress import Progress
 
 from hsgplan.cli.common import (
     CollectWorkers,
+    MarkdownFlag,
     RayAddress,
     bounded_option,
     check_ray,
@@ -115,10 +116,7 @@ def eval_motion(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
-    markdown: Annotated[
-        bool,
-        typer.Option("--markdown", help="Print a Markdown table (for the README).", metavar=""),
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """Single-shot success of the GNN, the MLP and Random on fresh random scenes (never the
     training scenes), per primitive and crowding level; every model sees the same scenes."""

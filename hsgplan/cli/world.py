@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.agents.registry import agent_name, agent_parts
 from hsgplan.cli.common import (
     AgentName,
+    MarkdownFlag,
     MotionName,
     PerceptionCheckpoint,
     PlannerName,
@@ -387,9 +388,7 @@ def compare(
         typer.Option(help="The rows' names, comma-separated (default: the folders' names)."),
     ] = None,
     method: Annotated[str, typer.Option(help="The column compared (gnn, mlp, ...).")] = "gnn",
-    markdown: Annotated[
-        bool, typer.Option("--markdown", help="Print a Markdown table.", metavar="")
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """One method's success per size across eval world runs, one row each: a ladder from one
     recipe to another, one change per row. The runs must be like for like (protocol, goals,

@@ -23,12 +23,11 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.compare import task_summaries
 from hsgplan.evaluation.motion_eval import CROWDED, LABELS
 from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable
+from hsgplan.motion.train import SELECTION
 from hsgplan.paths import shipped
 from hsgplan.planning.regression.combine import COMBINED
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 from hsgplan.training import TRAIN_CONFIG
-
-SELECTION = "training.json"  # a motion checkpoint's training record (`motion/train.py`)
 
 
 @dataclass(frozen=True)
