@@ -165,7 +165,9 @@ def _motion(runs: Sequence[Path], primitive: str):
             crowded = [r["ok"] for r in mine if r["shelf_top"] and r["crowding"] >= CROWDED]
             if crowded:  # where a place is hardest: a shelf top half full or more
                 success[f"{LABELS[model]}, crowded shelf tops"] = sum(crowded) / len(crowded)
-        by_run[run] = (trials_of(Path(config["checkpoints"]), primitive), success, None)
+        if not isinstance(checkpoints := config.get("checkpoints"), str):
+            raise InvalidInputError(f"'{run}' names no motion checkpoints")
+        by_run[run] = (trials_of(Path(checkpoints), primitive), success, None)
     title = (
         f"Single-shot {primitive} success on fresh scenes against the GNN's training trials: "
         f"{len(scenes[1])} scenes, seed {scenes[0]}"

@@ -131,6 +131,11 @@ def test_motion_points_read_the_gnns_training_trials_and_refuse_other_scenes(tmp
     other = _motion_run(tmp_path / "other", 200, {"gnn": 1}, scenes=3)
     with pytest.raises(InvalidInputError, match="differ in seed or scenes"):
         curves([("GNN", [more, other])])
+    config = json.loads((other / "config.json").read_text())
+    del config["checkpoints"]
+    (other / "config.json").write_text(json.dumps(config))
+    with pytest.raises(InvalidInputError, match="names no motion checkpoints"):
+        curves([("GNN", [other])])
     with pytest.raises(InvalidInputError, match="no finished push scene"):
         curves([("GNN", [more])], primitive="push")
     task = _run(tmp_path / "t", _checkpoint(tmp_path / "ct", 6), {2: 1})
