@@ -17,7 +17,7 @@ from hsgplan.evaluation.protocol import run_evaluation
 from hsgplan.evaluation.summary import summarize
 from hsgplan.runner.run_folder import RESULTS
 
-CONFIG = EvalConfig(agent="regression+gnn", sizes=(2, 3), goals=1, seed=3)
+CONFIG = EvalConfig(agent="regression+gnn", sizes=(2,), goals=2, seed=3)
 TIMES = {"seconds", "task_seconds", "motion_seconds", "execution_seconds"}
 
 
@@ -65,7 +65,7 @@ def test_a_worker_killed_mid_run_costs_its_episode_a_retry(tmp_path):
     undisturbed = run_evaluation(CONFIG, tmp_path / "calm", workers=1)
     out = tmp_path / "killed"
     command = [sys.executable, "-m", "hsgplan.cli", "eval", "world", "--planner", "regression"]
-    command += ["--motion", "gnn", "--sizes", "2-3", "--goals", "1", "--seed", "3"]
+    command += ["--motion", "gnn", "--sizes", "2", "--goals", "2", "--seed", "3"]
     command += ["--workers", "1", "--out", str(out)]
     proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     log = out / "gnn" / RESULTS
