@@ -32,6 +32,7 @@ from hsgplan.domain.recovery import PAPER, RECOVERING
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer, perception_folder
+from hsgplan.evaluation.seeds import episode_seed
 from hsgplan.runner.items import run_items
 from hsgplan.runner.run_folder import CONFIG, add_wall_seconds, check_claim
 from hsgplan.symbolic.generator import random_goals
@@ -67,10 +68,6 @@ def episode_specs(config: EvalConfig) -> list[EpisodeSpec]:
         for i, g in enumerate(by_size[n])
         for r in range(config.repeats)
     ]
-
-
-def episode_seed(seed: int, size: int, index: int, repeat: int = 0) -> int:
-    return (seed * 1_000_003 + size * 10_007 + index + repeat * 7_919_111) % (2**31)
 
 
 @lru_cache(maxsize=2)

@@ -23,3 +23,9 @@ def marked(title: str, seed: int, perception: bool = False) -> str:
     if is_tuning(seed, perception):
         return f"{title} (a tuning seed: for choosing rules, not a result)"
     return title
+
+
+def episode_seed(seed: int, size: int, index: int, repeat: int = 0) -> int:
+    """The seed of one episode of a run: its goal's index among those of its size, and its
+    repeat."""
+    return (seed * 1_000_003 + size * 10_007 + index + repeat * 7_919_111) % (2**31)

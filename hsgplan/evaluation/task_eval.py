@@ -27,7 +27,7 @@ from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.failures import Failure
-from hsgplan.evaluation.protocol import episode_seed
+from hsgplan.evaluation.seeds import episode_seed
 from hsgplan.runner.items import run_items
 from hsgplan.symbolic.generator import random_goals, random_state
 from hsgplan.symbolic.transition import apply, why_not
