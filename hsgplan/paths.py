@@ -28,6 +28,10 @@ MOTION_DATA = DATA / "motion"
 REACH_DATA = DATA / "reach" / "v1"  # primitives executed in the simulated world: f_reach's labels
 REACH_HELD_OUT = DATA / "reach" / "heldout"  # the same, another seed: f_reach is scored on it
 RUNS = Path("runs")
+SCENES = Path("scenes")
+# The default world. Read beside the package, not from `home()`: the world is the code's, and a
+# home that holds another user's checkpoints must not change it.
+KITCHEN_SCENE = Path(__file__).resolve().parent.parent / SCENES / "kitchen.toml"
 
 
 def home() -> Path:

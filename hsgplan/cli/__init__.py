@@ -1,9 +1,9 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval world, report),
-`data` (collect), `learn` (train task, eval task, eval reach), `motion` (train motion, eval
-motion), `perception` (train perception, eval perception), `bench`; `renamed` refuses the older
-spellings.
+`scenes` (layouts), `data` (collect), `learn` (train task, eval task, eval reach), `motion`
+(train motion, eval motion), `perception` (train perception, eval perception), `bench`;
+`renamed` refuses the older spellings.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli import bench, data, learn, motion, perception, symbolic, world
+from hsgplan.cli import bench, data, learn, motion, perception, scenes, symbolic, world
 from hsgplan.cli.common import OneLineErrors, Summaries
 
 app = typer.Typer(
@@ -40,6 +40,7 @@ eval_app.command("curve")(learn.eval_curve)
 app.command()(symbolic.plan)
 app.command()(symbolic.goals)
 app.command()(world.demo)
+app.command()(scenes.scenes)
 app.add_typer(eval_app, name="eval")
 app.command()(world.report)
 app.add_typer(data.app, name="collect")

@@ -29,6 +29,7 @@ MAX_TRIALS = 100_000  # `eval motion --trials` (per primitive)
 MAX_EPISODES = 10_000  # `bench sim --episodes`
 MAX_FAILURES = 1_000  # `report --failures`
 MAX_TASKS_PER_CHUNK = 100_000
+MAX_LAYOUTS = 10_000  # `scenes --layouts`
 # The bounds of each count and seed a user gives, by what it counts: configurations declare
 # their fields with them (`setting(0, **BOUNDS["seed"])`) and the command line's options take
 # theirs from here (`cli.common.bounded_option`), so each bound is written once.
@@ -43,6 +44,7 @@ BOUNDS: dict[str, dict[str, int]] = {
     "scenes": {"lo": 1, "hi": MAX_TRIALS},
     "episodes": {"lo": 1, "hi": MAX_EPISODES},
     "failures": {"lo": 0, "hi": MAX_FAILURES},
+    "layouts": {"lo": 1, "hi": MAX_LAYOUTS},
 }
 MAX_GOAL_FILE_GOALS = MAX_GOALS  # a goal file holds at most as many goals as --goals draws
 MAX_GOAL_FILE_BYTES = 32 * 2**20  # 100,000 goals of 12 objects fit; parsed in about 10 s

@@ -25,7 +25,7 @@ from enum import StrEnum
 
 from hsgplan.domain.objects import object_type
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
-from hsgplan.domain.world import REGIONS, SHELF_CLEARANCE, SHELF_TOP_Z, SHELVES, TABLE, Kind, Rect
+from hsgplan.domain.world import REGIONS, SHELVES, TABLE, Kind, Rect
 from hsgplan.scene_graph.geometric import GeometricNode, GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -167,13 +167,16 @@ def _supports(
         if offset is not None:
             out.append(_Support(on(name, b.name), dz + _XY_WEIGHT * offset, b.name))
     surfaces: list[tuple[Literal, Rect]] = []
-    if abs(bottom - SHELF_TOP_Z) <= tol.contact_z:
-        surfaces += [(on(name, s.name), s.top) for s in SHELVES.values()]
+    tops = [s for s in SHELVES.values() if abs(bottom - s.top.z) <= tol.contact_z]
+    surfaces += [(on(name, s.name), s.top) for s in tops]
     # At table height: inside a shelf (under its top board), or on a region. A centre within
     # margin of both a prepush region and the interior behind it goes to the nearer, by cost.
     if abs(bottom) <= tol.contact_z:
-        if z < SHELF_CLEARANCE:
-            surfaces += [(inside(name, s.name), s.interior) for s in SHELVES.values()]
+        surfaces += [
+            (inside(name, s.name), s.interior)
+            for s in SHELVES.values()
+            if s.interior is not None and z < s.clearance
+        ]
         surfaces += [(on(name, r), rect) for r, rect in REGIONS.items()]
     for lit, rect in surfaces:
         d = _rect_distance(rect, x, y)
@@ -204,9 +207,10 @@ def _by_centre(node: GeometricNode, tol: MappingTolerances) -> Literal:
     interior, or else the nearest region (a toppled object carries and rests on no object)."""
     x, y, z = node.pose.position
     for s in SHELVES.values():
-        if z >= SHELF_TOP_Z and _rect_distance(s.top, x, y) <= tol.xy_margin:
+        if z >= s.top.z and _rect_distance(s.top, x, y) <= tol.xy_margin:
             return on(node.name, s.name)
-        if z < SHELF_CLEARANCE and _rect_distance(s.interior, x, y) <= tol.xy_margin:
+        inner = s.interior
+        if inner is not None and z < s.clearance and _rect_distance(inner, x, y) <= tol.xy_margin:
             return inside(node.name, s.name)
     return on(node.name, _nearest_region(x, y))
 

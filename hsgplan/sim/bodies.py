@@ -5,10 +5,8 @@ from __future__ import annotations
 from pybullet_utils.bullet_client import BulletClient
 
 from hsgplan.domain.objects import object_type
-from hsgplan.domain.world import OBJECT_FRICTION, Kind
+from hsgplan.domain.world import Kind
 from hsgplan.scene_graph.geometry import Pose
-
-MASS = {Kind.CAN: 0.30, Kind.BOX: 0.15}
 
 
 def spawn_object(bc: BulletClient, name: str, pose: Pose) -> int:
@@ -25,9 +23,9 @@ def spawn_object(bc: BulletClient, name: str, pose: Pose) -> int:
         col = bc.createCollisionShape(bc.GEOM_BOX, halfExtents=half)
         vis = bc.createVisualShape(bc.GEOM_BOX, halfExtents=half, rgbaColor=t.color)
     body = bc.createMultiBody(
-        MASS[t.kind], col, vis, basePosition=pose.position, baseOrientation=pose.orientation
+        t.mass, col, vis, basePosition=pose.position, baseOrientation=pose.orientation
     )
     bc.changeDynamics(
-        body, -1, lateralFriction=OBJECT_FRICTION, spinningFriction=0.001, rollingFriction=0.0005
+        body, -1, lateralFriction=t.friction, spinningFriction=0.001, rollingFriction=0.0005
     )
     return body

@@ -1,0 +1,46 @@
+"""`hsgplan scenes`: random layouts of a scene, written as scene files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from hsgplan.cli.common import bounded_option, err, input_path, out_folder, refuses_bad_input, shown
+
+
+@refuses_bad_input
+def scenes(
+    layouts: Annotated[int, bounded_option("layouts", "How many layouts.")],
+    out: Annotated[
+        Path, typer.Option("--out", help="Folder to write the scene files in.", parser=out_folder)
+    ],
+    seed: Annotated[
+        int, bounded_option("seed", "Random seed; the same seed gives the same layouts.")
+    ] = 0,
+    new_objects: Annotated[
+        bool,
+        typer.Option(
+            "--new-objects", help="Object types never trained on, in place of the scene's."
+        ),
+    ] = False,
+    scene: Annotated[
+        Path | None,
+        typer.Option(help="The scene to vary (default: scenes/kitchen.toml).", parser=input_path),
+    ] = None,
+) -> None:
+    """Write random layouts of a scene as scene files: its shelves moved and resized, its
+    objects resized (or new ones); the ranges are in docs/scenes.md."""
+    from hsgplan.domain.layouts import write_layouts
+    from hsgplan.domain.scene_file import read_world
+    from hsgplan.paths import KITCHEN_SCENE
+
+    base = read_world(scene or KITCHEN_SCENE)
+    header = f"hsgplan scenes --layouts {layouts} --seed {seed}" + (
+        " --new-objects" if new_objects else ""
+    )
+    if scene is not None:
+        header += f" --scene {scene}"
+    written = write_layouts(base, layouts, seed, out, new_objects, header)
+    err.print(f"wrote {len(written)} scene files to {shown(out)}")

@@ -1,0 +1,129 @@
+"""Random layouts of a world: shelves moved and resized, groceries resized, or groceries never
+seen before. Their scene files are what the learned planners are measured on, beyond the scene
+they were trained in (`hsgplan scenes`).
+
+The ranges (documented in docs/scenes.md) keep every layout one the Panda can work: the shelves
+stay in front of it and within reach, their tops within the tower-height rule, every object's
+narrow side within what the gripper opens.
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import replace
+from pathlib import Path
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.scene import GRIPPER_MAX_OPENING, Kind, ObjectType, World
+from hsgplan.domain.scene_file import object_data, scene_data, to_toml, world_of
+from hsgplan.files import write_atomically
+
+SHELF_NEAR = (0.34, 0.44)  # x of a shelf's open front
+SHELF_DEPTH = (0.20, 0.26)
+SHELF_WIDTH = (0.28, 0.36)
+SHELF_SIDE_GAP = (0.02, 0.08)  # between the open space's side and the shelf beside it
+SHELF_CLEARANCE = (0.11, 0.14)
+OBJECT_SCALE = (0.8, 1.2)  # each dimension of each object type, drawn apart
+MAX_GRASP = GRIPPER_MAX_OPENING - 0.004  # a resized object's narrow side
+TRIES = 200
+# Groceries no model was trained on, by kind: drawn without replacement for `--new-objects`.
+NEW_NAMES = {
+    Kind.CAN: ("peaches", "corn", "tuna", "beans", "coconut_milk"),
+    Kind.BOX: ("crackers", "tea", "rice", "pasta", "oats"),
+}
+NEW_CAN = ((0.060, 0.076), (0.050, 0.110))  # diameter, height
+NEW_BOX = ((0.030, 0.070), (0.080, 0.130), (0.020, 0.130))  # along x (grasped), along y, height
+
+
+def _span(rng: random.Random, bounds: tuple[float, float]) -> float:
+    return round(rng.uniform(*bounds), 3)
+
+
+def _shelves(base: World, rng: random.Random) -> list[dict]:
+    open_space = base.regions["open_space"]
+    out = []
+    for s in base.shelf_list:
+        near, depth = _span(rng, SHELF_NEAR), _span(rng, SHELF_DEPTH)
+        width, gap = _span(rng, SHELF_WIDTH), _span(rng, SHELF_SIDE_GAP)
+        left = s.outer.y_min >= 0  # the side of the robot it stands on stays
+        y = (open_space.y_max + gap, open_space.y_max + gap + width)
+        if not left:
+            y = (open_space.y_min - gap - width, open_space.y_min - gap)
+        out.append(
+            {
+                "name": s.name,
+                "x": [near, round(near + depth, 3)],
+                "y": [round(v, 3) for v in y],
+                "clearance": _span(rng, SHELF_CLEARANCE),
+                "wall": s.wall,
+                "interior": s.interior is not None,
+            }  # fmt: skip
+        )
+    return out
+
+
+def _resized(t: ObjectType, rng: random.Random) -> ObjectType:
+    while True:
+        x, y, h = (round(v * rng.uniform(*OBJECT_SCALE), 3) for v in t.size)
+        if t.kind is Kind.CAN:
+            y = x
+        if min(x, y) <= MAX_GRASP:
+            return replace(t, size=(x, y, h))
+
+
+def _new(kind: Kind, name: str, rng: random.Random) -> ObjectType:
+    if kind is Kind.CAN:
+        d, h = _span(rng, NEW_CAN[0]), _span(rng, NEW_CAN[1])
+        size = (d, d, h)
+    else:
+        size = tuple(_span(rng, r) for r in NEW_BOX)
+    colour = tuple(round(rng.uniform(0.05, 0.95), 2) for _ in range(3))
+    mass = 0.30 if kind is Kind.CAN else 0.15
+    return ObjectType(name, kind, size, (*colour, 1.0), mass, 0.8)
+
+
+def _objects(base: World, rng: random.Random, new_objects: bool) -> list[ObjectType]:
+    if not new_objects:
+        return [_resized(t, rng) for t in base.type_list]
+    names = {k: rng.sample(v, len(v)) for k, v in NEW_NAMES.items()}
+    return [_new(t.kind, names[t.kind].pop(), rng) for t in base.type_list]
+
+
+def random_layout(base: World, seed: int, index: int, new_objects: bool = False) -> World:
+    """Layout `index` of `seed`: `base` with its shelves moved and resized and its object
+    types resized (or, with `new_objects`, replaced by as many new ones of each kind); the
+    same arguments give the same world."""
+    rng = random.Random(f"layout-{seed}-{index}-{int(new_objects)}")
+    for _ in range(TRIES):
+        data = scene_data(base)
+        data["name"] = f"{base.name}-layout-{seed}-{index}" + ("-new" if new_objects else "")
+        data["shelves"] = _shelves(base, rng)
+        data["objects"] = [object_data(t) for t in _objects(base, rng, new_objects)]
+        try:
+            return world_of(data)
+        except InvalidInputError:
+            continue  # a draw the scene file refuses (a shelf off the table): draw again
+    raise InvalidInputError(f"no valid layout of '{base.name}' in {TRIES} draws (seed {seed})")
+
+
+def write_layouts(
+    base: World, layouts: int, seed: int, folder: Path, new_objects: bool = False, header: str = ""
+) -> list[Path]:
+    """Layouts 0 .. `layouts` - 1 of `seed` as scene files `layout-NNN.toml` in `folder`, with
+    `header` as their first comment. A file already there with the same content is kept (a
+    rerun, or one cut short, repeats nothing); one with other content is refused before
+    anything is written."""
+    stem = "new-objects" if new_objects else "layout"
+    planned = []
+    for index in range(layouts):
+        path = folder / f"{stem}-{index:03d}.toml"
+        world = random_layout(base, seed, index, new_objects)
+        text = f"# {header}\n" + to_toml(scene_data(world))
+        if path.exists() and path.read_text() != text:
+            raise InvalidInputError(f"'{path}' holds another scene; choose another --out")
+        planned.append((path, text))
+    folder.mkdir(parents=True, exist_ok=True)
+    for path, text in planned:
+        if not path.exists():
+            write_atomically(path, text)
+    return [p for p, _ in planned]

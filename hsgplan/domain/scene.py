@@ -1,0 +1,301 @@
+"""A world as data: the table, its shelves and regions, the object types and the cameras, and
+the limits every part of the product derives from them.
+
+A `World` is read from a scene file (`domain/scene_file.py`; the default is
+`scenes/kitchen.toml`). The counting rules at the bottom (capacities, tower height) are what the
+goal validator, the symbolic transition model and the PDDL domain all enforce, so the three
+agree by construction, in whatever scene they are given.
+
+Frame: origin at the robot base on the table top, z up, x away from the robot, y to the left.
+All lengths are metres.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+from functools import cached_property
+
+
+class Kind(StrEnum):
+    CAN = "can"
+    BOX = "box"
+
+
+@dataclass(frozen=True)
+class ObjectType:
+    """A kind of grocery item, described in the orientation it rests in.
+
+    `size` is (extent along x, extent along y, height) when resting; for cans the first two are
+    the diameter. Boxes rest so that the gripper (max opening `GRIPPER_MAX_OPENING`) can close
+    across their narrow horizontal side: in the kitchen, cream cheese and butter lie flat,
+    popcorn stands upright because its flat footprint (12.6 x 8.5 cm) is wider than the gripper
+    opens. `color` is RGBA in [0, 1]; `friction` the lateral friction coefficient (PyBullet
+    multiplies the two bodies' values at a contact).
+    """
+
+    name: str
+    kind: Kind
+    size: tuple[float, float, float]
+    color: tuple[float, float, float, float]
+    mass: float = 0.3
+    friction: float = 0.8
+
+    @property
+    def height(self) -> float:
+        return self.size[2]
+
+    @property
+    def footprint(self) -> tuple[float, float]:
+        return self.size[0], self.size[1]
+
+    @property
+    def grasp_width(self) -> float:
+        return min(self.footprint)
+
+    @property
+    def top_face_min_side(self) -> float:
+        return min(self.footprint)
+
+
+@dataclass(frozen=True)
+class Rect:
+    """An axis-aligned rectangle on a horizontal plane at height `z`."""
+
+    x_min: float
+    x_max: float
+    y_min: float
+    y_max: float
+    z: float = 0.0
+
+    @property
+    def width_x(self) -> float:
+        return self.x_max - self.x_min
+
+    @property
+    def width_y(self) -> float:
+        return self.y_max - self.y_min
+
+    @property
+    def center(self) -> tuple[float, float]:
+        return (self.x_min + self.x_max) / 2, (self.y_min + self.y_max) / 2
+
+    def contains(self, x: float, y: float, margin: float = 0.0) -> bool:
+        return (
+            self.x_min - margin <= x <= self.x_max + margin
+            and self.y_min - margin <= y <= self.y_max + margin
+        )
+
+    def overlaps(self, other: Rect) -> bool:
+        """Whether the two share more than an edge."""
+        return (
+            self.x_min < other.x_max
+            and other.x_min < self.x_max
+            and self.y_min < other.y_max
+            and other.y_min < self.y_max
+        )
+
+
+@dataclass(frozen=True)
+class Shelf:
+    """An open-fronted cabinet facing the robot (open at its low-x side).
+
+    `outer` is its footprint on the table; `interior` the floor of the space inside (the table
+    itself, so objects can be pushed in), None for a closed cabinet; `top` the flat board
+    objects are placed on; `prepush` the region in front of it that pushes start from.
+    """
+
+    name: str
+    outer: Rect
+    interior: Rect | None
+    clearance: float
+    top: Rect
+    prepush: str | None
+    wall: float = 0.02
+
+
+@dataclass(frozen=True)
+class Board:
+    """One box of a shelf: its footprint and the heights of its bottom and top faces."""
+
+    rect: Rect
+    z_min: float
+    z_max: float
+
+
+@dataclass(frozen=True)
+class View:
+    """A fixed camera the robot sees with: image size, pose (eye, the point it looks at, z up)
+    and vertical field of view in degrees."""
+
+    width: int
+    height: int
+    eye: tuple[float, float, float]
+    target: tuple[float, float, float]
+    fov: float
+
+
+def make_shelf(
+    name: str,
+    x: tuple[float, float],
+    y: tuple[float, float],
+    clearance: float,
+    wall: float,
+    interior: bool,
+    prepush: str | None,
+) -> Shelf:
+    """A shelf from its footprint: walls `wall` thick, its top board on walls `clearance` high."""
+    outer = Rect(x[0], x[1], y[0], y[1], 0.0)
+    inside = Rect(x[0], x[1] - wall, y[0] + wall, y[1] - wall, 0.0) if interior else None
+    top = Rect(x[0], x[1], y[0], y[1], clearance + wall)
+    return Shelf(name, outer, inside, clearance, top, prepush, wall)
+
+
+def shelf_boards(shelf: Shelf) -> tuple[Board, ...]:
+    """A shelf's side walls, back wall and top board (and a front board when it has no
+    interior); the floor is the table."""
+    o, c, w = shelf.outer, shelf.clearance, shelf.wall
+    left = Rect(o.x_min, o.x_max, o.y_max - w, o.y_max)
+    right = Rect(o.x_min, o.x_max, o.y_min, o.y_min + w)
+    back = Rect(o.x_max - w, o.x_max, o.y_min + w, o.y_max - w)
+    walls = [left, right, back]
+    if shelf.interior is None:
+        walls.append(Rect(o.x_min, o.x_min + w, o.y_min + w, o.y_max - w))
+    return (*(Board(r, 0.0, c) for r in walls), Board(o, c, shelf.top.z))
+
+
+# --- the rules every world is counted by (the robot's and the paper's, not the scene's) ---
+
+GRIPPER_MAX_OPENING = 0.08
+
+# The cell each resting object is given when a surface is counted: the grid of SPOT cells that
+# fits on a surface, with objects resting long side along y (`PLACE_LONG_AXIS_YAW`), leaves
+# every object at least 1.5 cm of room for the open fingers. Measured: with 10 cm cells two
+# boxes (10.4 cm) cannot lie in a 22 cm deep shelf top with that room. Counting cells (not
+# areas) keeps capacities small integers that the PDDL domain can encode.
+SPOT = 0.11
+
+# A top face narrower than this does not hold another object steadily (popcorn's 3.8 cm does not).
+MIN_SUPPORT_SIDE = 0.045
+
+# Highest a tower's top may rise above the table: the hand holds the top object from above and
+# still needs room to approach and to withdraw.
+REACH_MAX_Z = 0.40
+
+# Objects enter an interior only through its open front, so it is filled as one row across,
+# a can's width plus a finger's gap apart (pushes measured to land within +-9 cm of the middle).
+INTERIOR_SPOT = 0.09
+
+# The region every world has: where objects are put aside and most start.
+OPEN_SPACE = "open_space"
+
+
+def spot_cells(rect: Rect) -> list[tuple[float, float]]:
+    """Centres of the cells a surface is counted in (its capacity), spread evenly over it."""
+    nx, ny = math.floor(rect.width_x / SPOT + 1e-9), math.floor(rect.width_y / SPOT + 1e-9)
+    return [
+        (rect.x_min + rect.width_x * (i + 0.5) / nx, rect.y_min + rect.width_y * (j + 0.5) / ny)
+        for i in range(nx)
+        for j in range(ny)
+    ]
+
+
+def capacity(rect: Rect) -> int:
+    """How many objects fit side by side on a rectangle: its SPOT cells."""
+    return len(spot_cells(rect))
+
+
+@dataclass(frozen=True)
+class World:
+    """Everything a scene file says, and what follows from it.
+
+    Attributes:
+        regions: the regions on the table in the order the scene lists them (the open space
+            first, then each shelf's prepush region); entity one-hots and PDDL objects follow
+            this order, and that of `shelves` and `object_types`.
+        goal_shelf_tops: the shelf tops that goal literals put objects on.
+        goal_interior: the shelf whose interior `In` goals name (cans only, in evaluation goals).
+        fixture_friction: the table's and the shelves' lateral friction.
+        cameras: the fixed views f_p sees the scene with.
+    """
+
+    name: str
+    table: Rect
+    shelf_list: tuple[Shelf, ...]
+    region_list: tuple[tuple[str, Rect], ...]
+    type_list: tuple[ObjectType, ...]
+    goal_shelf_tops: tuple[str, ...]
+    goal_interior: str
+    fixture_friction: float
+    cameras: tuple[View, ...]
+
+    @cached_property
+    def shelves(self) -> dict[str, Shelf]:
+        return {s.name: s for s in self.shelf_list}
+
+    @cached_property
+    def regions(self) -> dict[str, Rect]:
+        return dict(self.region_list)
+
+    @cached_property
+    def object_types(self) -> dict[str, ObjectType]:
+        return {t.name: t for t in self.type_list}
+
+    @cached_property
+    def surfaces(self) -> tuple[str, ...]:
+        """Every surface objects rest on: the regions, then the shelf tops."""
+        return tuple(self.regions) + tuple(self.shelves)
+
+    def surface_rect(self, name: str) -> Rect:
+        """The rectangle of a named surface: a region, or a shelf's top."""
+        if name in self.regions:
+            return self.regions[name]
+        return self.shelves[name].top
+
+    @cached_property
+    def surface_capacity(self) -> dict[str, int]:
+        return {name: capacity(self.surface_rect(name)) for name in self.surfaces}
+
+    @cached_property
+    def interior_capacity(self) -> dict[str, int]:
+        """Objects each shelf's interior holds in its row (shelves with an interior only)."""
+        return {
+            name: math.floor(s.interior.width_y / INTERIOR_SPOT + 1e-9)
+            for name, s in self.shelves.items()
+            if s.interior is not None
+        }
+
+    def interior_slots(self, shelf: str) -> list[float]:
+        """y of each spot in a shelf's interior row, evenly spread across its width."""
+        r = self.shelves[shelf].interior
+        assert r is not None, f"{shelf} has no interior"
+        n = self.interior_capacity[shelf]
+        return [r.y_min + r.width_y * (k + 0.5) / n for k in range(n)]
+
+    @cached_property
+    def max_tower_levels(self) -> int:
+        """How many objects one tower may hold so that any tower stays within reach on any
+        surface.
+
+        Counted with the tallest object, so a tower that obeys it never rises past
+        `REACH_MAX_Z`, whatever it is made of and whichever surface it stands on.
+        """
+        tallest = max(t.height for t in self.type_list)
+        highest_surface = max(self.surface_rect(n).z for n in self.surfaces)
+        return max(1, math.floor((REACH_MAX_Z - highest_surface) / tallest + 1e-9))
+
+    def can_support(self, type_name: str) -> bool:
+        """Whether an object of this type may carry another one on its top face."""
+        return self.object_types[type_name].top_face_min_side >= MIN_SUPPORT_SIDE
+
+    def fits_inside(self, type_name: str, shelf: str) -> bool:
+        """Whether an object of this type, as it rests, fits into a shelf's interior."""
+        t, s = self.object_types[type_name], self.shelves[shelf]
+        if s.interior is None:
+            return False
+        return (
+            t.height <= s.clearance
+            and max(t.footprint) <= max(s.interior.width_x, s.interior.width_y)
+            and min(t.footprint) <= min(s.interior.width_x, s.interior.width_y)
+        )

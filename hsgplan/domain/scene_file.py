@@ -1,0 +1,334 @@
+"""Scene files: a `World` from TOML, and back.
+
+Every field is checked as it is read, and the first bad one is refused in one line that names
+the file, the field's place (`shelves[2].clearance`) and what is wrong with it, as every other
+input of the product is. docs/scenes.md describes the fields; `scenes/kitchen.toml` is the
+default world.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import tomllib
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from hsgplan.domain.checks import read_text
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.scene import (
+    GRIPPER_MAX_OPENING,
+    OPEN_SPACE,
+    Kind,
+    ObjectType,
+    Rect,
+    Shelf,
+    View,
+    World,
+    make_shelf,
+)
+
+MAX_SCENE_BYTES = 2**20
+MAX_SHELVES = 8
+MAX_TYPES = 16
+MAX_CAMERAS = 8
+EXTENT = 3.0  # no table reaches further than this from the robot's base
+TYPE_NAME = re.compile(r"^[a-z]+(?:_[a-z]+)*$")  # `_2` on a type name is its second instance
+FIXTURE_NAME = re.compile(r"^[a-z][a-z0-9]*(?:_[a-z0-9]+)*$")
+SCENE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,79}$")
+# A prepush region a scene does not give: in front of its shelf's open side, inset from its walls
+PREPUSH_DEPTH = 0.13
+PREPUSH_GAP = 0.01
+
+
+class _Bad(Exception):
+    """A field refused: its place in the file and why (made one line by `read_world`)."""
+
+
+def _number(v: Any, at: str, lo: float, hi: float) -> float:
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        raise _Bad(f"{at} {v!r}: need a number")
+    if not lo <= v <= hi:
+        raise _Bad(f"{at} {v!r}: must be between {lo} and {hi}")
+    return float(v)
+
+
+def _numbers(v: Any, at: str, count: int | tuple[int, ...], lo: float, hi: float) -> tuple:
+    counts = (count,) if isinstance(count, int) else count
+    if not isinstance(v, list) or len(v) not in counts:
+        need = " or ".join(map(str, counts))
+        raise _Bad(f"{at} {v!r}: need a list of {need} numbers")
+    return tuple(_number(x, f"{at}[{k}]", lo, hi) for k, x in enumerate(v, 1))
+
+
+def _span(v: Any, at: str) -> tuple[float, float]:
+    low, high = _numbers(v, at, 2, -EXTENT, EXTENT)
+    if low >= high:
+        raise _Bad(f"{at} {v!r}: need [low, high] with low below high")
+    return low, high
+
+
+def _name(v: Any, at: str, pattern: re.Pattern) -> str:
+    if not isinstance(v, str) or not pattern.match(v):
+        allowed = {
+            TYPE_NAME: "lower-case letters and underscores",
+            FIXTURE_NAME: "lower-case letters, digits and underscores",
+        }.get(pattern, "letters, digits, '.', '-' and '_'")
+        raise _Bad(f"{at} {v!r}: need a name of {allowed}")
+    return v
+
+
+def _table(v: Any, at: str, required: set[str], optional: set[str] = frozenset()) -> dict:
+    if not isinstance(v, dict):
+        raise _Bad(f"{at}: need a table of fields")
+    if missing := sorted(required - set(v)):
+        raise _Bad(f"{at}: missing {', '.join(missing)}")
+    if unknown := sorted(set(v) - required - set(optional)):
+        raise _Bad(f"{at}: unknown field(s) {', '.join(unknown)}")
+    return v
+
+
+def _tables(v: Any, at: str, lo: int, hi: int) -> list[dict]:
+    if not isinstance(v, list) or not lo <= len(v) <= hi:
+        raise _Bad(f"{at}: need between {lo} and {hi} of them ([[{at}]] tables)")
+    return v
+
+
+def _rect(v: dict, at: str, z: float = 0.0) -> Rect:
+    (x0, x1), (y0, y1) = _span(v["x"], f"{at}.x"), _span(v["y"], f"{at}.y")
+    return Rect(x0, x1, y0, y1, z)
+
+
+def _object(v: Any, at: str) -> ObjectType:
+    v = _table(v, at, {"name", "kind", "size", "colour"}, {"mass", "friction"})
+    name = _name(v["name"], f"{at}.name", TYPE_NAME)
+    if v["kind"] not in set(Kind):
+        raise _Bad(f"{at}.kind {v['kind']!r}: need 'can' or 'box'")
+    kind = Kind(v["kind"])
+    size = _numbers(v["size"], f"{at}.size", 3, 0.01, 0.30)
+    if kind is Kind.CAN and size[0] != size[1]:
+        raise _Bad(f"{at}.size {v['size']!r}: a can's first two sizes are its diameter")
+    if min(size[:2]) > GRIPPER_MAX_OPENING:
+        raise _Bad(
+            f"{at}.size {v['size']!r}: its narrow side is wider than the gripper opens "
+            f"({GRIPPER_MAX_OPENING} m); stand it so that it is not"
+        )
+    colour = _numbers(v["colour"], f"{at}.colour", (3, 4), 0.0, 1.0)
+    mass = _number(v.get("mass", 0.3), f"{at}.mass", 0.01, 5.0)
+    friction = _number(v.get("friction", 0.8), f"{at}.friction", 0.05, 2.0)
+    return ObjectType(name, kind, size, (*colour[:3], colour[3] if len(colour) == 4 else 1.0),
+                      mass, friction)  # fmt: skip
+
+
+def _shelf(v: Any, at: str) -> tuple[Shelf, tuple[str, Rect] | None]:
+    v = _table(v, at, {"name", "x", "y"}, {"clearance", "wall", "interior", "prepush"})
+    name = _name(v["name"], f"{at}.name", FIXTURE_NAME)
+    x, y = _span(v["x"], f"{at}.x"), _span(v["y"], f"{at}.y")
+    clearance = _number(v.get("clearance", 0.12), f"{at}.clearance", 0.05, 0.40)
+    wall = _number(v.get("wall", 0.02), f"{at}.wall", 0.005, 0.05)
+    interior = v.get("interior", True)
+    if not isinstance(interior, bool):
+        raise _Bad(f"{at}.interior {interior!r}: true or false")
+    for axis, (low, high) in (("x", x), ("y", y)):
+        if high - low < 2 * wall + 0.05:
+            raise _Bad(f"{at}.{axis} {[low, high]}: a shelf spans at least 5 cm between walls")
+    prepush = None
+    if "prepush" in v:
+        if not interior:
+            raise _Bad(f"{at}.prepush: a shelf with no interior has nothing to push into")
+        p = _table(v["prepush"], f"{at}.prepush", {"name", "x", "y"})
+        prepush = (_name(p["name"], f"{at}.prepush.name", FIXTURE_NAME), _rect(p, f"{at}.prepush"))
+    elif interior:
+        # rounded to a micrometre, so that a layout's file reads as it was drawn
+        derived = Rect(round(x[0] - PREPUSH_GAP - PREPUSH_DEPTH, 6), round(x[0] - PREPUSH_GAP, 6),
+                       round(y[0] + wall, 6), round(y[1] - wall, 6))  # fmt: skip
+        prepush = ("prepush_" + name.removeprefix("shelf_"), derived)
+    shelf = make_shelf(name, x, y, clearance, wall, interior, prepush[0] if prepush else None)
+    return shelf, prepush
+
+
+def _camera(v: Any, at: str) -> View:
+    v = _table(v, at, {"width", "height", "eye", "target", "fov"})
+    size = [v["width"], v["height"]]
+    if any(isinstance(s, bool) or not isinstance(s, int) or not 16 <= s <= 4096 for s in size):
+        raise _Bad(f"{at} width and height {size!r}: need whole pixels from 16 to 4096")
+    eye = _numbers(v["eye"], f"{at}.eye", 3, -EXTENT, EXTENT)
+    target = _numbers(v["target"], f"{at}.target", 3, -EXTENT, EXTENT)
+    if eye == target:
+        raise _Bad(f"{at}: the eye is where it looks")
+    return View(size[0], size[1], eye, target, _number(v["fov"], f"{at}.fov", 1.0, 170.0))
+
+
+def _each(v: Any, at: str, lo: int, hi: int, read: Callable[[Any, str], Any]) -> list:
+    return [read(item, f"{at}[{k}]") for k, item in enumerate(_tables(v, at, lo, hi), 1)]
+
+
+def _check_places(table: Rect, shelves: list[Shelf], regions: list[tuple[str, Rect]]) -> None:
+    places = [(s.name, s.outer) for s in shelves] + regions
+    for name, rect in places:
+        if not (table.contains(rect.x_min, rect.y_min) and table.contains(rect.x_max, rect.y_max)):
+            raise _Bad(f"{name} is not wholly on the table")
+    for k, (a, ra) in enumerate(places):
+        for b, rb in places[k + 1 :]:
+            if ra.overlaps(rb):
+                raise _Bad(f"{a} and {b} overlap")
+
+
+def _check_names(types: list[ObjectType], fixtures: list[str]) -> None:
+    seen: set[str] = set()
+    for name in [t.name for t in types] + fixtures:
+        if name in seen:
+            raise _Bad(f"the name {name!r} is given twice")
+        seen.add(name)
+    for name in fixtures:
+        head, _, tail = name.rpartition("_")
+        if head in {t.name for t in types} and tail.isdigit():
+            raise _Bad(f"the name {name!r} reads as an instance of the object type {head!r}")
+
+
+def world_of(data: Any, source: str = "scene") -> World:
+    """A `World` from a scene file's parsed TOML; the first bad field refused in one line
+    (`InvalidInputError`) that starts with `source`."""
+    try:
+        return _world(data)
+    except _Bad as e:
+        raise InvalidInputError(f"{source}: {e}") from None
+
+
+def _world(data: Any) -> World:
+    top = _table(data, "the file", {"name", "table", "regions", "shelves", "objects", "cameras"},
+                 {"fixture_friction", "goals"})  # fmt: skip
+    name = _name(top["name"], "name", SCENE_NAME)
+    table = _rect(_table(top["table"], "table", {"x", "y"}), "table")
+    friction = _number(top.get("fixture_friction", 0.6), "fixture_friction", 0.05, 2.0)
+    regions = [
+        (_name(r["name"], f"{at}.name", FIXTURE_NAME), _rect(r, at))
+        for at, r in (
+            (f"regions[{k}]", _table(r, f"regions[{k}]", {"name", "x", "y"}))
+            for k, r in enumerate(_tables(top["regions"], "regions", 1, MAX_SHELVES + 1), 1)
+        )
+    ]
+    if OPEN_SPACE not in dict(regions):
+        raise _Bad(f"regions: need one named {OPEN_SPACE!r} (where objects are put aside)")
+    read = _each(top["shelves"], "shelves", 1, MAX_SHELVES, _shelf)
+    shelves = [s for s, _ in read]
+    regions += [p for _, p in read if p is not None]
+    types = _each(top["objects"], "objects", 1, MAX_TYPES, _object)
+    cameras = tuple(_each(top["cameras"], "cameras", 1, MAX_CAMERAS, _camera))
+    _check_names(types, [s.name for s in shelves] + [r for r, _ in regions])
+    _check_places(table, shelves, regions)
+    with_interior = [s.name for s in shelves if s.interior is not None]
+    goals = _table(top.get("goals", {}), "goals", set(), {"shelf_tops", "interior"})
+    names = [s.name for s in shelves]
+    tops = goals.get("shelf_tops", names)
+    if not isinstance(tops, list) or not tops or any(t not in names for t in tops):
+        raise _Bad(f"goals.shelf_tops {tops!r}: need a list of the scene's shelves")
+    interior = goals.get("interior", with_interior[0] if with_interior else None)
+    if interior not in with_interior:
+        raise _Bad(f"goals.interior {interior!r}: need a shelf with an interior")
+    return World(name, table, tuple(shelves), tuple(regions), tuple(types), tuple(tops),
+                 interior, friction, cameras)  # fmt: skip
+
+
+def read_world(path: Path | str) -> World:
+    """The world a scene file describes; anything wrong with it refused in one line
+    (`InvalidInputError`)."""
+    text = read_text(Path(path), "scene file", MAX_SCENE_BYTES)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InvalidInputError(f"scene file '{path}' is not valid TOML ({e})") from None
+    return world_of(data, f"scene file '{path}'")
+
+
+def _span_out(r: Rect) -> dict:
+    return {"x": [r.x_min, r.x_max], "y": [r.y_min, r.y_max]}
+
+
+def object_data(t: ObjectType) -> dict:
+    """An object type as a scene file's `[[objects]]` table."""
+    return {"name": t.name, "kind": str(t.kind), "size": list(t.size), "colour": list(t.color),
+            "mass": t.mass, "friction": t.friction}  # fmt: skip
+
+
+def scene_data(world: World) -> dict:
+    """A world as a scene file's TOML data (what `world_of` reads back as an equal world)."""
+    prepush = {s.prepush for s in world.shelf_list}
+    shelves = []
+    for s in world.shelf_list:
+        entry = {"name": s.name, **_span_out(s.outer), "clearance": s.clearance, "wall": s.wall,
+                 "interior": s.interior is not None}  # fmt: skip
+        if s.prepush is not None:
+            entry["prepush"] = {"name": s.prepush, **_span_out(world.regions[s.prepush])}
+        shelves.append(entry)
+    return {
+        "name": world.name,
+        "fixture_friction": world.fixture_friction,
+        "table": _span_out(world.table),
+        "regions": [{"name": n, **_span_out(r)} for n, r in world.region_list if n not in prepush],
+        "shelves": shelves,
+        "objects": [
+            {
+                "name": t.name,
+                "kind": str(t.kind),
+                "size": list(t.size),
+                "colour": list(t.color),
+                "mass": t.mass,
+                "friction": t.friction,
+            }  # fmt: skip
+            for t in world.type_list
+        ],
+        "goals": {"shelf_tops": list(world.goal_shelf_tops), "interior": world.goal_interior},
+        "cameras": [
+            {
+                "width": c.width,
+                "height": c.height,
+                "eye": list(c.eye),
+                "target": list(c.target),
+                "fov": c.fov,
+            }  # fmt: skip
+            for c in world.cameras
+        ],
+    }
+
+
+def _inline(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int | float):
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)  # a JSON string is a TOML basic string
+    if isinstance(v, list):
+        return "[" + ", ".join(map(_inline, v)) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{_key(k)} = {_inline(x)}" for k, x in v.items()) + " }"
+    raise TypeError(f"no TOML for {v!r}")
+
+
+def _key(k: str) -> str:
+    return k if re.match(r"^[A-Za-z0-9_-]+$", k) else json.dumps(k)
+
+
+def to_toml(data: dict) -> str:
+    """A scene file's data as TOML: plain values first, then each table, then each list of
+    tables; lists and nested tables inline, so a shelf or an object reads as one block."""
+    plain = {k: v for k, v in data.items() if not isinstance(v, dict) and not _tables_list(v)}
+    lines = [f"{_key(k)} = {_inline(v)}" for k, v in plain.items()]
+    for k, v in data.items():
+        if isinstance(v, dict):
+            lines += ["", f"[{_key(k)}]", *(f"{_key(a)} = {_inline(b)}" for a, b in v.items())]
+    for k, v in data.items():
+        if _tables_list(v):
+            for item in v:
+                lines += [
+                    "",
+                    f"[[{_key(k)}]]",
+                    *(f"{_key(a)} = {_inline(b)}" for a, b in item.items()),
+                ]
+    return "\n".join(lines) + "\n"
+
+
+def _tables_list(v: Any) -> bool:
+    return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)

@@ -1,0 +1,74 @@
+"""Random layouts: the same seed gives the same scenes, each within the documented ranges and
+read back by the scene file's own checks; `hsgplan scenes` writes them once."""
+
+import pytest
+from typer.testing import CliRunner
+
+from hsgplan.cli import app
+from hsgplan.domain import layouts
+from hsgplan.domain.scene import GRIPPER_MAX_OPENING, Kind
+from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.world import KITCHEN
+
+runner = CliRunner()
+
+
+@pytest.mark.parametrize("new_objects", [False, True])
+def test_a_layout_is_drawn_within_its_ranges_and_again_the_same(new_objects):
+    for index in range(5):
+        w = layouts.random_layout(KITCHEN, 3, index, new_objects)
+        assert w == layouts.random_layout(KITCHEN, 3, index, new_objects)
+        assert w != KITCHEN and w.cameras == KITCHEN.cameras
+        for s in w.shelf_list:
+            lo, hi = layouts.SHELF_NEAR
+            assert lo <= s.outer.x_min <= hi and s.prepush in w.regions
+            assert layouts.SHELF_DEPTH[0] <= round(s.outer.width_x, 3) <= layouts.SHELF_DEPTH[1]
+            assert layouts.SHELF_CLEARANCE[0] <= s.clearance <= layouts.SHELF_CLEARANCE[1]
+        kinds = [t.kind for t in w.type_list]
+        assert kinds == [t.kind for t in KITCHEN.type_list]
+        for t, old in zip(w.type_list, KITCHEN.type_list, strict=True):
+            assert min(t.footprint) <= GRIPPER_MAX_OPENING
+            if t.kind is Kind.CAN:
+                assert t.size[0] == t.size[1]
+            if new_objects:
+                assert t.name not in KITCHEN.object_types
+            else:
+                assert t.name == old.name
+                assert all(
+                    0.8 * a - 1e-3 <= b <= 1.2 * a + 1e-3
+                    for a, b in zip(old.size, t.size, strict=True)
+                )
+
+
+def test_layouts_of_other_seeds_differ():
+    assert layouts.random_layout(KITCHEN, 1, 0) != layouts.random_layout(KITCHEN, 2, 0)
+
+
+def test_the_command_writes_scene_files_once_and_refuses_to_overwrite_others(tmp_path):
+    out = tmp_path / "layouts"
+    args = ["scenes", "--layouts", "3", "--seed", "4", "--out", str(out)]
+    assert runner.invoke(app, args).exit_code == 0
+    files = sorted(out.iterdir())
+    assert [f.name for f in files] == [f"layout-{k:03d}.toml" for k in range(3)]
+    assert read_world(files[1]) == layouts.random_layout(KITCHEN, 4, 1)
+    assert files[0].read_text().startswith("# hsgplan scenes --layouts 3 --seed 4\n")
+    stamps = [f.stat().st_mtime_ns for f in files]
+    assert runner.invoke(app, args).exit_code == 0  # a rerun repeats nothing
+    assert [f.stat().st_mtime_ns for f in files] == stamps
+    other = runner.invoke(app, ["scenes", "--layouts", "2", "--seed", "5", "--out", str(out)])
+    assert other.exit_code == 2
+    assert other.output.strip().splitlines() == [
+        f"error: '{files[0]}' holds another scene; choose another --out"
+    ]
+    assert [f.stat().st_mtime_ns for f in files] == stamps
+
+
+def test_a_bad_base_scene_or_count_is_refused_in_one_line(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\n')
+    r = runner.invoke(app, ["scenes", "--layouts", "1", "--out", str(tmp_path / "o"),
+                            "--scene", str(bad)])  # fmt: skip
+    assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1
+    assert "scene file" in r.output and "missing" in r.output
+    r = runner.invoke(app, ["scenes", "--layouts", "-2", "--out", str(tmp_path / "o")])
+    assert r.exit_code == 2 and not (tmp_path / "o").exists()

@@ -1,0 +1,151 @@
+"""Scene files: the kitchen's reads as the world the product was built in, a world written out
+reads back equal, and every bad field is refused in one line that names it."""
+
+import copy
+import tomllib
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.scene import Kind, Rect, shelf_boards
+from hsgplan.domain.scene_file import read_world, scene_data, to_toml, world_of
+from hsgplan.paths import KITCHEN_SCENE
+
+KITCHEN = tomllib.loads(KITCHEN_SCENE.read_text())
+
+
+def test_the_kitchen_is_the_world_every_table_was_measured_in():
+    w = read_world(KITCHEN_SCENE)
+    assert list(w.object_types) == [
+        "cherries", "alphabet_soup", "tomato_soup", "popcorn", "cream_cheese", "butter",
+    ]  # fmt: skip
+    assert w.object_types["popcorn"].size == (0.038, 0.085, 0.126)
+    assert w.object_types["butter"].kind is Kind.BOX and w.object_types["butter"].mass == 0.15
+    assert w.object_types["cherries"].color == (0.80, 0.10, 0.15, 1.0)
+    assert w.table == Rect(-0.30, 1.00, -0.80, 0.80, 0.0)
+    assert list(w.regions) == ["open_space", "prepush_a", "prepush_b"]
+    assert w.regions["prepush_b"] == Rect(0.24, 0.37, -0.52, -0.24, 0.0)
+    a = w.shelves["shelf_a"]
+    assert a.outer == Rect(0.38, 0.60, 0.22, 0.54) and a.interior == Rect(0.38, 0.58, 0.24, 0.52)
+    assert a.top.z == pytest.approx(0.14) and a.prepush == "prepush_a"
+    assert w.surface_capacity == {
+        "open_space": 12, "prepush_a": 2, "prepush_b": 2, "shelf_a": 4, "shelf_b": 4,
+    }  # fmt: skip
+    assert w.interior_capacity == {"shelf_a": 3, "shelf_b": 3}
+    assert w.max_tower_levels == 2
+    assert w.goal_shelf_tops == ("shelf_a", "shelf_b") and w.goal_interior == "shelf_a"
+    assert len(w.cameras) == 5 and w.cameras[0].eye == (1.15, 0.0, 1.0)
+
+
+def test_a_world_written_out_reads_back_equal():
+    w = read_world(KITCHEN_SCENE)
+    again = world_of(tomllib.loads(to_toml(scene_data(w))))
+    assert again == w and hash(again) == hash(w)
+
+
+def test_a_shelf_given_no_prepush_region_gets_one_in_front_of_it():
+    data = copy.deepcopy(KITCHEN)
+    del data["shelves"][1]["prepush"]
+    w = world_of(data)
+    r = w.regions["prepush_b"]
+    assert r.x_max < w.shelves["shelf_b"].outer.x_min
+    assert (r.y_min, r.y_max) == pytest.approx((-0.52, -0.24))
+
+
+def test_a_closed_shelf_has_a_front_board_and_no_interior():
+    data = copy.deepcopy(KITCHEN)
+    del data["shelves"][1]["prepush"]
+    data["shelves"][1]["interior"] = False
+    w = world_of(data)
+    closed = w.shelves["shelf_b"]
+    assert closed.interior is None and closed.prepush is None
+    assert "prepush_b" not in w.regions and "shelf_b" not in w.interior_capacity
+    assert len(shelf_boards(closed)) == len(shelf_boards(w.shelves["shelf_a"])) + 1
+    assert not w.fits_inside("cherries", "shelf_b") and w.fits_inside("cherries", "shelf_a")
+
+
+def _set(path, value):
+    def change(data):
+        *head, last = path
+        for key in head:
+            data = data[key]
+        if value is _DELETE:
+            del data[last]
+        else:
+            data[last] = value
+
+    return change
+
+
+_DELETE = object()
+
+BAD = [
+    (_set(["shelves", 0, "clearance"], -0.1), "shelves[1].clearance -0.1: must be between"),
+    (_set(["shelves", 0, "x"], [0.6, 0.38]), "shelves[1].x [0.6, 0.38]: need [low, high]"),
+    (_set(["objects", 2, "kind"], "jar"), "objects[3].kind 'jar': need 'can' or 'box'"),
+    (_set(["objects", 0, "size"], [0.07, 0.06, 0.05]), "a can's first two sizes"),
+    (_set(["objects", 3, "size"], [0.09, 0.12, 0.05]), "wider than the gripper opens"),
+    (_set(["objects", 1, "colour"], [1.2, 0, 0]), "objects[2].colour[1] 1.2"),
+    (_set(["objects", 1, "name"], "Soup 2"), "objects[2].name 'Soup 2'"),
+    (_set(["objects", 1, "name"], "cherries"), "the name 'cherries' is given twice"),
+    (_set(["objects", 0, "mass"], "heavy"), "objects[1].mass 'heavy': need a number"),
+    (_set(["objects", 0, "colour"], _DELETE), "objects[1]: missing colour"),
+    (_set(["objects", 0, "shape"], "round"), "objects[1]: unknown field(s) shape"),
+    (_set(["regions", 0, "name"], "middle"), "need one named 'open_space'"),
+    (_set(["shelves", 1, "y"], [0.30, 0.60]), "shelf_a and shelf_b overlap"),
+    (_set(["shelves", 0, "x"], [0.38, 1.20]), "shelf_a is not wholly on the table"),
+    (_set(["shelves", 0, "interior"], "yes"), "shelves[1].interior 'yes': true or false"),
+    (_set(["shelves", 0, "interior"], False), "shelves[1].prepush: a shelf with no interior"),
+    (_set(["goals", "interior"], "pantry"), "goals.interior 'pantry'"),
+    (_set(["goals", "shelf_tops"], []), "goals.shelf_tops []"),
+    (_set(["shelves"], []), "shelves: need between 1 and 8"),
+    (_set(["cameras", 0, "width"], 0), "cameras[1] width and height [0, 240]"),
+    (_set(["cameras", 0, "target"], [1.15, 0.0, 1.0]), "cameras[1]: the eye is where it looks"),
+    (_set(["table"], "big"), "table: need a table of fields"),
+    (_set(["name"], 7), "name 7: need a name"),
+    (_set(["shelves", 0, "name"], "cherries_2"), "reads as an instance of the object type"),
+]
+
+
+@pytest.mark.parametrize(("change", "message"), BAD, ids=[m for _, m in BAD])
+def test_a_bad_field_is_refused_in_one_line_that_names_it(tmp_path, change, message):
+    data = copy.deepcopy(KITCHEN)
+    change(data)
+    path = tmp_path / "scene.toml"
+    path.write_text(to_toml(data))
+    with pytest.raises(InvalidInputError) as e:
+        read_world(path)
+    assert message in str(e.value) and "\n" not in str(e.value)
+    assert str(e.value).startswith(f"scene file '{path}': ")
+
+
+def test_a_file_that_is_not_toml_or_not_there_is_refused_in_one_line(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("name = [\n")
+    with pytest.raises(InvalidInputError, match="is not valid TOML"):
+        read_world(bad)
+    with pytest.raises(InvalidInputError, match="does not exist"):
+        read_world(tmp_path / "missing.toml")
+
+
+_values = st.recursive(
+    st.none() | st.booleans() | st.integers(-5, 5) | st.floats(-2, 2) | st.text(max_size=8),
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=6), inner),
+    max_leaves=6,
+)
+_places = [["name"], ["table"], ["table", "x"], ["regions", 0, "x"], ["shelves", 0, "y"],
+           ["shelves", 1, "prepush"], ["shelves", 0, "wall"], ["objects", 4, "size"],
+           ["objects", 5, "colour"], ["goals"], ["cameras", 2, "fov"], ["cameras", 0]]  # fmt: skip
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(place=st.sampled_from(_places), value=_values)
+def test_any_value_anywhere_is_read_or_refused_in_one_line(place, value):
+    data = copy.deepcopy(KITCHEN)
+    _set(place, value)(data)
+    try:
+        world_of(data)
+    except InvalidInputError as e:
+        assert str(e).startswith("scene: ") and "\n" not in str(e)
