@@ -13,14 +13,29 @@ All lengths are metres.
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import StrEnum
 from functools import cached_property
+
+from hsgplan.domain.errors import UnknownNameError
 
 
 class Kind(StrEnum):
     CAN = "can"
     BOX = "box"
+
+
+class EntityKind(StrEnum):
+    OBJECT = "object"
+    SHELF = "shelf"
+    REGION = "region"
+
+
+# A scene holds at most this many objects (instances are numbered up to it).
+MAX_OBJECTS = 12
+_INSTANCE = re.compile(r"^(?P<type>[a-z][a-z_]*?)(?:_(?P<k>[0-9]+))?$")
 
 
 @dataclass(frozen=True)
@@ -299,3 +314,64 @@ class World:
             and max(t.footprint) <= max(s.interior.width_x, s.interior.width_y)
             and min(t.footprint) <= min(s.interior.width_x, s.interior.width_y)
         )
+
+    # --- names: object instances are named by their type (`cherries`, `cherries_2`, ...) ---
+
+    @cached_property
+    def fixtures(self) -> tuple[str, ...]:
+        """The shelves, then the regions: every node of a scene graph that is no object."""
+        return tuple(self.shelves) + tuple(self.regions)
+
+    @cached_property
+    def entity_types(self) -> tuple[str, ...]:
+        """Entity types in a fixed order: the object types, the shelves, the regions."""
+        return tuple(self.object_types) + self.fixtures
+
+    def split_instance(self, name: str) -> tuple[str, int]:
+        """(type, k) of an object instance name; raises UnknownNameError with the reason."""
+        if name in self.object_types:
+            return name, 1
+        m = _INSTANCE.match(name)
+        if m and m.group("type") in self.object_types and m.group("k") is not None:
+            k = int(m.group("k"))
+            if k < 2 or str(k) != m.group("k"):
+                t = m.group("type")
+                raise UnknownNameError(
+                    f"unknown object '{name}' (the first {t} is named '{t}', "
+                    f"later ones '{t}_2', '{t}_3', ...)"
+                )
+            if k > MAX_OBJECTS:
+                raise UnknownNameError(
+                    f"unknown object '{name}' (a scene holds at most {MAX_OBJECTS})"
+                )
+            return m.group("type"), k
+        raise UnknownNameError(f"unknown name '{name}'")
+
+    def kind_of(self, name: str) -> EntityKind:
+        """Whether a name is an object, a shelf or a region; raises UnknownNameError otherwise."""
+        if name in self.shelves:
+            return EntityKind.SHELF
+        if name in self.regions:
+            return EntityKind.REGION
+        self.split_instance(name)
+        return EntityKind.OBJECT
+
+    def type_of(self, name: str) -> str:
+        """The entity type of a name: the object type for instances, the name itself
+        otherwise."""
+        return self.split_instance(name)[0] if self.kind_of(name) is EntityKind.OBJECT else name
+
+    def object_type(self, name: str) -> ObjectType:
+        """The type of an object instance."""
+        return self.object_types[self.split_instance(name)[0]]
+
+    def sort_objects(self, names: Iterable[str]) -> tuple[str, ...]:
+        """Object names in canonical order: by type as the scene lists them, then instance
+        number."""
+        order = {t: i for i, t in enumerate(self.object_types)}
+
+        def key(n: str) -> tuple[int, int]:
+            t, k = self.split_instance(n)
+            return order[t], k
+
+        return tuple(sorted(set(names), key=key))

@@ -16,6 +16,7 @@ import math
 from hsgplan.domain.scene import (
     GRIPPER_MAX_OPENING,
     INTERIOR_SPOT,
+    MAX_OBJECTS,
     MIN_SUPPORT_SIDE,
     REACH_MAX_Z,
     SPOT,
@@ -33,8 +34,9 @@ from hsgplan.domain.scene_file import read_world
 from hsgplan.paths import KITCHEN_SCENE
 
 __all__ = [
-    "GRIPPER_MAX_OPENING", "INTERIOR_SPOT", "MIN_SUPPORT_SIDE", "REACH_MAX_Z", "SPOT", "Board",
-    "Kind", "ObjectType", "Rect", "Shelf", "World", "capacity", "shelf_boards", "spot_cells",
+    "GRIPPER_MAX_OPENING", "INTERIOR_SPOT", "MAX_OBJECTS", "MIN_SUPPORT_SIDE", "REACH_MAX_Z",
+    "SPOT", "Board", "Kind", "ObjectType", "Rect", "Shelf", "World", "capacity", "shelf_boards",
+    "spot_cells",
 ]  # fmt: skip
 
 KITCHEN: World = read_world(KITCHEN_SCENE)
@@ -46,8 +48,6 @@ REGIONS: dict[str, Rect] = KITCHEN.regions
 WALL = SHELVES["shelf_a"].wall
 SHELF_CLEARANCE = SHELVES["shelf_a"].clearance
 SHELF_TOP_Z = SHELVES["shelf_a"].top.z
-
-MAX_OBJECTS = 12
 
 surface_rect = KITCHEN.surface_rect
 SURFACES: tuple[str, ...] = KITCHEN.surfaces
