@@ -12,25 +12,18 @@ from collections import defaultdict
 from collections.abc import Iterable
 
 from hsgplan.domain.errors import InfeasibleError
-from hsgplan.domain.objects import EntityKind, kind_of, object_type
 from hsgplan.domain.predicates import Literal, Predicate
-from hsgplan.domain.world import (
-    INTERIOR_CAPACITY,
-    MAX_OBJECTS,
-    MAX_TOWER_LEVELS,
-    REACH_MAX_Z,
-    SHELVES,
-    SURFACE_CAPACITY,
-    can_support,
-    fits_inside,
-)
+from hsgplan.domain.scene import MAX_OBJECTS, REACH_MAX_Z, EntityKind, World
+from hsgplan.domain.world import KITCHEN
 
 
 def _q(*lits: Literal) -> str:
     return " and ".join(f"'{lit}'" for lit in lits)
 
 
-def check_literals(literals: Iterable[Literal], limits: bool = True) -> None:
+def check_literals(
+    literals: Iterable[Literal], limits: bool = True, world: World = KITCHEN
+) -> None:
     """Raise InfeasibleError if no scene satisfies all the literals together.
 
     With `limits=False` only the structure is checked (one place per object, one object held,
@@ -48,10 +41,10 @@ def check_literals(literals: Iterable[Literal], limits: bool = True) -> None:
         raise InfeasibleError(f"{len(objects)} objects named; a scene holds at most {MAX_OBJECTS}")
     place = _placements(pos)
     _check_grasp_and_clear(pos, place)
-    carried = _check_stacks(pos, place, limits)
+    carried = _check_stacks(pos, place, limits, world)
     if limits:
-        _check_capacity(pos)
-        _check_shelves(pos, carried)
+        _check_capacity(pos, world)
+        _check_shelves(pos, carried, world)
 
 
 def _placements(pos: set[Literal]) -> dict[str, Literal]:
@@ -89,18 +82,20 @@ def _check_grasp_and_clear(pos: set[Literal], place: dict[str, Literal]) -> None
                 raise InfeasibleError(f"{_q(lit, other)}: something rests on '{o}'")
 
 
-def _check_stacks(pos: set[Literal], place: dict[str, Literal], limits: bool) -> dict[str, Literal]:
+def _check_stacks(
+    pos: set[Literal], place: dict[str, Literal], limits: bool, world: World
+) -> dict[str, Literal]:
     """Check every object-on-object literal; return, per carrier, the literal that loads it."""
     carried: dict[str, Literal] = {}
     for lit in sorted(place.values()):
-        if lit.predicate is not Predicate.ON or kind_of(lit.args[1]) is not EntityKind.OBJECT:
+        if lit.predicate is not Predicate.ON or world.kind_of(lit.args[1]) is not EntityKind.OBJECT:
             continue
         base = lit.args[1]
         if base in carried:
             raise InfeasibleError(f"{_q(carried[base], lit)}: an object carries at most one other")
         carried[base] = lit
-        t = object_type(base)
-        if limits and not can_support(t.name):
+        t = world.object_type(base)
+        if limits and not world.can_support(t.name):
             raise InfeasibleError(
                 f"'{lit}': the top of {base} ({100 * t.top_face_min_side:.1f} cm wide) is too "
                 "narrow to carry anything"
@@ -110,63 +105,66 @@ def _check_stacks(pos: set[Literal], place: dict[str, Literal], limits: bool) ->
             raise InfeasibleError(f"{_q(lit, below)}: a held object carries nothing")
     for o in place:
         chain = [o]
-        while (nxt := _below(place, chain[-1])) is not None:
+        while (nxt := _below(place, chain[-1], world)) is not None:
             if nxt in chain:
                 cycle = chain[chain.index(nxt) :]
                 raise InfeasibleError(
                     f"{_q(*(place[c] for c in cycle))}: the objects stack in a cycle"
                 )
             chain.append(nxt)
-        if limits and len(chain) > MAX_TOWER_LEVELS:
+        if limits and len(chain) > world.max_tower_levels:
             tower = " on ".join(chain)
             raise InfeasibleError(
                 f"'{place[o]}': the tower {tower} is {len(chain)} objects high; towers hold at "
-                f"most {MAX_TOWER_LEVELS} so that none rises past the arm's reach "
+                f"most {world.max_tower_levels} so that none rises past the arm's reach "
                 f"({100 * REACH_MAX_Z:.0f} cm above the table)"
             )
     return carried
 
 
-def _below(place: dict[str, Literal], o: str) -> str | None:
+def _below(place: dict[str, Literal], o: str, world: World) -> str | None:
     lit = place.get(o)
-    if lit and lit.predicate is Predicate.ON and kind_of(lit.args[1]) is EntityKind.OBJECT:
+    if lit and lit.predicate is Predicate.ON and world.kind_of(lit.args[1]) is EntityKind.OBJECT:
         return lit.args[1]
     return None
 
 
-def _check_capacity(pos: set[Literal]) -> None:
+def _check_capacity(pos: set[Literal], world: World) -> None:
     on_surface: dict[str, list[Literal]] = defaultdict(list)
     in_shelf: dict[str, list[Literal]] = defaultdict(list)
     for lit in sorted(pos):
-        if lit.predicate is Predicate.ON and kind_of(lit.args[1]) is not EntityKind.OBJECT:
+        if lit.predicate is Predicate.ON and world.kind_of(lit.args[1]) is not EntityKind.OBJECT:
             on_surface[lit.args[1]].append(lit)
         elif lit.predicate is Predicate.IN:
             in_shelf[lit.args[1]].append(lit)
     for surface, lits in on_surface.items():
-        if len(lits) > SURFACE_CAPACITY[surface]:
-            where = f"{surface}'s top" if surface in SHELVES else surface
+        if len(lits) > world.surface_capacity[surface]:
+            where = f"{surface}'s top" if surface in world.shelves else surface
             raise InfeasibleError(
                 f"'{lits[-1]}': {len(lits)} objects on {where}, which holds at most "
-                f"{SURFACE_CAPACITY[surface]}"
+                f"{world.surface_capacity[surface]}"
             )
     for shelf, lits in in_shelf.items():
-        if len(lits) > INTERIOR_CAPACITY[shelf]:
+        room = world.interior_capacity.get(shelf)
+        if room is None:
+            raise InfeasibleError(f"'{lits[-1]}': {shelf} has no interior")
+        if len(lits) > room:
             raise InfeasibleError(
                 f"'{lits[-1]}': {len(lits)} objects inside {shelf}, whose interior holds at most "
-                f"{INTERIOR_CAPACITY[shelf]}"
+                f"{room}"
             )
 
 
-def _check_shelves(pos: set[Literal], carried: dict[str, Literal]) -> None:
+def _check_shelves(pos: set[Literal], carried: dict[str, Literal], world: World) -> None:
     for lit in sorted(pos):
         if lit.predicate is not Predicate.IN:
             continue
         o, shelf = lit.args
-        t = object_type(o)
-        if not fits_inside(t.name, shelf):
+        t = world.object_type(o)
+        if not world.fits_inside(t.name, shelf):
             raise InfeasibleError(
                 f"'{lit}': {o} ({100 * t.height:.1f} cm tall as it rests) does not fit into "
-                f"{shelf}'s interior ({100 * SHELVES[shelf].clearance:.1f} cm clearance)"
+                f"{shelf}'s interior ({100 * world.shelves[shelf].clearance:.1f} cm clearance)"
             )
         if o in carried:
             raise InfeasibleError(

@@ -14,21 +14,13 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
-from hsgplan.domain.objects import type_of
-from hsgplan.domain.world import (
-    INTERIOR_CAPACITY,
-    MAX_TOWER_LEVELS,
-    SHELVES,
-    SURFACE_CAPACITY,
-    SURFACES,
-    can_support,
-    fits_inside,
-)
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import KITCHEN
 
 
-def can_carry(type_name: str, level: int) -> bool:
+def can_carry(type_name: str, level: int, world: World = KITCHEN) -> bool:
     """Whether an object of this type, `level` objects high in its tower, may take one more."""
-    return can_support(type_name) and level < MAX_TOWER_LEVELS
+    return world.can_support(type_name) and level < world.max_tower_levels
 
 
 @dataclass
@@ -46,20 +38,26 @@ class Room:
     interior: dict[str, int]
     level: dict[str, int] = field(default_factory=dict)
     bare: list[str] = field(default_factory=list)
+    world: World = KITCHEN
 
     @classmethod
     def left(
         cls,
-        tops: Iterable[str] = SURFACES,
-        interiors: Iterable[str] = tuple(SHELVES),
+        tops: Iterable[str] | None = None,
+        interiors: Iterable[str] | None = None,
         on_top: Mapping[str, int] | None = None,
         inside: Mapping[str, int] | None = None,
+        world: World = KITCHEN,
     ) -> Room:
-        """The room on `tops` and in `interiors` when `on_top[s]` / `inside[s]` places are taken."""
+        """The room on `tops` (default: every surface) and in `interiors` (default: every
+        shelf's) when `on_top[s]` / `inside[s]` places are taken."""
         on_top, inside = on_top or {}, inside or {}
+        tops = world.surfaces if tops is None else tops
+        interiors = world.interior_capacity if interiors is None else interiors
         return cls(
-            {s: SURFACE_CAPACITY[s] - on_top.get(s, 0) for s in tops},
-            {s: INTERIOR_CAPACITY[s] - inside.get(s, 0) for s in interiors},
+            {s: world.surface_capacity[s] - on_top.get(s, 0) for s in tops},
+            {s: world.interior_capacity[s] - inside.get(s, 0) for s in interiors},
+            world=world,
         )
 
     def free_tops(self, among: Iterable[str] | None = None) -> list[str]:
@@ -68,12 +66,12 @@ class Room:
 
     def free_interiors(self, obj: str) -> list[str]:
         """Counted shelf interiors with a free place that the object fits into."""
-        t = type_of(obj)
-        return [s for s in self.interior if self.interior[s] > 0 and fits_inside(t, s)]
+        t = self.world.type_of(obj)
+        return [s for s in self.interior if self.interior[s] > 0 and self.world.fits_inside(t, s)]
 
     def bases(self) -> list[str]:
         """Bare objects whose tower may still grow, in the order they were put."""
-        return [b for b in self.bare if self.level[b] < MAX_TOWER_LEVELS]
+        return [b for b in self.bare if self.level[b] < self.world.max_tower_levels]
 
     def put_on(self, obj: str, where: str) -> None:
         """Count `obj` as put on a counted surface or on a bare object."""
@@ -83,7 +81,7 @@ class Room:
         else:
             self.bare.remove(where)
             self.level[obj] = self.level[where] + 1
-        if can_support(type_of(obj)):
+        if self.world.can_support(self.world.type_of(obj)):
             self.bare.append(obj)
 
     def put_inside(self, obj: str, shelf: str) -> None:

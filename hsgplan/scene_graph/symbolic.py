@@ -13,14 +13,14 @@ from typing import TYPE_CHECKING
 
 from hsgplan.domain.errors import InfeasibleError
 from hsgplan.domain.feasibility import check_literals
-from hsgplan.domain.objects import ENTITY_TYPES, EntityKind, kind_of, sort_objects, type_of
 from hsgplan.domain.predicates import PREDICATES, Literal, Predicate, clear
-from hsgplan.domain.world import REGIONS, SHELVES
+from hsgplan.domain.scene import OPEN_SPACE, EntityKind, World
+from hsgplan.domain.world import KITCHEN
 
 if TYPE_CHECKING:
     from torch_geometric.data import Data
 
-FIXTURES: tuple[str, ...] = tuple(SHELVES) + tuple(REGIONS)
+FIXTURES: tuple[str, ...] = KITCHEN.fixtures  # the kitchen's; a state's are `state.fixtures`
 
 
 @dataclass(frozen=True)
@@ -30,15 +30,22 @@ class SymbolicSceneGraph:
     Attributes:
         objects: the object instances, in canonical order.
         literals: the positive literals that hold; everything else is false.
+        world: the world the state is of (its names, fixtures and limits); states of two
+            worlds with the same literals compare equal.
     """
 
     objects: tuple[str, ...]
     literals: frozenset[Literal]
     _location: dict[str, Literal] = field(default=None, compare=False, hash=False, repr=False)
+    world: World = field(default=KITCHEN, compare=False, hash=False, repr=False)
 
     @classmethod
     def from_literals(
-        cls, objects: Iterable[str], literals: Iterable[Literal], limits: bool = True
+        cls,
+        objects: Iterable[str],
+        literals: Iterable[Literal],
+        limits: bool = True,
+        world: World = KITCHEN,
     ) -> SymbolicSceneGraph:
         """A checked state from the placement literals (On / In / InGrasp) of every object.
 
@@ -46,16 +53,16 @@ class SymbolicSceneGraph:
         `limits=False` (for observed scenes) the world's capacity, tower and fit limits are
         not enforced, only the structure (see `check_literals`).
         """
-        objs = sort_objects(objects)
+        objs = world.sort_objects(objects)
         lits = set(literals)
         for lit in lits:
             if not lit.positive:
                 raise InfeasibleError(f"a state lists only true literals, not '{lit}'")
             for a in lit.args:
-                if kind_of(a) is EntityKind.OBJECT and a not in objs:
+                if world.kind_of(a) is EntityKind.OBJECT and a not in objs:
                     raise InfeasibleError(f"'{lit}' names '{a}', which is not in the scene")
         placements = {lit for lit in lits if lit.predicate is not Predicate.CLEAR}
-        graph = cls(objs, frozenset(placements | _derive_clear(objs, placements)))
+        graph = cls(objs, frozenset(placements | _derive_clear(objs, placements)), world=world)
         graph._check(limits)
         given_clear = {lit for lit in lits if lit.predicate is Predicate.CLEAR}
         wrong = given_clear - graph.literals
@@ -67,16 +74,23 @@ class SymbolicSceneGraph:
         return graph
 
     @classmethod
-    def initial(cls, objects: Iterable[str], region: str = "open_space") -> SymbolicSceneGraph:
+    def initial(
+        cls, objects: Iterable[str], region: str = OPEN_SPACE, world: World = KITCHEN
+    ) -> SymbolicSceneGraph:
         """Every object resting on one region, nothing held."""
-        objs = sort_objects(objects)
-        return cls.from_literals(objs, (Literal(Predicate.ON, (o, region)) for o in objs))
+        objs = world.sort_objects(objects)
+        placed = (Literal(Predicate.ON, (o, region)) for o in objs)
+        return cls.from_literals(objs, placed, world=world)
 
     # --- queries -----------------------------------------------------------------------
 
     @property
+    def fixtures(self) -> tuple[str, ...]:
+        return self.world.fixtures
+
+    @property
     def nodes(self) -> tuple[str, ...]:
-        return self.objects + FIXTURES
+        return self.objects + self.world.fixtures
 
     def holds(self, literal: Literal) -> bool:
         return (literal.atom in self.literals) == literal.positive
@@ -111,7 +125,7 @@ class SymbolicSceneGraph:
         if loc.predicate is not Predicate.ON:
             return 0
         below = loc.args[1]
-        return 1 if kind_of(below) is not EntityKind.OBJECT else 1 + self.level(below)
+        return 1 if self.world.kind_of(below) is not EntityKind.OBJECT else 1 + self.level(below)
 
     # --- text and tensors ------------------------------------------------------------------
 
@@ -145,7 +159,7 @@ class SymbolicSceneGraph:
         """The graph as `torch_geometric.data.Data`.
 
         Shapes:
-            x: [N, T] one-hot node type over `ENTITY_TYPES`, N = objects + fixtures.
+            x: [N, T] one-hot node type over the world's `entity_types`, N = objects + fixtures.
             edge_index: [2, E] source (subject) and target of each relation; self edges for
                 unary predicates.
             edge_attr: [E, P] multi-hot over `PREDICATES` for each (source, target) pair.
@@ -156,9 +170,10 @@ class SymbolicSceneGraph:
 
         nodes = self.nodes
         index = {n: i for i, n in enumerate(nodes)}
-        x = torch.zeros(len(nodes), len(ENTITY_TYPES))
+        types = self.world.entity_types
+        x = torch.zeros(len(nodes), len(types))
         for i, n in enumerate(nodes):
-            x[i, ENTITY_TYPES.index(type_of(n))] = 1.0
+            x[i, types.index(self.world.type_of(n))] = 1.0
         pairs: dict[tuple[int, int], list[int]] = {}
         for lit in self.literals:
             src = index[lit.args[0]]
@@ -174,7 +189,7 @@ class SymbolicSceneGraph:
     # --- consistency -------------------------------------------------------------------
 
     def _check(self, limits: bool) -> None:
-        check_literals(self.literals, limits)
+        check_literals(self.literals, limits, self.world)
         placed = {lit.subject for lit in self.literals if lit.predicate is not Predicate.CLEAR}
         missing = [o for o in self.objects if o not in placed]
         if missing:

@@ -2,24 +2,14 @@
 
 The PDDL domain in `pddl.py` states the same rules for Fast Downward; tests replay its plans
 here step by step. Limits (capacities, tower height, which objects carry others or fit into a
-shelf) come from `world.py`.
+shelf) come from the state's world.
 """
 
 from __future__ import annotations
 
 from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import object_type
 from hsgplan.domain.predicates import Literal, Predicate, in_grasp, inside, on
-from hsgplan.domain.world import (
-    INTERIOR_CAPACITY,
-    MAX_TOWER_LEVELS,
-    SHELVES,
-    SURFACE_CAPACITY,
-    SURFACES,
-    can_support,
-    fits_inside,
-)
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 
@@ -44,40 +34,42 @@ def why_not(state: SymbolicSceneGraph, action: Action) -> str | None:
 
 
 def _why_not_place(state: SymbolicSceneGraph, action: Place, held: str | None) -> str | None:
-    o, t = action.obj, action.target
+    o, t, world = action.obj, action.target, state.world
     if held != o:
         return f"'{o}' is not held"
-    if t in SURFACES:
-        if len(state.resting_on(t)) >= SURFACE_CAPACITY[t]:
-            return f"'{t}' is full ({SURFACE_CAPACITY[t]} objects)"
+    if t in world.surface_capacity:
+        if len(state.resting_on(t)) >= world.surface_capacity[t]:
+            return f"'{t}' is full ({world.surface_capacity[t]} objects)"
         return None
     if t not in state.objects:
         return f"'{t}' is neither a surface nor an object in the scene"
     if t == o:
         return "an object cannot be placed on itself"
-    if not can_support(object_type(t).name):
+    if not world.can_support(world.object_type(t).name):
         return f"'{t}' cannot carry another object"
     if not state.holds(Literal(Predicate.CLEAR, (t,))):
         return f"'{t}' is not clear"
-    if state.level(t) + 1 > MAX_TOWER_LEVELS:
-        return f"a tower may hold at most {MAX_TOWER_LEVELS} objects"
+    if state.level(t) + 1 > world.max_tower_levels:
+        return f"a tower may hold at most {world.max_tower_levels} objects"
     return None
 
 
 def _why_not_push(state: SymbolicSceneGraph, action: Push, held: str | None) -> str | None:
-    o, s = action.obj, action.shelf
-    if s not in SHELVES:
+    o, s, world = action.obj, action.shelf, state.world
+    if s not in world.shelves:
         return f"'{s}' is not a shelf"
+    if s not in world.interior_capacity:
+        return f"'{s}' has no interior"
     if held is not None:
         return f"the gripper holds '{held}'"
-    if state.location(o) != on(o, SHELVES[s].prepush):
-        return f"'{o}' is not on {SHELVES[s].prepush}"
+    if state.location(o) != on(o, world.shelves[s].prepush):
+        return f"'{o}' is not on {world.shelves[s].prepush}"
     if not state.holds(Literal(Predicate.CLEAR, (o,))):
         return f"'{o}' is not clear"
-    if not fits_inside(object_type(o).name, s):
+    if not world.fits_inside(world.object_type(o).name, s):
         return f"'{o}' does not fit into {s}"
-    if len(state.inside(s)) >= INTERIOR_CAPACITY[s]:
-        return f"{s}'s interior is full ({INTERIOR_CAPACITY[s]} objects)"
+    if len(state.inside(s)) >= world.interior_capacity[s]:
+        return f"{s}'s interior is full ({world.interior_capacity[s]} objects)"
     return None
 
 
@@ -96,7 +88,7 @@ def apply(state: SymbolicSceneGraph, action: Action) -> SymbolicSceneGraph:
         placements.add(on(o, action.target))
     else:
         placements.add(inside(o, action.shelf))
-    return SymbolicSceneGraph.from_literals(state.objects, placements)
+    return SymbolicSceneGraph.from_literals(state.objects, placements, world=state.world)
 
 
 def applicable_actions(state: SymbolicSceneGraph) -> list[Action]:
@@ -104,9 +96,9 @@ def applicable_actions(state: SymbolicSceneGraph) -> list[Action]:
     held = state.held()
     candidates: list[Action]
     if held is not None:
-        targets = list(SURFACES) + [x for x in state.objects if x != held]
+        targets = list(state.world.surfaces) + [x for x in state.objects if x != held]
         candidates = [Place(held, t) for t in targets]
     else:
         candidates = [Pick(o) for o in state.objects]
-        candidates += [Push(o, s) for o in state.objects for s in SHELVES]
+        candidates += [Push(o, s) for o in state.objects for s in state.world.shelves]
     return [a for a in candidates if why_not(state, a) is None]
