@@ -36,7 +36,7 @@ def check_literals(
     for lit in lits:
         if not lit.positive and lit.atom in pos:
             raise InfeasibleError(f"{_q(lit.atom, lit)}: a literal cannot be both true and false")
-    objects = {o for lit in lits for o in lit.objects()}
+    objects = {o for lit in lits for o in lit.objects(world)}
     if len(objects) > MAX_OBJECTS:
         raise InfeasibleError(f"{len(objects)} objects named; a scene holds at most {MAX_OBJECTS}")
     place = _placements(pos)

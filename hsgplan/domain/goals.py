@@ -11,14 +11,15 @@ from __future__ import annotations
 import itertools
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from hsgplan.domain.checks import MAX_GOAL_FILE_BYTES, MAX_GOAL_FILE_GOALS, read_text
 from hsgplan.domain.errors import GoalSyntaxError, InvalidInputError, UnknownNameError
 from hsgplan.domain.feasibility import check_literals
-from hsgplan.domain.objects import kind_of, sort_objects, split_instance
 from hsgplan.domain.predicates import PREDICATES, Literal, Predicate
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import KITCHEN
 from hsgplan.files import write_atomically
 
 MAX_GOAL_CHARS = 10_000
@@ -32,13 +33,20 @@ _PREDICATE_BY_KEY = {p.value.lower(): p for p in PREDICATES} | {"in_grasp": Pred
 
 @dataclass(frozen=True)
 class Goal:
-    """A conjunction of literals. Its problem size is the number of objects it names."""
+    """A conjunction of literals. Its problem size is the number of objects it names.
+
+    Attributes:
+        world: the world whose names the literals use (goals over the same literals in two
+            worlds compare equal).
+    """
 
     literals: frozenset[Literal]
+    world: World = field(default=KITCHEN, compare=False, hash=False, repr=False)
 
     @property
     def objects(self) -> tuple[str, ...]:
-        return sort_objects(o for lit in self.literals for o in lit.objects())
+        w = self.world
+        return w.sort_objects(o for lit in self.literals for o in lit.objects(w))
 
     @property
     def size(self) -> int:
@@ -68,7 +76,7 @@ class Goal:
         when any reading holds."""
         by_type: dict[str, list[str]] = {}
         for o in self.objects:
-            by_type.setdefault(split_instance(o)[0], []).append(o)
+            by_type.setdefault(self.world.split_instance(o)[0], []).append(o)
         groups = [names for names in by_type.values() if len(names) > 1]
         names = [o for g in groups for o in g]
         return [
@@ -82,7 +90,8 @@ class Goal:
             frozenset(
                 Literal(lit.predicate, tuple(names.get(a, a) for a in lit.args), lit.positive)
                 for lit in self.literals
-            )
+            ),
+            self.world,
         )
 
 
@@ -91,7 +100,7 @@ def _snake(name: str) -> str:
     return re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name).lower()
 
 
-def parse_literal(text: str) -> Literal:
+def parse_literal(text: str, world: World = KITCHEN) -> Literal:
     """One literal; raises an InvalidInputError naming it and the reason."""
     src = text.strip()
     m = _LITERAL.match(src)
@@ -116,7 +125,7 @@ def parse_literal(text: str) -> Literal:
             raise GoalSyntaxError(f"'{src}': '{raw}' is not a name")
         name = _snake(raw)
         try:
-            kind = kind_of(name)
+            kind = world.kind_of(name)
         except UnknownNameError as e:
             raise UnknownNameError(f"'{src}': {e}") from None
         if kind not in pred.signature[i]:
@@ -151,22 +160,22 @@ def split_literals(text: str) -> list[str]:
     return literals
 
 
-def parse_goal(text: str, validate: bool = True) -> Goal:
+def parse_goal(text: str, validate: bool = True, world: World = KITCHEN) -> Goal:
     """Parse goal text; with `validate`, also refuse contradictory or impossible goals."""
     if len(text) > MAX_GOAL_CHARS:
         raise GoalSyntaxError(f"the goal is {len(text)} characters long; at most {MAX_GOAL_CHARS}")
     if not re.sub(r"[&;\s]", "", text):
         raise GoalSyntaxError("the goal is empty")
-    goal = Goal(frozenset(parse_literal(part) for part in split_literals(text)))
+    goal = Goal(frozenset(parse_literal(part, world) for part in split_literals(text)), world)
     if validate:
-        check_literals(goal.literals)
+        check_literals(goal.literals, world=world)
     return goal
 
 
-def goal_of(literals: Iterable[Literal]) -> Goal:
+def goal_of(literals: Iterable[Literal], world: World = KITCHEN) -> Goal:
     """A checked goal from literals."""
-    goal = Goal(frozenset(literals))
-    check_literals(goal.literals)
+    goal = Goal(frozenset(literals), world)
+    check_literals(goal.literals, world=world)
     return goal
 
 
@@ -178,7 +187,7 @@ def write_goal_file(path: Path, goals: Iterable[Goal], header: str = "") -> None
     write_atomically(path, "\n".join(lines) + "\n")  # an existing file is replaced or kept
 
 
-def read_goal_file(path: Path) -> list[Goal]:
+def read_goal_file(path: Path, world: World = KITCHEN) -> list[Goal]:
     """Every goal in a goal file; a bad line raises with its line number. A file larger than
     `MAX_GOAL_FILE_BYTES` or holding more than `MAX_GOAL_FILE_GOALS` goals is refused before
     any goal is parsed (parsing a million would take minutes with nothing shown)."""
@@ -196,7 +205,7 @@ def read_goal_file(path: Path) -> list[Goal]:
     goals = []
     for n, text in lines:
         try:
-            goals.append(parse_goal(text))
+            goals.append(parse_goal(text, world=world))
         except InvalidInputError as e:
             raise type(e)(f"{path}:{n}: {e}") from None
     if not goals:

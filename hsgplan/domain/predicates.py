@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import StrEnum
 
-from hsgplan.domain.objects import EntityKind, kind_of
+from hsgplan.domain.scene import EntityKind, World
+from hsgplan.domain.world import KITCHEN
 
 
 class Predicate(StrEnum):
@@ -65,9 +66,9 @@ class Literal:
     def subject(self) -> str:
         return self.args[0]
 
-    def objects(self) -> tuple[str, ...]:
+    def objects(self, world: World = KITCHEN) -> tuple[str, ...]:
         """The object instances this literal names (fixtures and regions excluded)."""
-        return tuple(a for a in self.args if kind_of(a) is EntityKind.OBJECT)
+        return tuple(a for a in self.args if world.kind_of(a) is EntityKind.OBJECT)
 
     def __str__(self) -> str:
         text = f"{self.predicate.value}({', '.join(self.args)})"

@@ -1,12 +1,15 @@
 """Seeded random goals and random initial symbolic states.
 
 The goal distribution, for n objects (2..12):
-1. Objects: n distinct types drawn uniformly when n <= 6; otherwise all six types plus n - 6
-   duplicates drawn uniformly with replacement. Instances are named as in `objects.py`.
+1. Objects: n distinct types drawn uniformly when n is at most the world's number of types
+   (six in the kitchen); otherwise every type once plus duplicates drawn uniformly with
+   replacement. Instances are named as in `objects.py`.
 2. Each object, in a uniformly shuffled order, gets one literal of the paper's goal kinds, the
    kind drawn uniformly among those still feasible for it:
-   - `On(o, shelf_a)` or `On(o, shelf_b)`: on a shelf top, while the top has room;
-   - `In(o, shelf_a)`: inside shelf A, for cans, while the interior has room;
+   - `On(o, top)` for each of the world's goal shelf tops (in the kitchen `shelf_a` and
+     `shelf_b`): on a shelf top, while the top has room;
+   - `In(o, shelf)` for the world's goal interior (shelf A's in the kitchen): for cans, while
+     the interior has room;
    - `On(o, b)`: stacked on an object b placed earlier on a shelf top, if b can carry it, is
      still bare and the tower stays within the height limit (b uniform among such objects).
    With `stacking=False` the stacked kind is left out (the paper does so for 2 objects).
@@ -20,10 +23,11 @@ import random
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.feasibility import check_literals
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.objects import draw_objects, object_type
+from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import Literal, inside, on
 from hsgplan.domain.room import Room
-from hsgplan.domain.world import GOAL_INTERIOR, GOAL_SHELF_TOPS, MAX_OBJECTS, Kind
+from hsgplan.domain.scene import MAX_OBJECTS, OPEN_SPACE, Kind, World
+from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MIN_OBJECTS = 2
@@ -37,48 +41,54 @@ def check_size(n: int) -> None:
         )
 
 
-def random_objects(n: int, rng: random.Random) -> tuple[str, ...]:
+def random_objects(n: int, rng: random.Random, world: World = KITCHEN) -> tuple[str, ...]:
     """n object instances as the distribution above draws them, in canonical order."""
     check_size(n)
-    return draw_objects(n, rng)
+    return draw_objects(n, rng, world)
 
 
-def random_goal(n: int, rng: random.Random, stacking: bool = True) -> Goal:
+def random_goal(n: int, rng: random.Random, stacking: bool = True, world: World = KITCHEN) -> Goal:
     """One goal over n objects, drawn from the distribution in the module docstring."""
-    objects = list(random_objects(n, rng))
+    objects = list(random_objects(n, rng, world))
     rng.shuffle(objects)
-    room = Room.left(GOAL_SHELF_TOPS, (GOAL_INTERIOR,))
+    interior = world.goal_interior
+    room = Room.left(world.goal_shelf_tops, (interior,), world=world)
     literals: list[Literal] = []
     for o in objects:
         kinds: list[str] = room.free_tops()
-        if object_type(o).kind is Kind.CAN and room.free_interiors(o):
+        if world.object_type(o).kind is Kind.CAN and room.free_interiors(o):
             kinds.append("inside")
         bases = room.bases() if stacking else []
         if bases:
             kinds.append("stack")
         kind = rng.choice(kinds)
         if kind == "inside":
-            literals.append(inside(o, GOAL_INTERIOR))
-            room.put_inside(o, GOAL_INTERIOR)
+            literals.append(inside(o, interior))
+            room.put_inside(o, interior)
             continue
         where = rng.choice(bases) if kind == "stack" else kind
         literals.append(on(o, where))
         room.put_on(o, where)
-    goal = Goal(frozenset(literals))
-    check_literals(goal.literals)
+    goal = Goal(frozenset(literals), world)
+    check_literals(goal.literals, world=world)
     return goal
 
 
-def random_goals(n: int, count: int, seed: int, stacking: bool = True) -> list[Goal]:
+def random_goals(
+    n: int, count: int, seed: int, stacking: bool = True, world: World = KITCHEN
+) -> list[Goal]:
     """`count` goals over n objects; the same seed always gives the same goals."""
     if count < 0:
         raise InvalidInputError(f"count {count}: the number of goals cannot be negative")
     rng = random.Random(f"goals-{n}-{seed}")
-    return [random_goal(n, rng, stacking=stacking) for _ in range(count)]
+    return [random_goal(n, rng, stacking=stacking, world=world) for _ in range(count)]
 
 
 def random_state(
-    objects: tuple[str, ...], rng: random.Random, p_elsewhere: float = 0.3
+    objects: tuple[str, ...],
+    rng: random.Random,
+    p_elsewhere: float = 0.3,
+    world: World = KITCHEN,
 ) -> SymbolicSceneGraph:
     """A random start: most objects on the open space, some stacked or on a shelf top.
 
@@ -88,15 +98,15 @@ def random_state(
     """
     order = list(objects)
     rng.shuffle(order)
-    room = Room.left(interiors=())
+    room = Room.left(interiors=(), world=world)
     literals = []
     for o in order:
         options: list[str] = []
         if rng.random() < p_elsewhere:
-            options = room.free_tops(GOAL_SHELF_TOPS) + room.bases()
+            options = room.free_tops(world.goal_shelf_tops) + room.bases()
         if not options:
-            options = room.free_tops(("open_space",)) or room.free_tops()
+            options = room.free_tops((OPEN_SPACE,)) or room.free_tops()
         target = rng.choice(options)
         literals.append(on(o, target))
         room.put_on(o, target)
-    return SymbolicSceneGraph.from_literals(objects, literals)
+    return SymbolicSceneGraph.from_literals(objects, literals, world=world)
