@@ -134,11 +134,20 @@ def eval_task(
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
     markdown: MarkdownFlag = False,
+    scene: Annotated[
+        Path | None,
+        typer.Option(
+            help="The world: a scene file, or a folder of them, each run with the same goal "
+            "seeds (default: scenes/kitchen.toml; docs/scenes.md).",
+            parser=input_path,
+        ),
+    ] = None,
 ) -> None:
     """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
     wasted (inapplicable) actions per episode, milliseconds per decision. Episodes are kept in
     the run folder (by default
-    runs/eval-task-PLANNER[-CHECKPOINT]-SIZES-gGOALS-seedSEED[-paper]) as they finish."""
+    runs/eval-task-PLANNER[-CHECKPOINT]-SIZES-gGOALS-seedSEED[-paper][-SCENE]) as they
+    finish."""
     from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
 
     planner = planner.value
@@ -147,7 +156,10 @@ def eval_task(
     source = goals_file.stem if goals_file else f"g{goals}"
     tag = "" if checkpoint == TASK_CHECKPOINT else f"-{resolve(checkpoint).name}"
     paper = "-paper" if protocol.value == "paper" else ""
-    run_dir = run_dir or RUNS / f"eval-task-{planner}{tag}-{sizes}-{source}-seed{seed}{paper}"
+    where = f"-{scene.stem}" if scene else ""
+    run_dir = run_dir or RUNS / (
+        f"eval-task-{planner}{tag}-{sizes}-{source}-seed{seed}{paper}{where}"
+    )
     check_ray(ray)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(f"{planner} episodes", total=total)
@@ -163,11 +175,13 @@ def eval_task(
             run_dir,
             ray,
             protocol.value,
+            scene,
         )
     report = summarize_task(episodes) | {
         "planner": planner,
         "seed": seed,
         "protocol": protocol.value,
+        **({"scene": str(scene)} if scene else {}),
     }
     if as_json:
         print(json.dumps(report, indent=2))
@@ -187,7 +201,8 @@ def eval_task(
     ]
     print_table(
         f"{planner} in the symbolic loop, {goals} goals per size, seed {seed}"
-        + (" (paper protocol)" if paper else ""),
+        + (" (paper protocol)" if paper else "")
+        + (f", scene {scene}" if scene else ""),
         (
             "objects",
             "success",

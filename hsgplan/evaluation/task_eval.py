@@ -17,7 +17,7 @@ import random
 import statistics
 from collections import Counter
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from hsgplan.agents.registry import LEARNED_PLANNERS, make_planner
@@ -25,7 +25,9 @@ from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
-from hsgplan.domain.world import MAX_STEPS
+from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.world import KITCHEN, MAX_STEPS
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.seeds import episode_seed
 from hsgplan.runner.items import run_items
@@ -46,6 +48,7 @@ class TaskEpisode:
     decision_ms: tuple[float, ...]
     # actions whose preconditions did not hold: the state stayed, the step was spent
     wasted: int = 0
+    scene: str | None = None  # the scene file it ran in; None: the kitchen
 
 
 def run_task_episode(
@@ -53,7 +56,7 @@ def run_task_episode(
 ) -> TaskEpisode:
     """One episode; with `end_at_failure` (the paper's protocol) the first inapplicable action
     ends it."""
-    state = random_state(goal.objects, random.Random(f"task-{seed}"))
+    state = random_state(goal.objects, random.Random(f"task-{seed}"), world=goal.world)
     times, failure, steps, wasted = [], None, 0, 0
     while not goal.satisfied_by(state):
         if steps >= MAX_STEPS:
@@ -93,7 +96,7 @@ def run_task_episode(
 def fd_length(goal: Goal, seed: int) -> int:
     from hsgplan.planning.fast_downward import FastDownwardPlanner
 
-    state = random_state(goal.objects, random.Random(f"task-{seed}"))
+    state = random_state(goal.objects, random.Random(f"task-{seed}"), world=goal.world)
     return len(FastDownwardPlanner().plan(state, goal))
 
 
@@ -106,10 +109,12 @@ class TaskJob:
     goal: str
     seed: int
     protocol: str = RECOVERING
+    scene: str | None = None  # a scene file; None: the kitchen
 
     @property
     def key(self) -> str:
-        return f"{self.seed}/{self.goal}"
+        where = f"{Path(self.scene).stem}/" if self.scene else ""
+        return f"{where}{self.seed}/{self.goal}"
 
 
 def run_task_job(job: TaskJob) -> dict:
@@ -117,13 +122,14 @@ def run_task_job(job: TaskJob) -> dict:
     import torch
 
     torch.set_num_threads(1)  # one core per worker: the pool already fills the machine
-    goal = parse_goal(job.goal)
+    goal = parse_goal(job.goal, world=read_world(job.scene) if job.scene else KITCHEN)
     paper = job.protocol == PAPER
     rules = RecoveryRules.none() if paper else RecoveryRules()
     planner = make_planner(job.planner, Path(job.checkpoint), rules)
     planner.reset(goal, job.seed)
     length = fd_length(goal, job.seed)
-    return asdict(run_task_episode(planner, goal, job.seed, length, end_at_failure=paper))
+    episode = run_task_episode(planner, goal, job.seed, length, end_at_failure=paper)
+    return asdict(replace(episode, scene=job.scene))
 
 
 def evaluate_task(
@@ -138,24 +144,37 @@ def evaluate_task(
     run_dir: Path | None = None,
     ray: str | None = None,
     protocol: str = RECOVERING,
+    scene: Path | None = None,
 ) -> list[TaskEpisode]:
-    """Every episode, `workers` at a time, under `protocol` (one of PROTOCOLS). With
-    `run_dir`, finished episodes are appended to its `episodes.jsonl` as they finish, and a run
-    started again skips them."""
+    """Every episode, `workers` at a time, under `protocol` (one of PROTOCOLS), in the world of
+    the scene file `scene`, or of each scene file in the folder `scene`, with the same goal
+    seeds in each (default: the kitchen). With `run_dir`, finished episodes are appended to its
+    `episodes.jsonl` as they finish, and a run started again skips them."""
     if protocol not in PROTOCOLS:
         raise InvalidInputError(f"protocol '{protocol}': one of {', '.join(PROTOCOLS)}")
+    worlds = scene_files(scene)
+    for path, world in worlds.items():
+        if planner in LEARNED_PLANNERS and world.entity_types != KITCHEN.entity_types:
+            raise InvalidInputError(
+                f"the learned planners know the kitchen's objects, shelves and regions by name; "
+                f"scene '{path}' names others ({', '.join(_others(world))}): try --planner fd"
+            )
     make_planner(planner, checkpoint)  # a bad name or checkpoint fails here, once
     if goals < 0:
         raise InvalidInputError(f"--goals {goals}: the number of goals cannot be negative")
-    if goals_file:
-        chosen = [g for g in read_goal_file(goals_file) if g.size in sizes]
-        jobs = [(g, episode_seed(seed, g.size, i)) for i, g in enumerate(chosen)]
-    else:
-        jobs = [
-            (g, episode_seed(seed, n, i))
-            for n in sizes
-            for i, g in enumerate(random_goals(n, goals, seed, stacking=n > 2))
-        ]
+    jobs = []
+    for path, world in worlds.items():
+        if goals_file:
+            chosen = [g for g in read_goal_file(goals_file, world) if g.size in sizes]
+            drawn = [(g, episode_seed(seed, g.size, i)) for i, g in enumerate(chosen)]
+        else:
+            drawn = [
+                (g, episode_seed(seed, n, i))
+                for n in sizes
+                for i, g in enumerate(random_goals(n, goals, seed, stacking=n > 2, world=world))
+            ]
+        where = str(path) if path else None
+        jobs += [TaskJob(planner, str(checkpoint), str(g), s, protocol, where) for g, s in drawn]
     if not jobs:
         raise InvalidInputError(
             f"'{goals_file}' holds no goal of the sizes asked for"
@@ -163,9 +182,10 @@ def evaluate_task(
             else "--goals 0: nothing to evaluate"
         )
     learned = [checkpoint] if planner in LEARNED_PLANNERS else []
+    files = [*learned, *([goals_file] if goals_file else []), *(p for p in worlds if p)]
     rows = run_items(
         run_task_job,
-        [TaskJob(planner, str(checkpoint), str(g), s, protocol) for g, s in jobs],
+        jobs,
         key=lambda job: job.key,
         run_dir=run_dir,
         kind="eval-task",
@@ -173,13 +193,29 @@ def evaluate_task(
             "planner": planner,
             "checkpoint": str(checkpoint),
             **({"protocol": protocol} if protocol != RECOVERING else {}),
-            "fingerprint": fingerprint([*learned, *([goals_file] if goals_file else [])]),
+            **({"scene": str(scene)} if scene else {}),
+            "fingerprint": fingerprint(files),
         },
         workers=workers,
         ray=ray,
         on_result=on_episode and (lambda row: on_episode(_episode(row))),
     )
     return [_episode(row) for row in rows]
+
+
+def scene_files(scene: Path | None) -> dict[Path | None, World]:
+    """The worlds of a scene file, or of every `.toml` in a folder (by name); {None: the
+    kitchen} without one. Each is read, and so checked, before anything runs."""
+    if scene is None:
+        return {None: KITCHEN}
+    paths = sorted(Path(scene).glob("*.toml")) if Path(scene).is_dir() else [Path(scene)]
+    if not paths:
+        raise InvalidInputError(f"the folder '{scene}' holds no scene file (*.toml)")
+    return {p: read_world(p) for p in paths}
+
+
+def _others(world: World) -> list[str]:
+    return [n for n in world.entity_types if n not in KITCHEN.entity_types]
 
 
 def _episode(row: dict) -> TaskEpisode:

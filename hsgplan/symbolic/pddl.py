@@ -19,17 +19,8 @@ from unified_planning.shortcuts import BoolType, Not, UserType
 
 from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.objects import object_type
 from hsgplan.domain.predicates import Literal, Predicate
-from hsgplan.domain.world import (
-    INTERIOR_CAPACITY,
-    MAX_TOWER_LEVELS,
-    REGIONS,
-    SHELVES,
-    SURFACE_CAPACITY,
-    can_support,
-    fits_inside,
-)
+from hsgplan.domain.scene import World
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 ENTITY = UserType("entity")
@@ -63,9 +54,13 @@ FLUENTS = (ON, INSIDE, INGRASP, CLEAR, HANDEMPTY, COUNT, ICOUNT, LEVEL)
 BANS = (BANNED_PICK, BANNED_PLACE, BANNED_PUSH)
 STATICS = (SUCC, CAP, ICAP, MAXLEVEL, CARRIER, FITS, PREPUSH)
 
-MAX_NUM = max(max(SURFACE_CAPACITY.values()), max(INTERIOR_CAPACITY.values()), MAX_TOWER_LEVELS)
-NUMS = [Object(f"n{i}", NUM) for i in range(MAX_NUM + 1)]
-N1 = NUMS[1]
+N1 = Object("n1", NUM)
+
+
+def numbers(world: World) -> list[Object]:
+    """n0, n1, ... up to the largest count the world's limits need."""
+    counts = [*world.surface_capacity.values(), *world.interior_capacity.values()]
+    return [Object(f"n{i}", NUM) for i in range(max(*counts, world.max_tower_levels) + 1)]
 
 
 def _actions(bans: bool = False) -> list[InstantaneousAction]:
@@ -192,33 +187,34 @@ def build_problem(
         problem.add_fluent(f, default_initial_value=False)
     for a in ACTIONS_WITH_BANS if banned else ACTIONS:
         problem.add_action(a)
+    world, nums = state.world, numbers(state.world)
     ents: dict[str, Object] = {o: Object(o, OBJ) for o in state.objects}
-    ents |= {r: Object(r, REGION) for r in REGIONS}
-    ents |= {s: Object(s, SHELF) for s in SHELVES}
-    problem.add_objects(list(ents.values()) + NUMS)
+    ents |= {r: Object(r, REGION) for r in world.regions}
+    ents |= {s: Object(s, SHELF) for s in world.shelves}
+    problem.add_objects(list(ents.values()) + nums)
     init = problem.set_initial_value
-    for a, b in zip(NUMS, NUMS[1:], strict=False):
+    for a, b in zip(nums, nums[1:], strict=False):
         init(SUCC(a, b), True)
-    for s, c in SURFACE_CAPACITY.items():
+    for s, c in world.surface_capacity.items():
         for i in range(1, c + 1):
-            init(CAP(ents[s], NUMS[i]), True)
-        init(COUNT(ents[s], NUMS[len(state.resting_on(s))]), True)
-    for s, c in INTERIOR_CAPACITY.items():
+            init(CAP(ents[s], nums[i]), True)
+        init(COUNT(ents[s], nums[len(state.resting_on(s))]), True)
+    for s, c in world.interior_capacity.items():
         for i in range(1, c + 1):
-            init(ICAP(ents[s], NUMS[i]), True)
-        init(ICOUNT(ents[s], NUMS[len(state.inside(s))]), True)
-        init(PREPUSH(ents[SHELVES[s].prepush], ents[s]), True)
-    for i in range(1, MAX_TOWER_LEVELS + 1):
-        init(MAXLEVEL(NUMS[i]), True)
+            init(ICAP(ents[s], nums[i]), True)
+        init(ICOUNT(ents[s], nums[len(state.inside(s))]), True)
+        init(PREPUSH(ents[world.shelves[s].prepush], ents[s]), True)
+    for i in range(1, world.max_tower_levels + 1):
+        init(MAXLEVEL(nums[i]), True)
     for o in state.objects:
-        t = object_type(o).name
-        if can_support(t):
+        t = world.object_type(o).name
+        if world.can_support(t):
             init(CARRIER(ents[o]), True)
-        for s in SHELVES:
-            if fits_inside(t, s):
+        for s in world.shelves:
+            if world.fits_inside(t, s):
                 init(FITS(ents[o], ents[s]), True)
         if state.level(o):
-            init(LEVEL(ents[o], NUMS[state.level(o)]), True)
+            init(LEVEL(ents[o], nums[state.level(o)]), True)
     if state.held() is None:
         init(HANDEMPTY, True)
     for lit in state.literals:
