@@ -241,6 +241,17 @@ def input_path(text) -> Path:
     return Path(str(text)).expanduser()
 
 
+SceneOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--scene",
+        help="The world, as a scene file (default: scenes/kitchen.toml; docs/scenes.md).",
+        parser=input_path,
+        metavar="FILE",
+    ),
+]
+
+
 def check_ray(address: str | None) -> None:
     """`--ray` checked at the door (see `hsgplan.runner.engines.check_ray_address`)."""
     from hsgplan.runner.engines import check_ray_address

@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli.common import bounded_option, err, out, refuses_bad_input, shown
+from hsgplan.cli.common import SceneOption, bounded_option, err, out, refuses_bad_input, shown
 from hsgplan.cli.common import out_file as file_to_write
 from hsgplan.domain.errors import InvalidInputError
 
@@ -24,31 +24,38 @@ class Search(StrEnum):
         return {"auto": None, "optimal": True, "fast": False}[self.value]
 
 
-def _scene(goal_text: str, names_text: str | None, init: str | None):
+def _world(scene: Path | None):
+    from hsgplan.domain.scene_file import read_world
+    from hsgplan.domain.world import KITCHEN
+
+    return read_world(scene) if scene else KITCHEN
+
+
+def _scene(goal_text: str, names_text: str | None, init: str | None, scene: Path | None = None):
     from hsgplan.domain.goals import parse_goal
-    from hsgplan.domain.objects import kind_of, sort_objects
     from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
-    goal = parse_goal(goal_text)
+    world = _world(scene)
+    goal = parse_goal(goal_text, world=world)
     names = list(goal.objects)
     if names_text is not None:
         given = [o.strip() for o in names_text.split(",") if o.strip()]
         if not given:
             raise InvalidInputError(f"--names '{names_text}' names no object")
         for o in given:
-            kind_of(o)
+            world.kind_of(o)
         missing = [o for o in goal.objects if o not in given]
         if missing:
             raise InvalidInputError(f"--names lacks '{missing[0]}', which the goal names")
-        names = list(sort_objects(given))
+        names = list(world.sort_objects(given))
     if init:
-        literals = parse_goal(init, validate=False).literals
-        extra = {o for lit in literals for o in lit.objects()} - set(names)
+        literals = parse_goal(init, validate=False, world=world).literals
+        extra = {o for lit in literals for o in lit.objects(world)} - set(names)
         if extra:
             raise InvalidInputError(f"--init names '{sorted(extra)[0]}', which is not in the scene")
-        state = SymbolicSceneGraph.from_literals(names, literals)
+        state = SymbolicSceneGraph.from_literals(names, literals, world=world)
     else:
-        state = SymbolicSceneGraph.initial(names)
+        state = SymbolicSceneGraph.initial(names, world=world)
     return goal, state
 
 
@@ -88,11 +95,12 @@ def plan(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the plan as JSON.", metavar="")
     ] = False,
+    scene: SceneOption = None,
 ) -> None:
     """Plan a goal with Fast Downward and show the symbolic state after each step."""
     from hsgplan.planning.fast_downward import FastDownwardPlanner
 
-    g, state = _scene(goal, names, init)
+    g, state = _scene(goal, names, init, scene)
     result = FastDownwardPlanner(optimal=search.optimal_flag).plan(state, g)
     if as_json:
         steps = [
@@ -121,16 +129,19 @@ def goals(
         typer.Option("--out", help="Goal file to write (default: stdout).", parser=file_to_write),
     ] = None,
     stacking: Annotated[bool, typer.Option(help="Allow stacked goals.")] = True,
+    scene: SceneOption = None,
 ) -> None:
     """Write random feasible goals, one per line (distribution: `symbolic/generator.py`)."""
     from hsgplan.domain.goals import write_goal_file
     from hsgplan.symbolic.generator import check_size, random_goals
 
     check_size(objects)
-    drawn = random_goals(objects, goals, seed, stacking=stacking)
+    drawn = random_goals(objects, goals, seed, stacking=stacking, world=_world(scene))
     header = f"hsgplan goals --objects {objects} --goals {goals} --seed {seed}" + (
         "" if stacking else " --no-stacking"
     )
+    if scene is not None:
+        header += f" --scene {scene}"
     if out_file is None:
         print(f"# {header}")
         for g in drawn:

@@ -127,3 +127,21 @@ def test_eval_task_runs_every_scene_of_a_folder_on_the_same_goal_seeds(tmp_path)
     (tmp_path / "empty").mkdir()
     with pytest.raises(InvalidInputError, match="holds no scene file"):
         evaluate_task("fd", KITCHEN_SCENE, [3], 2, 0, workers=1, scene=tmp_path / "empty")
+
+
+def test_goals_and_plan_take_a_scene_file(tmp_path):
+    scene = tmp_path / "new.toml"
+    new = random_layout(KITCHEN, 0, 0, new_objects=True)
+    scene.write_text(to_toml(scene_data(new)))
+    r = runner.invoke(app, ["goals", "--objects", "3", "--goals", "4", "--scene", str(scene)])
+    assert r.exit_code == 0, r.output
+    lines = r.stdout.splitlines()
+    assert lines[0].endswith(f"--scene {scene}") and len(lines) == 5
+    goals = [parse_goal(line, world=new) for line in lines[1:]]
+    assert all(set(g.objects) <= set(new.object_types) for g in goals)
+    r = runner.invoke(app, ["plan", "--goal", str(goals[0]), "--scene", str(scene), "--json"])
+    assert r.exit_code == 0, r.output
+    steps = json.loads(r.stdout)
+    assert all(lit in steps[-1]["state"] for lit in map(str, goals[0].literals))
+    r = runner.invoke(app, ["plan", "--goal", str(goals[0])])  # not the kitchen's names
+    assert r.exit_code == 2 and "unknown" in r.output
