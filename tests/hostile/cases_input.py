@@ -72,6 +72,7 @@ report         | report run                                           | --failur
 collect images | collect images --workers 1 --out ds                  | --samples   | ALL
 eval perception | eval perception                                     | --scenes    | ALL
 bench observe  | bench observe                                        | --scenes    | -1 0 1e12
+scenes         | scenes --out sc                                      | --layouts   | ALL
 """
 # a small count each: a huge pool for one item would still start one process
 WORKERS = """
@@ -94,6 +95,7 @@ collect reach  | collect reach --states 1 --workers 1 --out ds
 train task     | train task --config tiny.json --out ck
 collect images | collect images --samples 1 --workers 1 --out ds
 eval perception | eval perception --scenes 1
+scenes         | scenes --layouts 1 --out sc
 """
 MALFORMED = """
 goals          | goals --objects 2 --goals abc
@@ -254,6 +256,8 @@ eval task | eval task --sizes 2 --goals 1 --checkpoint 'ck[/]' | ck[/]
 report | report 'run[/]' | run[/]
 train task | train task --config 'c[/].json' --out ck | c[/].json
 eval reach | eval reach --data 't[/]' | t[/]
+plan | plan --goal 'On(butter, shelf_a)' --scene 's[/].toml' | s[/].toml
+eval task | eval task --sizes 2 --goals 1 --scene 's[/]' | s[/]
 """
 
 
