@@ -26,6 +26,9 @@ SHELF_CLEARANCE = (0.11, 0.14)
 OBJECT_SCALE = (0.8, 1.2)  # each dimension of each object type, drawn apart
 MAX_GRASP = GRIPPER_MAX_OPENING - 0.004  # a resized object's narrow side
 TRIES = 200
+# A layout's goal shelf tops hold at least this many objects, so that a goal of every size the
+# paper measures (2 to 6 objects) can be drawn in it.
+GOAL_ROOM = 6
 # Groceries no model was trained on, by kind: drawn without replacement for `--new-objects`.
 NEW_NAMES = {
     Kind.CAN: ("peaches", "corn", "tuna", "beans", "coconut_milk"),
@@ -100,9 +103,11 @@ def random_layout(base: World, seed: int, index: int, new_objects: bool = False)
         data["shelves"] = _shelves(base, rng)
         data["objects"] = [object_data(t) for t in _objects(base, rng, new_objects)]
         try:
-            return world_of(data)
+            world = world_of(data)
         except InvalidInputError:
             continue  # a draw the scene file refuses (a shelf off the table): draw again
+        if world.goal_top_room >= GOAL_ROOM:
+            return world
     raise InvalidInputError(f"no valid layout of '{base.name}' in {TRIES} draws (seed {seed})")
 
 

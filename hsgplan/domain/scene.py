@@ -273,6 +273,11 @@ class World:
         return {name: capacity(self.surface_rect(name)) for name in self.surfaces}
 
     @cached_property
+    def goal_top_room(self) -> int:
+        """Objects the goal shelf tops hold side by side."""
+        return sum(self.surface_capacity[t] for t in self.goal_shelf_tops)
+
+    @cached_property
     def interior_capacity(self) -> dict[str, int]:
         """Objects each shelf's interior holds in its row (shelves with an interior only)."""
         return {

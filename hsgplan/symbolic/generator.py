@@ -61,6 +61,11 @@ def random_goal(n: int, rng: random.Random, stacking: bool = True, world: World 
         bases = room.bases() if stacking else []
         if bases:
             kinds.append("stack")
+        if not kinds:
+            raise InvalidInputError(
+                f"scene '{world.name}' has no room for a goal of {n} objects as goals are drawn "
+                f"(its goal shelf tops hold {world.goal_top_room})"
+            )
         kind = rng.choice(kinds)
         if kind == "inside":
             literals.append(inside(o, interior))

@@ -72,3 +72,29 @@ def test_a_bad_base_scene_or_count_is_refused_in_one_line(tmp_path):
     assert "scene file" in r.output and "missing" in r.output
     r = runner.invoke(app, ["scenes", "--layouts", "-2", "--out", str(tmp_path / "o")])
     assert r.exit_code == 2 and not (tmp_path / "o").exists()
+
+
+def test_every_layout_has_room_for_the_largest_goal_the_paper_measures():
+    from hsgplan.symbolic.generator import random_goals
+
+    for index in range(10):
+        w = layouts.random_layout(KITCHEN, 5, index)
+        assert w.goal_top_room >= layouts.GOAL_ROOM
+        assert len(random_goals(6, 3, 0, world=w)) == 3
+
+
+def test_a_scene_too_small_for_a_goal_is_refused_in_one_line():
+    import copy
+    import tomllib
+
+    from hsgplan.domain.errors import InvalidInputError
+    from hsgplan.domain.scene_file import world_of
+    from hsgplan.paths import KITCHEN_SCENE
+    from hsgplan.symbolic.generator import random_goals
+
+    data = tomllib.loads(KITCHEN_SCENE.read_text())
+    data = copy.deepcopy(data)
+    data["goals"] = {"shelf_tops": ["shelf_a"], "interior": "shelf_a"}
+    small = world_of(data)
+    with pytest.raises(InvalidInputError, match="no room for a goal of 12 objects"):
+        random_goals(12, 1, 0, world=small)
