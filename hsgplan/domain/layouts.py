@@ -26,9 +26,10 @@ SHELF_CLEARANCE = (0.11, 0.14)
 OBJECT_SCALE = (0.8, 1.2)  # each dimension of each object type, drawn apart
 MAX_GRASP = GRIPPER_MAX_OPENING - 0.004  # a resized object's narrow side
 TRIES = 200
-# A layout's goal shelf tops hold at least this many objects, so that a goal of every size the
-# paper measures (2 to 6 objects) can be drawn in it.
+# A layout's goal shelf tops hold at least this many objects, and its towers this many levels,
+# so that goals of every size (2 to 6 objects) and every kind the paper measures can be drawn.
 GOAL_ROOM = 6
+TOWER_LEVELS = 2
 # Groceries no model was trained on, by kind: drawn without replacement for `--new-objects`.
 NEW_NAMES = {
     Kind.CAN: ("peaches", "corn", "tuna", "beans", "coconut_milk"),
@@ -106,7 +107,7 @@ def random_layout(base: World, seed: int, index: int, new_objects: bool = False)
             world = world_of(data)
         except InvalidInputError:
             continue  # a draw the scene file refuses (a shelf off the table): draw again
-        if world.goal_top_room >= GOAL_ROOM:
+        if world.goal_top_room >= GOAL_ROOM and world.max_tower_levels >= TOWER_LEVELS:
             return world
     raise InvalidInputError(f"no valid layout of '{base.name}' in {TRIES} draws (seed {seed})")
 

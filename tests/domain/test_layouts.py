@@ -80,6 +80,7 @@ def test_every_layout_has_room_for_the_largest_goal_the_paper_measures():
     for index in range(10):
         w = layouts.random_layout(KITCHEN, 5, index)
         assert w.goal_top_room >= layouts.GOAL_ROOM
+        assert w.max_tower_levels >= layouts.TOWER_LEVELS
         assert len(random_goals(6, 3, 0, world=w)) == 3
 
 
