@@ -15,16 +15,14 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.scene import Kind, World
 from hsgplan.domain.world import (
+    KITCHEN,
     PLACE_BINS,
     PUSH_ANGLE_BINS,
     PUSH_ANGLE_RANGE,
     PUSH_DIST_BINS,
     PUSH_DIST_RANGE,
-    SURFACES,
-    Kind,
-    surface_rect,
 )
 
 PLACE_EDGE_GAP = 0.005
@@ -82,20 +80,22 @@ def _check_bin(value: int, bins: int, what: str) -> None:
         raise InvalidInputError(f"{what} {value} is outside 0..{bins - 1}")
 
 
-def place_inset(obj: str) -> tuple[float, float]:
+def place_inset(obj: str, world: World = KITCHEN) -> tuple[float, float]:
     """How far a bin centre stays from a surface's x and y edges: half the object's footprint
     as it is placed (long side along y), plus a small gap."""
-    fx, fy = sorted(object_type(obj).footprint)
+    fx, fy = sorted(world.object_type(obj).footprint)
     return fx / 2 + PLACE_EDGE_GAP, fy / 2 + PLACE_EDGE_GAP
 
 
-def place_xy(obj: str, target: str, x_bin: int, y_bin: int) -> tuple[float, float]:
+def place_xy(
+    obj: str, target: str, x_bin: int, y_bin: int, world: World = KITCHEN
+) -> tuple[float, float]:
     """The world (x, y) of a place bin's centre on a surface."""
-    if target not in SURFACES:
+    if target not in world.surface_capacity:
         raise InvalidInputError(f"place bins are over surfaces, not '{target}'")
     _check_bin(x_bin, PLACE_BINS, "x_bin")
     _check_bin(y_bin, PLACE_BINS, "y_bin")
-    r, (ix, iy) = surface_rect(target), place_inset(obj)
+    r, (ix, iy) = world.surface_rect(target), place_inset(obj, world)
     x0, x1 = r.x_min + ix, r.x_max - ix
     y0, y1 = r.y_min + iy, r.y_max - iy
     if x1 < x0:
@@ -120,9 +120,9 @@ def push_values(angle_bin: int, dist_bin: int) -> tuple[float, float]:
     )
 
 
-def extent_along(obj: str, yaw: float, angle: float) -> float:
+def extent_along(obj: str, yaw: float, angle: float, world: World = KITCHEN) -> float:
     """How far an object standing at `yaw` reaches from its centre towards `angle`."""
-    t = object_type(obj)
+    t = world.object_type(obj)
     if t.kind is Kind.CAN:
         return t.size[0] / 2
     rel = angle - yaw

@@ -7,10 +7,11 @@ from (simulator ground truth today, pose estimation later) is not its concern.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from hsgplan.domain.objects import ENTITY_TYPES, object_type, sort_objects
+from hsgplan.domain.scene import ObjectType, World
+from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometry import Pose
 
 if TYPE_CHECKING:
@@ -22,32 +23,39 @@ class GeometricNode:
     """An object: its instance name, type, and the pose of its geometric centre."""
 
     name: str
-    type_name: str
+    type: ObjectType
     pose: Pose
+
+    @property
+    def type_name(self) -> str:
+        return self.type.name
 
     @property
     def bottom_z(self) -> float:
         """Height of the lowest point, for an object standing as it rests (not toppled)."""
-        return self.pose.position[2] - object_type(self.name).height / 2
+        return self.pose.position[2] - self.type.height / 2
 
     @property
     def top_z(self) -> float:
-        return self.pose.position[2] + object_type(self.name).height / 2
+        return self.pose.position[2] + self.type.height / 2
 
 
 @dataclass(frozen=True)
 class GeometricSceneGraph:
-    """Object poses plus the robot's grasp state (which object, if any, is held)."""
+    """Object poses plus the robot's grasp state (which object, if any, is held), in a world
+    (not compared: the same poses in two worlds are equal graphs)."""
 
     nodes: tuple[GeometricNode, ...]
     held: str | None = None
+    world: World = field(default=KITCHEN, compare=False, hash=False, repr=False)
 
     @staticmethod
-    def from_poses(poses: dict[str, Pose], held: str | None = None) -> GeometricSceneGraph:
-        names = sort_objects(poses)
-        return GeometricSceneGraph(
-            tuple(GeometricNode(n, object_type(n).name, poses[n]) for n in names), held
-        )
+    def from_poses(
+        poses: dict[str, Pose], held: str | None = None, world: World = KITCHEN
+    ) -> GeometricSceneGraph:
+        names = world.sort_objects(poses)
+        nodes = tuple(GeometricNode(n, world.object_type(n), poses[n]) for n in names)
+        return GeometricSceneGraph(nodes, held, world)
 
     @property
     def objects(self) -> tuple[str, ...]:
@@ -66,7 +74,8 @@ class GeometricSceneGraph:
         """The graph as `torch_geometric.data.Data`, fully connected without self loops.
 
         Shapes:
-            x: [N, T + 7] type one-hot over `ENTITY_TYPES`, position (3), quaternion (4).
+            x: [N, T + 7] type one-hot over the world's `entity_types`, position (3),
+                quaternion (4).
             edge_index: [2, N * (N - 1)] every ordered pair of distinct objects.
             edge_attr: [E, 7] pose of the target in the source's frame (position, quaternion).
             names: list of N object names.
@@ -74,11 +83,11 @@ class GeometricSceneGraph:
         import torch
         from torch_geometric.data import Data
 
-        n = len(self.nodes)
-        x = torch.zeros(n, len(ENTITY_TYPES) + 7)
+        n, types = len(self.nodes), self.world.entity_types
+        x = torch.zeros(n, len(types) + 7)
         for i, node in enumerate(self.nodes):
-            x[i, ENTITY_TYPES.index(node.type_name)] = 1.0
-            x[i, len(ENTITY_TYPES) :] = torch.tensor(node.pose.position + node.pose.orientation)
+            x[i, types.index(node.type_name)] = 1.0
+            x[i, len(types) :] = torch.tensor(node.pose.position + node.pose.orientation)
         pairs = [(i, j) for i in range(n) for j in range(n) if i != j]
         attrs = []
         for i, j in pairs:

@@ -23,9 +23,8 @@ import math
 from dataclasses import dataclass
 from enum import StrEnum
 
-from hsgplan.domain.objects import object_type
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
-from hsgplan.domain.world import REGIONS, SHELVES, TABLE, Kind, Rect
+from hsgplan.domain.scene import Kind, Rect, World
 from hsgplan.scene_graph.geometric import GeometricNode, GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -102,6 +101,7 @@ def map_symbols(
     """
     if sg.held is not None and sg.held not in sg.objects:
         raise ValueError(f"the held object '{sg.held}' is not in the scene")
+    world = sg.world
     place: dict[str, Literal] = {}
     anomalies: dict[str, Anomaly] = {}
     upright: list[GeometricNode] = []
@@ -109,13 +109,13 @@ def map_symbols(
         x, y, z = node.pose.position
         if node.name == sg.held:
             place[node.name] = in_grasp(node.name)
-        elif not (z >= tol.off_table_z and TABLE.contains(x, y)):  # `not >=` also catches NaN
-            place[node.name] = on(node.name, _nearest_region(x, y))
+        elif not (z >= tol.off_table_z and world.table.contains(x, y)):  # `not >=`: NaN too
+            place[node.name] = on(node.name, _nearest_region(world, x, y))
             anomalies[node.name] = Anomaly(
                 node.name, AnomalyKind.OFF_TABLE, f"centre at ({x:.3f}, {y:.3f}, {z:.3f})"
             )
         elif node.pose.tilt > tol.tilt_max:
-            place[node.name] = _by_centre(node, tol)
+            place[node.name] = _by_centre(world, node, tol)
             anomalies[node.name] = Anomaly(
                 node.name,
                 AnomalyKind.TOPPLED,
@@ -127,7 +127,7 @@ def map_symbols(
     # Only upright, unheld objects on the table carry others: a held object carries nothing
     # (the symbolic rules forbid it; what sits on it is in the air with it), and a toppled
     # object's top face no longer faces up.
-    options = {n.name: _supports(n, upright, tol) for n in upright}
+    options = {n.name: _supports(world, n, upright, tol) for n in upright}
     below: dict[str, str] = {}  # object -> the object it rests on
     carrying: dict[str, str] = {}  # carrier -> the object resting on it
     ranked = sorted(
@@ -145,15 +145,15 @@ def map_symbols(
     for node in upright:
         if node.name not in place:
             x, y, _ = node.pose.position
-            place[node.name] = on(node.name, _nearest_region(x, y))
+            place[node.name] = on(node.name, _nearest_region(world, x, y))
             anomalies[node.name] = _why_unplaced(node, options[node.name], carrying, tol)
 
-    state = SymbolicSceneGraph.from_literals(sg.objects, place.values(), limits=False)
+    state = SymbolicSceneGraph.from_literals(sg.objects, place.values(), limits=False, world=world)
     return SymbolMapping(state, tuple(anomalies[o] for o in state.objects if o in anomalies))
 
 
 def _supports(
-    node: GeometricNode, upright: list[GeometricNode], tol: MappingTolerances
+    world: World, node: GeometricNode, upright: list[GeometricNode], tol: MappingTolerances
 ) -> list[_Support]:
     """Every support whose surface meets the object's bottom and holds its centre."""
     name, bottom = node.name, node.bottom_z
@@ -167,17 +167,17 @@ def _supports(
         if offset is not None:
             out.append(_Support(on(name, b.name), dz + _XY_WEIGHT * offset, b.name))
     surfaces: list[tuple[Literal, Rect]] = []
-    tops = [s for s in SHELVES.values() if abs(bottom - s.top.z) <= tol.contact_z]
+    tops = [s for s in world.shelf_list if abs(bottom - s.top.z) <= tol.contact_z]
     surfaces += [(on(name, s.name), s.top) for s in tops]
     # At table height: inside a shelf (under its top board), or on a region. A centre within
     # margin of both a prepush region and the interior behind it goes to the nearer, by cost.
     if abs(bottom) <= tol.contact_z:
         surfaces += [
             (inside(name, s.name), s.interior)
-            for s in SHELVES.values()
+            for s in world.shelf_list
             if s.interior is not None and z < s.clearance
         ]
-        surfaces += [(on(name, r), rect) for r, rect in REGIONS.items()]
+        surfaces += [(on(name, r), rect) for r, rect in world.region_list]
     for lit, rect in surfaces:
         d = _rect_distance(rect, x, y)
         if d <= tol.xy_margin:
@@ -189,7 +189,7 @@ def _supports(
 def _top_face_offset(b: GeometricNode, x: float, y: float, margin: float) -> float | None:
     """The horizontal distance of (x, y) from b's centre if it lies on b's top face (its
     footprint turned by its yaw, widened by margin); None otherwise. A can's top is a disc."""
-    t = object_type(b.name)
+    t = b.type
     bx, by, _ = b.pose.position
     dx, dy = x - bx, y - by
     dist = math.hypot(dx, dy)
@@ -202,17 +202,17 @@ def _top_face_offset(b: GeometricNode, x: float, y: float, margin: float) -> flo
     return None
 
 
-def _by_centre(node: GeometricNode, tol: MappingTolerances) -> Literal:
+def _by_centre(world: World, node: GeometricNode, tol: MappingTolerances) -> Literal:
     """Where a toppled object's centre lies: above a shelf's top board, under it inside the
     interior, or else the nearest region (a toppled object carries and rests on no object)."""
     x, y, z = node.pose.position
-    for s in SHELVES.values():
+    for s in world.shelf_list:
         if z >= s.top.z and _rect_distance(s.top, x, y) <= tol.xy_margin:
             return on(node.name, s.name)
         inner = s.interior
         if inner is not None and z < s.clearance and _rect_distance(inner, x, y) <= tol.xy_margin:
             return inside(node.name, s.name)
-    return on(node.name, _nearest_region(x, y))
+    return on(node.name, _nearest_region(world, x, y))
 
 
 def _why_unplaced(
@@ -258,6 +258,6 @@ def _rect_distance(rect: Rect, x: float, y: float) -> float:
     return math.inf if math.isnan(d) or math.isnan(x) or math.isnan(y) else d
 
 
-def _nearest_region(x: float, y: float) -> str:
+def _nearest_region(world: World, x: float, y: float) -> str:
     """The region nearest to (x, y); the first listed on ties (and for a NaN position)."""
-    return min(REGIONS, key=lambda r: _rect_distance(REGIONS[r], x, y))
+    return min(world.regions, key=lambda r: _rect_distance(world.regions[r], x, y))

@@ -16,6 +16,8 @@ from collections.abc import Iterable
 import numpy as np
 
 from hsgplan.domain.parameters import PickParams, PlaceParams
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
@@ -27,10 +29,11 @@ class BeliefWorld:
     """Args:
     objects: the goal's object names (each gets a body, parked until believed somewhere).
     seed: seeds the model's inverse-kinematics restarts and motion planning.
+    world: the arena and object types the robot knows its world by.
     """
 
-    def __init__(self, objects: Iterable[str], seed: int) -> None:
-        self.scene = Scene(objects, seed, visuals=False)  # a model: never pictured
+    def __init__(self, objects: Iterable[str], seed: int, world: World = KITCHEN) -> None:
+        self.scene = Scene(objects, seed, visuals=False, world=world)  # a model: never pictured
         self.holding: str | None = None
 
     def close(self) -> None:

@@ -4,14 +4,12 @@ from __future__ import annotations
 
 from pybullet_utils.bullet_client import BulletClient
 
-from hsgplan.domain.objects import object_type
-from hsgplan.domain.world import Kind
+from hsgplan.domain.scene import Kind, ObjectType
 from hsgplan.scene_graph.geometry import Pose
 
 
-def spawn_object(bc: BulletClient, name: str, pose: Pose) -> int:
-    """Create the body of an object instance at a pose (its geometric centre)."""
-    t = object_type(name)
+def spawn_object(bc: BulletClient, t: ObjectType, pose: Pose) -> int:
+    """Create the body of an object of type `t` at a pose (its geometric centre)."""
     if t.kind is Kind.CAN:
         radius, height = t.size[0] / 2, t.height
         col = bc.createCollisionShape(bc.GEOM_CYLINDER, radius=radius, height=height)

@@ -27,9 +27,9 @@ import gymnasium
 import numpy as np
 
 from hsgplan.domain.goals import Goal, parse_goal
-from hsgplan.domain.objects import sort_objects
 from hsgplan.domain.parameters import PickParams, PrimitiveParams
-from hsgplan.domain.world import MAX_STEPS
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import KITCHEN, MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
 from hsgplan.sim.actuation import holds_something
@@ -86,7 +86,7 @@ class ResetOptions:
     others: tuple[str, ...] = ()
 
     def objects(self) -> tuple[str, ...]:
-        return sort_objects({*self.goal.objects, *self.others})
+        return self.goal.world.sort_objects({*self.goal.objects, *self.others})
 
 
 class KitchenStorageEnv(gymnasium.Env):
@@ -109,6 +109,8 @@ class KitchenStorageEnv(gymnasium.Env):
         visuals: load the arm's visual meshes, for pictures of the scene (rendering, a camera
             observer, a demo's frames); an env nothing pictures resets faster without them,
             and runs the same episodes.
+        world: the world of the random goals `reset` draws and of goal texts it is given; an
+            episode's world is its goal's (`Goal.world`).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
@@ -123,7 +125,9 @@ class KitchenStorageEnv(gymnasium.Env):
         observer: SceneObserver | CameraObserver | None = None,
         relook: bool = True,
         visuals: bool = True,
+        world: World = KITCHEN,
     ):
+        self.scene_world = world
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
         check_size(objects)  # refused here, not at the first reset
@@ -162,17 +166,17 @@ class KitchenStorageEnv(gymnasium.Env):
         `objects` objects drawn from the scene's seed."""
         super().reset(seed=seed)
         scene_seed = seed if seed is not None else int(self.np_random.integers(2**31))
-        options = _options(options, self.objects, scene_seed)
+        options = _options(options, self.objects, scene_seed, self.scene_world)
         self.close()
         self.goal = options.goal
         self.scene, _ = sample_scene(
-            options.objects(), scene_seed, options.p_elsewhere, self.visuals
+            options.objects(), scene_seed, options.p_elsewhere, self.visuals, options.goal.world
         )
         self.steps = 0
         self._checked.clear()
         self._seen = self._judged = self._released = None
         if self.believing:
-            self.world = BeliefWorld(options.objects(), scene_seed)
+            self.world = BeliefWorld(options.objects(), scene_seed, options.goal.world)
             self.observer.start(options.objects())
         else:
             self.observer.reset(self.scene)
@@ -395,15 +399,17 @@ class KitchenStorageEnv(gymnasium.Env):
         return encode(self.scene.objects, typed.scene_graph, typed.symbols.state)
 
 
-def _options(options: ResetOptions | dict | None, objects: int, seed: int) -> ResetOptions:
+def _options(
+    options: ResetOptions | dict | None, objects: int, seed: int, world: World
+) -> ResetOptions:
     if isinstance(options, ResetOptions):
         return options
     options = options or {}
     goal = options.get("goal")
     if goal is None:
-        goal = random_goals(objects, 1, seed)[0]
+        goal = random_goals(objects, 1, seed, world=world)[0]
     if isinstance(goal, str):
-        goal = parse_goal(goal)
+        goal = parse_goal(goal, world=world)
     if not isinstance(goal, Goal):
         raise ValueError("options['goal']: a Goal or goal text")
     return ResetOptions(goal, float(options.get("p_elsewhere", ResetOptions.p_elsewhere)))

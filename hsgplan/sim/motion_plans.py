@@ -14,7 +14,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import object_type
 from hsgplan.domain.parameters import (
     PUSH_LEAD,
     PickParams,
@@ -25,15 +24,7 @@ from hsgplan.domain.parameters import (
     push_values,
 )
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
-from hsgplan.domain.world import (
-    GRIPPER_MAX_OPENING,
-    PLACE_LONG_AXIS_YAW,
-    REGIONS,
-    SHELVES,
-    SURFACES,
-    Kind,
-    surface_rect,
-)
+from hsgplan.domain.world import GRIPPER_MAX_OPENING, PLACE_LONG_AXIS_YAW, Kind, World
 from hsgplan.scene_graph.geometry import Pose, yaw_quat
 from hsgplan.sim.collision import SAFETY_MARGIN
 from hsgplan.sim.outcome import Status
@@ -194,7 +185,7 @@ def _plan_pick(scene: Scene, p: PickParams, q0: np.ndarray) -> MotionPlan | Plan
         return PlanFailure(Status.INVALID, f"'{p.obj}' is not in the scene")
     if scene.robot.held_body is not None:
         return PlanFailure(Status.INVALID, f"the gripper already holds '{scene.held()}'")
-    t, pose = object_type(p.obj), scene.pose(p.obj)
+    t, pose = scene.world.object_type(p.obj), scene.pose(p.obj)
     # Open only a little wider than the object: fully open fingers reach into close neighbours.
     opening = min(GRIPPER_MAX_OPENING, t.grasp_width + PREGRASP_ROOM)
     scene.robot.set_fingers(opening)  # checked as executed
@@ -226,19 +217,20 @@ def _plan_pick(scene: Scene, p: PickParams, q0: np.ndarray) -> MotionPlan | Plan
 def _plan_place(scene: Scene, p: PlaceParams, q0: np.ndarray) -> MotionPlan | PlanFailure:
     if scene.held() != p.obj:
         return PlanFailure(Status.INVALID, f"'{p.obj}' is not held")
-    t = object_type(p.obj)
-    if p.target in SURFACES:
+    world = scene.world
+    t = world.object_type(p.obj)
+    if p.target in world.surface_capacity:
         if p.x_bin is None or p.y_bin is None:
             return PlanFailure(Status.INVALID, f"placing on '{p.target}' needs x and y bins")
-        x, y = place_xy(p.obj, p.target, p.x_bin, p.y_bin)
-        z = surface_rect(p.target).z
+        x, y = place_xy(p.obj, p.target, p.x_bin, p.y_bin, world)
+        z = world.surface_rect(p.target).z
         # The convention first (long side along y), so the bins' insets hold; turned as needed.
         turns = (0, 2, 1, -1) if t.kind is Kind.BOX else (0, 1, 2, -1, 0.5, -0.5)
         yaws = [PLACE_LONG_AXIS_YAW + k * math.pi / 2 for k in turns]
     elif p.target in scene.bodies and p.target != p.obj:
         base = scene.pose(p.target)
         x, y = base.position[:2]
-        z = base.position[2] + object_type(p.target).height / 2
+        z = base.position[2] + world.object_type(p.target).height / 2
         yaws = [base.yaw + k * math.pi / 2 for k in (0, 1, -1, 2)]
     else:
         return PlanFailure(Status.INVALID, f"'{p.target}' is neither a surface nor another object")
@@ -264,24 +256,25 @@ def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
         return PlanFailure(Status.INVALID, f"'{p.obj}' is not in the scene")
     if scene.robot.held_body is not None:
         return PlanFailure(Status.INVALID, "the gripper is holding something")
-    shelf = prepush_shelf(scene.pose(p.obj))
+    world = scene.world
+    shelf = prepush_shelf(world, scene.pose(p.obj))
     if shelf is None:
         return PlanFailure(Status.INVALID, f"'{p.obj}' is not on a prepush region")
     angle, dist = push_values(p.angle_bin, p.dist_bin)
     u = np.array([math.cos(angle), math.sin(angle), 0.0])
-    pose, t = scene.pose(p.obj), object_type(p.obj)
+    pose, t = scene.pose(p.obj), world.object_type(p.obj)
     # The object goes at most as far as the fingertips push it, and measured about 4 cm less
     # (arm lag, finger shape). `scripts/push_reach.py`: of 480 uniformly drawn pushes, and of
     # 1,600 more, every success had this bound at least 2.63 cm past the shelf's front, while
     # under 2.5 cm ~130 of the 1,600 were carried out in vain; one short of that front plus
     # PUSH_SLACK is refused before it is planned and run.
     reach = pose.position[0] + (dist - PUSH_LEAD) * u[0]
-    if reach < SHELVES[shelf].interior.x_min + PUSH_SLACK:
+    if reach < world.shelves[shelf].interior.x_min + PUSH_SLACK:
         return PlanFailure(Status.EFFECT_NOT_REACHED, f"too short to bring '{p.obj}' into {shelf}")
     orn = tilted(angle, PUSH_PITCH)
     axis = Pose((0, 0, 0), orn).rotation[:, 2]
     start = np.array([*pose.position[:2], min(PUSH_TIP_Z, t.height / 2)])
-    tip0 = start - (extent_along(p.obj, pose.yaw, angle) + PUSH_LEAD) * u
+    tip0 = start - (extent_along(p.obj, pose.yaw, angle, world) + PUSH_LEAD) * u
     tcp = [
         Pose(tuple(tip0 + u * s - TIP_OFFSET * axis), orn)
         for s in np.arange(0.0, dist + 1e-9, PUSH_STEP)
@@ -356,9 +349,9 @@ def _line(scene: Scene, poses: list[Pose], q_start: np.ndarray) -> list[np.ndarr
     return qs[1:]
 
 
-def prepush_shelf(pose: Pose) -> str | None:
+def prepush_shelf(world: World, pose: Pose) -> str | None:
     """The shelf whose prepush region an object stands on, if any."""
-    for name, s in SHELVES.items():
-        if REGIONS[s.prepush].contains(*pose.position[:2], margin=0.01):
-            return name
+    for s in world.shelf_list:
+        if s.prepush and world.regions[s.prepush].contains(*pose.position[:2], margin=0.01):
+            return s.name
     return None

@@ -14,10 +14,10 @@ import math
 import random
 
 from hsgplan.domain.errors import UnsampledSceneError
-from hsgplan.domain.objects import EntityKind, kind_of, object_type
 from hsgplan.domain.parameters import place_inset
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import Kind, spot_cells, surface_rect
+from hsgplan.domain.scene import EntityKind
+from hsgplan.domain.world import KITCHEN, Kind, World, spot_cells
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -35,16 +35,21 @@ STACK_JITTER = 0.005
 
 
 def sample_scene(
-    objects: tuple[str, ...], seed: int, p_elsewhere: float = 0.3, visuals: bool = True
+    objects: tuple[str, ...],
+    seed: int,
+    p_elsewhere: float = 0.3,
+    visuals: bool = True,
+    world: World = KITCHEN,
 ) -> tuple[Scene, SymbolicSceneGraph]:
-    """A settled scene for the objects and the symbolic state it is in (`visuals`: `Scene`'s).
+    """A settled scene of `world` for the objects and the symbolic state it is in (`visuals`:
+    `Scene`'s).
 
     The same seed gives the same scene: every random number comes from `seed`.
     """
     rng = random.Random(f"scene-{seed}")
-    scene = Scene(objects, seed=seed, visuals=visuals)
+    scene = Scene(objects, seed=seed, visuals=visuals, world=world)
     for _ in range(ATTEMPTS):
-        state = random_state(objects, rng, p_elsewhere=p_elsewhere)
+        state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=world)
         for o in objects:
             scene.park(o)
         if place_all(scene, state, rng) and _settled_as(scene, state):
@@ -68,7 +73,7 @@ def place_all(
         if state.location(obj).predicate is not Predicate.ON:
             continue
         below = state.location(obj).args[1]
-        if kind_of(below) is EntityKind.OBJECT:
+        if scene.world.kind_of(below) is EntityKind.OBJECT:
             pose = _stacked_pose(scene, obj, below, rng)
         else:
             pose = free_spot(scene, obj, below, placed, rng)
@@ -80,14 +85,14 @@ def place_all(
 
 
 def _stacked_pose(scene: Scene, obj: str, base: str, rng: random.Random) -> Pose:
-    b = scene.pose(base)
-    top = b.position[2] + object_type(base).height / 2
+    b, types = scene.pose(base), scene.world
+    top = b.position[2] + types.object_type(base).height / 2
     jitter = [rng.uniform(-STACK_JITTER, STACK_JITTER) for _ in range(2)]
     yaw = b.yaw + rng.choice([0.0, math.pi / 2])
     return Pose.from_xyz_yaw(
         b.position[0] + jitter[0],
         b.position[1] + jitter[1],
-        top + object_type(obj).height / 2 + 0.001,
+        top + types.object_type(obj).height / 2 + 0.001,
         yaw,
     )
 
@@ -101,12 +106,13 @@ def free_spot(
     counted capacity could no longer be used. Cells are visited in a shuffled order, each with
     a few jittered tries and then its exact centre.
     """
-    r = surface_rect(surface)
-    z = r.z + object_type(obj).height / 2 + 0.001
-    ix, iy = place_inset(obj)  # kept from the edges, as place bins are
+    world = scene.world
+    r, t = world.surface_rect(surface), world.object_type(obj)
+    z = r.z + t.height / 2 + 0.001
+    ix, iy = place_inset(obj, world)  # kept from the edges, as place bins are
     # Boxes lie long side along y, as they are placed (a cell is too short for them the other
     # way round); cans may stand any way.
-    turns = [0.0, math.pi] if object_type(obj).kind is Kind.BOX else [0.0, math.pi / 2]
+    turns = [0.0, math.pi] if t.kind is Kind.BOX else [0.0, math.pi / 2]
     cells = spot_cells(r)
     rng.shuffle(cells)
     for cx, cy in cells:

@@ -14,7 +14,8 @@ import numpy as np
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
-from hsgplan.domain.objects import sort_objects
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.arena import Arena, build_arena
@@ -66,6 +67,7 @@ class Scene:
         seed: seeds inverse-kinematics restarts and motion planning.
         visuals: load the arm's visual meshes, for pictures of the scene (`Panda`); a scene
             nothing pictures builds faster without them and behaves the same.
+        world: the table, shelves and object types it is built from.
     """
 
     def __init__(
@@ -74,18 +76,21 @@ class Scene:
         seed: int = 0,
         poses: dict[str, Pose] | None = None,
         visuals: bool = True,
+        world: World = KITCHEN,
     ):
+        self.world = world
         with _quiet_stdout():
             self.bc = FastClient(connection_mode=pybullet.DIRECT)
         self.bc.setGravity(0, 0, -9.81)
         self.bc.setTimeStep(TIME_STEP)
-        self.arena: Arena = build_arena(self.bc)
+        self.arena: Arena = build_arena(self.bc, world)
         self.robot = Panda(self.bc, visuals)
-        names = sort_objects(objects)
+        names = world.sort_objects(objects)
         poses = poses or {}
         self.bodies: dict[str, int] = {}
         for name in names:
-            self.bodies[name] = spawn_object(self.bc, name, poses.get(name, self._parking(name)))
+            pose = poses.get(name, self._parking(name))
+            self.bodies[name] = spawn_object(self.bc, world.object_type(name), pose)
         self.rng = np.random.default_rng(seed)
         self.seed = seed
         self._closed_hand: HandGhost | None = None
@@ -122,8 +127,8 @@ class Scene:
         """Bring a new object instance into the scene, parked until `set_pose`."""
         if name in self.bodies:
             raise ValueError(f"'{name}' is already in the scene")
-        self.bodies[name] = spawn_object(self.bc, name, self._parking(name))
-        self.bodies = {n: self.bodies[n] for n in sort_objects(self.bodies)}
+        self.bodies[name] = spawn_object(self.bc, self.world.object_type(name), self._parking(name))
+        self.bodies = {n: self.bodies[n] for n in self.world.sort_objects(self.bodies)}
 
     def remove_object(self, name: str) -> None:
         if self.bodies.get(name) == self.robot.held_body:
@@ -145,7 +150,7 @@ class Scene:
 
     def scene_graph(self) -> GeometricSceneGraph:
         """s_g from the simulator's ground truth."""
-        return GeometricSceneGraph.from_poses(self.poses(), held=self.held())
+        return GeometricSceneGraph.from_poses(self.poses(), held=self.held(), world=self.world)
 
     # --- physics ---------------------------------------------------------------------------
 

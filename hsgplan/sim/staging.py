@@ -13,9 +13,8 @@ import random
 
 import numpy as np
 
-from hsgplan.domain.objects import object_type
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import GRIPPER_MAX_OPENING, SHELVES, Kind, interior_slots
+from hsgplan.domain.world import GRIPPER_MAX_OPENING, Kind
 from hsgplan.scene_graph.geometry import Pose, yaw_quat
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -61,14 +60,15 @@ def stage(scene: Scene, state: SymbolicSceneGraph, rng: random.Random) -> bool:
 def _put_inside(
     scene: Scene, state: SymbolicSceneGraph, rng: random.Random, placed: list[str]
 ) -> bool:
-    for shelf in SHELVES:
+    world = scene.world
+    for shelf in world.interior_capacity:
         inside = state.inside(shelf)
         if not inside:
             continue
-        slots = rng.sample(interior_slots(shelf), len(inside))
-        r = SHELVES[shelf].interior
+        slots = rng.sample(world.interior_slots(shelf), len(inside))
+        r = world.shelves[shelf].interior
         for o, y in zip(inside, slots, strict=True):
-            t = object_type(o)
+            t = world.object_type(o)
             x = r.x_min + t.size[0] / 2 + rng.uniform(*INSIDE_DEPTH)
             y += rng.uniform(-INSIDE_JITTER, INSIDE_JITTER)
             scene.set_pose(o, Pose.from_xyz_yaw(x, y, t.height / 2 + 0.001, 0.0))
@@ -85,7 +85,7 @@ def move_short_of(
     short of the interior: where a push that fell short leaves it. False when it would not
     rest there as `state` says (it met a neighbour, or f_m reads it otherwise)."""
     before = scene.pose(obj)
-    x = SHELVES[shelf].interior.x_min - gap
+    x = scene.world.shelves[shelf].interior.x_min - gap
     scene.set_pose(obj, Pose((x, *before.position[1:]), before.orientation))
     scene.settle()
     moved = np.subtract(scene.pose(obj).position[:2], (x, before.position[1]))
@@ -100,7 +100,7 @@ def move_short_of(
 def hold(scene: Scene, obj: str, rng: random.Random) -> bool:
     """Put an object in the gripper as a top-down pick would leave it, the hand somewhere
     above the table's middle. False if that hand pose has no IK solution."""
-    t = object_type(obj)
+    t = scene.world.object_type(obj)
     closing = rng.uniform(-math.pi, math.pi) if t.kind is Kind.CAN else rng.choice([0, math.pi])
     target = Pose(
         (rng.uniform(*HOLD_X), rng.uniform(*HOLD_Y), rng.uniform(*HOLD_Z)), topdown(closing)
