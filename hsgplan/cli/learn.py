@@ -202,7 +202,7 @@ def eval_task(
     print_table(
         f"{planner} in the symbolic loop, {goals} goals per size, seed {seed}"
         + (" (paper protocol)" if paper else "")
-        + (f", scene {scene}" if scene else ""),
+        + (f", {_scenes_shown(scene)}" if scene else ""),
         (
             "objects",
             "success",
@@ -317,3 +317,9 @@ def eval_curve(
         paper = {col: rates[0] for col, rates in c.paper.items()}
         plot_learning_curves(drawn, paper, c.unit, plot)
         err.print(f"wrote {shown(plot)}", highlight=False)  # stdout stays the table alone
+
+
+def _scenes_shown(scene: Path) -> str:
+    if scene.is_dir():
+        return f"each of the {len(list(scene.glob('*.toml')))} scenes in {scene}"
+    return f"scene {scene}"

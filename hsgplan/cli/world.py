@@ -19,6 +19,7 @@ from hsgplan.cli.common import (
     ProtocolName,
     RayAddress,
     RunFolder,
+    SceneOption,
     bounded_option,
     check_ray,
     choice,
@@ -91,23 +92,29 @@ def demo(
             parser=out_file,
         ),
     ] = None,
+    scene: SceneOption = None,
 ) -> None:
-    """One episode in the simulated kitchen: a GIF, a scene-graph drawing per step, a record;
-    with --rerun, a 3D recording for rerun's viewer."""
+    """One episode in the simulated kitchen (or the world of --scene): a GIF, a scene-graph
+    drawing per step, a record; with --rerun, a 3D recording for rerun's viewer."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.domain.goals import parse_goal
+    from hsgplan.domain.scene_file import read_world
+    from hsgplan.domain.world import KITCHEN
     from hsgplan.evaluation.demo import demo_goal, run_demo
     from hsgplan.evaluation.observers import make_observer
+    from hsgplan.evaluation.protocol import check_agent_world
     from hsgplan.symbolic.generator import check_size
 
     agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
     make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
+    world = read_world(scene) if scene else KITCHEN
+    check_agent_world(agent, world, scene)
     observer = make_observer(
         perception.value, perception_checkpoint and shipped(perception_checkpoint)
     )
     if goal is None:
         check_size(objects)
-    g = parse_goal(goal) if goal else demo_goal(objects, seed)
+    g = parse_goal(goal, world=world) if goal else demo_goal(objects, seed, world)
     check_own(out_dir, "episode.json", "demo")
     if rerun is not None:
         check_recording(rerun)
@@ -239,6 +246,7 @@ def evaluate(
             help=f"The tables printed, comma-separated: {', '.join(TABLES)} (all are written).",
         ),
     ] = ",".join(TABLES),
+    scene: SceneOption = None,
 ) -> None:
     """Success rate and subgoal completion per problem size and method, beside the paper's
     Table 1, with the failure taxonomy and the time per level, under a protocol (paper or
@@ -281,6 +289,7 @@ def evaluate(
         perception_checkpoint=perception_checkpoint and str(shipped(perception_checkpoint)),
         protocol=protocol.value,
         rules_off=_names(rules_off, "--rules-off", "rule", none=True),
+        scene=str(scene) if scene else None,
     )
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
         make_observer(p, config.perception_checkpoint)
@@ -329,7 +338,8 @@ def _run_name(methods, config) -> str:
     )
     protocol = "" if config.protocol == DEFAULT_PROTOCOL.value else f"-{config.protocol}"
     protocol += "".join(f"-no_{rule}" for rule in config.rules_off)
-    return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}"
+    where = f"-{Path(config.scene).stem}" if config.scene else ""
+    return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}{where}"
 
 
 @refuses_bad_input

@@ -85,7 +85,7 @@ def _table(v: Any, at: str, required: set[str], optional: set[str] = frozenset()
     if missing := sorted(required - set(v)):
         raise _Bad(f"{at}: missing {', '.join(missing)}")
     if unknown := sorted(set(v) - required - set(optional)):
-        raise _Bad(f"{at}: unknown field(s) {', '.join(unknown)}")
+        raise _Bad(f"{at}: unknown field(s) {', '.join(map(repr, unknown))}")
     return v
 
 

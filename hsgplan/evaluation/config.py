@@ -5,10 +5,15 @@ line takes its options' defaults from here."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
 
 from hsgplan.domain.checks import BOUNDS, bounded, check_fields, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
+from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.world import KITCHEN
 
 # What an agent sees the simulated world with: `gt` (the simulator's poses) or `rgb` (f_p on
 # the fixed cameras' images); `evaluation.observers` makes them.
@@ -38,6 +43,7 @@ class EvalConfig:
     perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
     protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
     rules_off: tuple[str, ...] = ()  # recovery rules switched off (the recovering protocol)
+    scene: str | None = None  # a scene file (None: the kitchen)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -48,9 +54,20 @@ class EvalConfig:
         if self.protocol == PAPER and self.rules_off:
             raise InvalidInputError("the paper protocol has no recovery rule to switch off")
         self.rules()  # an unknown rule's name is refused here
+        self.world()  # a bad scene file, too
+
+    def world(self) -> World:
+        """The world its episodes run in."""
+        return world_of_file(self.scene) if self.scene else KITCHEN
 
     def rules(self) -> RecoveryRules:
         """The recovery rules its agent runs under: none under the paper's protocol."""
         if self.protocol == PAPER:
             return RecoveryRules.none()
         return RecoveryRules().without(self.rules_off)
+
+
+@lru_cache(maxsize=8)
+def world_of_file(path: str) -> World:
+    """A scene file's world, read once per process (every episode of a run asks for it)."""
+    return read_world(Path(path))

@@ -17,7 +17,8 @@ import numpy as np
 from hsgplan.agents.base import Agent, Decision
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.world import MAX_STEPS
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import KITCHEN, MAX_STEPS
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord, params_text, run_episode
 from hsgplan.files import atomic, write_atomically
 from hsgplan.runner.engines import one_core
@@ -32,8 +33,8 @@ FRAME_EVERY = 12  # arm waypoints between two GIF frames
 HOLD = 5  # frames a step's end state stays on screen
 
 
-def demo_goal(objects: int, seed: int) -> Goal:
-    return random_goal(objects, random.Random(f"demo-{seed}"), stacking=objects > 2)
+def demo_goal(objects: int, seed: int, world: World = KITCHEN) -> Goal:
+    return random_goal(objects, random.Random(f"demo-{seed}"), stacking=objects > 2, world=world)
 
 
 def run_demo(
@@ -71,7 +72,7 @@ def run_demo(
         rec = EpisodeRecording(recording, str(goal), seed)
         if isinstance(observer, CameraObserver):
             observer = RecordedLooks(observer, rec)
-    env = KitchenStorageEnv(observer=observer)
+    env = KitchenStorageEnv(observer=observer, world=goal.world)
     seeing = observer is not None and observer.name != "gt"
     believed: dict = {}
     frames = []

@@ -29,6 +29,8 @@ from hsgplan.domain.checks import (
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.domain.recovery import PAPER, RECOVERING
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import KITCHEN
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer, perception_folder
@@ -51,17 +53,37 @@ class EpisodeSpec:
         return f"{self.size}/{self.index}/{self.seed}/{self.goal}"
 
 
+def check_world(config: EvalConfig) -> None:
+    """Refuse, in one line, an agent with learned parts in a scene whose names they were not
+    trained on."""
+    check_agent_world(config.agent, config.world(), config.scene)
+
+
+def check_agent_world(agent: str, world: World, scene: str | Path | None) -> None:
+    """Refuse, in one line, an agent with learned parts in a world whose names they were not
+    trained on (their encodings are one-hots over the kitchen's)."""
+    from hsgplan.agents.registry import agent_checkpoints
+
+    others = [n for n in world.entity_types if n not in KITCHEN.entity_types]
+    if others and agent_checkpoints(agent):
+        raise InvalidInputError(
+            f"{agent}'s networks know the kitchen's objects, shelves and regions by "
+            f"name; scene '{scene}' names others ({', '.join(others)})"
+        )
+
+
 def episode_specs(config: EvalConfig) -> list[EpisodeSpec]:
     by_size: dict[int, list[Goal]] = {}
+    world = config.world()
     if config.goals_file:
-        for g in read_goal_file(Path(config.goals_file)):
+        for g in read_goal_file(Path(config.goals_file), world):
             by_size.setdefault(g.size, []).append(g)
         by_size = {n: gs for n, gs in by_size.items() if n in config.sizes}
         if not by_size:
             raise InvalidInputError(f"'{config.goals_file}' holds no goal of the sizes asked for")
     else:
         for n in config.sizes:
-            by_size[n] = random_goals(n, config.goals, config.seed, stacking=n > 2)
+            by_size[n] = random_goals(n, config.goals, config.seed, stacking=n > 2, world=world)
     return [
         EpisodeSpec(n, i, str(g), episode_seed(config.seed, n, i, r), r)
         for n in sorted(by_size)
@@ -104,7 +126,9 @@ def run_config(config: EvalConfig) -> dict:
         del settings["protocol"], settings["rules_off"]
     else:
         settings["rules_off"] = list(config.rules_off)
-    files = [Path(config.goals_file)] if config.goals_file else []
+    if config.scene is None:  # as runs were claimed before scenes were files
+        del settings["scene"]
+    files = [Path(p) for p in (config.goals_file, config.scene) if p]
     return settings | {
         "sizes": list(config.sizes),
         "fingerprint": fingerprint([*folders, *files]),
@@ -155,9 +179,12 @@ def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
 
     agent = _worker_agent(config)
     env = KitchenStorageEnv(
-        observer=_worker_observer(config), relook=config.rules().relook, visuals=False
+        observer=_worker_observer(config),
+        relook=config.rules().relook,
+        visuals=False,
+        world=config.world(),
     )
-    goal = parse_goal(spec.goal)
+    goal = parse_goal(spec.goal, world=config.world())
     record = run_episode(env, agent, goal, spec.seed, end_at_failure=config.protocol == PAPER)
     return replace(record, repeat=spec.repeat).to_json()
 
@@ -171,6 +198,7 @@ def run_evaluation(
 ) -> list[EpisodeRecord]:
     """Run every episode not yet in `run_dir`, `workers` at a time; all records, in order.
     The wall-clock seconds spent running episodes are added to the run folder's timing."""
+    check_world(config)
     specs = episode_specs(config)
     start = time.perf_counter()
     try:

@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 
 from hsgplan.domain.actions import Action, Pick, Place, Push
-from hsgplan.domain.objects import object_type
 from hsgplan.domain.parameters import (
     PUSH_LEAD,
     PickParams,
@@ -26,14 +25,11 @@ from hsgplan.domain.parameters import (
 from hsgplan.domain.world import (
     PLACE_BINS,
     PLACE_LONG_AXIS_YAW,
-    SHELVES,
     SPOT,
-    SURFACES,
     Kind,
+    ObjectType,
     Rect,
-    interior_slots,
     spot_cells,
-    surface_rect,
 )
 from hsgplan.motion.generator import DO_NOT_RETRY, Feasibility, SingleShotMemory
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -51,9 +47,9 @@ HAND_DROP = 0.02  # m between footprints (as circles) for a bin to be considered
 PUSH_DEPTH = 0.02
 
 
-def _half_extents(obj: str, yaw: float) -> tuple[float, float]:
-    """Half-sizes along world x and y of the box bounding an object's footprint at a yaw."""
-    fx, fy = object_type(obj).footprint
+def _half_extents(t: ObjectType, yaw: float) -> tuple[float, float]:
+    """Half-sizes along world x and y of the box bounding a footprint at a yaw."""
+    fx, fy = t.footprint
     c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
     return (c * fx + s * fy) / 2, (s * fx + c * fy) / 2
 
@@ -76,20 +72,19 @@ def _hand_conflict(a, b) -> bool:
     return along < HAND_HALF_LENGTH + reach and across < HAND_HALF_WIDTH + reach
 
 
-def _standing(name: str, x: float, y: float, yaw: float, bottom: float):
-    t = object_type(name)
+def _standing(t: ObjectType, x: float, y: float, yaw: float, bottom: float):
     box_yaw = yaw if t.kind is Kind.BOX else None
-    return (x, y, *_half_extents(name, yaw), bottom + t.height, box_yaw)
+    return (x, y, *_half_extents(t, yaw), bottom + t.height, box_yaw)
 
 
 def free_slots(sg: GeometricSceneGraph, shelf: str, ignore: str = "") -> list[float]:
-    r = SHELVES[shelf].interior
+    r = sg.world.shelves[shelf].interior
     taken = [
         n.pose.position[1]
         for n in sg.nodes
         if n.name != ignore and r.contains(*n.pose.position[:2]) and n.pose.position[2] < r.z + 0.1
     ]
-    return [y for y in interior_slots(shelf) if all(abs(y - t) > 0.05 for t in taken)]
+    return [y for y in sg.world.interior_slots(shelf) if all(abs(y - t) > 0.05 for t in taken)]
 
 
 def _on_rect(sg: GeometricSceneGraph, rect: Rect, ignore: str) -> tuple[list, list]:
@@ -100,7 +95,7 @@ def _on_rect(sg: GeometricSceneGraph, rect: Rect, ignore: str) -> tuple[list, li
         x, y, _ = n.pose.position
         if n.name == ignore or not rect.contains(x, y, margin=0.05) or n.bottom_z < rect.z - 0.03:
             continue
-        item = _standing(n.name, x, y, n.pose.yaw, n.bottom_z)
+        item = _standing(n.type, x, y, n.pose.yaw, n.bottom_z)
         above.append(item)
         if n.bottom_z < rect.z + 0.03:
             resting.append(item)
@@ -122,11 +117,12 @@ def place_candidates(
     of a free spot cell (so that the surface's whole capacity stays usable) or, on a prepush
     region before a push, by how well they line up with a free slot inside the shelf.
     """
-    if target not in SURFACES:
+    world = sg.world
+    if target not in world.surface_capacity:
         return [PlaceParams(obj, target)]
-    rect = surface_rect(target)
+    rect, t = world.surface_rect(target), world.object_type(obj)
     others, above = _on_rect(sg, rect, ignore=obj)
-    hx, hy = _half_extents(obj, PLACE_LONG_AXIS_YAW)
+    hx, hy = _half_extents(t, PLACE_LONG_AXIS_YAW)
     free = [
         c
         for c in spot_cells(rect)
@@ -134,12 +130,12 @@ def place_candidates(
     ]
     slots = []
     if next_push:
-        shelf = next(s for s, sh in SHELVES.items() if sh.prepush == target)
-        slots = free_slots(sg, shelf) or interior_slots(shelf)
+        shelf = next(s.name for s in world.shelf_list if s.prepush == target)
+        slots = free_slots(sg, shelf) or world.interior_slots(shelf)
     ranked = []
     for xb in range(PLACE_BINS):
         for yb in range(PLACE_BINS):
-            x, y = place_xy(obj, target, xb, yb)
+            x, y = place_xy(obj, target, xb, yb, world)
             gap = min(
                 (max(abs(x - o[0]) - hx - o[2], abs(y - o[1]) - hy - o[3]) for o in others),
                 default=1.0,
@@ -149,7 +145,7 @@ def place_candidates(
             # The primitive turns a box a quarter turn when the hand would not fit the
             # other way: blocked means blocked both ways.
             blocked = all(
-                any(_hand_conflict(_standing(obj, x, y, yaw, rect.z), o) for o in above)
+                any(_hand_conflict(_standing(t, x, y, yaw, rect.z), o) for o in above)
                 for yaw in (PLACE_LONG_AXIS_YAW, PLACE_LONG_AXIS_YAW + math.pi / 2)
             )
             if slots:
@@ -165,13 +161,13 @@ def place_candidates(
 def push_candidates(sg: GeometricSceneGraph, obj: str, shelf: str) -> list[PushParams]:
     """Pushes aimed at the free interior slots, nearest slot first."""
     x, y, _ = sg.pose(obj).position
-    r = SHELVES[shelf].interior
+    r = sg.world.shelves[shelf].interior
     yaw = sg.pose(obj).yaw
     slots = sorted(free_slots(sg, shelf, ignore=obj), key=lambda s: abs(s - y))
     out = []
     for slot in slots:
         straight = math.atan2(slot - y, r.x_min - x)
-        tx = r.x_min + PUSH_DEPTH + extent_along(obj, yaw, straight)
+        tx = r.x_min + PUSH_DEPTH + extent_along(obj, yaw, straight, sg.world)
         angle = math.atan2(slot - y, tx - x)
         dist = math.hypot(tx - x, slot - y) + PUSH_LEAD
         out.append(PushParams(obj, *nearest_push_bins(angle, dist)))
@@ -190,7 +186,8 @@ def candidates(
         return [PickParams(action.obj)]
     if isinstance(action, Place):
         next_push = (
-            isinstance(following, Push) and action.target == SHELVES[following.shelf].prepush
+            isinstance(following, Push)
+            and action.target == sg.world.shelves[following.shelf].prepush
         )
         spots = avoid if next_push else ()
         return list(place_candidates(sg, action.obj, action.target, next_push, spots))

@@ -21,6 +21,9 @@ each carries the other object's offset (3) and horizontal distance (1). The subg
 vector `u` (`SUBGOAL_DIM`): the target entity, one-hot over `ENTITY_TYPES`, and the moved
 object's type, one-hot over `OBJECT_TYPES`. Lengths are in decimetres (`SCALE`), so that
 every feature is of order one.
+
+The one-hots are over the kitchen's names: they fix the networks' input size, so a scene of
+other names cannot be read yet. Every rectangle, size and place bin is the graph's world's.
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ import torch
 from torch_geometric.data import Data
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import ENTITY_TYPES, object_type
+from hsgplan.domain.objects import ENTITY_TYPES
 from hsgplan.domain.parameters import PUSH_LEAD, place_xy, push_values
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.world import (
@@ -41,8 +44,6 @@ from hsgplan.domain.world import (
     PUSH_DIST_BINS,
     REGIONS,
     SHELVES,
-    SURFACES,
-    surface_rect,
 )
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -76,12 +77,12 @@ def _region_class(state: SymbolicSceneGraph, obj: str) -> str:
 
 def check_subgoal(subgoal: Literal, sg: GeometricSceneGraph) -> None:
     """Refuse a subgoal that no motion parameters serve, in one line."""
-    obj = subgoal.args[0]
+    obj, world = subgoal.args[0], sg.world
     if obj not in sg.objects:
         raise InvalidInputError(f"'{subgoal}' names '{obj}', which is not in the scene")
-    if subgoal.predicate is Predicate.ON and subgoal.args[1] in SURFACES:
+    if subgoal.predicate is Predicate.ON and subgoal.args[1] in world.surface_capacity:
         return
-    if subgoal.predicate is Predicate.IN and subgoal.args[1] in SHELVES:
+    if subgoal.predicate is Predicate.IN and subgoal.args[1] in world.interior_capacity:
         return
     raise InvalidInputError(
         f"'{subgoal}': motion parameters are chosen for On(o, surface) and In(o, shelf) only"
@@ -93,20 +94,21 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal) -> Data:
     [N(N-1), EDGE_DIM], u [1, SUBGOAL_DIM], mover [N] bool)`; nodes in `sg`'s order."""
     check_subgoal(subgoal, sg)
     obj, target = subgoal.args
+    world = sg.world
     state = map_symbols(sg).state
     place = subgoal.predicate is Predicate.ON
     if place:
-        rect = surface_rect(target)
+        rect = world.surface_rect(target)
         cx, cy = rect.center
         ref_a = (cx, cy, rect.z)
     else:
-        rect = SHELVES[target].interior
+        rect = world.shelves[target].interior
         ref_a = sg.pose(obj).position
         front = (rect.x_min, (rect.y_min + rect.y_max) / 2)
     rows = []
     for node in sg.nodes:
         x, y, z = node.pose.position
-        t = object_type(node.name)
+        t = node.type
         feat = [0.0] * NODE_DIM
         feat[TYPES.index(t.name)] = 1.0
         feat[len(TYPES) + REGION_CLASSES.index(_region_class(state, node.name))] = 1.0
@@ -135,7 +137,7 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal) -> Data:
     edge_attr = torch.cat([offset, offset[:, :2].norm(dim=1, keepdim=True)], dim=1)
     u = torch.zeros(1, SUBGOAL_DIM)
     u[0, ENTITY_TYPES.index(target)] = 1.0
-    u[0, len(ENTITY_TYPES) + TYPES.index(object_type(obj).name)] = 1.0
+    u[0, len(ENTITY_TYPES) + TYPES.index(world.type_of(obj))] = 1.0
     mover = torch.tensor([node.name == obj for node in sg.nodes])
     return Data(
         x=torch.tensor(rows, dtype=torch.float),
@@ -158,10 +160,10 @@ def bin_queries(sg: GeometricSceneGraph, subgoal: Literal) -> torch.Tensor:
     obj, target = subgoal.args
     rows = []
     if subgoal.predicate is Predicate.ON:
-        cx, cy = surface_rect(target).center
+        cx, cy = sg.world.surface_rect(target).center
         for i in range(PLACE_BINS):
             for j in range(PLACE_BINS):
-                x, y = place_xy(obj, target, i, j)
+                x, y = place_xy(obj, target, i, j, sg.world)
                 rows.append(
                     [
                         SCALE * (x - cx),

@@ -132,8 +132,8 @@ class KitchenStorageEnv(gymnasium.Env):
             raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
         check_size(objects)  # refused here, not at the first reset
         self.render_mode = render_mode
-        self.observation_space = observation_space()
-        self.action_space = action_space()
+        self.observation_space = observation_space(world)
+        self.action_space = action_space(world)
         self.render_images = render
         self.camera = camera or Camera()
         self.max_steps = max_steps
@@ -167,6 +167,8 @@ class KitchenStorageEnv(gymnasium.Env):
         super().reset(seed=seed)
         scene_seed = seed if seed is not None else int(self.np_random.integers(2**31))
         options = _options(options, self.objects, scene_seed, self.scene_world)
+        if options.goal.world.entity_types != self.scene_world.entity_types:
+            raise ValueError("the goal names another world's objects than the env's spaces hold")
         self.close()
         self.goal = options.goal
         self.scene, _ = sample_scene(
@@ -189,7 +191,9 @@ class KitchenStorageEnv(gymnasium.Env):
         if self.scene is None or self.goal is None:
             raise RuntimeError("call reset() before step()")
         params = (
-            action if isinstance(action, PrimitiveParams) else decode(self.scene.objects, action)
+            action
+            if isinstance(action, PrimitiveParams)
+            else decode(self.scene.objects, action, self.scene.world)
         )
         true_before = self.scene.poses()
         self.last_plan = None

@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
-from hsgplan.domain.objects import type_of
 from hsgplan.domain.parameters import (
     BINS,
     MotionPrimitive,
@@ -25,62 +24,67 @@ from hsgplan.domain.parameters import (
     PushParams,
 )
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import MAX_OBJECTS, OBJECT_TYPES, SHELVES
+from hsgplan.domain.world import KITCHEN, MAX_OBJECTS, World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 # The action's "primitive" indexes this tuple.
 PRIMITIVES: tuple[type, ...] = (PickParams, PlaceParams, PushParams)
-ENTITIES = MAX_OBJECTS + len(FIXTURES)  # slots first, then the fixtures as the graphs list them
-TYPES: tuple[str, ...] = tuple(OBJECT_TYPES)
 # A Box needs finite bounds; metres, far beyond the table, so only an object that fell off it
 # (and keeps falling: there is no floor) is ever clipped.
 POSITION_BOUND = 10.0
 
 
-def observation_space() -> spaces.Dict:
-    """A fresh space (each env seeds its own)."""
+def _entities(world: World) -> int:
+    return MAX_OBJECTS + len(world.fixtures)  # slots first, then the fixtures as graphs list them
+
+
+def observation_space(world: World = KITCHEN) -> spaces.Dict:
+    """A fresh space of a world's scenes (each env seeds its own)."""
     return spaces.Dict(
         {
-            # 0: an empty slot; k: an object of type TYPES[k - 1]
-            "types": spaces.MultiDiscrete([len(TYPES) + 1] * MAX_OBJECTS),
+            # 0: an empty slot; k: an object of the world's k-th type
+            "types": spaces.MultiDiscrete([len(world.type_list) + 1] * MAX_OBJECTS),
             # position (m) and quaternion xyzw per slot; zeros for an empty slot
             "poses": spaces.Box(-POSITION_BOUND, POSITION_BOUND, (MAX_OBJECTS, 7), np.float32),
-            "on": spaces.MultiBinary([MAX_OBJECTS, ENTITIES]),  # On(slot i, entity j)
-            "inside": spaces.MultiBinary([MAX_OBJECTS, len(SHELVES)]),  # In(slot i, shelf j)
+            "on": spaces.MultiBinary([MAX_OBJECTS, _entities(world)]),  # On(slot i, entity j)
+            "inside": spaces.MultiBinary([MAX_OBJECTS, len(world.shelves)]),  # In(slot i, shelf j)
             "in_grasp": spaces.MultiBinary(MAX_OBJECTS),
             "clear": spaces.MultiBinary(MAX_OBJECTS),
         }
     )
 
 
-def action_space() -> spaces.Dict:
-    """A fresh space (each env seeds its own)."""
+def action_space(world: World = KITCHEN) -> spaces.Dict:
+    """A fresh space of a world's scenes (each env seeds its own)."""
     return spaces.Dict(
         {
             "primitive": spaces.Discrete(len(PRIMITIVES)),
             "object": spaces.Discrete(MAX_OBJECTS),
-            "target": spaces.Discrete(ENTITIES),  # place only: a slot, a shelf top or a region
+            # place only: a slot, a shelf top or a region
+            "target": spaces.Discrete(_entities(world)),
             "place_bins": spaces.MultiDiscrete(list(BINS[MotionPrimitive.PLACE])),  # x, y
             "push_bins": spaces.MultiDiscrete(list(BINS[MotionPrimitive.PUSH])),  # angle, dist
         }
     )
 
 
-def entity_names(objects: tuple[str, ...]) -> list[str | None]:
+def entity_names(objects: tuple[str, ...], world: World = KITCHEN) -> list[str | None]:
     """The name at every entity index of a scene with these objects (None: an empty slot)."""
-    return [*objects, *[None] * (MAX_OBJECTS - len(objects)), *FIXTURES]
+    return [*objects, *[None] * (MAX_OBJECTS - len(objects)), *world.fixtures]
 
 
 def encode(
     objects: tuple[str, ...], sg: GeometricSceneGraph, state: SymbolicSceneGraph
 ) -> dict[str, np.ndarray]:
-    """The numeric observation of a scene (its objects in slot order); an object the observer
-    has never seen (not in `sg`) has its type and a zero pose."""
-    index = {name: i for i, name in enumerate(entity_names(objects)) if name is not None}
-    obs = {k: np.zeros(s.shape, s.dtype) for k, s in observation_space().spaces.items()}
+    """The numeric observation of a scene (its objects in slot order) in the state's world;
+    an object the observer has never seen (not in `sg`) has its type and a zero pose."""
+    world = state.world
+    index = {name: i for i, name in enumerate(entity_names(objects, world)) if name is not None}
+    obs = {k: np.zeros(s.shape, s.dtype) for k, s in observation_space(world).spaces.items()}
+    types = list(world.object_types)
     for i, name in enumerate(objects):
-        obs["types"][i] = TYPES.index(type_of(name)) + 1
+        obs["types"][i] = types.index(world.type_of(name)) + 1
         if name not in sg.objects:
             continue
         pose = sg.pose(name)
@@ -91,7 +95,7 @@ def encode(
         if lit.predicate is Predicate.ON:
             obs["on"][slot, index[lit.args[1]]] = 1
         elif lit.predicate is Predicate.IN:
-            obs["inside"][slot, tuple(SHELVES).index(lit.args[1])] = 1
+            obs["inside"][slot, list(world.shelves).index(lit.args[1])] = 1
         elif lit.predicate is Predicate.IN_GRASP:
             obs["in_grasp"][slot] = 1
         elif lit.predicate is Predicate.CLEAR:
@@ -99,9 +103,9 @@ def encode(
     return obs
 
 
-def decode(objects: tuple[str, ...], action: dict) -> PrimitiveParams | str:
+def decode(objects: tuple[str, ...], action: dict, world: World = KITCHEN) -> PrimitiveParams | str:
     """The typed primitive an action names, or why it names none (an empty slot)."""
-    names = entity_names(objects)
+    names = entity_names(objects, world)
     obj = names[int(action["object"])]
     if obj is None:
         return f"object slot {int(action['object'])} is empty"
@@ -114,7 +118,7 @@ def decode(objects: tuple[str, ...], action: dict) -> PrimitiveParams | str:
     target = names[int(action["target"])]
     if target is None:
         return f"target slot {int(action['target'])} is empty"
-    if target in FIXTURES:
+    if target in world.fixtures:
         x, y = (int(b) for b in action["place_bins"])
         return PlaceParams(obj, target, x, y)
     return PlaceParams(obj, target)  # stacked: the position comes from the object below

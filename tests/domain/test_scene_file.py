@@ -92,7 +92,7 @@ BAD = [
     (_set(["objects", 1, "name"], "cherries"), "the name 'cherries' is given twice"),
     (_set(["objects", 0, "mass"], "heavy"), "objects[1].mass 'heavy': need a number"),
     (_set(["objects", 0, "colour"], _DELETE), "objects[1]: missing colour"),
-    (_set(["objects", 0, "shape"], "round"), "objects[1]: unknown field(s) shape"),
+    (_set(["objects", 0, "shape"], "round"), "objects[1]: unknown field(s) 'shape'"),
     (_set(["regions", 0, "name"], "middle"), "need one named 'open_space'"),
     (_set(["shelves", 1, "y"], [0.30, 0.60]), "shelf_a and shelf_b overlap"),
     (_set(["shelves", 0, "x"], [0.38, 1.20]), "shelf_a is not wholly on the table"),

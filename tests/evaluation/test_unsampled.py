@@ -21,7 +21,7 @@ def _ok(seed: int) -> EpisodeRecord:
 
 
 def test_an_unsampled_start_scene_is_recorded_as_such_and_nothing_is_tried(monkeypatch):
-    def no_scene(objects, seed, p_elsewhere=0.3, visuals=True):
+    def no_scene(objects, seed, p_elsewhere=0.3, visuals=True, world=None):
         raise UnsampledSceneError(f"no collision-free arrangement (seed {seed})")
 
     monkeypatch.setattr(env_module, "sample_scene", no_scene)

@@ -8,9 +8,9 @@ from gymnasium.utils.env_checker import check_env
 
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.parameters import PickParams
-from hsgplan.domain.world import MAX_OBJECTS
+from hsgplan.domain.world import KITCHEN, MAX_OBJECTS
 from hsgplan.sim.env import ENV_ID, KitchenStorageEnv, ResetOptions
-from hsgplan.sim.gym_spaces import ENTITIES, decode, encode, entity_names
+from hsgplan.sim.gym_spaces import decode, encode, entity_names
 
 GOAL = "On(butter, shelf_a) & In(cherries, shelf_a)"
 
@@ -60,7 +60,7 @@ def test_the_numeric_observation_says_what_the_typed_one_does():
         assert _same(obs, encode(objects, typed.scene_graph, typed.symbols.state))
         on_or_in = obs["on"][: len(objects)].sum(1) + obs["inside"][: len(objects)].sum(1)
         assert (on_or_in == 1).all()  # every object rests on or in exactly one thing
-        assert obs["on"].shape == (MAX_OBJECTS, ENTITIES)
+        assert obs["on"].shape == (MAX_OBJECTS, MAX_OBJECTS + len(KITCHEN.fixtures))
     finally:
         env.close()
 

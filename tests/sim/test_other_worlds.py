@@ -1,0 +1,97 @@
+"""The simulated world is built from the World it is given: its shelves stand where the scene
+says, its objects have the scene's sizes, f_m reads the scene's surfaces, and an episode runs in
+its goal's world."""
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hsgplan.cli import app
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.layouts import random_layout
+from hsgplan.domain.predicates import on
+from hsgplan.domain.scene_file import scene_data, to_toml
+from hsgplan.domain.world import KITCHEN
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.geometry import Pose
+from hsgplan.scene_graph.symbol_mapping import map_symbols
+from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
+from hsgplan.sim.scene import Scene
+
+LAYOUT = random_layout(KITCHEN, 3, 0)
+NEW = random_layout(KITCHEN, 3, 0, new_objects=True)
+
+
+def test_a_scene_stands_its_shelves_and_sizes_its_objects_as_its_world_says():
+    box = next(t for t in NEW.type_list if t.kind == "box")
+    with Scene((box.name,), world=NEW, visuals=False) as scene:
+        for shelf in NEW.shelf_list:
+            top_board = scene.arena.shelves[shelf.name][-1]
+            lo, hi = scene.bc.getAABB(top_board)
+            assert lo[0] == pytest.approx(shelf.top.x_min, abs=2e-3)
+            assert hi[1] == pytest.approx(shelf.top.y_max, abs=2e-3)
+            assert hi[2] == pytest.approx(shelf.top.z, abs=2e-3)
+        scene.set_pose(box.name, Pose.from_xyz_yaw(0.5, 0.0, 0.3, 0.0))
+        lo, hi = scene.bc.getAABB(scene.bodies[box.name])
+        assert np.subtract(hi, lo) == pytest.approx(box.size, abs=2e-3)
+        assert scene.scene_graph().world is NEW
+
+
+def test_f_m_reads_the_surfaces_of_the_graphs_world():
+    shelf = LAYOUT.shelves["shelf_a"]
+    butter = LAYOUT.object_types["butter"]
+    x, y = shelf.top.center
+    pose = Pose.from_xyz_yaw(x, y, shelf.top.z + butter.height / 2, 0.0)
+    laid_out = map_symbols(GeometricSceneGraph.from_poses({"butter": pose}, world=LAYOUT))
+    assert laid_out.state.holds(on("butter", "shelf_a")) and not laid_out.anomalies
+    kitchen_top = KITCHEN.shelves["shelf_a"].top
+    if not kitchen_top.contains(x, y) or abs(kitchen_top.z - shelf.top.z) > 0.005:
+        in_kitchen = map_symbols(GeometricSceneGraph.from_poses({"butter": pose}))
+        assert not in_kitchen.state.holds(on("butter", "shelf_a"))
+
+
+def test_an_episode_runs_in_its_goals_world_and_the_spaces_are_the_worlds():
+    can = next(t.name for t in NEW.type_list if t.kind == "can")
+    goal = parse_goal(f"On({can}, shelf_a)", world=NEW)
+    env = KitchenStorageEnv(visuals=False, world=NEW)
+    try:
+        obs, info = env.reset(seed=4, options=ResetOptions(goal))
+        assert env.scene.world is NEW and info["observation"].symbols.state.world is NEW
+        assert env.observation_space.contains(obs)
+        assert obs["types"][0] == list(NEW.object_types).index(can) + 1
+        with pytest.raises(ValueError, match="another world"):
+            env.reset(seed=4, options=ResetOptions(parse_goal("On(cherries, shelf_a)")))
+    finally:
+        env.close()
+
+
+runner = CliRunner()
+
+
+def test_an_agent_with_learned_parts_is_refused_a_world_of_other_names(tmp_path):
+    scene = tmp_path / "new.toml"
+    scene.write_text(to_toml(scene_data(NEW)))
+    evaluation = ["eval", "world", "--sizes", "2", "--goals", "1", "--workers", "1"]
+    for args in (
+        ["demo", "--agent", "learned", "--out", str(tmp_path / "d")],
+        [*evaluation, "--out", str(tmp_path / "e")],
+    ):
+        r = runner.invoke(app, [*args, "--scene", str(scene)])
+        assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
+        assert "know the kitchen's objects" in r.output
+    assert not (tmp_path / "d").exists()
+
+
+@pytest.mark.slow
+def test_the_oracle_solves_a_goal_of_new_objects_in_the_world(tmp_path):
+    scene = tmp_path / "new.toml"
+    scene.write_text(to_toml(scene_data(NEW)))
+    out = tmp_path / "run"
+    args = ["eval", "world", "--agent", "oracle", "--sizes", "2", "--goals", "1", "--workers", "1"]
+    r = runner.invoke(app, [*args, "--scene", str(scene), "--out", str(out), "--json"])
+    assert r.exit_code == 0, r.output
+    row = json.loads((out / "oracle" / "episodes.jsonl").read_text().splitlines()[0])["result"]
+    assert set(parse_goal(row["goal"], world=NEW).objects) <= set(NEW.object_types)
+    assert json.loads((out / "oracle" / "config.json").read_text())["scene"] == str(scene)
