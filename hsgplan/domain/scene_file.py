@@ -242,6 +242,16 @@ def read_world(path: Path | str) -> World:
     return world_of(data, f"scene file '{path}'")
 
 
+def read_worlds(path: Path | str) -> dict[Path, World]:
+    """The world of a scene file, or of every `.toml` file in a folder (by name), each read
+    (and so checked) before anything runs."""
+    path = Path(path)
+    paths = sorted(path.glob("*.toml")) if path.is_dir() else [path]
+    if not paths:
+        raise InvalidInputError(f"the folder '{path}' holds no scene file (*.toml)")
+    return {p: read_world(p) for p in paths}
+
+
 def _span_out(r: Rect) -> dict:
     return {"x": [r.x_min, r.x_max], "y": [r.y_min, r.y_max]}
 

@@ -12,7 +12,7 @@ from hsgplan.domain.checks import BOUNDS, bounded, check_fields, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.scene_file import read_world, read_worlds
 from hsgplan.domain.world import KITCHEN
 
 # What an agent sees the simulated world with: `gt` (the simulator's poses) or `rgb` (f_p on
@@ -43,7 +43,7 @@ class EvalConfig:
     perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
     protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
     rules_off: tuple[str, ...] = ()  # recovery rules switched off (the recovering protocol)
-    scene: str | None = None  # a scene file (None: the kitchen)
+    scene: str | None = None  # a scene file or a folder of them (None: the kitchen)
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -54,11 +54,13 @@ class EvalConfig:
         if self.protocol == PAPER and self.rules_off:
             raise InvalidInputError("the paper protocol has no recovery rule to switch off")
         self.rules()  # an unknown rule's name is refused here
-        self.world()  # a bad scene file, too
+        self.worlds()  # a bad scene file, too
 
-    def world(self) -> World:
-        """The world its episodes run in."""
-        return world_of_file(self.scene) if self.scene else KITCHEN
+    def worlds(self) -> dict[str | None, World]:
+        """The worlds its episodes run in, by scene file ({None: the kitchen} without one)."""
+        if self.scene is None:
+            return {None: KITCHEN}
+        return {str(p): world_of_file(str(p)) for p in read_worlds(self.scene)}
 
     def rules(self) -> RecoveryRules:
         """The recovery rules its agent runs under: none under the paper's protocol."""

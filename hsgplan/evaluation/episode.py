@@ -70,6 +70,7 @@ class EpisodeRecord:
     unseen_objects: int = 0
     # Looks taken again (`relook`) before the agent believed its goal reached.
     closing_relooks: int = 0
+    scene: str | None = None  # the scene file it ran in (None: the kitchen)
 
     @property
     def task_seconds(self) -> float:
@@ -84,7 +85,10 @@ class EpisodeRecord:
         return executed + self.unexecuted_motion_seconds
 
     def to_json(self) -> dict:
-        return asdict(self)
+        d = asdict(self)
+        if d["scene"] is None:  # as records were written before scenes were files
+            del d["scene"]
+        return d
 
     @staticmethod
     def from_json(d: dict) -> EpisodeRecord:

@@ -31,7 +31,7 @@ from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.domain.recovery import PAPER, RECOVERING
 from hsgplan.domain.scene import World
 from hsgplan.domain.world import KITCHEN
-from hsgplan.evaluation.config import EvalConfig
+from hsgplan.evaluation.config import EvalConfig, world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer, perception_folder
 from hsgplan.evaluation.seeds import episode_seed
@@ -47,16 +47,19 @@ class EpisodeSpec:
     goal: str
     seed: int
     repeat: int = 0
+    scene: str | None = None  # the scene file it runs in (None: the kitchen)
 
     @property
     def key(self) -> str:
-        return f"{self.size}/{self.index}/{self.seed}/{self.goal}"
+        where = f"{Path(self.scene).stem}/" if self.scene else ""
+        return f"{where}{self.size}/{self.index}/{self.seed}/{self.goal}"
 
 
 def check_world(config: EvalConfig) -> None:
     """Refuse, in one line, an agent with learned parts in a scene whose names they were not
     trained on."""
-    check_agent_world(config.agent, config.world(), config.scene)
+    for scene, world in config.worlds().items():
+        check_agent_world(config.agent, world, scene)
 
 
 def check_agent_world(agent: str, world: World, scene: str | Path | None) -> None:
@@ -73,8 +76,12 @@ def check_agent_world(agent: str, world: World, scene: str | Path | None) -> Non
 
 
 def episode_specs(config: EvalConfig) -> list[EpisodeSpec]:
+    """Every episode of a run: in each of its worlds, the same goal seeds."""
+    return [s for scene, world in config.worlds().items() for s in _specs(config, scene, world)]
+
+
+def _specs(config: EvalConfig, scene: str | None, world: World) -> list[EpisodeSpec]:
     by_size: dict[int, list[Goal]] = {}
-    world = config.world()
     if config.goals_file:
         for g in read_goal_file(Path(config.goals_file), world):
             by_size.setdefault(g.size, []).append(g)
@@ -85,7 +92,7 @@ def episode_specs(config: EvalConfig) -> list[EpisodeSpec]:
         for n in config.sizes:
             by_size[n] = random_goals(n, config.goals, config.seed, stacking=n > 2, world=world)
     return [
-        EpisodeSpec(n, i, str(g), episode_seed(config.seed, n, i, r), r)
+        EpisodeSpec(n, i, str(g), episode_seed(config.seed, n, i, r), r, scene)
         for n in sorted(by_size)
         for i, g in enumerate(by_size[n])
         for r in range(config.repeats)
@@ -128,7 +135,7 @@ def run_config(config: EvalConfig) -> dict:
         settings["rules_off"] = list(config.rules_off)
     if config.scene is None:  # as runs were claimed before scenes were files
         del settings["scene"]
-    files = [Path(p) for p in (config.goals_file, config.scene) if p]
+    files = [Path(p) for p in (config.goals_file, *config.worlds()) if p]
     return settings | {
         "sizes": list(config.sizes),
         "fingerprint": fingerprint([*folders, *files]),
@@ -178,15 +185,13 @@ def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
     from hsgplan.sim.env import KitchenStorageEnv
 
     agent = _worker_agent(config)
+    world = world_of_file(spec.scene) if spec.scene else KITCHEN
     env = KitchenStorageEnv(
-        observer=_worker_observer(config),
-        relook=config.rules().relook,
-        visuals=False,
-        world=config.world(),
+        observer=_worker_observer(config), relook=config.rules().relook, visuals=False, world=world
     )
-    goal = parse_goal(spec.goal, world=config.world())
+    goal = parse_goal(spec.goal, world=world)
     record = run_episode(env, agent, goal, spec.seed, end_at_failure=config.protocol == PAPER)
-    return replace(record, repeat=spec.repeat).to_json()
+    return replace(record, repeat=spec.repeat, scene=spec.scene).to_json()
 
 
 def run_evaluation(

@@ -20,7 +20,9 @@ from pathlib import Path
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError, a
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.world import KITCHEN
 from hsgplan.evaluation.ablation import ABLATION_KIND
+from hsgplan.evaluation.config import world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer
 from hsgplan.evaluation.protocol import EVAL_KIND, PAPER, checkpoints, read_eval_config
@@ -136,7 +138,7 @@ def rollout(
         shutil.rmtree(partial, ignore_errors=True)
         run_demo(
             make_agent(agent, *checkpoints(config), config.rules()),
-            parse_goal(record.goal),
+            parse_goal(record.goal, world=world_of_file(record.scene) if record.scene else KITCHEN),
             record.seed,
             partial,
             scale=GIF_SCALE,

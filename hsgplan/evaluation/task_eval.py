@@ -26,7 +26,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.scene_file import read_world, read_worlds
 from hsgplan.domain.world import KITCHEN, MAX_STEPS
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.seeds import episode_seed
@@ -204,14 +204,9 @@ def evaluate_task(
 
 
 def scene_files(scene: Path | None) -> dict[Path | None, World]:
-    """The worlds of a scene file, or of every `.toml` in a folder (by name); {None: the
-    kitchen} without one. Each is read, and so checked, before anything runs."""
-    if scene is None:
-        return {None: KITCHEN}
-    paths = sorted(Path(scene).glob("*.toml")) if Path(scene).is_dir() else [Path(scene)]
-    if not paths:
-        raise InvalidInputError(f"the folder '{scene}' holds no scene file (*.toml)")
-    return {p: read_world(p) for p in paths}
+    """The worlds of a scene file, or of every `.toml` in a folder; {None: the kitchen}
+    without one."""
+    return {None: KITCHEN} if scene is None else read_worlds(scene)
 
 
 def _others(world: World) -> list[str]:
