@@ -234,7 +234,11 @@ def _world(data: Any) -> World:
 def read_world(path: Path | str) -> World:
     """The world a scene file describes; anything wrong with it refused in one line
     (`InvalidInputError`)."""
-    text = read_text(Path(path), "scene file", MAX_SCENE_BYTES)
+    return read_world_text(read_text(Path(path), "scene file", MAX_SCENE_BYTES), path)
+
+
+def read_world_text(text: str, path: Path | str) -> World:
+    """The world of a scene file's text (read from `path`, which refusals name)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

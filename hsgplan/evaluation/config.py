@@ -8,11 +8,11 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
-from hsgplan.domain.checks import BOUNDS, bounded, check_fields, setting
+from hsgplan.domain.checks import BOUNDS, bounded, check_fields, read_text, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world, read_worlds
+from hsgplan.domain.scene_file import MAX_SCENE_BYTES, read_world_text, read_worlds
 from hsgplan.domain.world import KITCHEN
 
 # What an agent sees the simulated world with: `gt` (the simulator's poses) or `rgb` (f_p on
@@ -69,7 +69,12 @@ class EvalConfig:
         return RecoveryRules().without(self.rules_off)
 
 
-@lru_cache(maxsize=8)
 def world_of_file(path: str) -> World:
-    """A scene file's world, read once per process (every episode of a run asks for it)."""
-    return read_world(Path(path))
+    """A scene file's world, parsed once per process and content (every episode of a run asks
+    for it; a file written again is read again)."""
+    return _world_of_text(path, read_text(Path(path), "scene file", MAX_SCENE_BYTES))
+
+
+@lru_cache(maxsize=64)
+def _world_of_text(path: str, text: str) -> World:
+    return read_world_text(text, path)

@@ -95,3 +95,26 @@ def test_the_oracle_solves_a_goal_of_new_objects_in_the_world(tmp_path):
     row = json.loads((out / "oracle" / "episodes.jsonl").read_text().splitlines()[0])["result"]
     assert set(parse_goal(row["goal"], world=NEW).objects) <= set(NEW.object_types)
     assert json.loads((out / "oracle" / "config.json").read_text())["scene"] == str(scene)
+
+
+def test_an_evaluation_over_a_folder_runs_each_scene_on_the_same_goal_seeds(tmp_path):
+    from hsgplan.evaluation.config import EvalConfig
+    from hsgplan.evaluation.protocol import episode_specs, run_config
+
+    for k in range(2):
+        (tmp_path / f"layout-{k}.toml").write_text(
+            to_toml(scene_data(random_layout(KITCHEN, 8, k)))
+        )
+    config = EvalConfig("regression+gnn", (2, 3), 2, 0, scene=str(tmp_path))
+    specs = episode_specs(config)
+    assert len(specs) == 2 * 2 * 2 and len({s.key for s in specs}) == len(specs)
+    by_scene = {}
+    for s in specs:
+        by_scene.setdefault(s.scene, []).append((s.size, s.index, s.seed))
+    assert sorted(by_scene) == [str(tmp_path / "layout-0.toml"), str(tmp_path / "layout-1.toml")]
+    assert by_scene[str(tmp_path / "layout-0.toml")] == by_scene[str(tmp_path / "layout-1.toml")]
+    before = run_config(config)["fingerprint"]
+    (tmp_path / "layout-1.toml").write_text(to_toml(scene_data(random_layout(KITCHEN, 8, 5))))
+    assert run_config(config)["fingerprint"] != before  # another scene: another run
+    kitchen = run_config(EvalConfig("regression+gnn", (2,), 1, 0))
+    assert "scene" not in kitchen  # as runs in the kitchen were always claimed
