@@ -113,6 +113,7 @@ def run_table(
         "seed": config.seed,
         "tuning_seed": is_tuning(config.seed),
         "run": str(out),
+        **({"scenes": [str(p) for p in config.worlds()]} if config.scene else {}),
     }
     write_atomically(out / "summary.json", json.dumps(report, indent=2) + "\n")
     write_atomically(out / "table1.md", markdown(report) + "\n")
@@ -216,9 +217,14 @@ def _results(report: dict) -> TextTable:
         if report["repeats"] > 1
         else ", each run once"
     )
+    scenes = report.get("scenes", [])
+    where = (
+        f", in each of {len(scenes)} scene files" if len(scenes) > 1 else
+        f", in {scenes[0]}" if scenes else ""
+    )  # fmt: skip
     title = (
         f"Success rate / subgoal completion ({protocol_name(report)}): {source}{repeats}, "
-        f"seed {report['seed']}"
+        f"seed {report['seed']}{where}"
     )
     if unsampled := _unsampled(report):
         title += (
