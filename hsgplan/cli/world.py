@@ -106,9 +106,9 @@ def demo(
     from hsgplan.symbolic.generator import check_size
 
     agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
-    make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
     world = read_world(scene) if scene else KITCHEN
     check_agent_world(agent, world, scene)
+    make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
     observer = make_observer(
         perception.value, perception_checkpoint and shipped(perception_checkpoint)
     )

@@ -45,18 +45,18 @@ def test_held_out_scenes_are_whole_tasks(checkpoints):
 
 @pytest.mark.slow
 def test_every_model_is_tried_once_in_the_same_scenes(checkpoints):
-    report = evaluate_motion(["place"], 3, 0, checkpoints, workers=1)
+    report = evaluate_motion(["place"], 2, 0, checkpoints, workers=1)
     place = report["place"]
     assert set(place) == {"gnn", "mlp", "mlp_paper", "random"}  # no paper-head GNN here
     trials = {name: entry["trials"] for name, entry in place.items()}
-    assert len(set(trials.values())) == 1 and 1 <= trials["gnn"] <= 3
+    assert len(set(trials.values())) == 1 and 1 <= trials["gnn"] <= 2
     for entry in place.values():
         levels = entry["by_crowding"].values()
         assert sum(v["trials"] for v in levels) == entry["trials"]
         wins = sum(v["success_rate"] * v["trials"] for v in levels)
         assert abs(wins - entry["success_rate"] * entry["trials"]) < 1e-9
     # the same seed, the same result
-    assert evaluate_motion(["place"], 3, 0, checkpoints, workers=1) == report
+    assert evaluate_motion(["place"], 2, 0, checkpoints, workers=1) == report
 
 
 @pytest.mark.slow
