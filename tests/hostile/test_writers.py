@@ -37,7 +37,7 @@ def test_a_second_run_into_a_folder_being_written_is_refused(launcher, home, tmp
     cwd = tmp_path / "cwd"
     cwd.mkdir()
     at = EVAL.index("--goals") + 1
-    args = [*EVAL[:at], "4", *EVAL[at + 1 :]]  # long enough to be caught running
+    args = [*EVAL[:at], "3", *EVAL[at + 1 :]]  # long enough to be caught running
     first = subprocess.Popen(
         [sys.executable, "-m", "hsgplan.cli", *args],
         cwd=cwd,
@@ -62,7 +62,7 @@ def test_a_second_run_into_a_folder_being_written_is_refused(launcher, home, tmp
     assert f"pid {first.pid}" in second.error_lines[0]
     assert "another run" in second.error_lines[0]
     rows = (cwd / "run" / "oracle" / "episodes.jsonl").read_text().splitlines()
-    assert len(rows) == 8  # 4 goals of each size, each run once
+    assert len(rows) == 6  # 3 goals of each size, each run once
 
 
 def test_a_full_disk_leaves_the_last_summary_whole(launcher, home, tmp_path):
