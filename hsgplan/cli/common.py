@@ -241,6 +241,15 @@ def input_path(text) -> Path:
     return Path(str(text)).expanduser()
 
 
+SceneFiles = Annotated[
+    Path | None,
+    typer.Option(
+        "--scene",
+        help="The world: a scene file, or a folder of them, each run with the same goal seeds "
+        "(default: scenes/kitchen.toml; docs/scenes.md).",
+        parser=input_path,
+    ),
+]
 SceneOption = Annotated[
     Path | None,
     typer.Option(

@@ -16,6 +16,7 @@ from hsgplan.cli.common import (
     ProtocolName,
     RayAddress,
     RunFolder,
+    SceneFiles,
     Summaries,
     bounded_option,
     check_ray,
@@ -134,14 +135,7 @@ def eval_task(
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
     markdown: MarkdownFlag = False,
-    scene: Annotated[
-        Path | None,
-        typer.Option(
-            help="The world: a scene file, or a folder of them, each run with the same goal "
-            "seeds (default: scenes/kitchen.toml; docs/scenes.md).",
-            parser=input_path,
-        ),
-    ] = None,
+    scene: SceneFiles = None,
 ) -> None:
     """A task planner in the symbolic closed loop: success, plan length against Fast Downward,
     wasted (inapplicable) actions per episode, milliseconds per decision. Episodes are kept in

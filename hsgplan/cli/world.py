@@ -19,6 +19,7 @@ from hsgplan.cli.common import (
     ProtocolName,
     RayAddress,
     RunFolder,
+    SceneFiles,
     SceneOption,
     bounded_option,
     check_ray,
@@ -246,14 +247,7 @@ def evaluate(
             help=f"The tables printed, comma-separated: {', '.join(TABLES)} (all are written).",
         ),
     ] = ",".join(TABLES),
-    scene: Annotated[
-        Path | None,
-        typer.Option(
-            help="The world: a scene file, or a folder of them, each run with the same goal "
-            "seeds (default: scenes/kitchen.toml; docs/scenes.md).",
-            parser=input_path,
-        ),
-    ] = None,
+    scene: SceneFiles = None,
 ) -> None:
     """Success rate and subgoal completion per problem size and method, beside the paper's
     Table 1, with the failure taxonomy and the time per level, under a protocol (paper or

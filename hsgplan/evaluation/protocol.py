@@ -67,7 +67,7 @@ def check_agent_world(agent: str, world: World, scene: str | Path | None) -> Non
     trained on (their encodings are one-hots over the kitchen's)."""
     from hsgplan.agents.registry import agent_checkpoints
 
-    others = [n for n in world.entity_types if n not in KITCHEN.entity_types]
+    others = world.names_beyond(KITCHEN)
     if others and agent_checkpoints(agent):
         raise InvalidInputError(
             f"{agent}'s networks know the kitchen's objects, shelves and regions by "

@@ -154,10 +154,11 @@ def evaluate_task(
         raise InvalidInputError(f"protocol '{protocol}': one of {', '.join(PROTOCOLS)}")
     worlds = scene_files(scene)
     for path, world in worlds.items():
-        if planner in LEARNED_PLANNERS and world.entity_types != KITCHEN.entity_types:
+        others = world.names_beyond(KITCHEN)
+        if planner in LEARNED_PLANNERS and others:
             raise InvalidInputError(
                 f"the learned planners know the kitchen's objects, shelves and regions by name; "
-                f"scene '{path}' names others ({', '.join(_others(world))}): try --planner fd"
+                f"scene '{path}' names others ({', '.join(others)}): try --planner fd"
             )
     make_planner(planner, checkpoint)  # a bad name or checkpoint fails here, once
     if goals < 0:
@@ -207,10 +208,6 @@ def scene_files(scene: Path | None) -> dict[Path | None, World]:
     """The worlds of a scene file, or of every `.toml` in a folder; {None: the kitchen}
     without one."""
     return {None: KITCHEN} if scene is None else read_worlds(scene)
-
-
-def _others(world: World) -> list[str]:
-    return [n for n in world.entity_types if n not in KITCHEN.entity_types]
 
 
 def _episode(row: dict) -> TaskEpisode:
