@@ -2,8 +2,9 @@
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval world, report),
 `scenes` (layouts), `data` (collect), `learn` (train task, eval task, eval reach), `motion`
-(train motion, eval motion), `perception` (train perception, eval perception), `bench`;
-`renamed` refuses the older spellings.
+(train motion, eval motion), `perception` (train perception, eval perception), `bench` and
+`bench_motion` (the measurements behind the motion constants); `renamed` refuses the older
+spellings.
 """
 
 from __future__ import annotations
@@ -14,7 +15,17 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli import bench, data, learn, motion, perception, scenes, symbolic, world
+from hsgplan.cli import (
+    bench,
+    bench_motion,
+    data,
+    learn,
+    motion,
+    perception,
+    scenes,
+    symbolic,
+    world,
+)
 from hsgplan.cli.common import OneLineErrors, Summaries
 
 app = typer.Typer(
@@ -46,6 +57,10 @@ app.command()(world.report)
 app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
 app.add_typer(bench.app, name="bench")
+bench.app.command("push-reach")(bench_motion.push_reach)
+bench.app.command("line-error")(bench_motion.line_error)
+bench.app.command("push-settings")(bench_motion.push_settings)
+bench.app.command("compare-trials")(bench_motion.compare_trials)
 learn.train_app.command("motion")(motion.train_motion)
 
 

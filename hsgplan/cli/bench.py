@@ -31,7 +31,11 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.paths import RUNS, TASK_CHECKPOINT
 
-app = typer.Typer(cls=Summaries, no_args_is_help=True, help="Measure speed (medians over one run).")
+app = typer.Typer(
+    cls=Summaries,
+    no_args_is_help=True,
+    help="Measure speed (medians over one run) and what the motion constants rest on.",
+)
 SearchName = choice("SearchName", SEARCH_BASELINES)
 DEFAULT_SEARCH_NAME = SearchName(DEFAULT_SEARCH)
 

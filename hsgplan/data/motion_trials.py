@@ -35,7 +35,7 @@ TASKS_PER_CHUNK = 32
 # Staging a scene costs about one push trial (a cProfile of 3 chunks: 19 ms against 23 ms).
 # One uniformly drawn push in seven succeeds, one place in three fails: eight pushes a scene
 # still give about one sample per scene (place's four give nearly three), and a push sample
-# costs a fifth less time than with four (`python scripts/push_settings.py`, README "Decisions").
+# costs a fifth less time than with four (`hsgplan bench push-settings`, docs/decisions.md).
 ATTEMPTS_PER_TASK: dict[MotionPrimitive, int] = {MotionPrimitive.PLACE: 4, MotionPrimitive.PUSH: 8}
 
 

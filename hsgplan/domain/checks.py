@@ -26,6 +26,7 @@ MAX_REPEATS = 100
 MAX_SAMPLES = 1_000_000  # `collect place/push --samples`
 MAX_STATES = 1_000_000  # `collect reach --states`
 MAX_TRIALS = 100_000  # `eval motion --trials` (per primitive)
+MAX_TASKS = 100_000  # `bench push-reach --tasks`, `bench line-error --tasks`
 MAX_EPISODES = 10_000  # `bench sim --episodes`
 MAX_FAILURES = 1_000  # `report --failures`
 MAX_TASKS_PER_CHUNK = 100_000
@@ -41,6 +42,7 @@ BOUNDS: dict[str, dict[str, int]] = {
     "samples": {"lo": 1, "hi": MAX_SAMPLES},
     "states": {"lo": 1, "hi": MAX_STATES},
     "trials": {"lo": 1, "hi": MAX_TRIALS},
+    "tasks": {"lo": 1, "hi": MAX_TASKS},
     "scenes": {"lo": 1, "hi": MAX_TRIALS},
     "episodes": {"lo": 1, "hi": MAX_EPISODES},
     "failures": {"lo": 0, "hi": MAX_FAILURES},

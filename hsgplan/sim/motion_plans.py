@@ -264,7 +264,7 @@ def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
     u = np.array([math.cos(angle), math.sin(angle), 0.0])
     pose, t = scene.pose(p.obj), world.object_type(p.obj)
     # The object goes at most as far as the fingertips push it, and measured about 4 cm less
-    # (arm lag, finger shape). `scripts/push_reach.py`: of 480 uniformly drawn pushes, and of
+    # (arm lag, finger shape). `hsgplan bench push-reach`: of 480 uniformly drawn pushes, and of
     # 1,600 more, every success had this bound at least 2.63 cm past the shelf's front, while
     # under 2.5 cm ~130 of the 1,600 were carried out in vain; one short of that front plus
     # PUSH_SLACK is refused before it is planned and run.
@@ -322,7 +322,7 @@ def _line(scene: Scene, poses: list[Pose], q_start: np.ndarray) -> list[np.ndarr
 
     Inverse kinematics every LINE_IK_EVERY poses, each seeded by the last, and the joints
     interpolated between: the IK is most of a line's time. Measured over 59 lines
-    (`scripts/line_error.py`): with IK every 4 cm the hand is 0.92 mm from its line pose on
+    (`hsgplan bench line-error`): with IK every 4 cm the hand is 0.92 mm from its line pose on
     average and 3.1 mm at most, against 0.83 and 2.9 mm every 2 cm (the rest is the solver's
     tolerance); the same lines were found.
     Every joint value is collision-checked.

@@ -72,6 +72,10 @@ report         | report run                                           | --failur
 collect images | collect images --workers 1 --out ds                  | --samples   | ALL
 eval perception | eval perception                                     | --scenes    | ALL
 bench observe  | bench observe                                        | --scenes    | -1 0 1e12
+bench push-reach | bench push-reach                                   | --tasks     | -1 1e12
+bench push-reach | bench push-reach --tasks 1                         | --first     | -1 2**70
+bench line-error | bench line-error                                   | --tasks     | -1 1e12
+bench push-settings | bench push-settings                             | --trials    | -1 1e12
 scenes         | scenes --out sc                                      | --layouts   | ALL
 """
 # a small count each: a huge pool for one item would still start one process
@@ -303,6 +307,10 @@ eval motion    | eval motion --trials 1 --workers 1 --primitives ,
 eval motion    | eval motion --trials 1 --workers 1 --primitives place,place
 bench collect  | bench collect --samples 1 --workers 1 --primitives ''
 bench collect  | bench collect --samples 1 --workers 1 --primitives wizard
+bench push-settings | bench push-settings --scenes 1 --trials 1 --setting ''
+bench push-settings | bench push-settings --scenes 1 --trials 1 --setting 0:1
+bench compare-trials | bench compare-trials missing.npz missing.npz
+bench compare-trials | bench compare-trials . .
 eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --ray ''
 eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --rules-off wizard
 eval           | eval world --sizes 2 --goals 1 --out run --rules-off failed_bins,,least_taken
