@@ -21,6 +21,7 @@ from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
 
 if TYPE_CHECKING:  # the names are read by the CLI's --help, which should not load torch
     from hsgplan.agents.base import Agent
+    from hsgplan.domain.scene import World
     from hsgplan.motion.generator import MotionGenerator
     from hsgplan.planning.base import TaskPlanner
 
@@ -180,6 +181,34 @@ def agent_checkpoints(
 
         folders += [motion_checkpoints / f"{kind.value}-{motion}" for kind in MotionPrimitive]
     return folders
+
+
+def _reads_names(folder: Path) -> bool:
+    """Whether a checkpoint folder's networks know nodes by name (`features` "names", what a
+    configuration saved before the setting existed means); a folder that cannot be read is
+    left to the loader to refuse."""
+    import json
+
+    config = folder / "preimage" / "config.json"
+    config = config if config.exists() else folder / "config.json"
+    try:
+        return json.loads(config.read_text()).get("features", "names") == "names"
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def check_reads(folders: list[Path], world: World, scene: str | Path | None) -> None:
+    """Refuse, in one line, checkpoints whose networks know the kitchen's names in a scene
+    that names others (networks of the "geometry" features read any scene)."""
+    from hsgplan.domain.world import KITCHEN
+
+    others = world.names_beyond(KITCHEN)
+    bound = [f for f in folders if _reads_names(f)] if others else []
+    if bound:
+        raise InvalidInputError(
+            f"the networks of '{bound[0]}' know the kitchen's objects, shelves and regions by "
+            f"name; scene '{scene}' names others ({', '.join(others)})"
+        )
 
 
 def make_agent(

@@ -56,23 +56,27 @@ class EpisodeSpec:
 
 
 def check_world(config: EvalConfig) -> None:
-    """Refuse, in one line, an agent with learned parts in a scene whose names they were not
-    trained on."""
+    """Refuse, in one line, an agent whose networks know nodes by name in a scene whose names
+    they were not trained on."""
     for scene, world in config.worlds().items():
-        check_agent_world(config.agent, world, scene)
+        check_agent_world(config.agent, world, scene, *checkpoints(config))
 
 
-def check_agent_world(agent: str, world: World, scene: str | Path | None) -> None:
-    """Refuse, in one line, an agent with learned parts in a world whose names they were not
-    trained on (their encodings are one-hots over the kitchen's)."""
-    from hsgplan.agents.registry import agent_checkpoints
+def check_agent_world(
+    agent: str,
+    world: World,
+    scene: str | Path | None,
+    checkpoint: Path | None = None,
+    motion_checkpoints: Path | None = None,
+) -> None:
+    """`registry.check_reads` on the checkpoint folders of an agent (default: the shipped)."""
+    from hsgplan.agents.registry import agent_checkpoints, check_reads
+    from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
 
-    others = world.names_beyond(KITCHEN)
-    if others and agent_checkpoints(agent):
-        raise InvalidInputError(
-            f"{agent}'s networks know the kitchen's objects, shelves and regions by "
-            f"name; scene '{scene}' names others ({', '.join(others)})"
-        )
+    folders = agent_checkpoints(
+        agent, checkpoint or TASK_CHECKPOINT, motion_checkpoints or MOTION_CHECKPOINTS
+    )
+    check_reads(folders, world, scene)
 
 
 def episode_specs(config: EvalConfig) -> list[EpisodeSpec]:

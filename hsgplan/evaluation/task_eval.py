@@ -20,7 +20,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
-from hsgplan.agents.registry import LEARNED_PLANNERS, make_planner
+from hsgplan.agents.registry import LEARNED_PLANNERS, check_reads, make_planner
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
@@ -154,12 +154,8 @@ def evaluate_task(
         raise InvalidInputError(f"protocol '{protocol}': one of {', '.join(PROTOCOLS)}")
     worlds = scene_files(scene)
     for path, world in worlds.items():
-        others = world.names_beyond(KITCHEN)
-        if planner in LEARNED_PLANNERS and others:
-            raise InvalidInputError(
-                f"the learned planners know the kitchen's objects, shelves and regions by name; "
-                f"scene '{path}' names others ({', '.join(others)}): try --planner fd"
-            )
+        if planner in LEARNED_PLANNERS:
+            check_reads([checkpoint], world, path)
     make_planner(planner, checkpoint)  # a bad name or checkpoint fails here, once
     if goals < 0:
         raise InvalidInputError(f"--goals {goals}: the number of goals cannot be negative")

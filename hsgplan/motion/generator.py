@@ -43,7 +43,6 @@ from hsgplan.domain.parameters import (
 )
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
-from hsgplan.domain.world import SURFACES
 from hsgplan.motion.models import load_motion_net
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.grounding import check_subgoal, ground
@@ -178,7 +177,7 @@ class _BinGenerator(SingleShotMemory):
     ) -> PrimitiveParams | None:
         if isinstance(action, Pick):
             ranked: list[PrimitiveParams] = [PickParams(action.obj)]
-        elif isinstance(action, Place) and action.target not in SURFACES:
+        elif isinstance(action, Place) and action.target not in sg.world.surfaces:
             ranked = [PlaceParams(action.obj, action.target)]
         elif (
             isinstance(action, Push)
@@ -222,7 +221,7 @@ class LearnedMotion(_BinGenerator):
         """Logits over the flattened bin pairs: [bins[0] * bins[1]]."""
         net = self.nets[primitive_of(subgoal)]
         with torch.inference_mode():
-            return net(Batch.from_data_list([ground(sg, subgoal)]))[0]
+            return net(Batch.from_data_list([ground(sg, subgoal, net.config.features)]))[0]
 
     def ranked(self, sg: GeometricSceneGraph, subgoal: Literal) -> list[PlaceParams | PushParams]:
         scores = self.scores(sg, subgoal)

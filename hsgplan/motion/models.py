@@ -19,10 +19,10 @@ from torch_geometric.utils import to_dense_batch
 from hsgplan.checkpoint import load_trained
 from hsgplan.domain.errors import InvalidInputError, a
 from hsgplan.motion.layers import GroundedConv, mlp
-from hsgplan.scene_graph.grounding import EDGE_DIM, NODE_DIM, QUERY_DIM, SUBGOAL_DIM, TYPES
+from hsgplan.scene_graph.grounding import EDGE_DIM, QUERY_DIM, TYPES, dims
 
 MODELS = ("gnn", "mlp")
-REFERENCE_A = NODE_DIM - 6  # a node's reference-A position: three features from here
+REFERENCE_A = slice(-6, -3)  # a node's reference-A position: the last six features but three
 HEADS = ("mlp", "bins")
 
 
@@ -36,21 +36,31 @@ class MotionNetConfig:
     hidden: int = 256
     embed: int = 32
     rounds: int = 2
-    node_dim: int = NODE_DIM
+    node_dim: int = dims("names")[0]
     edge_dim: int = EDGE_DIM
-    subgoal_dim: int = SUBGOAL_DIM
+    subgoal_dim: int = dims("names")[1]
     slots: int = len(TYPES)  # the MLP's fixed input: one node slot per object type
     # The head: "mlp", the paper's (the embeddings, concatenated, through an MLP onto every
     # bin), or "bins" (beyond the paper): each bin is scored from where it would put the
     # object (the GNN: `BinQueryHead`; the MLP: `FlatBinHead`, the same inputs in slots).
     head: str = "mlp"
     query_dim: int = QUERY_DIM
+    # what a node is (`grounding.FEATURES`): "names", the paper's one-hots over the kitchen's
+    # names, or "geometry" (kind, size, the role of its region), which reads any scene
+    features: str = "names"
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:
             raise InvalidInputError(f"model '{self.model}': one of {', '.join(MODELS)}")
         if self.head not in HEADS:
             raise InvalidInputError(f"head '{self.head}': one of {', '.join(HEADS)}")
+        if (self.node_dim, self.subgoal_dim) != dims(self.features):
+            raise InvalidInputError(
+                f"node_dim {self.node_dim}, subgoal_dim {self.subgoal_dim}: the {self.features} "
+                f"features are {dims(self.features)[0]} and {dims(self.features)[1]} wide"
+            )
+        if self.model == "mlp" and self.features != "names":
+            raise InvalidInputError("the mlp keeps a slot per object type: features 'names' only")
         for name in ("hidden", "embed", "rounds"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
@@ -126,7 +136,7 @@ class FlatMotionNet(nn.Module):
         kind = batch.x[:, : self.slots].argmax(dim=1)
         b = int(batch.u.shape[0])
         positions = batch.x.new_zeros(b, self.slots, 3)
-        positions[batch.batch, kind] = batch.x[:, REFERENCE_A : REFERENCE_A + 3]
+        positions[batch.batch, kind] = batch.x[:, REFERENCE_A]
         present = torch.zeros(b, self.slots, dtype=torch.bool, device=batch.x.device)
         present[batch.batch, kind] = True
         return positions, present
@@ -184,7 +194,7 @@ class BinQueryHead(nn.Module):
         self, h: torch.Tensor, batch, subgoal: torch.Tensor, only: torch.Tensor | None = None
     ) -> torch.Tensor:
         nodes, mask = to_dense_batch(h, batch.batch)  # [B, N, hidden]
-        pos, _ = to_dense_batch(batch.x[:, REFERENCE_A : REFERENCE_A + 3], batch.batch)
+        pos, _ = to_dense_batch(batch.x[:, REFERENCE_A], batch.batch)
         b, n = mask.shape
         query = batch.query.view(b, -1, batch.query.shape[-1])  # [B, bins, query_dim]
         if only is not None:

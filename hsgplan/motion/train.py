@@ -39,7 +39,7 @@ from hsgplan.domain.predicates import inside, on
 from hsgplan.files import write_atomically
 from hsgplan.motion.models import MotionNetConfig, build
 from hsgplan.paths import MOTION_DATA, shipped
-from hsgplan.scene_graph.grounding import ground
+from hsgplan.scene_graph.grounding import dims, ground
 from hsgplan.training import TRAIN_CONFIG
 
 
@@ -66,6 +66,8 @@ class MotionTrainConfig:
     # The share of the training scenes held out to choose the epoch: the weights kept are
     # those of the epoch with the lowest loss on them (0: train on all, keep the last epoch).
     validation: float = setting(0.0, lo=0, hi=0.5)
+    # what a node is (`grounding.FEATURES`): "names" (the paper's) or "geometry"
+    features: str = "names"
 
     def __post_init__(self) -> None:
         check_fields(self)
@@ -77,8 +79,18 @@ class MotionTrainConfig:
 
     def net_config(self) -> MotionNetConfig:
         bins = BINS[MotionPrimitive(self.primitive)]
+        node_dim, subgoal_dim = dims(self.features)
         return MotionNetConfig(
-            self.model, self.primitive, bins, self.hidden, self.embed, self.rounds, head=self.head
+            self.model,
+            self.primitive,
+            bins,
+            self.hidden,
+            self.embed,
+            self.rounds,
+            node_dim=node_dim,
+            subgoal_dim=subgoal_dim,
+            head=self.head,
+            features=self.features,
         )
 
     @staticmethod
@@ -116,14 +128,15 @@ def _loss(kind: str, model: torch.nn.Module, batch) -> torch.Tensor:
     return torch.nn.functional.binary_cross_entropy_with_logits(picked, batch.ok.float())
 
 
-def grounded_examples(data: MotionData) -> list[Data]:
+def grounded_examples(data: MotionData, features: str = "names") -> list[Data]:
     """Every row grounded for its subgoal, labelled with its flattened bin pair and whether
     the trial succeeded."""
     ny = BINS[data.primitive][1]
     subgoal = on if data.primitive is MotionPrimitive.PLACE else inside
     out = []
     for i in range(len(data)):
-        g = ground(data.scene_graph(i), subgoal(data.object_name(i), data.target_name(i)))
+        lit = subgoal(data.object_name(i), data.target_name(i))
+        g = ground(data.scene_graph(i), lit, features)
         g.y = torch.tensor([int(data.bins[i, 0]) * ny + int(data.bins[i, 1])])
         g.ok = torch.tensor([bool(data.ok[i])])
         out.append(g)
@@ -163,12 +176,12 @@ def train_motion(
     if config.loss == "bce":
         files.append(folder / f"{config.primitive}_trials.npz")
     data = fingerprint(files)
-    training.claim(out, asdict(config), data=data)
+    training.claim(out, asdict(config), defaults={"features": "names"}, data=data)
     if training.finished(out):
         return  # finished earlier
     held = split_tasks(rows, config.validation, config.seed)
-    examples = grounded_examples(rows.take(~held))
-    checking = grounded_examples(rows.take(held))
+    examples = grounded_examples(rows.take(~held), config.features)
+    checking = grounded_examples(rows.take(held), config.features)
     torch.set_num_threads(config.threads)
     torch.manual_seed(config.seed)
     net_config = config.net_config()

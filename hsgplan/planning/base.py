@@ -14,7 +14,7 @@ from typing import Protocol
 from hsgplan.domain.actions import Action, Place, Push
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal
-from hsgplan.domain.world import SHELVES
+from hsgplan.domain.scene import World
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 
@@ -41,11 +41,10 @@ class TaskPlanner(Protocol):
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision: ...
 
 
-def push_after(action: Action) -> Push | None:
+def push_after(action: Action, world: World) -> Push | None:
     """The paper's heuristic from subgoal to primitive, one step on: an object placed on a
     shelf's prepush region is there to be pushed into that shelf."""
     if isinstance(action, Place):
-        return next(
-            (Push(action.obj, s) for s in SHELVES if SHELVES[s].prepush == action.target), None
-        )
+        shelves = world.shelves.values()
+        return next((Push(action.obj, s.name) for s in shelves if s.prepush == action.target), None)
     return None

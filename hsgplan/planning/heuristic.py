@@ -9,12 +9,15 @@ the state stays as it was and the step is wasted).
 from __future__ import annotations
 
 from hsgplan.domain.actions import Action, Pick, Place, Push
-from hsgplan.domain.objects import EntityKind, kind_of
 from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.scene import EntityKind
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
-# where an object that must leave the hand is put down
-BUFFER = "open_space"
+
+def buffer_region(state: SymbolicSceneGraph) -> str:
+    """Where an object that must leave the hand is put down: the open space, the region a
+    scene lists first."""
+    return next(iter(state.world.regions))
 
 
 def action_for(lit: Literal, state: SymbolicSceneGraph) -> Action | None:
@@ -32,7 +35,7 @@ def action_for(lit: Literal, state: SymbolicSceneGraph) -> Action | None:
         above = state.resting_on(lit.subject)
         return Pick(above[0]) if above else None
     if lit.predicate is Predicate.IN_GRASP:  # let go of it
-        return Place(lit.subject, BUFFER)
+        return Place(lit.subject, buffer_region(state))
     if lit.predicate is Predicate.ON:  # take it off
         return Pick(lit.subject)
     return None
@@ -48,7 +51,7 @@ def candidate_literals(state: SymbolicSceneGraph) -> list[Literal]:
             if x == o:
                 continue
             out.add(Literal(Predicate.ON, (o, x)))
-            if kind_of(x) is EntityKind.SHELF:
+            if state.world.kind_of(x) is EntityKind.SHELF:
                 out.add(Literal(Predicate.IN, (o, x)))
     out = {lit for lit in out if not state.holds(lit)}
     out |= {lit.negated() for lit in state.literals}

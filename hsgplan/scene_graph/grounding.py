@@ -22,8 +22,14 @@ vector `u` (`SUBGOAL_DIM`): the target entity, one-hot over `ENTITY_TYPES`, and 
 object's type, one-hot over `OBJECT_TYPES`. Lengths are in decimetres (`SCALE`), so that
 every feature is of order one.
 
-The one-hots are over the kitchen's names: they fix the networks' input size, so a scene of
-other names cannot be read yet. Every rectangle, size and place bin is the graph's world's.
+These are the "names" features, the paper's: their one-hots are over the kitchen's names, so a
+network trained on them reads only scenes of those names. The "geometry" features say what
+the scene file says instead of a name, and read any scene: a node's kind (can or box, 2) for
+its type; for its region, the region's role (open region, prepush region, shelf top, shelf
+interior, held: 5) and whether that region is the target's own or the target shelf's prepush
+region (2); the rest as above. Their subgoal vector (`GEOMETRY_SUBGOAL_DIM`) is the target's
+role (4), its rectangle's two sides and height (3), and the moved object's kind (2) and size
+(3). Every rectangle, size and place bin is the graph's world's.
 """
 
 from __future__ import annotations
@@ -37,6 +43,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import ENTITY_TYPES
 from hsgplan.domain.parameters import PUSH_LEAD, place_xy, push_values
 from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.scene import Kind, World
 from hsgplan.domain.world import (
     OBJECT_TYPES,
     PLACE_BINS,
@@ -59,8 +66,42 @@ REGION_CLASSES: tuple[str, ...] = (
 NODE_DIM = len(TYPES) + len(REGION_CLASSES) + 1 + 3 + 2 + 3 + 3
 EDGE_DIM = 4
 SUBGOAL_DIM = len(ENTITY_TYPES) + len(TYPES)
+FEATURES = ("names", "geometry")
+KINDS = tuple(Kind)
+ROLES = ("region", "prepush", "top", "in", "held")
+TARGET_ROLES = ROLES[:4]
+GEOMETRY_NODE_DIM = len(KINDS) + len(ROLES) + 2 + 1 + 3 + 2 + 3 + 3
+GEOMETRY_SUBGOAL_DIM = len(TARGET_ROLES) + 3 + len(KINDS) + 3
 SCALE = 10.0  # metres to decimetres
 QUERY_DIM = 5
+
+
+def dims(features: str) -> tuple[int, int]:
+    """(node, subgoal) feature widths of an encoding; InvalidInputError for an unknown one."""
+    if features not in FEATURES:
+        raise InvalidInputError(f"features '{features}': one of {', '.join(FEATURES)}")
+    if features == "names":
+        return NODE_DIM, SUBGOAL_DIM
+    return GEOMETRY_NODE_DIM, GEOMETRY_SUBGOAL_DIM
+
+
+def _role(world: World, entity: str) -> str:
+    """The role of a region class's entity (a region, or a shelf's top or interior)."""
+    if entity in world.regions:
+        return "prepush" if any(s.prepush == entity for s in world.shelf_list) else "region"
+    return "top"
+
+
+def _described(world: World, region: str, target: str, place: bool) -> list[float]:
+    """The geometry features of a node's region (`region` a `_region_class`)."""
+    role, _, entity = region.partition(":")
+    if region == "held":
+        entity = ""
+    elif not entity:
+        role, entity = _role(world, region), region
+    of_target = entity == target and (role != "in" if place else role == "in")
+    prepush = world.shelves[target].prepush if target in world.shelves else None
+    return [float(role == r) for r in ROLES] + [float(of_target), float(entity == prepush)]
 
 
 def _region_class(state: SymbolicSceneGraph, obj: str) -> str:
@@ -89,9 +130,11 @@ def check_subgoal(subgoal: Literal, sg: GeometricSceneGraph) -> None:
     )
 
 
-def ground(sg: GeometricSceneGraph, subgoal: Literal) -> Data:
-    """ŝ_g for a subgoal: `Data(x [N, NODE_DIM], edge_index [2, N(N-1)], edge_attr
-    [N(N-1), EDGE_DIM], u [1, SUBGOAL_DIM], mover [N] bool)`; nodes in `sg`'s order."""
+def ground(sg: GeometricSceneGraph, subgoal: Literal, features: str = "names") -> Data:
+    """ŝ_g for a subgoal: `Data(x [N, node_dim], edge_index [2, N(N-1)], edge_attr
+    [N(N-1), EDGE_DIM], u [1, subgoal_dim], mover [N] bool)` with the widths `dims(features)`;
+    nodes in `sg`'s order."""
+    node_dim, subgoal_dim = dims(features)
     check_subgoal(subgoal, sg)
     obj, target = subgoal.args
     world = sg.world
@@ -109,10 +152,15 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal) -> Data:
     for node in sg.nodes:
         x, y, z = node.pose.position
         t = node.type
-        feat = [0.0] * NODE_DIM
-        feat[TYPES.index(t.name)] = 1.0
-        feat[len(TYPES) + REGION_CLASSES.index(_region_class(state, node.name))] = 1.0
-        k = len(TYPES) + len(REGION_CLASSES)
+        region = _region_class(state, node.name)
+        if features == "names":
+            feat = [0.0] * (len(TYPES) + len(REGION_CLASSES))
+            feat[TYPES.index(t.name)] = 1.0
+            feat[len(TYPES) + REGION_CLASSES.index(region)] = 1.0
+        else:
+            feat = [float(t.kind is k) for k in KINDS] + _described(world, region, target, place)
+        k = len(feat)
+        feat += [0.0] * (node_dim - k)
         yaw = node.pose.yaw
         size = [SCALE * s for s in t.size]
         feat[k : k + 6] = [float(node.name == obj), *size, math.cos(2 * yaw), math.sin(2 * yaw)]
@@ -135,9 +183,8 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal) -> Data:
     edge_index = torch.stack([src[keep], dst[keep]])
     offset = SCALE * (pos[edge_index[1]] - pos[edge_index[0]])
     edge_attr = torch.cat([offset, offset[:, :2].norm(dim=1, keepdim=True)], dim=1)
-    u = torch.zeros(1, SUBGOAL_DIM)
-    u[0, ENTITY_TYPES.index(target)] = 1.0
-    u[0, len(ENTITY_TYPES) + TYPES.index(world.type_of(obj))] = 1.0
+    u = torch.tensor([_subgoal(world, obj, target, place, features)])
+    assert u.shape[1] == subgoal_dim
     mover = torch.tensor([node.name == obj for node in sg.nodes])
     return Data(
         x=torch.tensor(rows, dtype=torch.float),
@@ -148,6 +195,20 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal) -> Data:
         query=bin_queries(sg, subgoal),
         num_nodes=n,
     )
+
+
+def _subgoal(world: World, obj: str, target: str, place: bool, features: str) -> list[float]:
+    moved = world.object_type(obj)
+    if features == "names":
+        u = [0.0] * SUBGOAL_DIM
+        u[ENTITY_TYPES.index(target)] = 1.0
+        u[len(ENTITY_TYPES) + TYPES.index(moved.name)] = 1.0
+        return u
+    role = _role(world, target) if place else "in"
+    rect = world.surface_rect(target) if place else world.shelves[target].interior
+    side = [SCALE * rect.width_x, SCALE * rect.width_y, SCALE * rect.z]
+    kind = [float(moved.kind is k) for k in KINDS]
+    return [float(role == r) for r in TARGET_ROLES] + side + kind + [SCALE * s for s in moved.size]
 
 
 def bin_queries(sg: GeometricSceneGraph, subgoal: Literal) -> torch.Tensor:

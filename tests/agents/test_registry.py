@@ -162,3 +162,22 @@ def test_a_push_with_no_parameters_left_takes_the_object_up_to_put_it_elsewhere(
     place = sampler.propose(held, Place(can, "prepush_a"), Push(can, "shelf_a"))
     x, y = place_xy(can, "prepush_a", place.x_bin, place.y_bin)
     assert ((x - spot[0]) ** 2 + (y - spot[1]) ** 2) ** 0.5 >= AVOID_RADIUS
+
+
+def test_checkpoints_that_know_names_are_refused_a_scene_of_other_names(tmp_path):
+    import json
+
+    from hsgplan.agents.registry import check_reads
+    from hsgplan.domain.layouts import random_layout
+    from hsgplan.domain.world import KITCHEN
+
+    new = random_layout(KITCHEN, 0, 0, new_objects=True)
+    task, motion = tmp_path / "task", tmp_path / "place-gnn"
+    (task / "preimage").mkdir(parents=True)
+    motion.mkdir()
+    (task / "preimage" / "config.json").write_text(json.dumps({"features": "geometry"}))
+    (motion / "config.json").write_text(json.dumps({"model": "gnn"}))  # saved before features
+    check_reads([task], new, "new.toml")
+    check_reads([task, motion], KITCHEN, None)  # the kitchen's names: any network reads them
+    with pytest.raises(InvalidInputError, match="place-gnn' know the kitchen's objects"):
+        check_reads([task, motion], new, "new.toml")

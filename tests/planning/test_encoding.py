@@ -2,6 +2,7 @@
 
 import random
 
+import pytest
 import torch
 from torch_geometric.data import Batch
 
@@ -9,9 +10,7 @@ from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.predicates import PREDICATES, Predicate, clear, in_grasp, inside, on
 from hsgplan.planning.regression.encoding import (
     DONT_CARE,
-    EDGE_DIM,
     FALSE,
-    NODE_DIM,
     TRUE,
     Slots,
     decode,
@@ -20,6 +19,7 @@ from hsgplan.planning.regression.encoding import (
     encode_many,
     touching,
 )
+from hsgplan.planning.regression.features import FEATURES, edge_dim, node_dim
 from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
 from hsgplan.symbolic.generator import random_goal, random_state
 
@@ -34,9 +34,9 @@ def test_shapes_and_one_slot_per_literal():
     s = scene()
     data = encode(s, parse_goal("In(cherries, shelf_a) & not Clear(butter)").literals)
     n = 2 + len(FIXTURES)
-    assert data.x.shape == (n, NODE_DIM)
+    assert data.x.shape == (n, node_dim("names"))
     assert data.edge_index.shape == (2, n * n)
-    assert data.edge_attr.shape == (n * n, EDGE_DIM)
+    assert data.edge_attr.shape == (n * n, edge_dim("names"))
     assert data.valid.shape == data.goal.shape == (n * n, len(PREDICATES))
     slots = Slots(tuple(data.names))
     for lit in (on("butter", "cherries"), inside("cherries", "shelf_a"), clear("butter")):
@@ -80,13 +80,14 @@ def test_duplicates_share_features_and_order_follows_nodes():
     assert e == 1 * len(data.names) + 1 and data.goal[e, p] == TRUE
 
 
-def test_encode_many_equals_batching_single_encodings():
+@pytest.mark.parametrize("features", FEATURES)
+def test_encode_many_equals_batching_single_encodings(features):
     rng = random.Random(0)
     goal = random_goal(6, rng)
     s = random_state(goal.objects, rng)
     lits = sorted(goal.literals)
-    batched = Batch.from_data_list([encode(s, goal.literals, [lit]) for lit in lits])
-    many = encode_many(s, [goal.literals] * len(lits), [[lit] for lit in lits])
+    batched = Batch.from_data_list([encode(s, goal.literals, [lit], features) for lit in lits])
+    many = encode_many(s, [goal.literals] * len(lits), [[lit] for lit in lits], features)
     for key in ("x", "edge_index", "edge_attr", "valid", "goal", "active"):
         assert torch.equal(getattr(batched, key), getattr(many, key)), key
 
@@ -103,15 +104,16 @@ def test_active_edges_are_self_loops_and_related_pairs():
     assert all((n, n) in active for n in data.names)
 
 
-def test_encode_computed_is_encode_many_cut_to_the_computed_edges():
+@pytest.mark.parametrize("features", FEATURES)
+def test_encode_computed_is_encode_many_cut_to_the_computed_edges(features):
     rng = random.Random(3)
     goal = random_goal(5, rng)
     s = random_state(goal.objects, rng)
     lits = sorted(goal.literals)
     contexts = [frozenset(goal.literals)] * (len(lits) - 1) + [frozenset([clear(lits[0].subject)])]
     readout = touching(s.nodes, [lit.args for lit in lits])
-    batch = encode_computed(s, contexts, lits, readout)
-    many = encode_many(s, contexts, [[lit] for lit in lits])
+    batch = encode_computed(s, contexts, lits, readout, features)
+    many = encode_many(s, contexts, [[lit] for lit in lits], features)
     kept = (many.active | torch.from_numpy(readout.reshape(-1))).nonzero().squeeze(1)
     assert torch.equal(batch.x, many.x)
     assert torch.equal(batch.edge_index, many.edge_index[:, kept])
@@ -125,6 +127,8 @@ def test_encode_computed_is_encode_many_cut_to_the_computed_edges():
         kept
     )
     # without a query or read-out edges: the active edges alone
-    batch = encode_computed(s, [frozenset([lit]) for lit in lits], [None] * len(lits))
-    many = encode_many(s, [[lit] for lit in lits])
+    batch = encode_computed(
+        s, [frozenset([lit]) for lit in lits], [None] * len(lits), features=features
+    )
+    many = encode_many(s, [[lit] for lit in lits], features=features)
     assert torch.equal(batch.edge_attr, many.edge_attr[many.active])

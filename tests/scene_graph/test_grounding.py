@@ -1,5 +1,7 @@
 """Grounding f_g on hand-built scenes."""
 
+from dataclasses import replace
+
 import pytest
 import torch
 
@@ -11,10 +13,15 @@ from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.grounding import (
     EDGE_DIM,
+    GEOMETRY_NODE_DIM,
+    GEOMETRY_SUBGOAL_DIM,
+    KINDS,
     NODE_DIM,
     REGION_CLASSES,
+    ROLES,
     SCALE,
     SUBGOAL_DIM,
+    TARGET_ROLES,
     TYPES,
     ground,
 )
@@ -98,3 +105,66 @@ def test_subgoals_without_motion_parameters_are_refused():
         ground(_place_scene(), on("popcorn", "shelf_a"))
     with pytest.raises(InvalidInputError):
         ground(_place_scene(), on("tomato_soup", "butter"))  # stacking: geometry, not bins
+
+
+def _renamed(sg: GeometricSceneGraph, names: dict[str, str]) -> GeometricSceneGraph:
+    """The same poses in a world whose object types are renamed."""
+    types = tuple(replace(t, name=names.get(t.name, t.name)) for t in sg.world.type_list)
+    world = replace(sg.world, type_list=types)
+    poses = {names.get(n, n): sg.pose(n) for n in sg.objects}
+    held = names.get(sg.held, sg.held) if sg.held else None
+    return GeometricSceneGraph.from_poses(poses, held=held, world=world)
+
+
+def test_geometry_grounding_reads_what_the_scene_says_not_names():
+    sg = _place_scene()
+    g = ground(sg, on("tomato_soup", "shelf_a"), "geometry")
+    assert g.x.shape == (3, GEOMETRY_NODE_DIM) and g.u.shape == (1, GEOMETRY_SUBGOAL_DIM)
+    i = {n: sg.objects.index(n) for n in sg.objects}
+    kinds, roles = len(KINDS), len(ROLES)
+    # a can on the target's top; a box on a region; a can in the hand
+    assert g.x[i["cherries"], :kinds].tolist() == [1, 0]
+    assert g.x[i["cherries"], kinds + ROLES.index("top")] == 1
+    assert g.x[i["cherries"], kinds + roles] == 1  # the target's own surface
+    assert g.x[i["butter"], :kinds].tolist() == [0, 1]
+    assert g.x[i["butter"], kinds + ROLES.index("region")] == 1
+    assert g.x[i["butter"], kinds + roles] == 0
+    assert g.x[i["tomato_soup"], kinds + ROLES.index("held")] == 1
+    # the rest is the names' features, from the mover flag on
+    names = ground(sg, on("tomato_soup", "shelf_a"))
+    assert torch.equal(g.x[:, kinds + roles + 2 :], names.x[:, K:])
+    # the subgoal: a shelf top, its sides and height, a can of the soup's size
+    top = surface_rect("shelf_a")
+    u = g.u[0].tolist()
+    assert u[: len(TARGET_ROLES)] == [0, 0, 1, 0]
+    assert u[4:7] == pytest.approx([SCALE * top.width_x, SCALE * top.width_y, SCALE * top.z])
+    assert u[7:9] == [1, 0] and u[9:] == pytest.approx([0.70, 0.70, 0.83])
+    # renamed object types: the same features, where the names' one-hots cannot be made
+    renamed = _renamed(sg, {"cherries": "plums", "tomato_soup": "bisque"})
+    again = ground(renamed, on("bisque", "shelf_a"), "geometry")
+    assert torch.equal(again.x, g.x) and torch.equal(again.u, g.u)
+    with pytest.raises(ValueError):
+        ground(renamed, on("bisque", "shelf_a"))
+
+
+def test_geometry_grounding_of_a_push_marks_the_target_interior_and_its_prepush_region():
+    prepush = surface_rect("prepush_a")
+    sg = GeometricSceneGraph.from_poses(
+        {
+            "cherries": Pose.from_xyz_yaw(*prepush.center, 0.029),
+            "alphabet_soup": Pose.from_xyz_yaw(
+                SHELVES["shelf_a"].interior.center[0], SHELVES["shelf_a"].interior.center[1], 0.042
+            ),
+            "butter": _top("shelf_a", height=0.024),
+        }
+    )
+    g = ground(sg, inside("cherries", "shelf_a"), "geometry")
+    i = {n: sg.objects.index(n) for n in sg.objects}
+    at = len(KINDS)
+    row = {n: g.x[i[n], at : at + len(ROLES) + 2].tolist() for n in i}
+    assert row["cherries"] == [0, 1, 0, 0, 0, 0, 1]  # on the target shelf's prepush region
+    assert row["alphabet_soup"] == [0, 0, 0, 1, 0, 1, 0]  # inside the target shelf
+    assert row["butter"] == [0, 0, 1, 0, 0, 0, 0]  # on its top: not where the push goes
+    assert g.u[0, : len(TARGET_ROLES)].tolist() == [0, 0, 0, 1]
+    with pytest.raises(InvalidInputError, match="features 'colour'"):
+        ground(sg, inside("cherries", "shelf_a"), "colour")

@@ -16,50 +16,25 @@ import numpy as np
 import torch
 from torch_geometric.data import Data
 
-from hsgplan.domain.objects import ENTITY_TYPES, EntityKind, kind_of, type_of
-from hsgplan.domain.predicates import PREDICATES, Literal, Predicate
+from hsgplan.domain.predicates import PREDICATES, Literal
+from hsgplan.domain.scene import World
+from hsgplan.planning.regression.features import (
+    edge_dim,
+    fixture_edges,
+    node_features,
+    valid_mask,
+)
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 DONT_CARE, TRUE, FALSE = 0, 1, 2
-KINDS = tuple(EntityKind)
-NODE_DIM = len(ENTITY_TYPES) + len(KINDS)
-# state multi-hot, goal one-hot over {don't care, true, false} per predicate, valid slots, and
-# the query: the one literal of the goal being regressed
-EDGE_DIM = len(PREDICATES) + 3 * len(PREDICATES) + 2 * len(PREDICATES)
-
-
-def _valid(pred: Predicate, src: str, dst: str) -> bool:
-    """Whether a literal of this predicate can exist on the edge src -> dst."""
-    if kind_of(src) is not EntityKind.OBJECT:
-        return False
-    if pred.arity == 1:
-        return src == dst
-    if src == dst:
-        return False
-    return pred is Predicate.ON or kind_of(dst) is EntityKind.SHELF
-
 
 _PRED_INDEX = {p: i for i, p in enumerate(PREDICATES)}
 
 
 @cache
-def _valid_mask(nodes: tuple[str, ...]) -> torch.Tensor:
-    n = len(nodes)
-    return torch.tensor(
-        [[_valid(p, nodes[i], nodes[j]) for p in PREDICATES] for i in range(n) for j in range(n)]
-    )
-
-
-@cache
-def _layout(nodes: tuple[str, ...]) -> tuple[torch.Tensor, torch.Tensor]:
-    """Node features and the complete edge index of a node list (the same for every call)."""
-    n = len(nodes)
-    x = torch.zeros(n, NODE_DIM)
-    for i, name in enumerate(nodes):
-        x[i, ENTITY_TYPES.index(type_of(name))] = 1.0
-        x[i, len(ENTITY_TYPES) + KINDS.index(kind_of(name))] = 1.0
-    edge_index = torch.tensor(Slots(nodes).edges, dtype=torch.long).t().contiguous()
-    return x, edge_index
+def _edge_index(n: int) -> torch.Tensor:
+    """The complete edge index over n nodes, self loops included (shared: do not write)."""
+    return torch.tensor([(i, j) for i in range(n) for j in range(n)], dtype=torch.long).t()
 
 
 @dataclass(frozen=True)
@@ -95,10 +70,6 @@ class Slots:
         """The (shared, cached) slots of a node list."""
         return _slots(nodes)
 
-    def valid_mask(self) -> torch.Tensor:
-        """[E, P] bool: which slots can hold a literal at all."""
-        return _valid_mask(self.nodes).clone()
-
     def goal_values(self, goal: Iterable[Literal]) -> torch.Tensor:
         """[E, P] long: DONT_CARE, TRUE or FALSE for each slot."""
         values = torch.full((len(self.nodes) ** 2, len(PREDICATES)), DONT_CARE, dtype=torch.long)
@@ -127,41 +98,51 @@ def _valued(nodes: tuple[str, ...], edge: int, pred: int, value: int) -> Literal
 
 
 def encode(
-    state: SymbolicSceneGraph, goal: Iterable[Literal], query: Iterable[Literal] = ()
+    state: SymbolicSceneGraph,
+    goal: Iterable[Literal],
+    query: Iterable[Literal] = (),
+    features: str = "names",
 ) -> Data:
-    """The state, a goal (literals over the state's nodes) and a query within it, as a graph.
+    """The state, a goal (literals over the state's nodes) and a query within it, as a graph,
+    its nodes described by `features` (`features.FEATURES`).
 
     Shapes:
-        x: [N, NODE_DIM] node type one-hot over `ENTITY_TYPES`, then kind one-hot.
+        x: [N, node_dim(features)] (`features.node_features`).
         edge_index: [2, N * N] every ordered pair, self loops included.
-        edge_attr: [N * N, EDGE_DIM] the state's literals (multi-hot over `PREDICATES`), the
-            goal's value per predicate (one-hot over don't care / true / false), valid slots,
-            the query's slots.
+        edge_attr: [N * N, edge_dim(features)] the state's literals (multi-hot over
+            `PREDICATES`), the goal's value per predicate (one-hot over don't care / true /
+            false), valid slots, the query's slots; for "geometry", then the fixture column
+            (`features.fixture_edges`).
         valid: [N * N, P] bool, the slots a literal can occupy.
         goal: [N * N, P] long, the goal's values.
-        active: [N * N] bool, the edges messages travel on: self loops and the pairs a state,
-            goal or query literal relates. Other pairs are read out but pass nothing on, so
-            that objects nothing relates do not change what the network says elsewhere (scenes
-            grow from two objects in training to twelve).
+        active: [N * N] bool, the edges messages travel on: self loops, the pairs a state,
+            goal or query literal relates, and for "geometry" a shelf and its prepush region
+            (else a prepush region could not learn which shelf it serves). Other pairs are read
+            out but pass nothing on, so that objects nothing relates do not change what the
+            network says elsewhere (scenes grow from two objects in training to twelve).
         names: list of N node names.
     """
     slots = Slots(state.nodes)
     n = len(slots.nodes)
-    x, edge_index = _layout(slots.nodes)
+    x, edge_index = node_features(slots.nodes, state.world, features), _edge_index(n)
     holds = torch.zeros(n * n, len(PREDICATES))
     for lit in state.literals:
         e, p = slots.slot(lit)
         holds[e, p] = 1.0
     values = slots.goal_values(goal)
-    valid = slots.valid_mask()
+    valid = valid_mask(slots.nodes, state.world).clone()
     goal_onehot = torch.nn.functional.one_hot(values, 3).float().reshape(n * n, -1)
     asked = torch.zeros(n * n, len(PREDICATES))
     for lit in query:
         e, p = slots.slot(lit)
         asked[e, p] = 1.0
-    edge_attr = torch.cat([holds, goal_onehot, valid.float(), asked], dim=1)
-    self_loop = edge_index[0] == edge_index[1]
-    active = self_loop | (holds.sum(1) > 0) | (values != DONT_CARE).any(1) | (asked.sum(1) > 0)
+    parts = [holds, goal_onehot, valid.float(), asked]
+    always = edge_index[0] == edge_index[1]
+    if features == "geometry":
+        parts.append(fixture_edges(slots.nodes, state.world))
+        always = always | (parts[-1][:, 0] > 0)
+    edge_attr = torch.cat(parts, dim=1)
+    active = always | (holds.sum(1) > 0) | (values != DONT_CARE).any(1) | (asked.sum(1) > 0)
     return Data(
         x=x,
         edge_index=edge_index,
@@ -171,6 +152,20 @@ def encode(
         active=active,
         names=list(slots.nodes),
     )
+
+
+def with_features(data: Data, world: World, features: str) -> Data:
+    """A graph `encode` made with the "names" features, described by `features` instead (the
+    training examples are encoded once, by name, and trained under either)."""
+    if features == "names":
+        return data
+    nodes = tuple(data.names)
+    out = data.clone()
+    out.x = node_features(nodes, world, features)
+    joined = fixture_edges(nodes, world)
+    out.edge_attr = torch.cat([data.edge_attr, joined], dim=1)
+    out.active = data.active | (joined[:, 0] > 0)
+    return out
 
 
 def decode(data: Data, values: torch.Tensor) -> list[Literal]:
@@ -189,24 +184,26 @@ def decode_values(names, values: torch.Tensor, valid: torch.Tensor) -> list[Lite
 
 
 @lru_cache(maxsize=4)
-def _encode_state(state: SymbolicSceneGraph) -> Data:
-    return encode(state, ())
+def _encode_state(state: SymbolicSceneGraph, world: World, features: str) -> Data:
+    # `world` keys the cache: states of two worlds with the same literals compare equal
+    return encode(state, (), features=features)
 
 
 def encode_many(
     state: SymbolicSceneGraph,
     goals: list[Iterable[Literal]],
     queries: list[Iterable[Literal]] | None = None,
+    features: str = "names",
 ) -> Data:
     """Several (goal, query) graphs over one state, batched into one disjoint graph: graph k
     owns nodes [k N, (k + 1) N) and edges [k N^2, (k + 1) N^2). Equal to batching `encode`'s
     graphs, without building each one (the planner asks many questions per decision).
 
-    Shapes: as `encode`, with K = len(goals) graphs: x [K N, NODE_DIM], edge_index
-    [2, K N^2], edge_attr [K N^2, EDGE_DIM], valid / goal [K N^2, P], active [K N^2].
+    Shapes: as `encode`, with K = len(goals) graphs: x [K N, node_dim], edge_index
+    [2, K N^2], edge_attr [K N^2, edge_dim], valid / goal [K N^2, P], active [K N^2].
     """
     queries = queries if queries is not None else [()] * len(goals)
-    one = _encode_state(state)
+    one = _encode_state(state, state.world, features)
     slots = Slots.of(state.nodes)
     k, n, e = len(goals), len(slots.nodes), len(slots.nodes) ** 2
     values = torch.zeros(k, e, len(PREDICATES), dtype=torch.long)
@@ -222,9 +219,11 @@ def encode_many(
     holds = one.edge_attr[:, : len(PREDICATES)].expand(k, e, -1)
     valid = one.valid.expand(k, e, -1)
     goal_onehot = torch.nn.functional.one_hot(values, 3).float().reshape(k, e, -1)
-    edge_attr = torch.cat([holds, goal_onehot, valid.float(), asked], dim=2)
-    self_loop = (one.edge_index[0] == one.edge_index[1]).expand(k, e)
-    active = self_loop | (holds.sum(2) > 0) | (values != DONT_CARE).any(2) | (asked.sum(2) > 0)
+    parts = [holds, goal_onehot, valid.float(), asked]
+    if features == "geometry":
+        parts.append(one.edge_attr[:, _FIXTURE_COL:].expand(k, e, -1))
+    edge_attr = torch.cat(parts, dim=2)
+    active = one.active.expand(k, e) | (values != DONT_CARE).any(2) | (asked.sum(2) > 0)
     offsets = (torch.arange(k) * n).repeat_interleave(e)
     return Data(
         x=one.x.repeat(k, 1),
@@ -247,51 +246,64 @@ def encode_many(
 _GOAL_COL = len(PREDICATES)  # edge_attr columns: holds, goal one-hot (3 per predicate), valid,
 _VALID_COL = 4 * len(PREDICATES)  # query
 _QUERY_COL = 5 * len(PREDICATES)
+_FIXTURE_COL = 6 * len(PREDICATES)  # "geometry" only
 
 
 @dataclass(frozen=True)
 class _Template:
     """What every graph over one node list shares, as numpy arrays."""
 
-    x: np.ndarray  # [N, NODE_DIM] float32
-    attr: np.ndarray  # [E, EDGE_DIM] float32: no literal holds, don't care everywhere, no query
+    x: np.ndarray  # [N, node_dim] float32
+    attr: np.ndarray  # [E, edge_dim] float32: no literal holds, don't care everywhere, no query
     self_loop: np.ndarray  # [E] bool
     edge_index: np.ndarray  # [2, E] int64
-    touching: np.ndarray  # [N, E] bool: the edges from or to node i
 
 
 @cache
-def _template(nodes: tuple[str, ...]) -> _Template:
-    x, edge_index = _layout(nodes)
+def _template(nodes: tuple[str, ...], world: World, features: str) -> _Template:
     n, e = len(nodes), len(nodes) ** 2
-    attr = np.zeros((e, EDGE_DIM), dtype=np.float32)
+    attr = np.zeros((e, edge_dim(features)), dtype=np.float32)
     attr[:, _GOAL_COL:_VALID_COL:3] = 1.0  # DONT_CARE's one-hot
-    attr[:, _VALID_COL:_QUERY_COL] = _valid_mask(nodes).numpy()
-    src, dst = edge_index.numpy()
-    nodes_i = np.arange(n)[:, None]
-    touching = (src[None] == nodes_i) | (dst[None] == nodes_i)
-    return _Template(x.numpy(), attr, src == dst, edge_index.numpy(), touching)
+    attr[:, _VALID_COL:_QUERY_COL] = valid_mask(nodes, world).numpy()
+    if features == "geometry":
+        attr[:, _FIXTURE_COL:] = fixture_edges(nodes, world).numpy()
+    edge_index = _edge_index(n).numpy()
+    x = node_features(nodes, world, features).numpy()
+    return _Template(x, attr, edge_index[0] == edge_index[1], edge_index)
+
+
+@cache
+def _touching(nodes: tuple[str, ...]) -> np.ndarray:
+    """[N, E] bool: the edges from or to node i."""
+    src, dst = _edge_index(len(nodes)).numpy()
+    nodes_i = np.arange(len(nodes))[:, None]
+    return (src[None] == nodes_i) | (dst[None] == nodes_i)
 
 
 @lru_cache(maxsize=256)
-def _batch(nodes: tuple[str, ...], k: int) -> tuple[torch.Tensor, np.ndarray, torch.Tensor]:
-    """[K N, NODE_DIM] node features, [2, K E] edge index and [K N] graph of each node, of K
+def _batch(
+    nodes: tuple[str, ...], world: World, features: str, k: int
+) -> tuple[torch.Tensor, np.ndarray, torch.Tensor]:
+    """[K N, node_dim] node features, [2, K E] edge index and [K N] graph of each node, of K
     graphs (read only, shared)."""
-    t = _template(nodes)
+    t = _template(nodes, world, features)
     offsets = np.repeat(np.arange(k) * len(nodes), len(nodes) ** 2)
     batch = torch.arange(k).repeat_interleave(len(nodes))
     return torch.from_numpy(np.tile(t.x, (k, 1))), np.tile(t.edge_index, k) + offsets, batch
 
 
 @lru_cache(maxsize=4)
-def _state_edges(state: SymbolicSceneGraph) -> tuple[np.ndarray, np.ndarray]:
-    """[E, EDGE_DIM] features of the state with no goal and no query, and [E] active edges."""
-    t = _template(state.nodes)
+def _state_edges(
+    state: SymbolicSceneGraph, world: World, features: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """[E, edge_dim] features of the state with no goal and no query, and [E] active edges
+    (`world` keys the cache: states of two worlds with the same literals compare equal)."""
+    t = _template(state.nodes, world, features)
     slots = Slots.of(state.nodes)
     attr = t.attr.copy()
     for lit in state.literals:
         attr[slots.slot(lit)] = 1.0
-    return attr, t.self_loop | attr[:, :_GOAL_COL].any(1)
+    return attr, t.self_loop | attr[:, :_GOAL_COL].any(1) | attr[:, _FIXTURE_COL:].any(1)
 
 
 @lru_cache(maxsize=4096)
@@ -307,7 +319,7 @@ class Computed:
     """K (goal, query) graphs over one state, as the network computes them: only the edges that
     pass messages (active) or are read out, in batch order (graph k's edge e is k E + e).
 
-    Shapes: x [K N, NODE_DIM]; edge_index [2, M]; edge_attr [M, EDGE_DIM]; weight [M] (1 on
+    Shapes: x [K N, node_dim]; edge_index [2, M]; edge_attr [M, edge_dim]; weight [M] (1 on
     active edges, 0 on read-out-only ones); graph, edge [M] (which graph, which of its E edges);
     row [K E] (the row of graph k's edge e, -1 where it is not computed); batch [K N] (the
     graph of each node).
@@ -336,9 +348,9 @@ class Computed:
 def touching(nodes: tuple[str, ...], args: list[tuple[str, ...]]) -> np.ndarray:
     """[K, E] bool: the edges of graph k that start or end at one of the nodes args[k], a
     literal's arguments (one or two names)."""
-    t, index = _template(nodes), Slots.of(nodes)._index
+    near, index = _touching(nodes), Slots.of(nodes)._index
     first, last = [index[a[0]] for a in args], [index[a[-1]] for a in args]
-    return t.touching[first] | t.touching[last]
+    return near[first] | near[last]
 
 
 def encode_computed(
@@ -346,14 +358,15 @@ def encode_computed(
     goals: list[frozenset[Literal]],
     queries: list[Literal | None],
     readout: np.ndarray | None = None,
+    features: str = "names",
 ) -> Computed:
-    """`encode_many(state, goals, [[q] for q in queries])` with the `readout` edges ([K, E]
-    bool) read out, cut to what the network computes (see `EdgeClassifier.forward`)."""
+    """`encode_many(state, goals, [[q] for q in queries], features)` with the `readout` edges
+    ([K, E] bool) read out, cut to what the network computes (see `EdgeClassifier.forward`)."""
     nodes = state.nodes
     slots = Slots.of(nodes)
-    base, base_active = _state_edges(state)
+    base, base_active = _state_edges(state, state.world, features)
     k, e = len(goals), len(nodes) ** 2
-    x, edge_index, batch = _batch(nodes, k)
+    x, edge_index, batch = _batch(nodes, state.world, features, k)
     goal = [_goal_slots(nodes, g) for g in goals]
     ge, gp, gv = np.concatenate(goal).T
     ge = ge + np.repeat(np.arange(0, k * e, e), [len(g) for g in goal])  # k E + e

@@ -33,8 +33,8 @@ from torch_geometric.data import Data
 
 from hsgplan.data.demos import Demo
 from hsgplan.data.world_trials import WorldTrial
-from hsgplan.domain.objects import EntityKind, kind_of
 from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.scene import EntityKind
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.planning.regression.augment import Trajectory, varied
 from hsgplan.planning.regression.encoding import DONT_CARE, FALSE, TRUE, Slots, encode
@@ -127,7 +127,7 @@ def _alterations(lit: Literal, state: SymbolicSceneGraph) -> set[Literal]:
         for x in state.nodes:
             if x != lit.args[0]:
                 out.add(Literal(Predicate.ON, (lit.args[0], x)))
-                if kind_of(x) is EntityKind.SHELF:
+                if state.world.kind_of(x) is EntityKind.SHELF:
                     out.add(Literal(Predicate.IN, (lit.args[0], x)))
     else:  # either unary predicate, of any object (grasping another while holding one, say)
         for o in objects:
@@ -143,7 +143,7 @@ def _other_predicates(lit: Literal, state: SymbolicSceneGraph) -> set[Literal]:
     if lit.predicate.arity == 2:
         a, x = lit.args
         out = {Literal(Predicate.ON, (a, x))}
-        if kind_of(x) is EntityKind.SHELF:
+        if state.world.kind_of(x) is EntityKind.SHELF:
             out.add(Literal(Predicate.IN, (a, x)))
     else:
         out = {Literal(p, lit.args) for p in (Predicate.IN_GRASP, Predicate.CLEAR)}

@@ -24,9 +24,11 @@ import numpy as np
 import torch
 
 from hsgplan.domain.actions import Action
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
+from hsgplan.domain.scene import World
 from hsgplan.planning.base import TaskDecision, push_after
 from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.encoding import (
@@ -47,8 +49,9 @@ MAX_DEPTH = 8
 GIVE_UP_AFTER = 2
 
 
-def _decision(action: Action, subgoal: Literal, start: float) -> TaskDecision:
-    return TaskDecision(action, subgoal, time.perf_counter() - start, following=push_after(action))
+def _decision(action: Action, subgoal: Literal, start: float, world: World) -> TaskDecision:
+    seconds = time.perf_counter() - start
+    return TaskDecision(action, subgoal, seconds, following=push_after(action, world))
 
 
 def _given_up(failures: Counter[Action] | None) -> set[Action]:
@@ -126,6 +129,12 @@ class RegressionPlanner:
         rules: RecoveryRules = ALL_RULES,
     ) -> None:
         self.preimage, self.reach = _inference_networks(str(checkpoint))
+        self.features = self.preimage.config.features
+        if self.reach.config.features != self.features:
+            raise InvalidInputError(
+                f"'{checkpoint}': f_preimage reads {self.features} and f_reach "
+                f"{self.reach.config.features}; both must read the same"
+            )
         self.max_depth = max_depth
         self.rules = rules
         self.reset(None, seed)
@@ -144,7 +153,9 @@ class RegressionPlanner:
         # Read out the edges of the query's objects: a preimage names them (the active edges
         # are computed anyway).
         readout = touching(state.nodes, [n.lit.args for n in nodes])
-        batch = encode_computed(state, [n.context for n in nodes], [n.lit for n in nodes], readout)
+        batch = encode_computed(
+            state, [n.context for n in nodes], [n.lit for n in nodes], readout, self.features
+        )
         values = self.preimage.computed(*batch.inputs).argmax(-1).numpy()
         rows, preds = np.nonzero((values != DONT_CARE) & batch.valid)
         out: list[set[Literal]] = [set() for _ in nodes]
@@ -166,7 +177,12 @@ class RegressionPlanner:
     def reach_scores(self, state: SymbolicSceneGraph, lits: list[Literal]) -> list[float]:
         """f_reach's probability of "reachable" for each literal alone."""
         # each literal's slot is on an edge its own goal makes active, so it is computed
-        batch = encode_computed(state, [frozenset((lit,)) for lit in lits], [None] * len(lits))
+        batch = encode_computed(
+            state,
+            [frozenset((lit,)) for lit in lits],
+            [None] * len(lits),
+            features=self.features,
+        )
         slots = Slots.of(state.nodes)
         e = len(state.nodes) ** 2
         where = [slots.slot(lit) for lit in lits]
@@ -186,7 +202,7 @@ class RegressionPlanner:
         if (step := self._follow(state, goal, taken if rules.avoid_taken else ())) is not None:
             taken[step[1]] += 1
             self._last = (state, step[1], step[2])
-            return _decision(step[1], step[0], start)
+            return _decision(step[1], step[0], start, state.world)
         context = frozenset(goal.literals)
         roots = [_Node(lit, context, (lit,)) for lit in unsatisfied]
         preimages = self._preimages(state, roots)
@@ -230,7 +246,7 @@ class RegressionPlanner:
         taken[action] += 1
         self._plan = (goal, list(reversed(node.chain)), node.path[0])
         self._last = (state, action, node.path[0])
-        return _decision(action, node.lit, start)
+        return _decision(action, node.lit, start, state.world)
 
     def _follow(self, state, goal, avoid) -> tuple[Literal, Action, Literal] | None:
         """The next step up the kept chain, if its preimage holds now, and the chain's root."""
@@ -337,7 +353,7 @@ class ForwardPlanner:
         start = time.perf_counter()
         if goal.satisfied_by(state):
             return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
-        data = encode(state, goal.literals)
+        data = encode(state, goal.literals, features=self.net.config.features)
         probs = self.net(data).softmax(-1)[..., TRUE].masked_fill(~data.valid, 0.0)
         slots = Slots(tuple(data.names))
         ranked = []
@@ -356,4 +372,4 @@ class ForwardPlanner:
         lit, action = fresh[0]
         taken.add(action)
         self._last = (state, action)
-        return _decision(action, lit, start)
+        return _decision(action, lit, start, state.world)

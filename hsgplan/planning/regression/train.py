@@ -25,10 +25,11 @@ from hsgplan.checkpoint import fingerprint
 from hsgplan.data.world_trials import load_world_trials
 from hsgplan.domain.checks import BOUNDS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.world import KITCHEN
 from hsgplan.files import write_atomically
 from hsgplan.paths import DEMOS, REACH_DATA, shipped
 from hsgplan.planning.regression.augment import trajectories
-from hsgplan.planning.regression.encoding import EDGE_DIM, NODE_DIM
+from hsgplan.planning.regression.encoding import with_features
 from hsgplan.planning.regression.examples import (
     Example,
     forward_examples,
@@ -36,6 +37,7 @@ from hsgplan.planning.regression.examples import (
     preimage_examples,
     world_reach_examples,
 )
+from hsgplan.planning.regression.features import check_features, edge_dim, node_dim
 from hsgplan.planning.regression.gnn import (
     EdgeClassifier,
     EdgeClassifierConfig,
@@ -84,9 +86,13 @@ class TaskTrainConfig:
     # torch's threads: the graphs are small, and on 2 busy cores 2 threads trained f_preimage
     # about ten times slower than 1 (4.3 against 0.5 s an epoch on 36 demonstrations)
     threads: int = setting(1, **BOUNDS["workers"])
+    # what a node is to the networks (`features.FEATURES`): its name, as the paper's, or what
+    # the scene file says of it, so that the networks read scenes of other names
+    features: str = "names"
 
     def __post_init__(self) -> None:
         check_fields(self)
+        check_features(self.features)
         if self.reach not in REACH_SOURCES:
             raise InvalidInputError(f"reach {self.reach!r}: one of {', '.join(REACH_SOURCES)}")
 
@@ -180,18 +186,19 @@ def _train_one(
         return  # finished earlier
     torch.manual_seed(config.seed)
     net_config = EdgeClassifierConfig(
-        NODE_DIM,
-        EDGE_DIM,
+        node_dim(config.features),
+        edge_dim(config.features),
         4,
         classes,
         config.hidden,
         config.rounds,
         name == "reach" and config.reach_pool,
+        config.features,
     )
     model = EdgeClassifier(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start = training.resume(folder, model, optim, data)
-    graphs = [e.as_data() for e in examples]
+    graphs = [with_features(e.as_data(), KITCHEN, config.features) for e in examples]
     epochs = config.reach_epochs if name == "reach" and config.reach_epochs else config.epochs
     for epoch in range(start, epochs):
         rng = random.Random(f"{config.seed}-{name}-{epoch}")
