@@ -15,6 +15,7 @@ from hsgplan.cli.common import (
     CollectWorkers,
     MarkdownFlag,
     RayAddress,
+    SceneFiles,
     bounded_option,
     check_ray,
     err,
@@ -117,9 +118,11 @@ def eval_motion(
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
     markdown: MarkdownFlag = False,
+    scene: SceneFiles = None,
 ) -> None:
     """Single-shot success of the GNN, the MLP and Random on fresh random scenes (never the
     training scenes), per primitive and crowding level; every model sees the same scenes."""
+    from hsgplan.domain.scene_file import read_worlds
     from hsgplan.evaluation.motion_eval import LABELS, MODELS, evaluate_motion
 
     kinds = [p.strip() for p in primitives.split(",")]
@@ -127,7 +130,8 @@ def eval_motion(
         raise InvalidInputError(f"--primitives '{primitives}': name place, push or both, each once")
     check_ray(ray)
     with Progress(console=err, transient=True) as progress:
-        bar = progress.add_task("scenes", total=trials * len(kinds))
+        worlds = len(read_worlds(scene)) if scene else 1
+        bar = progress.add_task("scenes", total=trials * len(kinds) * worlds)
         report = evaluate_motion(
             kinds,
             trials,
@@ -137,6 +141,7 @@ def eval_motion(
             lambda: progress.advance(bar),
             run_dir,
             ray,
+            scene,
         )
     if as_json:
         print(json.dumps(report, indent=2))
@@ -156,7 +161,8 @@ def eval_motion(
             n = next(r["trials"] for r in found if r is not None)
             rows.append((kind, label, str(n), *cells))
     print_table(
-        f"Single-shot motion success on fresh scenes, seed {seed}",
+        f"Single-shot motion success on fresh scenes, seed {seed}"
+        + (f", in each scene of {scene}" if scene else ""),
         ("primitive", "crowding", "scenes", *(LABELS[m] for m in MODELS)),
         rows,
         markdown,

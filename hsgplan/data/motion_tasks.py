@@ -25,24 +25,17 @@ import random
 from dataclasses import dataclass
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import object_type, objects_for_types
+from hsgplan.domain.objects import objects_for_types
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.room import Room
-from hsgplan.domain.world import (
-    GOAL_INTERIOR,
-    INTERIOR_CAPACITY,
-    OBJECT_TYPES,
-    SHELVES,
-    SURFACE_CAPACITY,
-    SURFACES,
-    Kind,
-    fits_inside,
-)
+from hsgplan.domain.scene import Kind, World
+from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
-MIN_OBJECTS, MAX_SCENE_OBJECTS = 2, len(OBJECT_TYPES)
-PUSH_SHELF = GOAL_INTERIOR  # the task domain pushes only to fill the goals' interior
+# at most one object of each type; pushes go only into the goals' interior (`goal_interior`),
+# as the task domain pushes only to fill it
+MIN_OBJECTS = 2
 P_STACK = 0.25  # chance that an object left to place goes on top of a bare one
 P_FELL_SHORT = 0.3  # chance that a pushed can starts where a short push left it
 # m the can's centre stands short of the interior's front: from just short of where f_m calls
@@ -82,52 +75,56 @@ class MotionTask:
         return inside(self.obj, self.target)
 
 
-def draw_task(primitive: MotionPrimitive, seed: int, index: int) -> MotionTask:
-    """The task at `index` of the stream for `(primitive, seed)`."""
+def draw_task(
+    primitive: MotionPrimitive, seed: int, index: int, world: World = KITCHEN
+) -> MotionTask:
+    """The task at `index` of the stream for `(primitive, seed)`, in `world`."""
     if index < 0:
         raise InvalidInputError(f"task index {index} cannot be negative")
     rng = random.Random(f"motion-{primitive.value}-{seed}-{index}")
     if primitive is MotionPrimitive.PLACE:
-        return _draw_place(rng, seed, index)
-    return _draw_push(rng, seed, index)
+        return _draw_place(rng, seed, index, world)
+    return _draw_push(rng, seed, index, world)
 
 
-def _draw_place(rng: random.Random, seed: int, index: int) -> MotionTask:
-    objects = _objects(rng)
+def _draw_place(rng: random.Random, seed: int, index: int, world: World) -> MotionTask:
+    objects = _objects(rng, world)
     obj = rng.choice(objects)
-    target = rng.choice(SURFACES)
+    target = rng.choice(world.surfaces)
     others = [o for o in objects if o != obj]
-    crowding = rng.randint(0, min(SURFACE_CAPACITY[target] - 1, len(others)))
+    crowding = rng.randint(0, min(world.surface_capacity[target] - 1, len(others)))
     rng.shuffle(others)
     literals = [in_grasp(obj)]
-    literals += _arrange(others[:crowding], others[crowding:], target, rng, keep_off=target)
-    state = SymbolicSceneGraph.from_literals(objects, literals)
+    literals += _arrange(others[:crowding], others[crowding:], target, rng, world, keep_off=target)
+    state = SymbolicSceneGraph.from_literals(objects, literals, world=world)
     return MotionTask(MotionPrimitive.PLACE, seed, index, obj, target, crowding, state)
 
 
-def _draw_push(rng: random.Random, seed: int, index: int) -> MotionTask:
-    cans = [t for t, k in OBJECT_TYPES.items() if k.kind is Kind.CAN and fits_inside(t, PUSH_SHELF)]
+def _draw_push(rng: random.Random, seed: int, index: int, world: World) -> MotionTask:
+    shelf = world.goal_interior
+    types = world.object_types
+    cans = [t for t, k in types.items() if k.kind is Kind.CAN and world.fits_inside(t, shelf)]
     obj = rng.choice(cans)
-    rest = [t for t in OBJECT_TYPES if t != obj]
-    chosen = [obj] + rng.sample(rest, rng.randint(MIN_OBJECTS, MAX_SCENE_OBJECTS) - 1)
-    objects = objects_for_types(chosen)
+    rest = [t for t in types if t != obj]
+    chosen = [obj] + rng.sample(rest, rng.randint(MIN_OBJECTS, len(types)) - 1)
+    objects = objects_for_types(chosen, world)
     others = [o for o in objects if o != obj]
     rng.shuffle(others)
-    fitting = [o for o in others if object_type(o).name in cans]
-    crowding = rng.randint(0, min(INTERIOR_CAPACITY[PUSH_SHELF] - 1, len(fitting)))
+    fitting = [o for o in others if world.object_type(o).name in cans]
+    crowding = rng.randint(0, min(world.interior_capacity[shelf] - 1, len(fitting)))
     inside_now = fitting[:crowding]
-    prepush = SHELVES[PUSH_SHELF].prepush
-    literals = [on(obj, prepush)] + [inside(o, PUSH_SHELF) for o in inside_now]
+    prepush = world.shelves[shelf].prepush
+    literals = [on(obj, prepush)] + [inside(o, shelf) for o in inside_now]
     left = [o for o in others if o not in inside_now]
-    literals += _arrange([], left, prepush, rng, taken={prepush: 1})
-    state = SymbolicSceneGraph.from_literals(objects, literals)
+    literals += _arrange([], left, prepush, rng, world, taken={prepush: 1})
+    state = SymbolicSceneGraph.from_literals(objects, literals, world=world)
     gap = rng.uniform(*FRONT_GAPS) if rng.random() < P_FELL_SHORT else None
-    return MotionTask(MotionPrimitive.PUSH, seed, index, obj, PUSH_SHELF, crowding, state, gap)
+    return MotionTask(MotionPrimitive.PUSH, seed, index, obj, shelf, crowding, state, gap)
 
 
-def _objects(rng: random.Random) -> list[str]:
-    n = rng.randint(MIN_OBJECTS, MAX_SCENE_OBJECTS)
-    return list(objects_for_types(rng.sample(list(OBJECT_TYPES), n)))
+def _objects(rng: random.Random, world: World) -> list[str]:
+    n = rng.randint(MIN_OBJECTS, len(world.object_types))
+    return list(objects_for_types(rng.sample(list(world.object_types), n), world))
 
 
 def _arrange(
@@ -135,12 +132,13 @@ def _arrange(
     elsewhere: list[str],
     target: str,
     rng: random.Random,
+    world: World,
     keep_off: str | None = None,
     taken: dict[str, int] | None = None,
 ) -> list[Literal]:
     """On-literals for objects: `on_target` on the target surface, then `elsewhere` on any
     other surface with room or (with `P_STACK`) on a bare object, towers within their limit."""
-    room = Room.left(interiors=(), on_top=taken)
+    room = Room.left(interiors=(), on_top=taken, world=world)
     literals = []
 
     def put(o: str, where: str) -> None:

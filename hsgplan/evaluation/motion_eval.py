@@ -1,7 +1,9 @@
 """`hsgplan eval motion`: single-shot success of each motion model on fresh scenes.
 
 Scenes come from the same generator as the training data but from another stream
-(`EVAL_STREAM + seed`), so no evaluation scene is a training scene. In every staged scene each
+(`EVAL_STREAM + seed`), so no evaluation scene is a training scene. With scene files, each
+world gets the same task indices; a model whose networks know the kitchen's names is left out
+of a world that names others (the GNN is then refused). In every staged scene each
 model proposes its best bin pair once, and that primitive is executed from the same saved
 state: the models are compared on identical scenes.
 """
@@ -18,7 +20,10 @@ from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import stage_task, try_params
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
-from hsgplan.domain.world import SHELVES
+from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import read_worlds
+from hsgplan.domain.world import KITCHEN
+from hsgplan.evaluation.config import world_of_file
 from hsgplan.paths import shipped
 from hsgplan.runner.items import run_items
 from hsgplan.sim.scene import Scene
@@ -52,21 +57,35 @@ CHUNK = 8
 CROWDED = 2  # a shelf top with this many of its 4 cells taken counts as crowded
 
 
-def _learned(kind: MotionPrimitive, checkpoints: Path) -> dict:
-    """The trained models for a primitive, loaded once (optional ones where they exist)."""
+def _learned(
+    kind: MotionPrimitive, checkpoints: Path, world: World = KITCHEN, scene: str | None = None
+) -> dict:
+    """The trained models for a primitive, loaded once (optional ones where they exist and
+    read `world`'s names)."""
+    from hsgplan.agents.registry import check_reads
     from hsgplan.motion.generator import LearnedMotion
 
     out = {}
     checkpoints = shipped(checkpoints)
     for name, folder in FOLDERS.items():
         path = checkpoints / f"{kind.value}-{folder}"
-        if name not in OPTIONAL or path.exists():
-            out[name] = LearnedMotion(name, {kind: path})
+        if name in OPTIONAL and not path.exists():
+            continue
+        try:
+            check_reads([path], world, scene)
+        except InvalidInputError:
+            if name in OPTIONAL:
+                continue
+            raise
+        out[name] = LearnedMotion(name, {kind: path})
     return out
 
 
-def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> list[dict]:
-    """Every model once in each staged scene of tasks start..start+CHUNK-1 (a worker's job)."""
+def run_eval_chunk(
+    primitive: str, seed: int, start: int, checkpoints: str, scene: str | None = None
+) -> list[dict]:
+    """Every model once in each staged scene of tasks start..start+CHUNK-1, in the world of the
+    scene file `scene` (None: the kitchen); a worker's job."""
     import torch
 
     torch.set_num_threads(1)  # one process per core already
@@ -74,26 +93,27 @@ def run_eval_chunk(primitive: str, seed: int, start: int, checkpoints: str) -> l
     rows = []
     from hsgplan.motion.generator import RandomMotion
 
-    learned = _learned(kind, Path(checkpoints))
+    world = world_of_file(scene) if scene else KITCHEN
+    learned = _learned(kind, Path(checkpoints), world, scene)
     for index in range(start, start + CHUNK):
-        task = draw_task(kind, EVAL_STREAM + seed, index)
+        task = draw_task(kind, EVAL_STREAM + seed, index, world)
         # Random draws from its own seed per task, so chunking cannot change its choices.
         generators = learned | {"random": RandomMotion(seed * 1_000_003 + index)}
         for name in generators:
             # A fresh scene per model: a restored physics state still carries the solver's
             # contact caches, so one model's trial would nudge the next one's outcome.
-            with Scene((), seed=seed, visuals=False) as scene:
-                staged = stage_task(scene, task)
+            with Scene((), seed=seed, visuals=False, world=world) as sim:
+                staged = stage_task(sim, task)
                 if staged is None:
                     break
                 params = generators[name].ranked(staged.before, task.subgoal)[0]
-                outcome = try_params(scene, staged, params)
+                outcome = try_params(sim, staged, params)
             rows.append(
                 {
                     "task": index,
                     "model": name,
                     "crowding": task.crowding,
-                    "shelf_top": task.target in SHELVES and kind is MotionPrimitive.PLACE,
+                    "shelf_top": task.target in world.shelves and kind is MotionPrimitive.PLACE,
                     "ok": outcome.ok,
                     "status": outcome.status.value,
                 }
@@ -131,14 +151,16 @@ class MotionChunk:
     seed: int
     start: int
     checkpoints: str
+    scene: str | None = None  # the scene file it runs in (None: the kitchen)
 
     @property
     def key(self) -> str:
-        return f"{self.primitive}/{self.start}"
+        where = f"{Path(self.scene).stem}/" if self.scene else ""
+        return f"{where}{self.primitive}/{self.start}"
 
 
 def run_motion_chunk(chunk: MotionChunk) -> list[dict]:
-    return run_eval_chunk(chunk.primitive, chunk.seed, chunk.start, chunk.checkpoints)
+    return run_eval_chunk(chunk.primitive, chunk.seed, chunk.start, chunk.checkpoints, chunk.scene)
 
 
 def evaluate_motion(
@@ -150,10 +172,12 @@ def evaluate_motion(
     progress: Callable[[], None] | None = None,
     run_dir: Path | None = None,
     ray: str | None = None,
+    scene: Path | None = None,
 ) -> dict:
     """`{primitive: {model: {"success_rate", "trials", "by_crowding", ...}}}` over the first
-    `trials` tasks of the evaluation stream (scenes that could not be staged are skipped).
-    With `run_dir`, finished chunks are kept there and a run started again skips them."""
+    `trials` tasks of the evaluation stream (scenes that could not be staged are skipped), in
+    the scene file `scene` or in each of a folder's (default: the kitchen), pooled. With
+    `run_dir`, finished chunks are kept there and a run started again skips them."""
     if trials < 1:
         raise InvalidInputError(f"--trials {trials}: need at least one")
     if not primitives:
@@ -163,9 +187,13 @@ def evaluate_motion(
         if p not in ("place", "push"):
             raise InvalidInputError(f"primitive '{p}': place or push")
         kinds.append(MotionPrimitive(p))
-        _learned(MotionPrimitive(p), checkpoints)  # refuse missing checkpoints before any work
+    worlds = {None: KITCHEN} if scene is None else read_worlds(scene)
+    for path, world in worlds.items():  # missing checkpoints, or names unread: before any work
+        for kind in kinds:
+            _learned(kind, checkpoints, world, path and str(path))
     chunks = [
-        MotionChunk(kind.value, seed, start, str(checkpoints))
+        MotionChunk(kind.value, seed, start, str(checkpoints), path and str(path))
+        for path in worlds
         for kind in kinds
         for start in range(0, trials, CHUNK)
     ]
@@ -186,8 +214,10 @@ def evaluate_motion(
             "seed": seed,
             "checkpoints": str(checkpoints),
             "fingerprint": fingerprint(
-                shipped(checkpoints) / f"{k.value}-{f}" for k in kinds for f in FOLDERS.values()
+                [shipped(checkpoints) / f"{k.value}-{f}" for k in kinds for f in FOLDERS.values()]
+                + [p for p in worlds if p is not None]
             ),
+            **({"scene": str(scene)} if scene else {}),
         },
         workers=workers,
         ray=ray,
@@ -205,7 +235,8 @@ def evaluate_motion(
         rows.sort(key=lambda r: (r["task"], MODELS.index(r["model"])))
         report[kind.value] = summarize(rows)
         for name, record in _trained_on(kind, checkpoints).items():
-            report[kind.value][name] |= asdict(record)
+            if name in report[kind.value]:  # left out where it cannot read the scene's names
+                report[kind.value][name] |= asdict(record)
     return report
 
 

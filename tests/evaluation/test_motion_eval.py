@@ -106,3 +106,22 @@ def test_eval_motion_resumes_from_its_run_folder(checkpoints, tmp_path):
     log.write_text(log.read_text() + '{"key": "place/8", "resu')  # a line cut short
     again = evaluate_motion(["place"], 3, 0, checkpoints, workers=1, run_dir=run)
     assert again == report and len(log.read_text().splitlines()) == 2  # read back, not rerun
+
+
+def test_a_network_of_geometry_features_is_measured_in_a_scene_of_new_objects(checkpoints):
+    from pathlib import Path
+
+    from hsgplan.domain.errors import InvalidInputError
+
+    scene = Path(__file__).parents[2] / "scenes/new-objects/new-objects-000.toml"
+    geometry = checkpoints.parent / "geometry"
+    config = MotionTrainConfig(
+        head="bins", loss="bce", data=str(checkpoints.parent / "data"), epochs=1, hidden=16,
+        embed=8, features="geometry",
+    )  # fmt: skip
+    train_motion(config, geometry / "place-gnn")
+    report = evaluate_motion(["place"], 1, 0, geometry, workers=1, scene=scene)
+    assert set(report["place"]) == {"gnn", "random"}
+    assert report["place"]["gnn"]["trials"] == report["place"]["random"]["trials"] == 1
+    with pytest.raises(InvalidInputError, match="know the kitchen's objects"):
+        evaluate_motion(["place"], 1, 0, checkpoints, workers=1, scene=scene)
