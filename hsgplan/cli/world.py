@@ -39,7 +39,7 @@ from hsgplan.cli.common import (
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import RecoveryRules
 from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
-from hsgplan.paths import RUNS, shipped
+from hsgplan.paths import MOTION_CHECKPOINTS, RUNS, TASK_CHECKPOINT, shipped
 from hsgplan.runner.run_folder import check_own
 
 # what each agent is: docs/cli.md, "Agents" (a test holds the two to the same names)
@@ -59,6 +59,18 @@ MotionOption = Annotated[
     typer.Option(
         help=f"Motion generator in place of the agent's: {', '.join(MotionName)}.",
         metavar="MOTION",
+    ),
+]
+
+
+TaskCheckpoint = Annotated[
+    Path | None,
+    typer.Option(help="Task planner checkpoint (default: the shipped one).", parser=input_path),
+]
+MotionCheckpoints = Annotated[
+    Path | None,
+    typer.Option(
+        help="Folder of motion networks, KIND-MODEL each (default: shipped).", parser=input_path
     ),
 ]
 
@@ -94,6 +106,8 @@ def demo(
         ),
     ] = None,
     scene: SceneOption = None,
+    checkpoint: TaskCheckpoint = None,
+    motion_checkpoints: MotionCheckpoints = None,
 ) -> None:
     """One episode in the simulated kitchen (or the world of --scene): a GIF, a scene-graph
     drawing per step, a record; with --rerun, a 3D recording for rerun's viewer."""
@@ -108,8 +122,12 @@ def demo(
 
     agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
     world = read_world(scene) if scene else KITCHEN
-    check_agent_world(agent, world, scene)
-    make_agent(agent)  # an unknown name or a missing checkpoint is refused before any work
+    folders = (
+        shipped(checkpoint) if checkpoint else TASK_CHECKPOINT,
+        shipped(motion_checkpoints) if motion_checkpoints else MOTION_CHECKPOINTS,
+    )
+    check_agent_world(agent, world, scene, *folders)
+    made = make_agent(agent, *folders)  # an unknown name or a missing checkpoint: before work
     observer = make_observer(
         perception.value, perception_checkpoint and shipped(perception_checkpoint)
     )
@@ -125,7 +143,7 @@ def demo(
         soft_wrap=True,
     )
     record = run_demo(
-        agent, g, seed, out_dir, on_step=_print_step, observer=observer, recording=rerun
+        made, g, seed, out_dir, on_step=_print_step, observer=observer, recording=rerun
     )
     verdict = "[green]success[/]" if record.success else f"[red]failed: {shown(record.failure)}[/]"
     out.print(
@@ -187,17 +205,8 @@ def evaluate(
     goals_file: Annotated[
         Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
     ] = None,
-    checkpoint: Annotated[
-        Path | None,
-        typer.Option(help="Task planner checkpoint (default: the shipped one).", parser=input_path),
-    ] = None,
-    motion_checkpoints: Annotated[
-        Path | None,
-        typer.Option(
-            help="Folder of motion networks, KIND-MODEL each (default: shipped).",
-            parser=input_path,
-        ),
-    ] = None,
+    checkpoint: TaskCheckpoint = None,
+    motion_checkpoints: MotionCheckpoints = None,
     perception: Annotated[
         str,
         typer.Option(
