@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from functools import cached_property
 
-from hsgplan.domain.errors import UnknownNameError
+from hsgplan.domain.errors import InvalidInputError, UnknownNameError
 
 
 class Kind(StrEnum):
@@ -35,6 +35,17 @@ class EntityKind(StrEnum):
 
 # A scene holds at most this many objects (instances are numbered up to it).
 MAX_OBJECTS = 12
+# What a learned network reads a scene by: "names" (one-hots over the kitchen's names, the
+# paper's) or "geometry" (what the scene file says of each node); see docs/scenes.md.
+FEATURES = ("names", "geometry")
+
+
+def check_features(features: str) -> None:
+    """Refuse, in one line, an encoding that is not one of FEATURES."""
+    if features not in FEATURES:
+        raise InvalidInputError(f"features '{features}': one of {', '.join(FEATURES)}")
+
+
 _INSTANCE = re.compile(r"^(?P<type>[a-z][a-z_]*?)(?:_(?P<k>[0-9]+))?$")
 
 

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from hsgplan.agents.registry import check_reads
 from hsgplan.checkpoint import fingerprint
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import stage_task, try_params
@@ -62,7 +63,6 @@ def _learned(
 ) -> dict:
     """The trained models for a primitive, loaded once (optional ones where they exist and
     read `world`'s names)."""
-    from hsgplan.agents.registry import check_reads
     from hsgplan.motion.generator import LearnedMotion
 
     out = {}
@@ -188,9 +188,11 @@ def evaluate_motion(
             raise InvalidInputError(f"primitive '{p}': place or push")
         kinds.append(MotionPrimitive(p))
     worlds = {None: KITCHEN} if scene is None else read_worlds(scene)
-    for path, world in worlds.items():  # missing checkpoints, or names unread: before any work
-        for kind in kinds:
-            _learned(kind, checkpoints, world, path and str(path))
+    for kind in kinds:  # missing checkpoints, or a GNN that cannot read a scene: before work
+        _learned(kind, checkpoints)
+        gnn = shipped(checkpoints) / f"{kind.value}-{FOLDERS['gnn']}"
+        for path, world in worlds.items():
+            check_reads([gnn], world, path and str(path))
     chunks = [
         MotionChunk(kind.value, seed, start, str(checkpoints), path and str(path))
         for path in worlds

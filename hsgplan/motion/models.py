@@ -45,7 +45,7 @@ class MotionNetConfig:
     # object (the GNN: `BinQueryHead`; the MLP: `FlatBinHead`, the same inputs in slots).
     head: str = "mlp"
     query_dim: int = QUERY_DIM
-    # what a node is (`grounding.FEATURES`): "names", the paper's one-hots over the kitchen's
+    # what a node is (`domain.scene.FEATURES`): "names", the paper's one-hots over the kitchen's
     # names, or "geometry" (kind, size, the role of its region), which reads any scene
     features: str = "names"
 

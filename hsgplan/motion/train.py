@@ -66,7 +66,7 @@ class MotionTrainConfig:
     # The share of the training scenes held out to choose the epoch: the weights kept are
     # those of the epoch with the lowest loss on them (0: train on all, keep the last epoch).
     validation: float = setting(0.0, lo=0, hi=0.5)
-    # what a node is (`grounding.FEATURES`): "names" (the paper's) or "geometry"
+    # what a node is (`domain.scene.FEATURES`): "names" (the paper's) or "geometry"
     features: str = "names"
 
     def __post_init__(self) -> None:

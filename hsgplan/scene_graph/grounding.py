@@ -43,7 +43,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import ENTITY_TYPES
 from hsgplan.domain.parameters import PUSH_LEAD, place_xy, push_values
 from hsgplan.domain.predicates import Literal, Predicate
-from hsgplan.domain.scene import Kind, World
+from hsgplan.domain.scene import Kind, World, check_features
 from hsgplan.domain.world import (
     OBJECT_TYPES,
     PLACE_BINS,
@@ -66,7 +66,6 @@ REGION_CLASSES: tuple[str, ...] = (
 NODE_DIM = len(TYPES) + len(REGION_CLASSES) + 1 + 3 + 2 + 3 + 3
 EDGE_DIM = 4
 SUBGOAL_DIM = len(ENTITY_TYPES) + len(TYPES)
-FEATURES = ("names", "geometry")
 KINDS = tuple(Kind)
 ROLES = ("region", "prepush", "top", "in", "held")
 TARGET_ROLES = ROLES[:4]
@@ -78,8 +77,7 @@ QUERY_DIM = 5
 
 def dims(features: str) -> tuple[int, int]:
     """(node, subgoal) feature widths of an encoding; InvalidInputError for an unknown one."""
-    if features not in FEATURES:
-        raise InvalidInputError(f"features '{features}': one of {', '.join(FEATURES)}")
+    check_features(features)
     if features == "names":
         return NODE_DIM, SUBGOAL_DIM
     return GEOMETRY_NODE_DIM, GEOMETRY_SUBGOAL_DIM

@@ -8,6 +8,7 @@ from torch_geometric.data import Batch
 
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.predicates import PREDICATES, Predicate, clear, in_grasp, inside, on
+from hsgplan.domain.scene import FEATURES
 from hsgplan.planning.regression.encoding import (
     DONT_CARE,
     FALSE,
@@ -19,7 +20,7 @@ from hsgplan.planning.regression.encoding import (
     encode_many,
     touching,
 )
-from hsgplan.planning.regression.features import FEATURES, edge_dim, node_dim
+from hsgplan.planning.regression.features import edge_dim, node_dim
 from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
 from hsgplan.symbolic.generator import random_goal, random_state
 

@@ -104,7 +104,7 @@ def encode(
     features: str = "names",
 ) -> Data:
     """The state, a goal (literals over the state's nodes) and a query within it, as a graph,
-    its nodes described by `features` (`features.FEATURES`).
+    its nodes described by `features` (`domain.scene.FEATURES`).
 
     Shapes:
         x: [N, node_dim(features)] (`features.node_features`).

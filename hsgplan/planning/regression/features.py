@@ -17,12 +17,10 @@ from functools import cache
 
 import torch
 
-from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.predicates import PREDICATES, Predicate
-from hsgplan.domain.scene import EntityKind, Kind, World
+from hsgplan.domain.scene import EntityKind, Kind, World, check_features
 from hsgplan.domain.world import KITCHEN
 
-FEATURES = ("names", "geometry")
 KINDS = tuple(EntityKind)
 OBJECT_KINDS = tuple(Kind)
 SCALE = 10.0  # metres to decimetres, so that sizes are of order one
@@ -30,11 +28,6 @@ ROOM_SCALE = 10.0  # objects a surface holds, scaled to order one
 # literal slots (state, goal's three values, valid, query per predicate); geometry adds one
 SLOT_DIM = 6 * len(PREDICATES)
 GEOMETRY_NODE_DIM = len(KINDS) + len(OBJECT_KINDS) + 3 + 1 + 2 + 2
-
-
-def check_features(features: str) -> None:
-    if features not in FEATURES:
-        raise InvalidInputError(f"features '{features}': one of {', '.join(FEATURES)}")
 
 
 def node_dim(features: str) -> int:

@@ -19,6 +19,7 @@ from torch_geometric.data import Data
 from torch_geometric.nn import MessagePassing
 
 from hsgplan.checkpoint import load_trained
+from hsgplan.domain.scene import FEATURES
 
 
 def graph_max(x: Tensor, batch: Tensor | None) -> Tensor:
@@ -127,7 +128,7 @@ class EdgeClassifierConfig:
     hidden: int = 256
     rounds: int = 3
     pool: bool = False  # max-pooled graph context in every layer (see `RelationalLayer`)
-    features: str = "names"  # what a node is (`features.FEATURES`), as the graphs are encoded
+    features: str = "names"  # what a node is (`domain.scene.FEATURES`), as the graphs are encoded
 
     def __post_init__(self) -> None:
         for name in ("node_dim", "edge_dim", "predicates", "hidden"):
@@ -139,8 +140,8 @@ class EdgeClassifierConfig:
             raise ValueError(f"rounds must be a non-negative integer, got {self.rounds!r}")
         if not isinstance(self.pool, bool):
             raise ValueError(f"pool must be true or false, got {self.pool!r}")
-        if self.features not in ("names", "geometry"):
-            raise ValueError(f"features must be names or geometry, got {self.features!r}")
+        if self.features not in FEATURES:
+            raise ValueError(f"features must be one of {FEATURES}, got {self.features!r}")
 
     def to_json(self) -> dict:
         return asdict(self)

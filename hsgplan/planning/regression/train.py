@@ -86,7 +86,7 @@ class TaskTrainConfig:
     # torch's threads: the graphs are small, and on 2 busy cores 2 threads trained f_preimage
     # about ten times slower than 1 (4.3 against 0.5 s an epoch on 36 demonstrations)
     threads: int = setting(1, **BOUNDS["workers"])
-    # what a node is to the networks (`features.FEATURES`): its name, as the paper's, or what
+    # what a node is to the networks (`domain.scene.FEATURES`): its name, as the paper's, or what
     # the scene file says of it, so that the networks read scenes of other names
     features: str = "names"
 
