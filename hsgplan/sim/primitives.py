@@ -22,7 +22,7 @@ from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
 from hsgplan.sim.outcome import Outcome, Status, verify
 from hsgplan.sim.scene import TIME_STEP, Scene
 
-PUSH_SUBSTEPS = 3  # physics steps per 5 mm of push: 0.4 m/s (see README "Decisions")
+PUSH_SUBSTEPS = 3  # physics steps per 5 mm of push: 0.4 m/s (docs/decisions.md)
 
 Frame = Callable[[], None]
 

@@ -29,6 +29,7 @@ import resource
 import signal
 import sys
 import time
+import traceback
 
 
 def preload() -> None:
@@ -118,6 +119,11 @@ def serve(request: dict) -> dict:
     if pid == 0:
         try:
             _become_command(request)
+        except BaseException:
+            # onto the command's stderr, so that the case's record says what broke
+            with contextlib.suppress(BaseException):
+                traceback.print_exc()
+                sys.stderr.flush()
         finally:
             os._exit(70)  # never back into the server's loop, whatever happened
     deadline = start + float(request["timeout"])
