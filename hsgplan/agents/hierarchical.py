@@ -13,7 +13,7 @@ from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.predicates import in_grasp
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
-from hsgplan.motion.generator import Feasibility, MotionGenerator
+from hsgplan.motion.interface import Feasibility, MotionGenerator
 from hsgplan.planning.base import TaskPlanner
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph

@@ -22,7 +22,7 @@ from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
 if TYPE_CHECKING:  # the names are read by the CLI's --help, which should not load torch
     from hsgplan.agents.base import Agent
     from hsgplan.domain.scene import World
-    from hsgplan.motion.generator import MotionGenerator
+    from hsgplan.motion.interface import MotionGenerator
     from hsgplan.planning.base import TaskPlanner
 
 

@@ -24,7 +24,7 @@ from hsgplan.agents.base import Decision
 from hsgplan.domain.actions import Action, intended_literal
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
-from hsgplan.motion.generator import Feasibility
+from hsgplan.motion.interface import Feasibility
 from hsgplan.motion.sampler import candidates
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError, Plan
 from hsgplan.scene_graph.geometric import GeometricSceneGraph

@@ -27,7 +27,7 @@ from hsgplan.domain.actions import Action, intended_literal
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.predicates import Predicate
-from hsgplan.motion.generator import Feasibility
+from hsgplan.motion.interface import Feasibility
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.lookahead import Lookahead

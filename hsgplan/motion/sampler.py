@@ -31,7 +31,7 @@ from hsgplan.domain.world import (
     Rect,
     spot_cells,
 )
-from hsgplan.motion.generator import DO_NOT_RETRY, Feasibility, SingleShotMemory
+from hsgplan.motion.interface import DO_NOT_RETRY, Feasibility, SingleShotMemory
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.sim.outcome import Outcome
 
