@@ -266,7 +266,9 @@ class StreamWorld:
                 continue
             end = PoseValue(
                 start.obj,
-                interior.x_min + PUSH_DEPTH + extent_along(start.obj, start.yaw, 0.0),
+                interior.x_min
+                + PUSH_DEPTH
+                + extent_along(start.obj, start.yaw, 0.0, self.scene.world),
                 slot,
                 start.z,
                 start.yaw,

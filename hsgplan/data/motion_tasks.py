@@ -25,12 +25,12 @@ import random
 from dataclasses import dataclass
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import objects_for_types
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.room import Room
 from hsgplan.domain.scene import Kind, World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 # at most one object of each type; pushes go only into the goals' interior (`goal_interior`),

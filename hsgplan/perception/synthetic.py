@@ -19,6 +19,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import draw_objects, object_type
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.world import INTERIOR_CAPACITY, Kind
@@ -72,7 +73,7 @@ class ImageSample:
 
 def draw_state(rng: random.Random, p_elsewhere: float = P_ELSEWHERE) -> SymbolicSceneGraph:
     """A random arrangement of 2 to `MAX_OBJECTS` objects, some cans inside the shelves."""
-    objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng)
+    objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng, KITCHEN)
     state = random_state(objects, rng, p_elsewhere=p_elsewhere)
     inside_count = dict.fromkeys(INTERIOR_CAPACITY, 0)
     literals = []

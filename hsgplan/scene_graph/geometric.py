@@ -10,8 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.scene import ObjectType, World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometry import Pose
 
 if TYPE_CHECKING:

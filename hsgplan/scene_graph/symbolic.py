@@ -13,9 +13,9 @@ from typing import TYPE_CHECKING
 
 from hsgplan.domain.errors import InfeasibleError
 from hsgplan.domain.feasibility import check_literals
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import PREDICATES, Literal, Predicate, clear
 from hsgplan.domain.scene import OPEN_SPACE, EntityKind, World
-from hsgplan.domain.world import KITCHEN
 
 if TYPE_CHECKING:
     from torch_geometric.data import Data
@@ -189,7 +189,7 @@ class SymbolicSceneGraph:
     # --- consistency -------------------------------------------------------------------
 
     def _check(self, limits: bool) -> None:
-        check_literals(self.literals, limits, self.world)
+        check_literals(self.literals, limits, world=self.world)
         placed = {lit.subject for lit in self.literals if lit.predicate is not Predicate.CLEAR}
         missing = [o for o in self.objects if o not in placed]
         if missing:

@@ -15,9 +15,9 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PlaceParams
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive

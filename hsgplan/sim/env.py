@@ -27,9 +27,10 @@ import gymnasium
 import numpy as np
 
 from hsgplan.domain.goals import Goal, parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PrimitiveParams
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN, MAX_STEPS
+from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
 from hsgplan.sim.actuation import holds_something

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import (
     BINS,
     MotionPrimitive,
@@ -24,7 +25,7 @@ from hsgplan.domain.parameters import (
     PushParams,
 )
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import KITCHEN, MAX_OBJECTS, World
+from hsgplan.domain.world import MAX_OBJECTS, World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 

@@ -14,10 +14,11 @@ import math
 import random
 
 from hsgplan.domain.errors import UnsampledSceneError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import place_inset
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.scene import EntityKind
-from hsgplan.domain.world import KITCHEN, Kind, World, spot_cells
+from hsgplan.domain.world import Kind, World, spot_cells
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph

@@ -23,11 +23,11 @@ import random
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.feasibility import check_literals
 from hsgplan.domain.goals import Goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import Literal, inside, on
 from hsgplan.domain.room import Room
 from hsgplan.domain.scene import MAX_OBJECTS, OPEN_SPACE, Kind, World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MIN_OBJECTS = 2

@@ -17,10 +17,13 @@ from hsgplan.agents.stream import StreamAgent
 from hsgplan.agents.stream_problem import aim, initial_problem
 from hsgplan.domain.actions import Pick, Place, Push
 from hsgplan.domain.goals import Goal, parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
 
-GOAL = parse_goal("On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)")
+GOAL = parse_goal(
+    "On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN
+)
 
 
 def _problem(goal, seed=4, goal_stacks=False):
@@ -134,7 +137,7 @@ def test_a_goal_that_holds_needs_no_stream():
     _, info = env.reset(seed=4, options=ResetOptions(GOAL))
     obs = info["observation"]
     env.close()
-    holds = Goal(frozenset({obs.symbols.state.location("butter")}))
+    holds = Goal(frozenset({obs.symbols.state.location("butter")}), world=KITCHEN)
     found = FocusedPlanner().plan(obs.scene_graph, obs.symbols.state, holds, world=None)
     assert found.steps == () and found.levels == 0  # no world asked: no stream evaluated
 

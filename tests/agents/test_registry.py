@@ -14,6 +14,7 @@ from hsgplan.agents.registry import (
 from hsgplan.domain.actions import Pick, Place, Push
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams
 from hsgplan.domain.predicates import in_grasp, inside, on
 from hsgplan.motion.generator import RandomMotion
@@ -85,7 +86,7 @@ def test_the_agent_passes_the_subgoal_and_the_action_to_the_motion_level():
         TaskDecision(None, None, 0.004, "regression stuck"),
     ]
     agent = HierarchicalAgent("test", _Script(decisions), RandomMotion())
-    goal = parse_goal(f"On({obj}, shelf_a)")
+    goal = parse_goal(f"On({obj}, shelf_a)", world=KITCHEN)
     agent.reset(goal, 7)
     assert agent.planner.resets == [7]
     state = SymbolicSceneGraph.initial(sg.objects)
@@ -149,7 +150,7 @@ def test_a_push_with_no_parameters_left_takes_the_object_up_to_put_it_elsewhere(
     push = TaskDecision(Push(can, "shelf_a"), inside(can, "shelf_a"), 0.001)
     sampler = GeometricSampler()
     agent = HierarchicalAgent("test", _Script([push] * 12), sampler)
-    goal = parse_goal(f"In({can}, shelf_a)")
+    goal = parse_goal(f"In({can}, shelf_a)", world=KITCHEN)
     agent.reset(goal, 0)
     state = SymbolicSceneGraph.initial(standing.objects)
     tried = []
@@ -160,7 +161,7 @@ def test_a_push_with_no_parameters_left_takes_the_object_up_to_put_it_elsewhere(
     assert d.action == Pick(can) and d.params == PickParams(can) and d.subgoal == in_grasp(can)
     held = GeometricSceneGraph(standing.nodes, held=can)
     place = sampler.propose(held, Place(can, "prepush_a"), Push(can, "shelf_a"))
-    x, y = place_xy(can, "prepush_a", place.x_bin, place.y_bin)
+    x, y = place_xy(can, "prepush_a", place.x_bin, place.y_bin, world=KITCHEN)
     assert ((x - spot[0]) ** 2 + (y - spot[1]) ** 2) ** 0.5 >= AVOID_RADIUS
 
 
@@ -168,8 +169,8 @@ def test_checkpoints_that_know_names_are_refused_a_scene_of_other_names(tmp_path
     import json
 
     from hsgplan.agents.registry import check_reads
+    from hsgplan.domain.kitchen import KITCHEN
     from hsgplan.domain.layouts import random_layout
-    from hsgplan.domain.world import KITCHEN
 
     new = random_layout(KITCHEN, 0, 0, new_objects=True)
     task, motion = tmp_path / "task", tmp_path / "place-gnn"

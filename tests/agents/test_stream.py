@@ -19,6 +19,7 @@ from hsgplan.cli import app
 from hsgplan.domain.actions import Pick, Place, Push
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PushParams
 from hsgplan.domain.predicates import in_grasp, on
 from hsgplan.evaluation.episode import run_episode
@@ -54,7 +55,9 @@ def test_expected_state_moves_only_the_acting_object():
 
 
 def test_solves_a_three_object_goal():
-    goal = parse_goal("On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)")
+    goal = parse_goal(
+        "On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN
+    )
     record = run_episode(KitchenStorageEnv(), StreamAgent(), goal, seed=4)
     assert record.success, record.steps
     assert any(s.action.startswith("push(tomato_soup") for s in record.steps)
@@ -65,7 +68,7 @@ def test_solves_a_three_object_goal():
 
 
 def test_follows_its_plan_and_leaves_out_what_failed_in_that_scene():
-    goal = parse_goal("On(butter, shelf_b)")
+    goal = parse_goal("On(butter, shelf_b)", world=KITCHEN)
     env = KitchenStorageEnv()
     _, info = env.reset(seed=5, options=ResetOptions(goal))
     obs = info["observation"]
@@ -85,7 +88,7 @@ def test_follows_its_plan_and_leaves_out_what_failed_in_that_scene():
 
 
 def test_without_the_world_offers_nothing():
-    goal = parse_goal("On(butter, shelf_b)")
+    goal = parse_goal("On(butter, shelf_b)", world=KITCHEN)
     env = KitchenStorageEnv()
     _, info = env.reset(seed=3, options=ResetOptions(goal))
     obs = info["observation"]
@@ -115,7 +118,7 @@ def test_timing_refuses_an_unknown_baseline_in_one_line():
 
 
 def test_plans_a_push_from_a_prepush_pose():
-    goal = parse_goal("In(tomato_soup, shelf_a)")
+    goal = parse_goal("In(tomato_soup, shelf_a)", world=KITCHEN)
     env = KitchenStorageEnv()
     _, info = env.reset(seed=2, options=ResetOptions(goal))
     obs = info["observation"]
@@ -141,7 +144,9 @@ class _NoRobot:
 
 
 def test_goal_restricted_streams_stack_and_place_only_where_the_goal_leads():
-    goal = parse_goal("On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)")
+    goal = parse_goal(
+        "On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN
+    )
     env = KitchenStorageEnv()
     _, info = env.reset(seed=4, options=ResetOptions(goal))
     obs = info["observation"]

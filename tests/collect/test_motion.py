@@ -13,6 +13,7 @@ from hsgplan.collect.motion import CollectConfig, collect, work_folder
 from hsgplan.data import motion_store as store
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import SURFACE_CAPACITY
@@ -231,6 +232,6 @@ def test_some_push_tasks_start_where_a_short_push_leaves_the_can():
             assert staged is not None
             x = staged.before.node(task.obj).pose.position[0]
             assert x == pytest.approx(front - task.front_gap, abs=0.005)
-            farthest_place = place_xy(task.obj, "prepush_a", PLACE_BINS - 1, 0)[0]
+            farthest_place = place_xy(task.obj, "prepush_a", PLACE_BINS - 1, 0, world=KITCHEN)[0]
             assert x > farthest_place
             release(scene, staged)

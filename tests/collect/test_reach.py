@@ -23,6 +23,7 @@ from hsgplan.collect.reach import (
 )
 from hsgplan.data.world_trials import load_world_trials, trials_of
 from hsgplan.domain.actions import Pick, Place, Push
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import in_grasp, on
 from hsgplan.domain.world import INTERIOR_CAPACITY, SHELVES, SURFACE_CAPACITY
 from hsgplan.planning.heuristic import action_for, candidate_literals
@@ -85,7 +86,7 @@ def test_the_world_refuses_a_pick_while_the_hand_holds_another_object():
     actions = [Place("butter", "open_space"), Pick("cherries"), Push("cherries", "shelf_a")]
     with Scene(()) as scene:
         row = run_trials(scene, state, actions, random.Random(0))
-    placed, pick, push = trials_of(row)
+    placed, pick, push = trials_of(row, world=KITCHEN)
     assert placed.status == "success" and placed.after.holds(on("butter", "open_space"))
     assert pick.status == push.status == "invalid" and pick.after == push.after == state
 
@@ -122,7 +123,7 @@ def test_the_collector_never_asks_the_transition_model(monkeypatch):
         rows = [run_reach_item(ReachItem(1, i)) for i in range(2)]
     finally:
         sys.setprofile(None)
-    assert calls == [] and sum(len(trials_of(r)) for r in rows) > 0
+    assert calls == [] and sum(len(trials_of(r, world=KITCHEN)) for r in rows) > 0
 
 
 @pytest.mark.slow
@@ -134,7 +135,7 @@ def test_collect_reach_end_to_end_and_a_rerun_repeats_nothing(tmp_path):
     assert "; 2 run now" in r.stdout
     lines = (out / "episodes.jsonl").read_text().splitlines()
     assert sorted(json.loads(x)["key"] for x in lines) == ["0/0", "0/1"]
-    trials = load_world_trials(out)
+    trials = load_world_trials(out, world=KITCHEN)
     assert 0 < len(trials) <= 2 * ACTIONS_PER_STATE
     assert f"{len(trials)} primitives executed" in r.stdout
     r = CliRunner().invoke(app, args)

@@ -1,6 +1,7 @@
 import pytest
 
 from hsgplan.domain.errors import UnknownNameError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import (
     EntityKind,
     instance_name,
@@ -12,8 +13,8 @@ from hsgplan.domain.objects import (
 
 
 def test_instance_names():
-    assert instance_name("cherries", 1) == "cherries"
-    assert instance_name("cherries", 3) == "cherries_3"
+    assert instance_name("cherries", 1, world=KITCHEN) == "cherries"
+    assert instance_name("cherries", 3, world=KITCHEN) == "cherries_3"
     assert split_instance("cherries_3") == ("cherries", 3)
     assert split_instance("alphabet_soup") == ("alphabet_soup", 1)
     assert split_instance("alphabet_soup_12") == ("alphabet_soup", 12)
@@ -34,6 +35,8 @@ def test_kinds():
 
 
 def test_duplicates_are_numbered_in_order_and_sorted_canonically():
-    names = objects_for_types(["butter", "cherries", "butter", "cherries", "cherries"])
+    names = objects_for_types(
+        ["butter", "cherries", "butter", "cherries", "cherries"], world=KITCHEN
+    )
     assert names == ("butter", "cherries", "butter_2", "cherries_2", "cherries_3")
     assert sort_objects(names) == ("cherries", "cherries_2", "cherries_3", "butter", "butter_2")

@@ -8,6 +8,7 @@ import pytest
 from hsgplan.agents.base import Decision
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.domain.recovery import PERCEPTION_RULES, RecoveryRules
 from hsgplan.evaluation.config import EvalConfig
@@ -16,7 +17,7 @@ from hsgplan.evaluation.protocol import run_config
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, failure_class
 from hsgplan.sim.env import KitchenStorageEnv
 
-GOAL = parse_goal("On(butter, shelf_a) & On(popcorn, shelf_b)")
+GOAL = parse_goal("On(butter, shelf_a) & On(popcorn, shelf_b)", world=KITCHEN)
 
 
 class PicksAbsentObject:

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.recording import EpisodeRecording
 from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.detection import Detection
@@ -60,7 +61,7 @@ def _untimed(record) -> dict:
 def test_an_episode_recorded_holds_truth_belief_robot_cameras_and_every_step(tmp_path):
     from hsgplan.evaluation.demo import run_demo
 
-    goal = parse_goal(GOAL)
+    goal = parse_goal(GOAL, world=KITCHEN)
     kw = {"scale": 0.25, "frame_every": 1000}
     rrd = tmp_path / "rec" / "episode.rrd"
     recorded = run_demo("oracle", goal, 4, tmp_path / "rec", recording=rrd, **kw)

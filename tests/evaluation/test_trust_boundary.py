@@ -5,12 +5,13 @@ import pytest
 
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.evaluation.observers import make_observer
 from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
 from hsgplan.sim.outcome import Status
 
-GOAL = parse_goal("On(butter, shelf_a) & On(tomato_soup, shelf_b)")
+GOAL = parse_goal("On(butter, shelf_a) & On(tomato_soup, shelf_b)", world=KITCHEN)
 SEED = 3
 
 

@@ -12,6 +12,7 @@ import torch
 
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import type_of
 from hsgplan.domain.parameters import PickParams
 from hsgplan.domain.world import OBJECT_TYPES
@@ -136,7 +137,7 @@ def _watched_env(**kwargs) -> tuple[KitchenStorageEnv, _Watching]:
 
 def test_the_loop_runs_on_what_the_cameras_make_of_the_scene_and_is_judged_on_the_truth():
     env, observer = _watched_env()
-    goal = parse_goal("On(butter, shelf_b) & On(cherries, butter)")
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, butter)", world=KITCHEN)
     record = run_episode(env, make_agent("oracle"), goal, seed=4)
     assert record.observer == "rgb"
     assert record.success and record.failure is None, record.steps
@@ -197,7 +198,7 @@ def test_an_object_no_view_has_found_has_no_pose_and_ends_the_episode_as_never_s
     observer = Blind(PoseEstimator(_SceneMaps()))
     env = KitchenStorageEnv(observer=observer)
     observer.env = env
-    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)")
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)", world=KITCHEN)
     record = run_episode(env, make_agent("oracle"), goal, seed=4)
     assert record.failure == Failure.NEVER_SEEN and record.steps == ()
 
@@ -247,7 +248,9 @@ def test_a_goal_only_seen_reached_is_a_failure_of_perception():
             return Seen(GeometricSceneGraph.from_poses(poses, held=sg.held))
 
     env = KitchenStorageEnv(observer=Fooled())
-    record = run_episode(env, make_agent("oracle"), parse_goal("On(cherries, butter)"), seed=4)
+    record = run_episode(
+        env, make_agent("oracle"), parse_goal("On(cherries, butter)", world=KITCHEN), seed=4
+    )
     assert record.observer == "fooled" and record.steps == ()
     assert not record.success and record.failure == Failure.MISPERCEIVED
     assert record.subgoal_completion == 0.0
@@ -373,7 +376,7 @@ def test_an_uncertain_object_is_looked_at_again_from_out_of_the_way_unless_the_r
     observer = _Unsure(PoseEstimator(_SceneMaps()))
     env = KitchenStorageEnv(observer=observer, relook=relook)
     observer.env = env
-    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)")
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)", world=KITCHEN)
     record = run_episode(env, make_agent("oracle"), goal, seed=4)
     assert record.success, record.steps
     looks = sum(s.relooks for s in record.steps)

@@ -7,6 +7,7 @@ import torch
 from torch_geometric.data import Batch
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import PREDICATES, Predicate, clear, in_grasp, inside, on
 from hsgplan.domain.scene import FEATURES
 from hsgplan.planning.regression.encoding import (
@@ -33,7 +34,9 @@ def scene():
 
 def test_shapes_and_one_slot_per_literal():
     s = scene()
-    data = encode(s, parse_goal("In(cherries, shelf_a) & not Clear(butter)").literals)
+    data = encode(
+        s, parse_goal("In(cherries, shelf_a) & not Clear(butter)", world=KITCHEN).literals
+    )
     n = 2 + len(FIXTURES)
     assert data.x.shape == (n, node_dim("names"))
     assert data.edge_index.shape == (2, n * n)
@@ -50,7 +53,9 @@ def test_shapes_and_one_slot_per_literal():
 
 def test_state_goal_and_validity_features():
     s = scene()
-    data = encode(s, parse_goal("In(cherries, shelf_a) & not Clear(butter)").literals)
+    data = encode(
+        s, parse_goal("In(cherries, shelf_a) & not Clear(butter)", world=KITCHEN).literals
+    )
     slots = Slots(tuple(data.names))
     e, p = slots.slot(on("butter", "cherries"))
     assert data.edge_attr[e, p] == 1.0  # holds in the state
@@ -67,7 +72,9 @@ def test_state_goal_and_validity_features():
 
 
 def test_decode_inverts_the_goal():
-    goal = parse_goal("On(butter, shelf_b) & InGrasp(cherries) & not On(butter, cherries)")
+    goal = parse_goal(
+        "On(butter, shelf_b) & InGrasp(cherries) & not On(butter, cherries)", world=KITCHEN
+    )
     data = encode(scene(), goal.literals)
     assert set(decode(data, data.goal)) == set(goal.literals)
 

@@ -6,6 +6,7 @@ import pytest
 
 from hsgplan.domain.actions import Place
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import inside, on
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -57,7 +58,7 @@ def test_optimal_plans_are_never_longer():
 
 
 def test_known_plan():
-    goal = parse_goal("On(butter, cherries) & In(tomato_soup, shelf_a)")
+    goal = parse_goal("On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN)
     start = SymbolicSceneGraph.initial(goal.objects)
     plan = FastDownwardPlanner(optimal=True).plan(start, goal)
     assert len(plan) == 5  # pick, place; pick, place on prepush_a, push
@@ -74,7 +75,7 @@ def test_banned_actions_are_left_out_of_the_plan():
     start = SymbolicSceneGraph.from_literals(
         ["cream_cheese", "butter"], [on("cream_cheese", "open_space"), on("butter", "cream_cheese")]
     )
-    goal = parse_goal("On(cream_cheese, shelf_b)")
+    goal = parse_goal("On(cream_cheese, shelf_b)", world=KITCHEN)
     planner = FastDownwardPlanner(optimal=True)
     first = planner.plan(start, goal)
     away = next(a for a in first.actions if isinstance(a, Place) and a.obj == "butter")
@@ -89,7 +90,7 @@ def test_banned_actions_are_left_out_of_the_plan():
 
 def test_goal_already_true_needs_no_plan():
     start = SymbolicSceneGraph.initial(["butter", "cherries"])
-    plan = FastDownwardPlanner().plan(start, parse_goal("On(butter, open_space)"))
+    plan = FastDownwardPlanner().plan(start, parse_goal("On(butter, open_space)", world=KITCHEN))
     assert len(plan) == 0 and plan.states == (start,)
 
 
@@ -99,11 +100,11 @@ def test_unreachable_goal_is_reported():
         ["cherries", "butter"], [inside("cherries", "shelf_a"), on("butter", "open_space")]
     )
     with pytest.raises(NoPlanError, match="no sequence"):
-        FastDownwardPlanner().plan(start, parse_goal("On(cherries, shelf_b)"))
+        FastDownwardPlanner().plan(start, parse_goal("On(cherries, shelf_b)", world=KITCHEN))
 
 
 def test_pddl_text_names_the_domain_actions():
-    goal = parse_goal("On(butter, cherries)")
+    goal = parse_goal("On(butter, cherries)", world=KITCHEN)
     domain, problem = to_pddl_text(SymbolicSceneGraph.initial(goal.objects), goal)
     for name in (
         "pick_from_surface",

@@ -7,9 +7,9 @@ import pytest
 import torch
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.scene_file import read_world
-from hsgplan.domain.world import KITCHEN
 from hsgplan.planning.regression.encoding import encode, encode_computed, with_features
 from hsgplan.planning.regression.features import (
     GEOMETRY_NODE_DIM,

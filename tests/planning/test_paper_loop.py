@@ -5,12 +5,13 @@ from pathlib import Path
 
 from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import Literal, in_grasp, on
 from hsgplan.paths import TASK_CHECKPOINT
 from hsgplan.planning.regression.paper_loop import TRIES, PaperRegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
-GOAL = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)")
+GOAL = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)", world=KITCHEN)
 START = SymbolicSceneGraph.from_literals(
     ["cherries", "butter"], [on("cherries", "open_space"), on("butter", "open_space")]
 )

@@ -5,6 +5,7 @@ import random
 
 import pytest
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import object_type, objects_for_types
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import OBJECT_TYPES, REGIONS, SHELF_TOP_Z, SHELVES, TABLE, Kind
@@ -296,17 +297,20 @@ SCENES = [
         [
             rest(n, x, y, TOP)
             for n, (x, y) in zip(
-                objects_for_types(["cherries"] * 7),
+                objects_for_types(["cherries"] * 7, world=KITCHEN),
                 [(x, y) for x in (0.42, 0.56) for y in (0.26, 0.34, 0.42, 0.50)],
                 strict=False,
             )
         ],
-        " & ".join(oc(n, "shelf_a") for n in objects_for_types(["cherries"] * 7)),
+        " & ".join(oc(n, "shelf_a") for n in objects_for_types(["cherries"] * 7, world=KITCHEN)),
     ),
     case(
         "crowded_interior_past_capacity",
-        [rest(n, 0.45, 0.27 + 0.07 * i) for i, n in enumerate(objects_for_types(["cherries"] * 4))],
-        " & ".join(f"In({n}, shelf_a)" for n in objects_for_types(["cherries"] * 4)),
+        [
+            rest(n, 0.45, 0.27 + 0.07 * i)
+            for i, n in enumerate(objects_for_types(["cherries"] * 4, world=KITCHEN))
+        ],
+        " & ".join(f"In({n}, shelf_a)" for n in objects_for_types(["cherries"] * 4, world=KITCHEN)),
     ),
 ]
 
@@ -360,7 +364,7 @@ def test_default_tolerances_fit_the_world():
 def _random_scene(rng: random.Random):
     types = rng.choices(list(OBJECT_TYPES), k=rng.randint(1, 12))
     poses = {}
-    for name in objects_for_types(types):
+    for name in objects_for_types(types, world=KITCHEN):
         yaw, tilt = rng.uniform(-math.pi, math.pi), rng.choice([0.0, 0.0, rng.uniform(0, 3.2)])
         q = Pose.from_xyz_yaw(0, 0, 0, yaw).compose(Pose((0, 0, 0), _tilt_quat(tilt)))
         xy = (rng.uniform(-0.4, 1.1), rng.uniform(-0.9, 0.9))

@@ -7,8 +7,9 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
-from hsgplan.domain.world import KITCHEN, MAX_OBJECTS
+from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.sim.env import ENV_ID, KitchenStorageEnv, ResetOptions
 from hsgplan.sim.gym_spaces import decode, encode, entity_names
 
@@ -68,7 +69,7 @@ def test_the_numeric_observation_says_what_the_typed_one_does():
 def test_a_sampled_action_steps_and_an_empty_slot_is_an_invalid_step():
     env = KitchenStorageEnv()
     try:
-        env.reset(seed=0, options=ResetOptions(parse_goal(GOAL)))
+        env.reset(seed=0, options=ResetOptions(parse_goal(GOAL, world=KITCHEN)))
         env.action_space.seed(0)
         obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
         assert env.observation_space.contains(obs) and env.steps == 1
@@ -99,7 +100,7 @@ def test_actions_decode_to_the_papers_primitives():
 def test_the_typed_path_of_the_agents_still_works():
     env = KitchenStorageEnv()
     try:
-        _, info = env.reset(seed=0, options=ResetOptions(parse_goal(GOAL)))
+        _, info = env.reset(seed=0, options=ResetOptions(parse_goal(GOAL, world=KITCHEN)))
         before = info["observation"].scene_graph
         _, _, _, _, info = env.step(PickParams("butter"))
         assert info["outcome"].ok, info["outcome"]
@@ -143,7 +144,7 @@ def test_reward_and_termination_are_what_the_observer_sees_and_the_truth_is_in_i
 
     env = KitchenStorageEnv(observer=Fooled())
     try:
-        goal = parse_goal("On(butter, shelf_a) & On(cherries, open_space)")
+        goal = parse_goal("On(butter, shelf_a) & On(cherries, open_space)", world=KITCHEN)
         env.reset(seed=4, options=ResetOptions(goal))
         _, reward, terminated, truncated, info = env.step(PickParams("alphabet_soup"))
         assert info["outcome"].status.value == "invalid"  # not in the scene: nothing moved

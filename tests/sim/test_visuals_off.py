@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.outcome import Status
@@ -39,7 +40,7 @@ def test_a_pick_runs_the_same_with_and_without_visuals():
 
 
 def test_an_env_nothing_pictures_resets_without_visuals_and_a_rendering_one_with_them():
-    goal = parse_goal("In(cherries, shelf_a)")
+    goal = parse_goal("In(cherries, shelf_a)", world=KITCHEN)
     quiet, rendering = KitchenStorageEnv(visuals=False), KitchenStorageEnv(render=True)
     try:
         for env in (quiet, rendering):

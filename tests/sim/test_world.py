@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
@@ -63,7 +64,7 @@ def test_same_seed_same_scene_other_seed_other_scene():
 
 def test_env_reset_step_render():
     env = KitchenStorageEnv(render=True)
-    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)")
+    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)", world=KITCHEN)
     _, info = env.reset(seed=2, options=ResetOptions(goal))
     obs = info["observation"]
     try:

@@ -5,6 +5,7 @@ import pytest
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.feasibility import check_literals
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import split_instance
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import OBJECT_TYPES, Kind
@@ -20,7 +21,7 @@ def test_same_seed_same_goals_and_other_seed_other_goals():
 def test_goals_name_exactly_n_objects_and_are_feasible(n):
     for goal in random_goals(n, 30, seed=0):
         assert goal.size == n
-        check_literals(goal.literals)
+        check_literals(goal.literals, world=KITCHEN)
         assert len(goal.literals) == n  # one placement literal per object
 
 
