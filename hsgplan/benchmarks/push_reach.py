@@ -65,9 +65,11 @@ def push_reach(tasks: int, first: int, on_task: Callable[[], None] | None = None
     # with the refusal off, the pushes it would refuse are run and their margins seen
     motion_plans.PUSH_SLACK = -math.inf
     try:
-        with Scene((), seed=SEED) as scene:
+        with Scene((), seed=SEED, world=KITCHEN) as scene:
             for index in range(first, first + tasks):
-                for trial in run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, index)) or []:
+                for trial in (
+                    run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, index, KITCHEN)) or []
+                ):
                     angle, dist = push_values(*trial.bins)
                     x = trial.before.pose(trial.obj).position[0]
                     x_min = KITCHEN.shelves[trial.target].interior.x_min

@@ -41,7 +41,7 @@ def bench_sim(
     for spec in specs:
         records.append(
             run_episode(
-                KitchenStorageEnv(visuals=False),
+                KitchenStorageEnv(visuals=False, world=KITCHEN),
                 make_agent("oracle"),
                 parse_goal(spec.goal, world=KITCHEN),
                 spec.seed,

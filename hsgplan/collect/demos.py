@@ -53,7 +53,7 @@ def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) 
         states.append(obs.symbols.state)
 
     result = run_episode(
-        KitchenStorageEnv(visuals=False),
+        KitchenStorageEnv(visuals=False, world=KITCHEN),
         make_agent("oracle"),
         goal,
         seed,

@@ -221,7 +221,7 @@ class ReachItem:
 
 @functools.cache
 def _process_scene() -> Scene:
-    return Scene((), visuals=False)
+    return Scene((), visuals=False, world=KITCHEN)
 
 
 def run_reach_item(item: ReachItem) -> dict:

@@ -25,7 +25,6 @@ import random
 from dataclasses import dataclass
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import objects_for_types
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
@@ -75,9 +74,7 @@ class MotionTask:
         return inside(self.obj, self.target)
 
 
-def draw_task(
-    primitive: MotionPrimitive, seed: int, index: int, world: World = KITCHEN
-) -> MotionTask:
+def draw_task(primitive: MotionPrimitive, seed: int, index: int, world: World) -> MotionTask:
     """The task at `index` of the stream for `(primitive, seed)`, in `world`."""
     if index < 0:
         raise InvalidInputError(f"task index {index} cannot be negative")

@@ -14,15 +14,6 @@ from hsgplan.domain.scene import MAX_OBJECTS, EntityKind, World
 
 __all__ = ["EntityKind", "MAX_OBJECTS"]
 
-from hsgplan.domain.kitchen import KITCHEN  # noqa: E402  (going: callers take a World)
-
-ENTITY_TYPES: tuple[str, ...] = KITCHEN.entity_types
-split_instance = KITCHEN.split_instance
-kind_of = KITCHEN.kind_of
-type_of = KITCHEN.type_of
-object_type = KITCHEN.object_type
-sort_objects = KITCHEN.sort_objects
-
 
 def instance_name(type_name: str, k: int, world: World) -> str:
     """The name of the k-th instance (1-based) of an object type."""

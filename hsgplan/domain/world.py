@@ -35,27 +35,6 @@ __all__ = [
     "spot_cells",
 ]  # fmt: skip
 
-from hsgplan.domain.kitchen import KITCHEN  # noqa: E402  (going: callers take a World)
-
-OBJECT_TYPES: dict[str, ObjectType] = KITCHEN.object_types
-TABLE = KITCHEN.table
-SHELVES: dict[str, Shelf] = KITCHEN.shelves
-REGIONS: dict[str, Rect] = KITCHEN.regions
-WALL = SHELVES["shelf_a"].wall
-SHELF_CLEARANCE = SHELVES["shelf_a"].clearance
-SHELF_TOP_Z = SHELVES["shelf_a"].top.z
-surface_rect = KITCHEN.surface_rect
-SURFACES: tuple[str, ...] = KITCHEN.surfaces
-SURFACE_CAPACITY: dict[str, int] = KITCHEN.surface_capacity
-INTERIOR_CAPACITY: dict[str, int] = KITCHEN.interior_capacity
-interior_slots = KITCHEN.interior_slots
-MAX_TOWER_LEVELS = KITCHEN.max_tower_levels
-can_support = KITCHEN.can_support
-fits_inside = KITCHEN.fits_inside
-GOAL_SHELF_TOPS: tuple[str, ...] = KITCHEN.goal_shelf_tops
-GOAL_INTERIOR = KITCHEN.goal_interior
-FIXTURE_FRICTION = KITCHEN.fixture_friction
-
 # --- motion primitive parameters (the paper's discretisation) ---
 
 PLACE_BINS = 10  # x and y bins over the target region or shelf top

@@ -14,7 +14,6 @@ import math
 import random
 
 from hsgplan.domain.errors import UnsampledSceneError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import place_inset
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.scene import EntityKind
@@ -40,7 +39,8 @@ def sample_scene(
     seed: int,
     p_elsewhere: float = 0.3,
     visuals: bool = True,
-    world: World = KITCHEN,
+    *,
+    world: World,
 ) -> tuple[Scene, SymbolicSceneGraph]:
     """A settled scene of `world` for the objects and the symbolic state it is in (`visuals`:
     `Scene`'s).

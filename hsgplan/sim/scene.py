@@ -14,7 +14,6 @@ import numpy as np
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.scene import World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -76,7 +75,8 @@ class Scene:
         seed: int = 0,
         poses: dict[str, Pose] | None = None,
         visuals: bool = True,
-        world: World = KITCHEN,
+        *,
+        world: World,
     ):
         self.world = world
         with _quiet_stdout():

@@ -27,7 +27,7 @@ GOAL = parse_goal(
 
 
 def _problem(goal, seed=4, goal_stacks=False):
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=seed, options=ResetOptions(goal))
     obs = info["observation"]
     env.close()
@@ -118,7 +118,7 @@ def test_a_failed_stream_certifies_nothing_and_its_dependants_wait():
 
 
 def test_plans_and_acts_a_three_object_goal_with_only_certified_objects():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=4, options=ResetOptions(GOAL))
     obs = info["observation"]
     agent = StreamAgent(FocusedPlanner(), "stream-focused")
@@ -128,12 +128,14 @@ def test_plans_and_acts_a_three_object_goal_with_only_certified_objects():
     assert len(actions) == 7 and d.task_seconds > 0
     assert {type(a) for a in actions} == {Pick, Place, Push}
     env.close()
-    record = run_episode(KitchenStorageEnv(), make_agent("stream-focused-goal"), GOAL, seed=4)
+    record = run_episode(
+        KitchenStorageEnv(world=KITCHEN), make_agent("stream-focused-goal"), GOAL, seed=4
+    )
     assert record.success, record.steps
 
 
 def test_a_goal_that_holds_needs_no_stream():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=4, options=ResetOptions(GOAL))
     obs = info["observation"]
     env.close()

@@ -40,7 +40,7 @@ def test_the_profiler_catches_a_call_into_the_transition_model():
 
     calls: list[str] = []
     goal = parse_goal(GOALS[0], world=KITCHEN)
-    state = random_state(goal.objects, random.Random(0))
+    state = random_state(goal.objects, random.Random(0), world=KITCHEN)
     with rules_forbidden(calls):
         applicable_actions(state)
     assert any("applicable_actions" in c for c in calls)

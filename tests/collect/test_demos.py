@@ -89,13 +89,11 @@ FULL_SCENE = SHIPPED.parent / "full-scene"
 
 
 def test_full_scene_demos_hold_every_type_and_replay_in_the_transition_model():
-    from hsgplan.domain.world import OBJECT_TYPES
-
     demos = load_demos(FULL_SCENE, world=KITCHEN)
     assert [d.task for d in demos] == [t for t, _ in TASKS]
     assert json.loads((FULL_SCENE / "meta.json").read_text())["full_scene"] is True
     for d in demos:
-        assert sorted(d.objects) == sorted(OBJECT_TYPES), d.task
+        assert sorted(d.objects) == sorted(KITCHEN.object_types), d.task
         states, actions = d.symbolic_states(), d.symbolic_actions()
         assert d.goal_literals().satisfied_by(states[-1])
         for before, action, after in zip(states[:-1], actions, states[1:], strict=True):

@@ -33,7 +33,9 @@ def _moved(state: SymbolicSceneGraph, obj: str) -> SymbolicSceneGraph:
     rest = [
         lit for lit in state.literals if lit.subject != obj and lit.predicate is not Predicate.CLEAR
     ]
-    return SymbolicSceneGraph.from_literals(state.objects, [*rest, on(obj, "open_space")], False)
+    return SymbolicSceneGraph.from_literals(
+        state.objects, [*rest, on(obj, "open_space")], False, world=KITCHEN
+    )
 
 
 @st.composite

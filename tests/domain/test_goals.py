@@ -4,7 +4,6 @@ from hsgplan.domain.errors import InfeasibleError, InvalidInputError, UnknownNam
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file, write_goal_file
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import Literal, Predicate, clear, in_grasp, inside, on
-from hsgplan.domain.world import SURFACE_CAPACITY
 
 
 def test_separators_and_spacing():
@@ -111,9 +110,9 @@ HOSTILE = [
     (
         " & ".join(
             f"On(cherries{'' if k == 1 else f'_{k}'}, shelf_b)"
-            for k in range(1, SURFACE_CAPACITY["shelf_b"] + 2)
+            for k in range(1, KITCHEN.surface_capacity["shelf_b"] + 2)
         ),
-        f"holds at most {SURFACE_CAPACITY['shelf_b']}",
+        f"holds at most {KITCHEN.surface_capacity['shelf_b']}",
     ),
     (
         " & ".join(f"On(butter{'' if k == 1 else f'_{k}'}, prepush_a)" for k in range(1, 4)),
@@ -182,7 +181,7 @@ def test_goal_is_satisfied_by_state():
     from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
     state = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_a")]
+        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_a")], world=KITCHEN
     )
     assert parse_goal("On(butter, cherries) & not Clear(cherries)", world=KITCHEN).satisfied_by(
         state

@@ -4,13 +4,6 @@ import pytest
 
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.room import Room, can_carry
-from hsgplan.domain.world import (
-    INTERIOR_CAPACITY,
-    MAX_TOWER_LEVELS,
-    SHELVES,
-    SURFACE_CAPACITY,
-    SURFACES,
-)
 
 
 def test_left_counts_capacity_minus_what_is_taken_in_the_order_given():
@@ -18,15 +11,17 @@ def test_left_counts_capacity_minus_what_is_taken_in_the_order_given():
         ("shelf_b", "shelf_a"), ("shelf_a",), on_top={"shelf_a": 3}, inside={}, world=KITCHEN
     )
     assert list(room.top) == ["shelf_b", "shelf_a"]
-    assert room.top == {"shelf_b": SURFACE_CAPACITY["shelf_b"], "shelf_a": 1}
-    assert room.interior == {"shelf_a": INTERIOR_CAPACITY["shelf_a"]}
+    assert room.top == {"shelf_b": KITCHEN.surface_capacity["shelf_b"], "shelf_a": 1}
+    assert room.interior == {"shelf_a": KITCHEN.interior_capacity["shelf_a"]}
     assert room.level == {} and room.bare == []
 
 
 def test_left_defaults_to_every_surface_and_interior():
     room = Room.left(world=KITCHEN)
-    assert room.top == SURFACE_CAPACITY and tuple(room.top) == SURFACES
-    assert room.interior == INTERIOR_CAPACITY and tuple(room.interior) == tuple(SHELVES)
+    assert room.top == KITCHEN.surface_capacity and tuple(room.top) == KITCHEN.surfaces
+    assert room.interior == KITCHEN.interior_capacity and tuple(room.interior) == tuple(
+        KITCHEN.shelves
+    )
 
 
 def test_a_full_surface_is_no_longer_free():
@@ -47,7 +42,7 @@ def test_towers_grow_only_on_carriers_and_up_to_the_level_limit():
     assert room.level == {"popcorn": 1, "butter": 1, "cherries": 2}
     assert "butter" not in room.bare  # covered now
     assert room.top["shelf_a"] == 2  # a stacked object takes no place on the surface
-    assert MAX_TOWER_LEVELS == 2, "the next line assumes two-level towers"
+    assert KITCHEN.max_tower_levels == 2, "the next line assumes two-level towers"
     assert room.bases() == []  # cherries carries, but its tower is full
 
 
@@ -79,4 +74,4 @@ def test_putting_on_an_object_that_is_not_bare_fails_loudly():
 def test_can_carry_needs_a_wide_top_and_a_tower_below_the_limit():
     assert can_carry("butter", 1, world=KITCHEN)
     assert not can_carry("popcorn", 1, world=KITCHEN)
-    assert not can_carry("butter", MAX_TOWER_LEVELS, world=KITCHEN)
+    assert not can_carry("butter", KITCHEN.max_tower_levels, world=KITCHEN)

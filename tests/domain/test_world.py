@@ -1,21 +1,22 @@
 from hsgplan.domain import world
-from hsgplan.domain.world import OBJECT_TYPES, Kind
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import Kind
 
 
 def test_every_object_is_graspable_and_distinctly_coloured():
-    for t in OBJECT_TYPES.values():
+    for t in KITCHEN.object_types.values():
         assert t.grasp_width <= world.GRIPPER_MAX_OPENING, t.name
-    colours = [t.color for t in OBJECT_TYPES.values()]
+    colours = [t.color for t in KITCHEN.object_types.values()]
     assert len(set(colours)) == len(colours)
 
 
 def test_the_paper_objects_three_cans_three_boxes():
-    kinds = sorted(t.kind for t in OBJECT_TYPES.values())
+    kinds = sorted(t.kind for t in KITCHEN.object_types.values())
     assert kinds.count(Kind.CAN) == 3 and kinds.count(Kind.BOX) == 3
 
 
 def test_cans_fit_inside_shelves_and_upright_popcorn_does_not():
-    for name, t in OBJECT_TYPES.items():
+    for name, t in KITCHEN.object_types.items():
         for shelf in world.SHELVES:
             assert world.fits_inside(name, shelf) == (t.height <= world.SHELF_CLEARANCE)
     assert world.fits_inside("cherries", "shelf_a")
@@ -29,7 +30,7 @@ def test_capacities_hold_a_twelve_object_scene():
 
 
 def test_tower_limit_keeps_any_tower_within_reach():
-    tallest = max(t.height for t in OBJECT_TYPES.values())
+    tallest = max(t.height for t in KITCHEN.object_types.values())
     levels = world.MAX_TOWER_LEVELS
     assert world.SHELF_TOP_Z + levels * tallest <= world.REACH_MAX_Z
     assert world.SHELF_TOP_Z + (levels + 1) * tallest > world.REACH_MAX_Z

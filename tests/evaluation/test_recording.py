@@ -102,7 +102,7 @@ def test_a_look_is_recorded_with_its_images_keypoints_and_detected_cuboids(tmp_p
     detection = Detection("butter", pose, 0.9, 1, 0.5, keypoints=(seen_by,))
     images = np.zeros((2, cameras[0].height, cameras[0].width, 3), np.uint8)
     look = Look(images, cameras, np.zeros(7))
-    seen = Seen(GeometricSceneGraph.from_poses({"butter": pose}))
+    seen = Seen(GeometricSceneGraph.from_poses({"butter": pose}, world=KITCHEN))
 
     recording = EpisodeRecording(rrd, "On(butter, shelf_a)", 0)
     recording.observe(look, seen, (detection,))

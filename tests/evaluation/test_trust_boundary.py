@@ -17,7 +17,7 @@ SEED = 3
 
 @pytest.mark.slow
 def test_moving_the_true_objects_after_a_look_changes_neither_belief_nor_decision():
-    env = KitchenStorageEnv(observer=make_observer("rgb"))
+    env = KitchenStorageEnv(observer=make_observer("rgb"), world=KITCHEN)
     try:
         _, info = env.reset(seed=SEED, options=ResetOptions(GOAL))
         obs = info["observation"]

@@ -27,7 +27,7 @@ def test_an_unsampled_start_scene_is_recorded_as_such_and_nothing_is_tried(monke
 
     monkeypatch.setattr(env_module, "sample_scene", no_scene)
     record = run_episode(
-        KitchenStorageEnv(), make_agent("oracle"), parse_goal(GOAL, world=KITCHEN), 12
+        KitchenStorageEnv(world=KITCHEN), make_agent("oracle"), parse_goal(GOAL, world=KITCHEN), 12
     )
     assert record.failure == Failure.UNSAMPLED == "unsampled_scene"
     assert not record.success and record.steps == () and record.seed == 12

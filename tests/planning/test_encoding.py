@@ -22,13 +22,13 @@ from hsgplan.planning.regression.encoding import (
     touching,
 )
 from hsgplan.planning.regression.features import edge_dim, node_dim
-from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.symbolic.generator import random_goal, random_state
 
 
 def scene():
     return SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_a")]
+        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_a")], world=KITCHEN
     )
 
 
@@ -37,7 +37,7 @@ def test_shapes_and_one_slot_per_literal():
     data = encode(
         s, parse_goal("In(cherries, shelf_a) & not Clear(butter)", world=KITCHEN).literals
     )
-    n = 2 + len(FIXTURES)
+    n = 2 + len(KITCHEN.fixtures)
     assert data.x.shape == (n, node_dim("names"))
     assert data.edge_index.shape == (2, n * n)
     assert data.edge_attr.shape == (n * n, edge_dim("names"))
@@ -80,7 +80,7 @@ def test_decode_inverts_the_goal():
 
 
 def test_duplicates_share_features_and_order_follows_nodes():
-    s = SymbolicSceneGraph.initial(["cherries", "cherries_2"])
+    s = SymbolicSceneGraph.initial(["cherries", "cherries_2"], world=KITCHEN)
     data = encode(s, [in_grasp("cherries_2")])
     assert torch.equal(data.x[0], data.x[1])
     slots = Slots(tuple(data.names))
@@ -91,8 +91,8 @@ def test_duplicates_share_features_and_order_follows_nodes():
 @pytest.mark.parametrize("features", FEATURES)
 def test_encode_many_equals_batching_single_encodings(features):
     rng = random.Random(0)
-    goal = random_goal(6, rng)
-    s = random_state(goal.objects, rng)
+    goal = random_goal(6, rng, world=KITCHEN)
+    s = random_state(goal.objects, rng, world=KITCHEN)
     lits = sorted(goal.literals)
     batched = Batch.from_data_list([encode(s, goal.literals, [lit], features) for lit in lits])
     many = encode_many(s, [goal.literals] * len(lits), [[lit] for lit in lits], features)
@@ -102,7 +102,9 @@ def test_encode_many_equals_batching_single_encodings(features):
 
 def test_active_edges_are_self_loops_and_related_pairs():
     s = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "open_space")]
+        ["cherries", "butter"],
+        [on("butter", "cherries"), on("cherries", "open_space")],
+        world=KITCHEN,
     )
     data = encode(s, [inside("cherries", "shelf_a")], [in_grasp("butter")])
     slots = Slots(tuple(data.names))
@@ -115,8 +117,8 @@ def test_active_edges_are_self_loops_and_related_pairs():
 @pytest.mark.parametrize("features", FEATURES)
 def test_encode_computed_is_encode_many_cut_to_the_computed_edges(features):
     rng = random.Random(3)
-    goal = random_goal(5, rng)
-    s = random_state(goal.objects, rng)
+    goal = random_goal(5, rng, world=KITCHEN)
+    s = random_state(goal.objects, rng, world=KITCHEN)
     lits = sorted(goal.literals)
     contexts = [frozenset(goal.literals)] * (len(lits) - 1) + [frozenset([clear(lits[0].subject)])]
     readout = touching(s.nodes, [lit.args for lit in lits])

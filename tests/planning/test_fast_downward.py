@@ -29,11 +29,11 @@ def replay(plan, start, goal):
 def test_plans_for_random_goals_replay_in_the_transition_model(n):
     planner = FastDownwardPlanner()
     rng = random.Random(f"test-fd-{n}")
-    goals = random_goals(n, 12, seed=11)
-    starts = [random_state(g.objects, rng) for g in goals]
+    goals = random_goals(n, 12, seed=11, world=KITCHEN)
+    starts = [random_state(g.objects, rng, world=KITCHEN) for g in goals]
     for i, goal in enumerate(goals):
         # Half start with everything on the open space, half from a random arrangement.
-        start = SymbolicSceneGraph.initial(goal.objects) if i % 2 else starts[i]
+        start = SymbolicSceneGraph.initial(goal.objects, world=KITCHEN) if i % 2 else starts[i]
         replay(planner.plan(start, goal), start, goal)
 
 
@@ -42,16 +42,16 @@ def test_plans_for_random_goals_replay_in_the_transition_model(n):
 def test_generated_goals_up_to_twelve_objects_are_solved(n):
     planner = FastDownwardPlanner(optimal=False)
     rng = random.Random(f"test-fd-large-{n}")
-    for goal in random_goals(n, 8, seed=12):
-        start = random_state(goal.objects, rng)
+    for goal in random_goals(n, 8, seed=12, world=KITCHEN):
+        start = random_state(goal.objects, rng, world=KITCHEN)
         replay(planner.plan(start, goal), start, goal)
 
 
 @pytest.mark.slow
 def test_optimal_plans_are_never_longer():
     rng = random.Random(0)
-    for goal in random_goals(4, 6, seed=5):
-        start = random_state(goal.objects, rng)
+    for goal in random_goals(4, 6, seed=5, world=KITCHEN):
+        start = random_state(goal.objects, rng, world=KITCHEN)
         best = FastDownwardPlanner(optimal=True).plan(start, goal)
         fast = FastDownwardPlanner(optimal=False).plan(start, goal)
         assert len(best) <= len(fast)
@@ -59,7 +59,7 @@ def test_optimal_plans_are_never_longer():
 
 def test_known_plan():
     goal = parse_goal("On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN)
-    start = SymbolicSceneGraph.initial(goal.objects)
+    start = SymbolicSceneGraph.initial(goal.objects, world=KITCHEN)
     plan = FastDownwardPlanner(optimal=True).plan(start, goal)
     assert len(plan) == 5  # pick, place; pick, place on prepush_a, push
     assert [str(a) for a in plan.actions if "tomato_soup" in str(a)] == [
@@ -73,7 +73,9 @@ def test_banned_actions_are_left_out_of_the_plan():
     # butter must go somewhere before cream_cheese can be picked: banning where it went gives
     # a plan that puts it elsewhere
     start = SymbolicSceneGraph.from_literals(
-        ["cream_cheese", "butter"], [on("cream_cheese", "open_space"), on("butter", "cream_cheese")]
+        ["cream_cheese", "butter"],
+        [on("cream_cheese", "open_space"), on("butter", "cream_cheese")],
+        world=KITCHEN,
     )
     goal = parse_goal("On(cream_cheese, shelf_b)", world=KITCHEN)
     planner = FastDownwardPlanner(optimal=True)
@@ -89,7 +91,7 @@ def test_banned_actions_are_left_out_of_the_plan():
 
 
 def test_goal_already_true_needs_no_plan():
-    start = SymbolicSceneGraph.initial(["butter", "cherries"])
+    start = SymbolicSceneGraph.initial(["butter", "cherries"], world=KITCHEN)
     plan = FastDownwardPlanner().plan(start, parse_goal("On(butter, open_space)", world=KITCHEN))
     assert len(plan) == 0 and plan.states == (start,)
 
@@ -97,7 +99,9 @@ def test_goal_already_true_needs_no_plan():
 def test_unreachable_goal_is_reported():
     # An object inside a shelf can never come out again.
     start = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [inside("cherries", "shelf_a"), on("butter", "open_space")]
+        ["cherries", "butter"],
+        [inside("cherries", "shelf_a"), on("butter", "open_space")],
+        world=KITCHEN,
     )
     with pytest.raises(NoPlanError, match="no sequence"):
         FastDownwardPlanner().plan(start, parse_goal("On(cherries, shelf_b)", world=KITCHEN))
@@ -105,7 +109,7 @@ def test_unreachable_goal_is_reported():
 
 def test_pddl_text_names_the_domain_actions():
     goal = parse_goal("On(butter, cherries)", world=KITCHEN)
-    domain, problem = to_pddl_text(SymbolicSceneGraph.initial(goal.objects), goal)
+    domain, problem = to_pddl_text(SymbolicSceneGraph.initial(goal.objects, world=KITCHEN), goal)
     for name in (
         "pick_from_surface",
         "pick_from_object",

@@ -81,10 +81,12 @@ def test_world_labels_are_what_the_executed_action_made_hold():
     from hsgplan.data.world_trials import WorldTrial
 
     before = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "open_space")]
+        ["cherries", "butter"],
+        [on("butter", "cherries"), on("cherries", "open_space")],
+        world=KITCHEN,
     )
     after = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [in_grasp("butter"), on("cherries", "open_space")]
+        ["cherries", "butter"], [in_grasp("butter"), on("cherries", "open_space")], world=KITCHEN
     )
     labels = world_labels(WorldTrial(before, Pick("butter"), "success", after))
     assert labels == {
@@ -100,7 +102,9 @@ def test_world_labels_are_what_the_executed_action_made_hold():
 
 def test_action_heuristic_reads_the_state_and_checks_no_precondition():
     s = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "prepush_a")]
+        ["cherries", "butter"],
+        [on("butter", "cherries"), on("cherries", "prepush_a")],
+        world=KITCHEN,
     )
     assert str(action_for(clear("cherries"), s)) == "pick(butter)"
     assert str(action_for(in_grasp("butter"), s)) == "pick(butter)"

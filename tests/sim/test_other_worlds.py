@@ -48,7 +48,7 @@ def test_f_m_reads_the_surfaces_of_the_graphs_world():
     assert laid_out.state.holds(on("butter", "shelf_a")) and not laid_out.anomalies
     kitchen_top = KITCHEN.shelves["shelf_a"].top
     if not kitchen_top.contains(x, y) or abs(kitchen_top.z - shelf.top.z) > 0.005:
-        in_kitchen = map_symbols(GeometricSceneGraph.from_poses({"butter": pose}))
+        in_kitchen = map_symbols(GeometricSceneGraph.from_poses({"butter": pose}, world=KITCHEN))
         assert not in_kitchen.state.holds(on("butter", "shelf_a"))
 
 

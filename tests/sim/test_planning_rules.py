@@ -5,6 +5,7 @@ import contextlib
 import numpy as np
 import pytest
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams, place_xy
 from hsgplan.domain.world import PLACE_BINS, PUSH_DIST_BINS
 from hsgplan.scene_graph.geometry import Pose
@@ -27,6 +28,7 @@ def scene():
             "butter": standing("butter", 0.55, -0.10),
             "tomato_soup": standing("tomato_soup", 0.305, 0.38),
         },
+        world=KITCHEN,
     )
     s.settle()
     yield s

@@ -9,7 +9,7 @@ from hsgplan.symbolic.transition import InapplicableActionError, applicable_acti
 
 def state(*literals, objects=None):
     objs = objects or sorted({o for lit in literals for o in lit.objects(KITCHEN)})
-    return G.from_literals(objs, literals)
+    return G.from_literals(objs, literals, world=KITCHEN)
 
 
 def test_pick_from_a_stack_frees_the_object_below():
