@@ -87,7 +87,7 @@ def observed_pose(obj: str, pose: Pose, relation: str, support: str) -> PoseValu
     bins = None
     if relation == "supported":
         grid = [(xb, yb) for xb in range(PLACE_BINS) for yb in range(PLACE_BINS)]
-        bins = min(grid, key=lambda b: math.dist(place_xy(obj, support, *b), (x, y)))
+        bins = min(grid, key=lambda b: math.dist(place_xy(obj, support, *b, KITCHEN), (x, y)))
     return PoseValue(obj, x, y, z, pose.yaw, relation, support, bins)
 
 
@@ -102,7 +102,7 @@ def bin_order(obj: str, surface: str, rng: np.random.Generator) -> list[tuple[in
     first: list[tuple[int, int]] = []
     for i in rng.permutation(len(cells)):
         centre = cells[i]
-        nearest = min(grid, key=lambda b: math.dist(place_xy(obj, surface, *b), centre))
+        nearest = min(grid, key=lambda b: math.dist(place_xy(obj, surface, *b, KITCHEN), centre))
         if nearest not in first:
             first.append(nearest)
     return first + [grid[i] for i in rng.permutation(len(grid)) if grid[i] not in first]
@@ -110,7 +110,7 @@ def bin_order(obj: str, surface: str, rng: np.random.Generator) -> list[tuple[in
 
 def surface_pose(obj: str, surface: str, bins: tuple[int, int]) -> PoseValue:
     """The pose a place at these bins puts the object in (standing, long side along y)."""
-    x, y = place_xy(obj, surface, *bins)
+    x, y = place_xy(obj, surface, *bins, KITCHEN)
     z = KITCHEN.surface_rect(surface).z + KITCHEN.object_type(obj).height / 2
     return PoseValue(obj, x, y, z, PLACE_LONG_AXIS_YAW, "supported", surface, bins)
 

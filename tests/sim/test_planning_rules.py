@@ -73,7 +73,9 @@ def test_placing_where_a_neighbour_stands_fails_without_moving_anything(scene):
     bx, by, _ = scene.pose("butter").position
     bins = min(
         ((i, j) for i in range(PLACE_BINS) for j in range(PLACE_BINS)),
-        key=lambda b: np.hypot(*(np.subtract(place_xy("cherries", "open_space", *b), (bx, by)))),
+        key=lambda b: np.hypot(
+            *(np.subtract(place_xy("cherries", "open_space", *b, KITCHEN), (bx, by)))
+        ),
     )
     before = scene.poses()
     out = execute(scene, PlaceParams("cherries", "open_space", *bins))
