@@ -128,7 +128,7 @@ class _Watching(RgbObserver):
 
 def _watched_env(**kwargs) -> tuple[KitchenStorageEnv, _Watching]:
     observer = _Watching(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer, **kwargs)
+    env = KitchenStorageEnv(observer=observer, **({"world": KITCHEN} | kwargs))
     observer.env = env
     return env, observer
 
