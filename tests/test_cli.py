@@ -8,6 +8,7 @@ from typer.testing import CliRunner
 
 from hsgplan.cli import app
 from hsgplan.domain.goals import parse_goal, read_goal_file
+from hsgplan.domain.kitchen import KITCHEN
 
 runner = CliRunner()
 
@@ -27,7 +28,7 @@ def test_plan_json_lists_every_step_with_its_state():
     actions = [s["action"] for s in steps[1:]]
     assert len(actions) == 5  # the shortest plan: two steps for butter, three for the soup
     assert {"place(butter, cherries)", "push(tomato_soup, shelf_a)"} <= set(actions)
-    final = parse_goal(" & ".join(steps[-1]["state"]), validate=False)
+    final = parse_goal(" & ".join(steps[-1]["state"]), validate=False, world=KITCHEN)
     assert {str(x) for x in final.literals} >= {"On(butter, cherries)", "In(tomato_soup, shelf_a)"}
 
 
@@ -51,7 +52,7 @@ def test_goals_file_is_deterministic(tmp_path):
         r = run("goals", "--objects", "4", "--goals", "7", "--seed", "3", "--out", str(path))
         assert r.exit_code == 0, r.output
     assert a.read_text() == b.read_text()
-    goals = read_goal_file(a)
+    goals = read_goal_file(a, world=KITCHEN)
     assert len(goals) == 7 and all(g.size == 4 for g in goals)
     r = run("goals", "--objects", "4", "--goals", "7", "--seed", "3")
     assert r.stdout == a.read_text()
@@ -150,7 +151,7 @@ def test_goals_replace_an_existing_goal_file(tmp_path):
     path.write_text("On(butter, shelf_a)\n")
     r = run("goals", "--objects", "4", "--goals", "3", "--out", str(path))
     assert r.exit_code == 0, r.output
-    assert len(read_goal_file(path)) == 3
+    assert len(read_goal_file(path, world=KITCHEN)) == 3
     assert sorted(p.name for p in tmp_path.iterdir()) == ["goals.txt"]
 
 

@@ -14,6 +14,7 @@ from hsgplan.checkpoint import load_trained
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import read_goal_file
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.motion.train import MotionTrainConfig
 from hsgplan.planning.regression.train import TaskTrainConfig
 from hsgplan.runner.run_folder import claim, logged_rows
@@ -55,7 +56,7 @@ def test_a_goal_file_is_goals_or_one_refusal(lines, encoding, junk):
     except UnicodeEncodeError:
         data = junk
     try:
-        goals = read_goal_file(_file(data))
+        goals = read_goal_file(_file(data), world=KITCHEN)
     except InvalidInputError as e:
         _one_line(e)
     else:

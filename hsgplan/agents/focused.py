@@ -56,7 +56,6 @@ from hsgplan.agents.streams import (
 )
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
-from hsgplan.domain.world import SURFACES
 from hsgplan.planning.fast_downward import NoPlanError, solve_pddl
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -244,8 +243,8 @@ def _sketch(value: PoseValue) -> PoseValue:
 def _surfaces(prob: StreamProblem, obj: str, cfg: FocusedConfig) -> list[str]:
     goal = goal_surface(prob, obj)
     if not cfg.goal_places or goal is None:
-        return list(SURFACES)
-    return ["open_space"] + ([goal] if goal in SURFACES and goal != "open_space" else [])
+        return list(prob.world.surfaces)
+    return ["open_space"] + ([goal] if goal in prob.world.surfaces and goal != "open_space" else [])
 
 
 def _evaluate(

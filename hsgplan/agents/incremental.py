@@ -26,7 +26,7 @@ goal (`goal_stacks`, `goal_places`):
 
 - stack-pose(o, b, pb) only where the goal has On(o, b), and only on poses pb where b's own
   On goal (if it has one) would have it. A tower the goal does not name is never needed: the
-  open space alone holds every object a goal may name (12 cells, `SURFACE_CAPACITY`, and
+  open space alone holds every object a goal may name (12 cells, its `surface_capacity`, and
   `MAX_OBJECTS` 12), nothing starts held or in an interior (`symbolic/generator.py`), so any
   object can wait there; an observed tower stays at its observed poses (level 0).
 - place-pose(o, s) only on the open space (where anything waits) and on o's goal surface, or
@@ -71,7 +71,6 @@ from hsgplan.agents.streams import (
 )
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
-from hsgplan.domain.world import SURFACES
 from hsgplan.planning.fast_downward import NoPlanError, solve_pddl
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -220,8 +219,8 @@ def place_surfaces(prob: StreamProblem, obj: str, cfg: IncrementalConfig) -> lis
     puts it on, or the prepush region of the shelf its In goal names."""
     goal = goal_surface(prob, obj)
     if not cfg.goal_places or goal is None:
-        return [(s, cfg.place_samples) for s in SURFACES]
+        return [(s, cfg.place_samples) for s in prob.world.surfaces]
     wanted = [("open_space", cfg.place_samples)]
-    if goal in SURFACES and goal != "open_space":
+    if goal in prob.world.surfaces and goal != "open_space":
         wanted.append((goal, cfg.goal_place_samples))
     return wanted

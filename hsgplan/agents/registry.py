@@ -200,7 +200,7 @@ def _reads_names(folder: Path) -> bool:
 def check_reads(folders: list[Path], world: World, scene: str | Path | None) -> None:
     """Refuse, in one line, checkpoints whose networks know the kitchen's names in a scene
     that names others (networks of the "geometry" features read any scene)."""
-    from hsgplan.domain.world import KITCHEN
+    from hsgplan.domain.kitchen import KITCHEN
 
     others = world.names_beyond(KITCHEN)
     bound = [f for f in folders if _reads_names(f)] if others else []

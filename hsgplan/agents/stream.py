@@ -112,7 +112,9 @@ def expected_after(state: SymbolicSceneGraph, action: Action) -> SymbolicSceneGr
         if lit.predicate is not Predicate.CLEAR and lit.subject != action.obj
     }
     placements.add(intended_literal(action))
-    return SymbolicSceneGraph.from_literals(state.objects, placements, limits=False)
+    return SymbolicSceneGraph.from_literals(
+        state.objects, placements, limits=False, world=state.world
+    )
 
 
 def scene_key(sg: GeometricSceneGraph) -> SceneKey:

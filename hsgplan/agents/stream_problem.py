@@ -14,10 +14,10 @@ import numpy as np
 from hsgplan.agents.streams import PoseTable, PoseValue, PushValue, observed_pose
 from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.objects import EntityKind, kind_of
+from hsgplan.domain.objects import EntityKind
 from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams, PushParams
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import REGIONS, SHELVES, SURFACES
+from hsgplan.domain.scene import World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.symbolic.stream_pddl import Fact
@@ -66,6 +66,7 @@ class StreamProblem:
     """The objects and certified facts so far, and the streams' progress."""
 
     rng: np.random.Generator
+    world: World  # the observed scene's: its surfaces, shelves and names
     facts: dict[Fact, None] = field(default_factory=dict)  # ordered, without repeats
     poses: dict[str, PoseValue] = field(default_factory=dict)
     table: PoseTable = field(default_factory=PoseTable)  # the poses' geometry, in that order
@@ -121,7 +122,7 @@ def aim(prob: StreamProblem, goal: Goal, goal_stacks: bool) -> None:
     if goal_stacks:
         prob.stacks = {}
         for o, x in prob.sites.items():
-            if kind_of(x) is EntityKind.OBJECT:
+            if goal.world.kind_of(x) is EntityKind.OBJECT:
                 prob.stacks.setdefault(x, set()).add(o)
 
 
@@ -129,7 +130,7 @@ def goal_surface(prob: StreamProblem, obj: str) -> str | None:
     """The surface the goal puts an object on, or the prepush region of the shelf its In goal
     names; None when the goal places it nowhere."""
     if obj in prob.shelves:
-        return SHELVES[prob.shelves[obj]].prepush
+        return prob.world.shelves[prob.shelves[obj]].prepush
     return prob.sites.get(obj)
 
 
@@ -155,7 +156,7 @@ def add_grasp(prob: StreamProblem, obj: str, level: int) -> str:
 def initial_problem(sg: GeometricSceneGraph, state: SymbolicSceneGraph, rng) -> StreamProblem:
     """Level 0: the observed poses (objects below first, so a stacked pose names the pose
     under it), the grasp of a held object, and whether the hand is empty."""
-    prob = StreamProblem(rng)
+    prob = StreamProblem(rng, state.world)
     held = state.held()
     if held is None:
         prob.add("handempty")
@@ -166,12 +167,12 @@ def initial_problem(sg: GeometricSceneGraph, state: SymbolicSceneGraph, rng) -> 
         for o in list(pending):
             loc = state.location(o)
             x = loc.args[1] if len(loc.args) > 1 else ""
-            if kind_of(x) is EntityKind.OBJECT and x in pending:
+            if state.world.kind_of(x) is EntityKind.OBJECT and x in pending:
                 continue  # its support first
             pending.remove(o)
             if loc.predicate is Predicate.IN:
                 value = observed_pose(o, sg.pose(o), "inside", x)
-            elif x in SURFACES:
+            elif x in state.world.surfaces:
                 value = observed_pose(o, sg.pose(o), "supported", x)
             elif x in prob.observed:
                 value = observed_pose(o, sg.pose(o), "stacked", x)
@@ -195,7 +196,7 @@ def start_problem(
 def pddl_objects(prob: StreamProblem, state: SymbolicSceneGraph) -> dict[str, list[str]]:
     return {
         "obj": list(state.objects),
-        "surface": [*REGIONS, *SHELVES],
+        "surface": [*state.world.regions, *state.world.shelves],
         "pose": list(prob.poses),
         "grasp": list(prob.grasps.values()),
         "conf": prob.confs,

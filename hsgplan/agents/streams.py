@@ -19,20 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PushParams, extent_along, place_xy
-from hsgplan.domain.world import (
-    PLACE_BINS,
-    PLACE_LONG_AXIS_YAW,
-    REACH_MAX_Z,
-    SHELVES,
-    Kind,
-    can_support,
-    fits_inside,
-    interior_slots,
-    spot_cells,
-    surface_rect,
-)
+from hsgplan.domain.world import PLACE_BINS, PLACE_LONG_AXIS_YAW, REACH_MAX_Z, Kind, spot_cells
 from hsgplan.motion.sampler import (
     HAND_DROP,
     HAND_HALF_LENGTH,
@@ -76,11 +65,11 @@ class PoseValue:
 
     @property
     def bottom(self) -> float:
-        return self.z - object_type(self.obj).height / 2
+        return self.z - KITCHEN.object_type(self.obj).height / 2
 
     @property
     def top(self) -> float:
-        return self.z + object_type(self.obj).height / 2
+        return self.z + KITCHEN.object_type(self.obj).height / 2
 
 
 @dataclass(frozen=True)
@@ -98,7 +87,7 @@ def observed_pose(obj: str, pose: Pose, relation: str, support: str) -> PoseValu
     bins = None
     if relation == "supported":
         grid = [(xb, yb) for xb in range(PLACE_BINS) for yb in range(PLACE_BINS)]
-        bins = min(grid, key=lambda b: math.dist(place_xy(obj, support, *b), (x, y)))
+        bins = min(grid, key=lambda b: math.dist(place_xy(obj, support, *b, KITCHEN), (x, y)))
     return PoseValue(obj, x, y, z, pose.yaw, relation, support, bins)
 
 
@@ -109,11 +98,11 @@ def bin_order(obj: str, surface: str, rng: np.random.Generator) -> list[tuple[in
     (Measured on one 6-object goal: with every bin drawn uniformly, no plan was found within
     three levels, and the fourth held 3.8 million facts; cells first, the third had a plan.)"""
     grid = [(xb, yb) for xb in range(PLACE_BINS) for yb in range(PLACE_BINS)]
-    cells = spot_cells(surface_rect(surface))
+    cells = spot_cells(KITCHEN.surface_rect(surface))
     first: list[tuple[int, int]] = []
     for i in rng.permutation(len(cells)):
         centre = cells[i]
-        nearest = min(grid, key=lambda b: math.dist(place_xy(obj, surface, *b), centre))
+        nearest = min(grid, key=lambda b: math.dist(place_xy(obj, surface, *b, KITCHEN), centre))
         if nearest not in first:
             first.append(nearest)
     return first + [grid[i] for i in rng.permutation(len(grid)) if grid[i] not in first]
@@ -121,8 +110,8 @@ def bin_order(obj: str, surface: str, rng: np.random.Generator) -> list[tuple[in
 
 def surface_pose(obj: str, surface: str, bins: tuple[int, int]) -> PoseValue:
     """The pose a place at these bins puts the object in (standing, long side along y)."""
-    x, y = place_xy(obj, surface, *bins)
-    z = surface_rect(surface).z + object_type(obj).height / 2
+    x, y = place_xy(obj, surface, *bins, KITCHEN)
+    z = KITCHEN.surface_rect(surface).z + KITCHEN.object_type(obj).height / 2
     return PoseValue(obj, x, y, z, PLACE_LONG_AXIS_YAW, "supported", surface, bins)
 
 
@@ -131,16 +120,16 @@ def stack_pose(obj: str, below: PoseValue) -> PoseValue | None:
     tower stays within the arm's reach."""
     if below.obj == obj or below.relation not in ("supported", "stacked"):
         return None
-    if not can_support(object_type(below.obj).name):
+    if not KITCHEN.can_support(KITCHEN.object_type(below.obj).name):
         return None
-    height = object_type(obj).height
+    height = KITCHEN.object_type(obj).height
     if below.top + height > REACH_MAX_Z:
         return None
     return PoseValue(obj, below.x, below.y, below.top + height / 2, below.yaw, "stacked", below.obj)
 
 
 def _half_extents(p: PoseValue) -> tuple[float, float]:
-    fx, fy = object_type(p.obj).footprint
+    fx, fy = KITCHEN.object_type(p.obj).footprint
     c, s = abs(math.cos(p.yaw)), abs(math.sin(p.yaw))
     return (c * fx + s * fy) / 2, (s * fx + c * fy) / 2
 
@@ -169,7 +158,7 @@ class PoseTable:
 
     def _row(self, p: PoseValue) -> np.ndarray:
         hx, hy = _half_extents(p)
-        box = object_type(p.obj).kind is Kind.BOX
+        box = KITCHEN.object_type(p.obj).kind is Kind.BOX
         oid = self._ids.setdefault(p.obj, len(self._ids))
         c, s = math.cos(p.yaw), math.sin(p.yaw)
         return np.array([oid, p.x, p.y, p.bottom, p.top, hx, hy, box, c, s, max(hx, hy)])
@@ -214,9 +203,9 @@ def collides(a: PoseValue, b: PoseValue) -> bool:
 
 def push_shelf(p: PoseValue) -> str | None:
     """The shelf whose prepush region a pose rests on, if the object fits into it."""
-    for name, shelf in SHELVES.items():
+    for name, shelf in KITCHEN.shelves.items():
         if p.relation == "supported" and p.support == shelf.prepush:
-            return name if fits_inside(object_type(p.obj).name, name) else None
+            return name if KITCHEN.fits_inside(KITCHEN.object_type(p.obj).name, name) else None
     return None
 
 
@@ -256,9 +245,9 @@ class StreamWorld:
     def pushes(self, start: PoseValue, shelf: str) -> Iterator[tuple[PushValue, tuple[float, ...]]]:
         """The push stream: pushes from the pose into each of the shelf's slots, nearest
         first, those the arm can carry out (with the joints it starts from)."""
-        interior = SHELVES[shelf].interior
-        sg = GeometricSceneGraph.from_poses({start.obj: start.pose})
-        slots = sorted(interior_slots(shelf), key=lambda s: abs(s - start.y))
+        interior = KITCHEN.shelves[shelf].interior
+        sg = GeometricSceneGraph.from_poses({start.obj: start.pose}, world=self.scene.world)
+        slots = sorted(KITCHEN.interior_slots(shelf), key=lambda s: abs(s - start.y))
         for slot, params in zip(slots, push_candidates(sg, start.obj, shelf), strict=True):
             self._show(start)
             plan = plan_primitive(self.scene, params)
@@ -266,7 +255,9 @@ class StreamWorld:
                 continue
             end = PoseValue(
                 start.obj,
-                interior.x_min + PUSH_DEPTH + extent_along(start.obj, start.yaw, 0.0),
+                interior.x_min
+                + PUSH_DEPTH
+                + extent_along(start.obj, start.yaw, 0.0, self.scene.world),
                 slot,
                 start.z,
                 start.yaw,

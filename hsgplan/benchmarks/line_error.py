@@ -15,6 +15,7 @@ import numpy as np
 
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.sim import motion_plans
 from hsgplan.sim.scene import Scene
@@ -67,9 +68,9 @@ def line_error(tasks: int, every: int, on_task: Callable[[], None] | None = None
 
     motion_plans._line, motion_plans.LINE_IK_EVERY = watched, every
     try:
-        with Scene((), seed=SEED) as scene:
+        with Scene((), seed=SEED, world=KITCHEN) as scene:
             for i in range(tasks):
-                run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, i))
+                run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, i, KITCHEN))
                 if on_task:
                     on_task()
     finally:

@@ -16,8 +16,8 @@ from dataclasses import asdict, dataclass
 
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PUSH_LEAD, MotionPrimitive, push_values
-from hsgplan.domain.world import SHELVES
 from hsgplan.sim import motion_plans
 from hsgplan.sim.scene import Scene
 
@@ -65,12 +65,14 @@ def push_reach(tasks: int, first: int, on_task: Callable[[], None] | None = None
     # with the refusal off, the pushes it would refuse are run and their margins seen
     motion_plans.PUSH_SLACK = -math.inf
     try:
-        with Scene((), seed=SEED) as scene:
+        with Scene((), seed=SEED, world=KITCHEN) as scene:
             for index in range(first, first + tasks):
-                for trial in run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, index)) or []:
+                for trial in (
+                    run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, index, KITCHEN)) or []
+                ):
                     angle, dist = push_values(*trial.bins)
                     x = trial.before.pose(trial.obj).position[0]
-                    x_min = SHELVES[trial.target].interior.x_min
+                    x_min = KITCHEN.shelves[trial.target].interior.x_min
                     margins.append((reach_margin(x, angle, dist, x_min), trial.ok))
                     statuses[trial.status.value] += 1
                 if on_task:

@@ -16,6 +16,7 @@ from dataclasses import asdict, dataclass
 from hsgplan.data import motion_trials
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.sim import primitives
 from hsgplan.sim.motion_plans import PUSH_STEP
@@ -90,9 +91,9 @@ def push_settings(
     start = time.process_time()
     try:
         for seed in range(FIRST_SEED, FIRST_SEED + scenes):
-            with Scene((), seed=seed) as scene:
+            with Scene((), seed=seed, world=KITCHEN) as scene:
                 for index in range(tasks):
-                    got = motion_trials.run_task(scene, draw_task(PUSH, seed, index)) or []
+                    got = motion_trials.run_task(scene, draw_task(PUSH, seed, index, KITCHEN)) or []
                     ran += len(got)
                     successes += sum(t.ok for t in got)
                     if on_task:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord, run_episode
 from hsgplan.evaluation.protocol import episode_specs
@@ -40,9 +41,9 @@ def bench_sim(
     for spec in specs:
         records.append(
             run_episode(
-                KitchenStorageEnv(visuals=False),
+                KitchenStorageEnv(visuals=False, world=KITCHEN),
                 make_agent("oracle"),
-                parse_goal(spec.goal),
+                parse_goal(spec.goal, world=KITCHEN),
                 spec.seed,
             )
         )

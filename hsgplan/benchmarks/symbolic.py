@@ -12,6 +12,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
 from hsgplan.symbolic.generator import random_goals, random_state
 
@@ -53,7 +54,10 @@ def bench_symbolic(
     rows = []
     for n in sizes:
         rng = random.Random(f"bench-symbolic-{n}-{seed}")
-        problems = [(random_state(g.objects, rng), g) for g in random_goals(n, goals, seed)]
+        problems = [
+            (random_state(g.objects, rng, world=KITCHEN), g)
+            for g in random_goals(n, goals, seed, world=KITCHEN)
+        ]
         for planner in planners:
             if planner.optimal and n > optimal_max_size:
                 continue

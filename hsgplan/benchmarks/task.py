@@ -18,6 +18,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.symbolic.generator import random_goals, random_state
 
@@ -69,7 +70,7 @@ def bench_task(
     closed_loop = FastDownwardTaskPlanner(follow_plan=False)
     rows = []
     for n in sizes:
-        problems = random_goals(n, goals, seed, stacking=n > 2)
+        problems = random_goals(n, goals, seed, stacking=n > 2, world=KITCHEN)
         times: dict[str, list[list[float]]] = {"regression": [], "fd (closed loop)": []}
         solved = {"regression": 0, "fd (closed loop)": 0, "fd (one plan)": 0}
         plans = []
@@ -79,7 +80,7 @@ def bench_task(
                 episode = run_task_episode(planner, goal, episode_seed, 0)
                 times[name].append(list(episode.decision_ms))
                 solved[name] += episode.success
-            state = random_state(goal.objects, random.Random(f"task-{episode_seed}"))
+            state = random_state(goal.objects, random.Random(f"task-{episode_seed}"), world=KITCHEN)
             try:
                 plans.append([1000 * closed_loop.planner.plan(state, goal).seconds])
                 solved["fd (one plan)"] += 1

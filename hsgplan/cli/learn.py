@@ -62,6 +62,7 @@ def train_task(
     ] = None,
 ) -> None:
     """Train f_preimage, f_reach and the forward baseline on the demonstrations."""
+    from hsgplan.domain.kitchen import KITCHEN
     from hsgplan.planning.regression.train import TaskTrainConfig
     from hsgplan.planning.regression.train import train_task as run
 
@@ -77,7 +78,7 @@ def train_task(
                 bars[name] = progress.add_task(name, total=cfg.epochs)
             progress.update(bars[name], completed=epoch, description=f"{name} loss {loss:.4f}")
 
-        run(cfg, out_dir, on_epoch)
+        run(cfg, out_dir, on_epoch, world=KITCHEN)  # the demonstrations are the kitchen's
     out.print(f"trained f_preimage, f_reach and the forward baseline into {shown(out_dir)}")
 
 

@@ -25,8 +25,8 @@ class Search(StrEnum):
 
 
 def _world(scene: Path | None):
+    from hsgplan.domain.kitchen import KITCHEN
     from hsgplan.domain.scene_file import read_world
-    from hsgplan.domain.world import KITCHEN
 
     return read_world(scene) if scene else KITCHEN
 

@@ -113,8 +113,8 @@ def demo(
     drawing per step, a record; with --rerun, a 3D recording for rerun's viewer."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.domain.goals import parse_goal
+    from hsgplan.domain.kitchen import KITCHEN
     from hsgplan.domain.scene_file import read_world
-    from hsgplan.domain.world import KITCHEN
     from hsgplan.evaluation.demo import demo_goal, run_demo
     from hsgplan.evaluation.observers import make_observer
     from hsgplan.evaluation.protocol import check_agent_world

@@ -20,7 +20,7 @@ from hsgplan.data.demos import DEMOS, FORMAT, META, TASKS, VERSION, Demo, read_d
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.files import write_atomically
 from hsgplan.runner.lock import hold_folder
@@ -40,8 +40,8 @@ def round_task(task: str, r: int) -> str:
 
 def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) -> Demo | None:
     """Run the oracle on one task; the demonstration, or None if the episode failed."""
-    goal = parse_goal(goal_text)
-    others = tuple(t for t in OBJECT_TYPES if t not in goal.objects) if full_scene else ()
+    goal = parse_goal(goal_text, world=KITCHEN)
+    others = tuple(t for t in KITCHEN.object_types if t not in goal.objects) if full_scene else ()
     states: list[SymbolicSceneGraph] = []
     actions: list[str] = []
 
@@ -53,7 +53,7 @@ def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) 
         states.append(obs.symbols.state)
 
     result = run_episode(
-        KitchenStorageEnv(visuals=False),
+        KitchenStorageEnv(visuals=False, world=KITCHEN),
         make_agent("oracle"),
         goal,
         seed,
@@ -69,6 +69,7 @@ def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) 
         ResetOptions(goal, others=others).objects(),
         tuple(actions),
         tuple(tuple(str(lit) for lit in s.sorted_literals()) for s in states),
+        world=KITCHEN,
     )
 
 
@@ -83,7 +84,7 @@ def _recorded(out: Path, seed: int, full_scene: bool) -> dict[str, Demo]:
         if saved.get("full_scene", False) != full_scene:
             scene = "every object type" if saved.get("full_scene") else "their goal's objects alone"
             raise InvalidInputError(f"'{out}' holds demonstrations recorded in a scene of {scene}")
-    return {d.task: d for d in read_demos(out / DEMOS, tolerate_cut=True)}
+    return {d.task: d for d in read_demos(out / DEMOS, KITCHEN, tolerate_cut=True)}
 
 
 def collect_demos(

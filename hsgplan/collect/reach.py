@@ -47,10 +47,10 @@ import numpy as np
 from hsgplan.data.world_trials import NO_PARAMETERS, UNSTAGED, WorldTrial, state_row, trials_of
 from hsgplan.domain.actions import Action, Place
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.room import Room
-from hsgplan.domain.world import REGIONS, SHELVES, SURFACES
 from hsgplan.motion.sampler import candidates
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.runner.items import run_items
@@ -68,23 +68,23 @@ MIN_OBJECTS, MAX_OBJECTS = 2, 8
 P_HOLD, P_CROWDED_STATE, P_CROWD, P_STACK = 0.5, 5 / 6, 0.85, 0.35
 
 OPEN = "open_space"
-TOPS = tuple(SHELVES)
-PREPUSH = tuple(r for r in REGIONS if r != OPEN)
+TOPS = tuple(KITCHEN.shelves)
+PREPUSH = tuple(r for r in KITCHEN.regions if r != OPEN)
 # a place to crowd: ("on", surface) or ("in", shelf)
-CROWDABLE = (*(("on", s) for s in TOPS + PREPUSH), *(("in", s) for s in SHELVES))
+CROWDABLE = (*(("on", s) for s in TOPS + PREPUSH), *(("in", s) for s in KITCHEN.shelves))
 
 
 def draw_reach_state(seed: int, index: int) -> SymbolicSceneGraph:
     """A state to stage (the distribution is in the module docstring)."""
     rng = random.Random(f"reach-{seed}-{index}")
-    objects = draw_objects(rng.randint(MIN_OBJECTS, MAX_OBJECTS), rng)
+    objects = draw_objects(rng.randint(MIN_OBJECTS, MAX_OBJECTS), rng, KITCHEN)
     order = list(objects)
     rng.shuffle(order)
     literals = [in_grasp(order.pop())] if rng.random() < P_HOLD else []
     crowd = rng.choice(CROWDABLE) if rng.random() < P_CROWDED_STATE else None
-    room = Room.left()
+    room = Room.left(world=KITCHEN)
     literals += [_put(o, room, crowd, rng) for o in order]
-    return SymbolicSceneGraph.from_literals(objects, literals, limits=False)
+    return SymbolicSceneGraph.from_literals(objects, literals, limits=False, world=KITCHEN)
 
 
 def _put(o: str, room: Room, crowd: tuple[str, str] | None, rng: random.Random) -> Literal:
@@ -135,7 +135,7 @@ def _stratum(action: Action, state: SymbolicSceneGraph) -> str:
         return type(action).__name__
     if state.held() != action.obj:
         return "place not held"
-    return "place on surface" if action.target in SURFACES else "place on object"
+    return "place on surface" if action.target in KITCHEN.surfaces else "place on object"
 
 
 def execute_action(scene: Scene, action: Action, max_params: int = MAX_PARAMS) -> tuple[str, bool]:
@@ -221,7 +221,7 @@ class ReachItem:
 
 @functools.cache
 def _process_scene() -> Scene:
-    return Scene((), visuals=False)
+    return Scene((), visuals=False, world=KITCHEN)
 
 
 def run_reach_item(item: ReachItem) -> dict:
@@ -292,7 +292,7 @@ def collect_reach(
         on_result=on_item,
     )
     ran = sum(item.key not in logged for item in items)
-    trials: list[WorldTrial] = [t for row in rows for t in trials_of(row)]
+    trials: list[WorldTrial] = [t for row in rows for t in trials_of(row, KITCHEN)]
     return ReachSummary(
         states,
         sum(row.get("staged", True) is not False for row in rows),

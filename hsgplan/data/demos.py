@@ -21,13 +21,14 @@ in the goal / action text syntax.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from hsgplan.domain.actions import Action, parse_action
 from hsgplan.domain.checks import read_json, read_text
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal
+from hsgplan.domain.scene import World
 from hsgplan.paths import shipped
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -66,7 +67,8 @@ TASKS: tuple[tuple[str, str], ...] = (
 
 @dataclass(frozen=True)
 class Demo:
-    """One demonstration: the goal, the seed of its scene, and its symbolic trajectory."""
+    """One demonstration: the goal, the seed of its scene, and its symbolic trajectory, in the
+    world it was recorded in (not written: a dataset's world is its reader's to give)."""
 
     task: str
     goal: str
@@ -74,39 +76,43 @@ class Demo:
     objects: tuple[str, ...]
     actions: tuple[str, ...]
     states: tuple[tuple[str, ...], ...]
+    world: World = field(kw_only=True, compare=False, repr=False)
 
     def to_json(self) -> dict:
-        return asdict(self)
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name != "world"}
 
     def goal_literals(self) -> Goal:
-        return parse_goal(self.goal)
+        return parse_goal(self.goal, world=self.world)
 
     def symbolic_states(self) -> list[SymbolicSceneGraph]:
         return [
             SymbolicSceneGraph.from_literals(
-                self.objects, parse_goal(" & ".join(s), validate=False).literals, limits=False
+                self.objects,
+                parse_goal(" & ".join(s), validate=False, world=self.world).literals,
+                limits=False,
+                world=self.world,
             )
             for s in self.states
         ]
 
     def symbolic_actions(self) -> list[Action]:
-        return [parse_action(a) for a in self.actions]
+        return [parse_action(a, self.world) for a in self.actions]
 
 
-def load_demos(folder: Path) -> list[Demo]:
+def load_demos(folder: Path, world: World) -> list[Demo]:
     """The demonstrations of a dataset folder (found as `hsgplan.paths.shipped` finds it),
-    checked; bad input raises InvalidInputError."""
+    recorded in `world`, checked; bad input raises InvalidInputError."""
     folder = shipped(folder)
     meta = read_json(folder / META, "demonstration metadata")
     if meta.get("format") != FORMAT or meta.get("version") != VERSION:
         raise InvalidInputError(f"'{folder}' is not a version {VERSION} demonstration dataset")
-    demos = read_demos(folder / DEMOS, tolerate_cut=False)
+    demos = read_demos(folder / DEMOS, world, tolerate_cut=False)
     if not demos:
         raise InvalidInputError(f"'{folder / DEMOS}' holds no demonstration")
     return demos
 
 
-def read_demos(path: Path, tolerate_cut: bool) -> list[Demo]:
+def read_demos(path: Path, world: World, tolerate_cut: bool) -> list[Demo]:
     if not path.exists():
         return []
     demos = []
@@ -122,6 +128,7 @@ def read_demos(path: Path, tolerate_cut: bool) -> list[Demo]:
                 tuple(d["objects"]),
                 tuple(d["actions"]),
                 tuple(tuple(s) for s in d["states"]),
+                world=world,
             )
             if len(demo.states) != len(demo.actions) + 1:
                 raise ValueError("states and actions do not match")

@@ -8,8 +8,8 @@ Schema (version `SCHEMA_VERSION`), written beside the data as `schema.json`:
 | attempt  | int8    | [S]       | try within the task                                           |
 | status   | int8    | [S]       | index into `STATUSES` (0 = success)                           |
 | crowding | int8    | [S]       | objects already on the target surface / inside the shelf      |
-| obj      | int8    | [S]       | index into `OBJECT_TYPES` of the object placed or pushed      |
-| target   | int8    | [S]       | index into `ENTITY_TYPES` of the target surface or shelf      |
+| obj      | int8    | [S]       | index into the kitchen's object types, of the object moved    |
+| target   | int8    | [S]       | index into the kitchen's entity types, of the target          |
 | bins     | int8    | [S, 2]    | (x_bin, y_bin) for place, (angle_bin, dist_bin) for push      |
 | poses    | float32 | [S, 6, 7] | per object type: position, quaternion xyzw; NaN if absent     |
 
@@ -32,9 +32,8 @@ import numpy as np
 
 from hsgplan.data.motion_trials import ChunkResult, Trial
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import ENTITY_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import BINS, MotionPrimitive
-from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.files import atomic, write_atomically
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -45,7 +44,7 @@ from hsgplan.sim.outcome import Status
 SCHEMA_VERSION = 3
 CHUNK_FORMAT = 2  # 2: a chunk carries its index and seed, checked on load
 STATUSES: tuple[Status, ...] = tuple(Status)
-TYPES: tuple[str, ...] = tuple(OBJECT_TYPES)
+TYPES: tuple[str, ...] = tuple(KITCHEN.object_types)
 SCHEMA = "schema.json"
 FIELDS = ("task", "attempt", "status", "crowding", "obj", "target", "bins", "poses")
 
@@ -78,7 +77,7 @@ class MotionData:
         return TYPES[int(self.obj[i])]
 
     def target_name(self, i: int) -> str:
-        return ENTITY_TYPES[int(self.target[i])]
+        return KITCHEN.entity_types[int(self.target[i])]
 
     def scene_graph(self, i: int) -> GeometricSceneGraph:
         """s_g of row i, as the primitive found it."""
@@ -88,7 +87,7 @@ class MotionData:
             if not np.isnan(p[0])
         }
         held = self.object_name(i) if self.primitive is MotionPrimitive.PLACE else None
-        return GeometricSceneGraph.from_poses(poses, held=held)
+        return GeometricSceneGraph.from_poses(poses, held=held, world=KITCHEN)
 
 
 def from_trials(primitive: MotionPrimitive, trials: list[Trial]) -> MotionData:
@@ -104,7 +103,7 @@ def from_trials(primitive: MotionPrimitive, trials: list[Trial]) -> MotionData:
         np.array([STATUSES.index(t.status) for t in trials], dtype=np.int8),
         np.array([t.crowding for t in trials], dtype=np.int8),
         np.array([TYPES.index(t.obj) for t in trials], dtype=np.int8),
-        np.array([ENTITY_TYPES.index(t.target) for t in trials], dtype=np.int8),
+        np.array([KITCHEN.entity_types.index(t.target) for t in trials], dtype=np.int8),
         np.array([t.bins for t in trials], dtype=np.int8).reshape(s, 2),
         poses,
     )
@@ -158,7 +157,7 @@ def row_problem(data: MotionData) -> str | None:
         "crowding": (data.crowding, None),
         "status": (data.status, len(STATUSES)),
         "obj": (data.obj, len(TYPES)),
-        "target": (data.target, len(ENTITY_TYPES)),
+        "target": (data.target, len(KITCHEN.entity_types)),
         "x or angle bin": (data.bins[:, 0], nx),
         "y or distance bin": (data.bins[:, 1], ny),
     }
@@ -236,7 +235,7 @@ def write_schema(folder: Path) -> None:
         "version": SCHEMA_VERSION,
         "statuses": [s.value for s in STATUSES],
         "object_types": list(TYPES),
-        "entity_types": list(ENTITY_TYPES),
+        "entity_types": list(KITCHEN.entity_types),
         "fields": FIELDS,
         "description": "Schema" + doc,
     }

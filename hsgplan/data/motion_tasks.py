@@ -30,7 +30,6 @@ from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.room import Room
 from hsgplan.domain.scene import Kind, World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 # at most one object of each type; pushes go only into the goals' interior (`goal_interior`),
@@ -75,9 +74,7 @@ class MotionTask:
         return inside(self.obj, self.target)
 
 
-def draw_task(
-    primitive: MotionPrimitive, seed: int, index: int, world: World = KITCHEN
-) -> MotionTask:
+def draw_task(primitive: MotionPrimitive, seed: int, index: int, world: World) -> MotionTask:
     """The task at `index` of the stream for `(primitive, seed)`, in `world`."""
     if index < 0:
         raise InvalidInputError(f"task index {index} cannot be negative")

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgplan.data.motion_tasks import MotionTask, draw_task
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import BINS, MotionPrimitive, params_for
 from hsgplan.domain.predicates import Predicate
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -82,9 +83,9 @@ def run_chunk(
     kind = MotionPrimitive(primitive)
     trials: list[Trial] = []
     unstaged = 0
-    with Scene((), seed=seed, visuals=False) as scene:
+    with Scene((), seed=seed, visuals=False, world=KITCHEN) as scene:
         for index in range(chunk * tasks_per_chunk, (chunk + 1) * tasks_per_chunk):
-            got = run_task(scene, draw_task(kind, seed, index))
+            got = run_task(scene, draw_task(kind, seed, index, KITCHEN))
             unstaged += got is None
             trials += got or []
     return ChunkResult(kind, seed, chunk, tuple(trials), unstaged)

@@ -32,6 +32,7 @@ from hsgplan.domain.checks import read_json, read_text
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_literal
 from hsgplan.domain.predicates import Predicate
+from hsgplan.domain.scene import World
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.outcome import Status
 
@@ -60,8 +61,10 @@ def state_json(state: SymbolicSceneGraph) -> list[str]:
     return [str(lit) for lit in state.sorted_literals() if lit.predicate is not Predicate.CLEAR]
 
 
-def read_state(objects: Sequence[str], literals: Sequence[str]) -> SymbolicSceneGraph:
-    return SymbolicSceneGraph.from_literals(objects, map(parse_literal, literals), limits=False)
+def read_state(objects: Sequence[str], literals: Sequence[str], world: World) -> SymbolicSceneGraph:
+    return SymbolicSceneGraph.from_literals(
+        objects, (parse_literal(lit, world) for lit in literals), limits=False, world=world
+    )
 
 
 def state_row(state: SymbolicSceneGraph, trials: Sequence[WorldTrial]) -> dict:
@@ -82,25 +85,27 @@ def state_row(state: SymbolicSceneGraph, trials: Sequence[WorldTrial]) -> dict:
     }
 
 
-def trials_of(row: dict) -> list[WorldTrial]:
-    """The trials of one logged result; none for a state that was not staged."""
+def trials_of(row: dict, world: World) -> list[WorldTrial]:
+    """The trials of one logged result in the world it was collected in; none for a state that
+    was not staged."""
     if row.get("staged", True) is False:
         return []
     objects = row["objects"]
-    state = read_state(objects, row["state"])
+    state = read_state(objects, row["state"], world)
     return [
         WorldTrial(
             state,
-            parse_action(t["action"]),
+            parse_action(t["action"], world),
             str(t["status"]),
-            None if t["after"] is None else read_state(objects, t["after"]),
+            None if t["after"] is None else read_state(objects, t["after"], world),
         )
         for t in row["trials"]
     ]
 
 
-def load_world_trials(folder: Path) -> list[WorldTrial]:
-    """Every trial of a collection folder, states in key order, trials in the order run."""
+def load_world_trials(folder: Path, world: World) -> list[WorldTrial]:
+    """Every trial of a collection folder collected in `world`, states in key order, trials in
+    the order run."""
     path = Path(folder) / RESULTS
     if not path.is_file():
         raise InvalidInputError(f"'{folder}' holds no collection of executed primitives")
@@ -122,7 +127,7 @@ def load_world_trials(folder: Path) -> list[WorldTrial]:
     for key in sorted(results):
         result = results[key]
         try:
-            trials += trials_of(result)
+            trials += trials_of(result, world)
         except (AttributeError, KeyError, TypeError, ValueError) as e:
             where = "/".join(map(str, key))
             raise InvalidInputError(f"'{path}' state {where} is damaged: {_why(e)}") from None

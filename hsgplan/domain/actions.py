@@ -9,8 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import EntityKind, kind_of
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
+from hsgplan.domain.scene import EntityKind, World
 
 
 @dataclass(frozen=True)
@@ -48,16 +48,17 @@ class Push:
 Action = Pick | Place | Push
 
 
-def parse_action(text: str) -> Action:
-    """`pick(o)`, `place(o, target)` or `push(o, shelf)` back into an action."""
+def parse_action(text: str, world: World) -> Action:
+    """`pick(o)`, `place(o, target)` or `push(o, shelf)` back into an action; its names must
+    be the world's."""
     name, _, rest = text.strip().partition("(")
     args = [a.strip() for a in rest.rstrip(") ").split(",") if a.strip()]
     kinds = {"pick": (Pick, 1), "place": (Place, 2), "push": (Push, 2)}
     if name.strip() not in kinds or len(args) != kinds[name.strip()][1]:
         raise InvalidInputError(f"'{text}' is not an action (pick(o), place(o, x), push(o, shelf))")
     for a in args:
-        kind_of(a)
-    if kind_of(args[0]) is not EntityKind.OBJECT:
+        world.kind_of(a)
+    if world.kind_of(args[0]) is not EntityKind.OBJECT:
         raise InvalidInputError(f"'{text}': the first argument must be an object")
     cls = kinds[name.strip()][0]
     return cls(*args)

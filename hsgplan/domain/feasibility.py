@@ -14,16 +14,13 @@ from collections.abc import Iterable
 from hsgplan.domain.errors import InfeasibleError
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.scene import MAX_OBJECTS, REACH_MAX_Z, EntityKind, World
-from hsgplan.domain.world import KITCHEN
 
 
 def _q(*lits: Literal) -> str:
     return " and ".join(f"'{lit}'" for lit in lits)
 
 
-def check_literals(
-    literals: Iterable[Literal], limits: bool = True, world: World = KITCHEN
-) -> None:
+def check_literals(literals: Iterable[Literal], limits: bool = True, *, world: World) -> None:
     """Raise InfeasibleError if no scene satisfies all the literals together.
 
     With `limits=False` only the structure is checked (one place per object, one object held,

@@ -19,7 +19,6 @@ from hsgplan.domain.errors import GoalSyntaxError, InvalidInputError, UnknownNam
 from hsgplan.domain.feasibility import check_literals
 from hsgplan.domain.predicates import PREDICATES, Literal, Predicate
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.files import write_atomically
 
 MAX_GOAL_CHARS = 10_000
@@ -41,7 +40,7 @@ class Goal:
     """
 
     literals: frozenset[Literal]
-    world: World = field(default=KITCHEN, compare=False, hash=False, repr=False)
+    world: World = field(compare=False, hash=False, repr=False)
 
     @property
     def objects(self) -> tuple[str, ...]:
@@ -100,7 +99,7 @@ def _snake(name: str) -> str:
     return re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name).lower()
 
 
-def parse_literal(text: str, world: World = KITCHEN) -> Literal:
+def parse_literal(text: str, world: World) -> Literal:
     """One literal; raises an InvalidInputError naming it and the reason."""
     src = text.strip()
     m = _LITERAL.match(src)
@@ -160,7 +159,7 @@ def split_literals(text: str) -> list[str]:
     return literals
 
 
-def parse_goal(text: str, validate: bool = True, world: World = KITCHEN) -> Goal:
+def parse_goal(text: str, validate: bool = True, *, world: World) -> Goal:
     """Parse goal text; with `validate`, also refuse contradictory or impossible goals."""
     if len(text) > MAX_GOAL_CHARS:
         raise GoalSyntaxError(f"the goal is {len(text)} characters long; at most {MAX_GOAL_CHARS}")
@@ -172,7 +171,7 @@ def parse_goal(text: str, validate: bool = True, world: World = KITCHEN) -> Goal
     return goal
 
 
-def goal_of(literals: Iterable[Literal], world: World = KITCHEN) -> Goal:
+def goal_of(literals: Iterable[Literal], world: World) -> Goal:
     """A checked goal from literals."""
     goal = Goal(frozenset(literals), world)
     check_literals(goal.literals, world=world)
@@ -187,7 +186,7 @@ def write_goal_file(path: Path, goals: Iterable[Goal], header: str = "") -> None
     write_atomically(path, "\n".join(lines) + "\n")  # an existing file is replaced or kept
 
 
-def read_goal_file(path: Path, world: World = KITCHEN) -> list[Goal]:
+def read_goal_file(path: Path, world: World) -> list[Goal]:
     """Every goal in a goal file; a bad line raises with its line number. A file larger than
     `MAX_GOAL_FILE_BYTES` or holding more than `MAX_GOAL_FILE_GOALS` goals is refused before
     any goal is parsed (parsing a million would take minutes with nothing shown)."""

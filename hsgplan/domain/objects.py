@@ -11,21 +11,11 @@ from collections.abc import Iterable
 
 from hsgplan.domain.errors import UnknownNameError
 from hsgplan.domain.scene import MAX_OBJECTS, EntityKind, World
-from hsgplan.domain.world import KITCHEN
 
 __all__ = ["EntityKind", "MAX_OBJECTS"]
 
 
-# The kitchen's names, for the code that does not yet take a `World` (`World` has each).
-ENTITY_TYPES: tuple[str, ...] = KITCHEN.entity_types
-split_instance = KITCHEN.split_instance
-kind_of = KITCHEN.kind_of
-type_of = KITCHEN.type_of
-object_type = KITCHEN.object_type
-sort_objects = KITCHEN.sort_objects
-
-
-def instance_name(type_name: str, k: int, world: World = KITCHEN) -> str:
+def instance_name(type_name: str, k: int, world: World) -> str:
     """The name of the k-th instance (1-based) of an object type."""
     if type_name not in world.object_types:
         raise UnknownNameError(f"unknown object type '{type_name}'")
@@ -34,7 +24,7 @@ def instance_name(type_name: str, k: int, world: World = KITCHEN) -> str:
     return type_name if k == 1 else f"{type_name}_{k}"
 
 
-def objects_for_types(type_names: Iterable[str], world: World = KITCHEN) -> tuple[str, ...]:
+def objects_for_types(type_names: Iterable[str], world: World) -> tuple[str, ...]:
     """Instance names for a multiset of types, numbered in order of appearance."""
     counts: dict[str, int] = {}
     names = []
@@ -44,7 +34,7 @@ def objects_for_types(type_names: Iterable[str], world: World = KITCHEN) -> tupl
     return tuple(names)
 
 
-def draw_objects(n: int, rng: random.Random, world: World = KITCHEN) -> tuple[str, ...]:
+def draw_objects(n: int, rng: random.Random, world: World) -> tuple[str, ...]:
     """n object instances, in canonical order: n distinct types drawn uniformly when n is at
     most the number of types, else every type once and the rest uniformly with replacement.
     The goal generator's objects and the reach collector's scenes are drawn this way."""

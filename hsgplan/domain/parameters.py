@@ -17,7 +17,6 @@ from enum import StrEnum
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import Kind, World
 from hsgplan.domain.world import (
-    KITCHEN,
     PLACE_BINS,
     PUSH_ANGLE_BINS,
     PUSH_ANGLE_RANGE,
@@ -80,16 +79,14 @@ def _check_bin(value: int, bins: int, what: str) -> None:
         raise InvalidInputError(f"{what} {value} is outside 0..{bins - 1}")
 
 
-def place_inset(obj: str, world: World = KITCHEN) -> tuple[float, float]:
+def place_inset(obj: str, world: World) -> tuple[float, float]:
     """How far a bin centre stays from a surface's x and y edges: half the object's footprint
     as it is placed (long side along y), plus a small gap."""
     fx, fy = sorted(world.object_type(obj).footprint)
     return fx / 2 + PLACE_EDGE_GAP, fy / 2 + PLACE_EDGE_GAP
 
 
-def place_xy(
-    obj: str, target: str, x_bin: int, y_bin: int, world: World = KITCHEN
-) -> tuple[float, float]:
+def place_xy(obj: str, target: str, x_bin: int, y_bin: int, world: World) -> tuple[float, float]:
     """The world (x, y) of a place bin's centre on a surface."""
     if target not in world.surface_capacity:
         raise InvalidInputError(f"place bins are over surfaces, not '{target}'")
@@ -120,7 +117,7 @@ def push_values(angle_bin: int, dist_bin: int) -> tuple[float, float]:
     )
 
 
-def extent_along(obj: str, yaw: float, angle: float, world: World = KITCHEN) -> float:
+def extent_along(obj: str, yaw: float, angle: float, world: World) -> float:
     """How far an object standing at `yaw` reaches from its centre towards `angle`."""
     t = world.object_type(obj)
     if t.kind is Kind.CAN:

@@ -6,7 +6,6 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from hsgplan.domain.scene import EntityKind, World
-from hsgplan.domain.world import KITCHEN
 
 
 class Predicate(StrEnum):
@@ -66,7 +65,7 @@ class Literal:
     def subject(self) -> str:
         return self.args[0]
 
-    def objects(self, world: World = KITCHEN) -> tuple[str, ...]:
+    def objects(self, world: World) -> tuple[str, ...]:
         """The object instances this literal names (fixtures and regions excluded)."""
         return tuple(a for a in self.args if world.kind_of(a) is EntityKind.OBJECT)
 

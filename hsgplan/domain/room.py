@@ -2,9 +2,9 @@
 
 Why one home: the goal and start-state generator, the motion-task sampler and the augmentation of
 demonstrations all draw arrangements object by object, and each must keep within the same limits
-(`SURFACE_CAPACITY`, `INTERIOR_CAPACITY`, `MAX_TOWER_LEVELS`, `can_support`, `fits_inside`) that
-the goal validator and the transition model enforce. Kept apart, the three tallies drifted in
-small ways (one hard-coded two-level towers); here the limits are counted once.
+(the world's `surface_capacity`, `interior_capacity`, `max_tower_levels`, `can_support`,
+`fits_inside`) that the goal validator and the transition model enforce. Kept apart, the three
+tallies drifted in small ways (one hard-coded two-level towers); here the limits are counted once.
 
 A `Room` only counts; it draws nothing, so callers keep their own random draws, in their order.
 """
@@ -15,10 +15,9 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN
 
 
-def can_carry(type_name: str, level: int, world: World = KITCHEN) -> bool:
+def can_carry(type_name: str, level: int, world: World) -> bool:
     """Whether an object of this type, `level` objects high in its tower, may take one more."""
     return world.can_support(type_name) and level < world.max_tower_levels
 
@@ -38,7 +37,7 @@ class Room:
     interior: dict[str, int]
     level: dict[str, int] = field(default_factory=dict)
     bare: list[str] = field(default_factory=list)
-    world: World = KITCHEN
+    world: World = field(kw_only=True)
 
     @classmethod
     def left(
@@ -47,7 +46,8 @@ class Room:
         interiors: Iterable[str] | None = None,
         on_top: Mapping[str, int] | None = None,
         inside: Mapping[str, int] | None = None,
-        world: World = KITCHEN,
+        *,
+        world: World,
     ) -> Room:
         """The room on `tops` (default: every surface) and in `interiors` (default: every
         shelf's) when `on_top[s]` / `inside[s]` places are taken."""

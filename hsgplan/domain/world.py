@@ -1,9 +1,7 @@
-"""The default world (`scenes/kitchen.toml`) under the names modules import, and the constants
-of the robot and the paper's discretisation, which no scene changes.
+"""The constants of the robot and the paper's discretisation, which no scene changes.
 
-The kitchen's values here are read from its scene file, so the file is their one source; the
-types and the counting rules are `domain/scene.py`'s. Code that takes a `World` reads these from
-the world it is given; what still imports them here sees the kitchen.
+A scene's facts (its object types, shelves, regions, capacities, friction) are its `World`'s
+(`domain/scene.py`), passed to whatever needs them; the default world is `domain/kitchen.py`.
 
 Frame: origin at the robot base on the table top, z up, x away from the robot, y to the left.
 All lengths are metres.
@@ -30,34 +28,12 @@ from hsgplan.domain.scene import (
     shelf_boards,
     spot_cells,
 )
-from hsgplan.domain.scene_file import read_world
-from hsgplan.paths import KITCHEN_SCENE
 
 __all__ = [
     "GRIPPER_MAX_OPENING", "INTERIOR_SPOT", "MAX_OBJECTS", "MIN_SUPPORT_SIDE", "REACH_MAX_Z",
     "SPOT", "Board", "Kind", "ObjectType", "Rect", "Shelf", "World", "capacity", "shelf_boards",
     "spot_cells",
 ]  # fmt: skip
-
-KITCHEN: World = read_world(KITCHEN_SCENE)
-
-OBJECT_TYPES: dict[str, ObjectType] = KITCHEN.object_types
-TABLE = KITCHEN.table
-SHELVES: dict[str, Shelf] = KITCHEN.shelves
-REGIONS: dict[str, Rect] = KITCHEN.regions
-WALL = SHELVES["shelf_a"].wall
-SHELF_CLEARANCE = SHELVES["shelf_a"].clearance
-SHELF_TOP_Z = SHELVES["shelf_a"].top.z
-
-surface_rect = KITCHEN.surface_rect
-SURFACES: tuple[str, ...] = KITCHEN.surfaces
-SURFACE_CAPACITY: dict[str, int] = KITCHEN.surface_capacity
-INTERIOR_CAPACITY: dict[str, int] = KITCHEN.interior_capacity
-interior_slots = KITCHEN.interior_slots
-MAX_TOWER_LEVELS = KITCHEN.max_tower_levels
-can_support = KITCHEN.can_support
-fits_inside = KITCHEN.fits_inside
-
 
 # --- motion primitive parameters (the paper's discretisation) ---
 
@@ -79,14 +55,3 @@ PUSH_DIST_RANGE = (0.08, 0.20)
 # Primitives an episode may take before it counts as an overstep (the paper's limit), in the
 # simulated world and in the symbolic loop alike.
 MAX_STEPS = 50
-
-# --- the paper's goal kinds ---
-
-# Goal literals put an object on one of these shelf tops, stack it on another object, or put it
-# into this shelf's interior (cans only, in evaluation goals); pushes go into the same shelf.
-GOAL_SHELF_TOPS: tuple[str, ...] = KITCHEN.goal_shelf_tops
-GOAL_INTERIOR = KITCHEN.goal_interior
-
-# Lateral friction of the table and the shelves' walls and top boards (each object type has its
-# own); PyBullet multiplies the two bodies' values at a contact.
-FIXTURE_FRICTION = KITCHEN.fixture_friction

@@ -10,10 +10,10 @@ from pathlib import Path
 
 from hsgplan.domain.checks import BOUNDS, bounded, check_fields, read_text, setting
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import MAX_SCENE_BYTES, read_world_text, read_worlds
-from hsgplan.domain.world import KITCHEN
 
 # What an agent sees the simulated world with: `gt` (the simulator's poses) or `rgb` (f_p on
 # the fixed cameras' images); `evaluation.observers` makes them.

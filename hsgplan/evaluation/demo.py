@@ -17,8 +17,9 @@ import numpy as np
 from hsgplan.agents.base import Agent, Decision
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import Goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN, MAX_STEPS
+from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord, params_text, run_episode
 from hsgplan.files import atomic, write_atomically
 from hsgplan.runner.engines import one_core

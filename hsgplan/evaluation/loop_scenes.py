@@ -21,6 +21,7 @@ import numpy as np
 
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.checks import MAX_SEED
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.env import KitchenStorageEnv
@@ -47,12 +48,12 @@ class _Taken(Exception):
 
 def loop_scenes(scenes: int, seed: int, cameras: tuple[Camera, ...]) -> Iterator[LoopScene]:
     """`scenes` scenes, each from an episode of its own."""
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     agent = make_agent("oracle")
     try:
         for index in range(scenes):
             rng = random.Random(f"{seed}/{index}")
-            goal = random_goals(rng.randint(*SIZES), 1, rng.randrange(MAX_SEED))[0]
+            goal = random_goals(rng.randint(*SIZES), 1, rng.randrange(MAX_SEED), world=KITCHEN)[0]
             wanted = rng.randint(1, MAX_STEPS_INTO)
             steps = _run_into(env, agent, goal, rng.randrange(MAX_SEED), wanted)
             scene = env.scene

@@ -20,10 +20,10 @@ from hsgplan.checkpoint import fingerprint
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import stage_task, try_params
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import read_worlds
-from hsgplan.domain.world import KITCHEN
 from hsgplan.evaluation.config import world_of_file
 from hsgplan.paths import shipped
 from hsgplan.runner.items import run_items

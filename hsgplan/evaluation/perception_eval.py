@@ -27,7 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.domain.objects import EntityKind, kind_of, object_type, type_of
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.objects import EntityKind
 from hsgplan.domain.world import Kind
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
@@ -65,7 +66,7 @@ class SceneResult:
 def rotation_error(obj: str, truth: Pose, estimate: Pose) -> float:
     """Degrees between two orientations of an object, up to its cuboid's symmetries."""
     a, b = truth.rotation, estimate.rotation
-    if object_type(obj).kind is Kind.CAN:
+    if KITCHEN.object_type(obj).kind is Kind.CAN:
         cos = abs(float(a[:, 2] @ b[:, 2]))  # the axis, either way up
         return math.degrees(math.acos(min(1.0, cos)))
     best = max(np.trace(a.T @ b @ s) for s in BOX_SYMMETRIES)
@@ -79,7 +80,7 @@ def match(truth: dict[str, Pose], detections: list[Detection]) -> dict[str, Dete
         (np.linalg.norm(np.subtract(d.pose.position, truth[o].position)), o, k)
         for o in truth
         for k, d in enumerate(detections)
-        if d.type_name == type_of(o)
+        if d.type_name == KITCHEN.type_of(o)
     )
     matched: dict[str, Detection] = {}
     taken: set[int] = set()
@@ -103,9 +104,9 @@ def score(truth: dict[str, Pose], detections: list[Detection]) -> SceneResult:
         for o in names
     ]
     rotation = [rotation_error(o, truth[o], matched[o].pose) for o in names]
-    true_state = map_symbols(GeometricSceneGraph.from_poses(truth)).state
+    true_state = map_symbols(GeometricSceneGraph.from_poses(truth, world=KITCHEN)).state
     seen_state = map_symbols(
-        GeometricSceneGraph.from_poses({o: matched[o].pose for o in names})
+        GeometricSceneGraph.from_poses({o: matched[o].pose for o in names}, world=KITCHEN)
     ).state
     same = len(names) == len(truth) and true_state == seen_state
     return SceneResult(
@@ -113,7 +114,7 @@ def score(truth: dict[str, Pose], detections: list[Detection]) -> SceneResult:
         len(names),
         tuple(translation),
         tuple(rotation),
-        tuple(type_of(o) for o in names),
+        tuple(KITCHEN.type_of(o) for o in names),
         same,
         len(detections),
         None if same else misread(truth, detections, matched, true_state, seen_state),
@@ -134,7 +135,7 @@ def misread(truth, detections, matched, true_state, seen_state) -> str:
     if missing:
         return "unseen"
     wrong = set(true_state.literals) ^ set(seen_state.literals)
-    targets = {kind_of(lit.args[-1]) for lit in wrong if lit.predicate.arity == 2}
+    targets = {KITCHEN.kind_of(lit.args[-1]) for lit in wrong if lit.predicate.arity == 2}
     if EntityKind.OBJECT in targets:
         return "stack_relation"
     if EntityKind.SHELF in targets:
@@ -144,7 +145,7 @@ def misread(truth, detections, matched, true_state, seen_state) -> str:
 
 def _on_object(state, obj: str) -> bool:
     below = state.location(obj).args[-1]
-    return kind_of(below) is EntityKind.OBJECT
+    return KITCHEN.kind_of(below) is EntityKind.OBJECT
 
 
 def evaluate(

@@ -28,9 +28,9 @@ from hsgplan.domain.checks import (
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.recovery import PAPER, RECOVERING
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.evaluation.config import EvalConfig, world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer, perception_folder

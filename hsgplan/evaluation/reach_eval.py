@@ -19,7 +19,7 @@ import torch
 
 from hsgplan.data.world_trials import WorldTrial, load_world_trials
 from hsgplan.domain.actions import Action, Place, Push
-from hsgplan.domain.world import INTERIOR_CAPACITY, SURFACE_CAPACITY, SURFACES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.planning.regression.examples import world_labels
 from hsgplan.planning.regression.planner import RegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -35,13 +35,13 @@ class QuestionKind(StrEnum):
 
 
 def kind_of_question(state: SymbolicSceneGraph, action: Action) -> QuestionKind:
-    held = state.held()
+    held, world = state.held(), state.world
     if isinstance(action, Place):
         if held != action.obj:
             return QuestionKind.NOT_HELD
         t = action.target
-        if t in SURFACES:
-            full = len(state.resting_on(t)) >= SURFACE_CAPACITY[t]
+        if t in world.surfaces:
+            full = len(state.resting_on(t)) >= world.surface_capacity[t]
             return QuestionKind.SURFACE_FULL if full else QuestionKind.ORDINARY
         return QuestionKind.COVERED if state.resting_on(t) else QuestionKind.ORDINARY
     if held is not None and held != action.obj:
@@ -50,7 +50,7 @@ def kind_of_question(state: SymbolicSceneGraph, action: Action) -> QuestionKind:
         return QuestionKind.COVERED
     if (
         isinstance(action, Push)
-        and len(state.inside(action.shelf)) >= INTERIOR_CAPACITY[action.shelf]
+        and len(state.inside(action.shelf)) >= world.interior_capacity[action.shelf]
     ):
         return QuestionKind.INTERIOR_FULL
     return QuestionKind.ORDINARY
@@ -97,7 +97,7 @@ def _add(s: Scores, truth: bool, said: bool) -> Scores:
 def evaluate_reach(checkpoint: Path, trials: list[WorldTrial] | Path) -> dict:
     """Scores by kind and overall: `{"by_kind": {kind: {...}}, "overall": {...}}`."""
     if isinstance(trials, Path):
-        trials = load_world_trials(trials)
+        trials = load_world_trials(trials, KITCHEN)
     planner = RegressionPlanner(checkpoint)
     scores: dict[str, Scores] = defaultdict(Scores)
     for trial in trials:

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from hsgplan.agents.base import Decision
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.world import Kind
 from hsgplan.perception.draw import EDGES, cuboid_pixels
 from hsgplan.perception.keypoints import PinholeCamera
@@ -86,7 +86,7 @@ def _object_shape(name: str, colour, label: str | None = None):
     """An object as its type's box or cylinder, centred on its pose."""
     import rerun as rr
 
-    t = object_type(name)
+    t = KITCHEN.object_type(name)
     labels = None if label is None else [label]
     if t.kind is Kind.CAN:
         return rr.Cylinders3D(
@@ -151,7 +151,7 @@ class EpisodeRecording:
                 path = f"world/arena/body_{k}/part_{j}"
                 self._log(path, _transform(_compose(pose, part.local)), _shape(part), static=True)
         for name in scene.objects:
-            colour = _rgba(object_type(name).color)
+            colour = _rgba(KITCHEN.object_type(name).color)
             self._log(f"world/true/{name}", _object_shape(name, colour, name), static=True)
         parts = visual_parts(scene.bc, scene.robot.body)
         self._links = links_of(parts)
@@ -265,7 +265,7 @@ class EpisodeRecording:
         unsure = set(obs.uncertain)
         now = set()
         for node in obs.scene_graph.nodes:
-            colour = UNSURE if node.name in unsure else _rgba(object_type(node.name).color)
+            colour = UNSURE if node.name in unsure else _rgba(KITCHEN.object_type(node.name).color)
             label = f"{node.name} (unsure)" if node.name in unsure else node.name
             path = f"world/believed/{node.name}"
             self._log(path, _transform(node.pose), _object_shape(node.name, colour, label))
@@ -294,7 +294,7 @@ class EpisodeRecording:
             self._log("robot/path", rr.Clear(recursive=False))
             return
         if self._kinematics is None:
-            self._kinematics = Scene((), visuals=False)
+            self._kinematics = Scene((), visuals=False, world=KITCHEN)
         robot = self._kinematics.robot
         joints = (*plan.path, plan.q_above, *plan.descent, plan.q_at, *plan.line)
         points = []

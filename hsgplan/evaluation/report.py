@@ -20,7 +20,7 @@ from pathlib import Path
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError, a
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.world import KITCHEN
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.ablation import ABLATION_KIND
 from hsgplan.evaluation.config import world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord

@@ -24,10 +24,11 @@ from hsgplan.agents.registry import LEARNED_PLANNERS, check_reads, make_planner
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import read_world, read_worlds
-from hsgplan.domain.world import KITCHEN, MAX_STEPS
+from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.seeds import episode_seed
 from hsgplan.runner.items import run_items

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
-from hsgplan.domain.world import KITCHEN
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.sim.render import Camera
 
 # The scene's fixed views (in the kitchen, five at 320 x 240: facing the robot over the table;

@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from hsgplan.domain.objects import object_type
-from hsgplan.domain.world import OBJECT_TYPES, TABLE, Kind
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import Kind
 from hsgplan.paths import shipped
 from hsgplan.perception import phantoms
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
@@ -50,7 +50,7 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sensing import Box
 
-TYPES = tuple(OBJECT_TYPES)
+TYPES = tuple(KITCHEN.object_types)
 # A free (tilted) fit stands for a toppled object only where its reprojection cost is at most
 # this fraction of the best upright fit's. At 1 (no preference for upright), a thin box half
 # hidden under a can was often fitted a little better tilted, was no carrier to settle on,
@@ -186,7 +186,7 @@ class PoseEstimator:
         for d in (found[k] for k in split):
             x, y, z = d.pose.position
             base = max(t for t in surfaces_under(x, y) if t <= z)
-            height = object_type(d.type_name).size[2]
+            height = KITCHEN.object_type(d.type_name).size[2]
             for level in (0.5, 1.5):
                 halves.append(len(out))
                 at = Pose((x, y, base + level * height), d.pose.orientation)
@@ -197,7 +197,7 @@ class PoseEstimator:
                 d = out[k]
                 probs = torch.stack(votes[k]).mean(dim=0)
                 best, confidence = _of_kind(probs, d.type_name, np.array(d.pose.position))
-                if object_type(TYPES[best]).size[2] <= THIN:  # the same cuboid but for a mm
+                if KITCHEN.object_type(TYPES[best]).size[2] <= THIN:  # the same cuboid but for a mm
                     out[k] = replace(d, type_name=TYPES[best], type_confidence=confidence)
         return out
 
@@ -251,7 +251,7 @@ class PoseEstimator:
 
 def _inside_table(pose: Pose) -> bool:
     x, y, z = pose.position
-    return TABLE.contains(x, y) and z < TABLE.z
+    return KITCHEN.table.contains(x, y) and z < KITCHEN.table.z
 
 
 def _stack_of_two(d: Detection, found: list[Detection]) -> bool:
@@ -260,7 +260,7 @@ def _stack_of_two(d: Detection, found: list[Detection]) -> bool:
     detection within `OVERLAP_XY` across either lower (a carrier, or the lower box found) or
     resting on it with its bottom under one and a half boxes up (it stands on one box: seed 1's
     scene 11 split a butter under a soup into two boxes, the upper one where the soup stood)."""
-    height = object_type(d.type_name).size[2]
+    height = KITCHEN.object_type(d.type_name).size[2]
     if height > THIN or len(d.rays) < 2:
         return False
     x, y, z = d.pose.position
@@ -274,7 +274,7 @@ def _stack_of_two(d: Detection, found: list[Detection]) -> bool:
             continue
         if k.pose.position[2] < z:
             return False  # a carrier, or the lower box found
-        if k.pose.position[2] - object_type(k.type_name).size[2] / 2 < base + 1.5 * height:
+        if k.pose.position[2] - KITCHEN.object_type(k.type_name).size[2] / 2 < base + 1.5 * height:
             return False  # what it carries rests on one box, not on two
     return True
 
@@ -286,8 +286,8 @@ def _cost_at(d: Detection, centre: np.ndarray) -> float:
 
 def _same_kind(type_name: str) -> torch.Tensor:
     """Which types [types] (bool) are of `type_name`'s kind (can or box)."""
-    kind = OBJECT_TYPES[type_name].kind
-    return torch.tensor([OBJECT_TYPES[t].kind is kind for t in TYPES])
+    kind = KITCHEN.object_types[type_name].kind
+    return torch.tensor([KITCHEN.object_types[t].kind is kind for t in TYPES])
 
 
 def _of_kind(
@@ -359,7 +359,7 @@ def _apart(detections: list[Detection]) -> list[Detection]:
     several = [d for d in detections if d.views > 1]
     kept: list[Detection] = []
     for d in sorted(detections, key=lambda d: (-d.type_confidence, -d.score)):
-        again = d.views == 1 and OBJECT_TYPES[d.type_name].kind is Kind.CAN
+        again = d.views == 1 and KITCHEN.object_types[d.type_name].kind is Kind.CAN
         if again and any(_found_again(d, k) for k in several):
             continue
         if not any(same_place(d.type_name, d.pose, k.type_name, k.pose) for k in kept):

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.domain.world import TABLE
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.settle import Ray
 from hsgplan.scene_graph.geometry import Pose
@@ -71,7 +71,9 @@ def ray_gap(a: Seen, b: Seen) -> float:
     tb = ((db @ w) - cross * (da @ w)) / denom
     qa, qb = pa + ta * da, pb + tb * db
     meet = (qa + qb) / 2
-    plausible = TABLE.contains(meet[0], meet[1]) and TABLE.z - 0.05 < meet[2] < TOP_Z
+    plausible = (
+        KITCHEN.table.contains(meet[0], meet[1]) and KITCHEN.table.z - 0.05 < meet[2] < TOP_Z
+    )
     if ta <= 0 or tb <= 0 or not plausible:
         return float("inf")
     return float(np.linalg.norm(qa - qb))

@@ -9,7 +9,7 @@ keypoints, M = `MAX_OBJECTS`):
 |-----------|---------|--------------------|------------------------------------------------------|
 | index     | int32   | [n]                | the sample's index in the `(seed)` stream            |
 | images    | uint8   | [n, V, H, W, 3]    | RGB                                                  |
-| types     | int8    | [n, M]             | index into `OBJECT_TYPES`, -1 past the last object   |
+| types     | int8    | [n, M]             | index into the kitchen's types, -1 past the last one |
 | instance  | int8    | [n, M]             | 1 for `cherries`, 2 for `cherries_2`, ...; 0 padding |
 | poses     | float32 | [n, M, 7]          | position (m), quaternion xyzw; NaN padding           |
 | keypoints | float32 | [n, V, M, K, 2]    | pixel (u right, v down; OpenCV's centres); NaN pad   |
@@ -30,8 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import split_instance
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.files import atomic, write_atomically
 from hsgplan.perception.keypoints import KEYPOINTS
 from hsgplan.perception.synthetic import (
@@ -45,7 +44,7 @@ from hsgplan.runner.run_folder import logged_rows
 
 FORMAT = 1
 CHUNK = 16
-TYPES = tuple(OBJECT_TYPES)
+TYPES = tuple(KITCHEN.object_types)
 
 
 def chunk_path(run_dir: Path, chunk: int) -> Path:
@@ -93,7 +92,7 @@ def pack(samples: list[ImageSample], views: int = len(VIEWS)) -> dict[str, np.nd
         m = len(s.objects)
         out["images"][i] = s.images
         for j, name in enumerate(s.objects):
-            type_name, k = split_instance(name)
+            type_name, k = KITCHEN.split_instance(name)
             out["types"][i, j], out["instance"][i, j] = TYPES.index(type_name), k
         out["poses"][i, :m] = s.poses
         out["keypoints"][i, :, :m] = s.keypoints

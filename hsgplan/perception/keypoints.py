@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.world import Kind
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -46,7 +46,7 @@ BOX_SYMMETRIES = (
 
 def cuboid(obj: str) -> np.ndarray:
     """The object's 9 keypoints in its own frame, metres: [9, 3]."""
-    half = np.asarray(object_type(obj).size, dtype=np.float64) / 2
+    half = np.asarray(KITCHEN.object_type(obj).size, dtype=np.float64) / 2
     return np.vstack([CORNER_SIGNS * half, np.zeros((1, 3))])
 
 
@@ -65,7 +65,7 @@ def canonical_rotation(
     if r[2, 2] < 0:  # upside down: the same look turned half way about x
         r = r @ BOX_SYMMETRIES[1]
     toward = np.asarray(eye, dtype=np.float64) - np.asarray(position, dtype=np.float64)
-    if object_type(obj).kind is Kind.CAN:
+    if KITCHEN.object_type(obj).kind is Kind.CAN:
         local = r.T @ toward
         phi = math.atan2(local[1], local[0])
         c, s = math.cos(phi), math.sin(phi)

@@ -27,7 +27,7 @@ from torch import nn
 
 from hsgplan.checkpoint import load_trained
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.keypoints import KEYPOINTS
 
 STRIDE = 4  # input pixels per output cell, unless a config says 2
@@ -39,7 +39,7 @@ CORNERS = KEYPOINTS - 1
 class PerceptionNetConfig:
     """What builds a keypoint network; saved as `config.json` beside its weights."""
 
-    types: int = len(OBJECT_TYPES)
+    types: int = len(KITCHEN.object_types)
     width: int = 32  # channels of the first block; doubled at each of the next two
     stages: int = 2
     stride: int = STRIDE  # input pixels per output cell: 4, or 2 through `_Refine`

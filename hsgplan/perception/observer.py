@@ -31,8 +31,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from hsgplan.domain.objects import object_type, type_of
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
@@ -111,7 +110,7 @@ class RgbObserver:
         unknown = tuple(o for o in self._objects if o not in self._last)
         uncertain = tuple(o for o in self._last if views.get(o, 0) <= 1) + unknown
         return Seen(
-            GeometricSceneGraph.from_poses(self._last, held=held),
+            GeometricSceneGraph.from_poses(self._last, held=held, world=KITCHEN),
             tracks.unseen,
             unknown,
             uncertain,
@@ -167,7 +166,7 @@ def tracked(
     index = {id(d): k for k, d in enumerate(detections)}
     near = {index[id(d)]: last[o] for o, d in found.items() if len(d.rays) == 1}
     if (unseen or near) and rest is not None:
-        fixed = [(type_of(o), last[o]) for o in unseen]
+        fixed = [(KITCHEN.type_of(o), last[o]) for o in unseen]
         detections = rest(detections, fixed, near)
         found = assigned(detections, last)
         unseen = tuple(o for o in last if o not in found)
@@ -190,18 +189,18 @@ def first_sight(
     out: dict[str, Detection] = {}
     pool = sorted(detections, key=lambda d: (-d.views, -d.type_confidence, -d.score))
     for o in never:
-        d = next((d for d in pool if d.type_name == type_of(o)), None)
+        d = next((d for d in pool if d.type_name == KITCHEN.type_of(o)), None)
         if d is not None:
             out[o] = d
             pool.remove(d)
-    present = {type_of(o) for o in objects}
+    present = {KITCHEN.type_of(o) for o in objects}
     for o in (o for o in never if o not in out):
-        kind = object_type(o).kind
+        kind = KITCHEN.object_type(o).kind
         d = next(
             (
                 d
                 for d in pool
-                if OBJECT_TYPES[d.type_name].kind is kind and d.type_name not in present
+                if KITCHEN.object_types[d.type_name].kind is kind and d.type_name not in present
             ),
             None,
         )
@@ -227,9 +226,9 @@ def assigned(detections: list[Detection], last: dict[str, Pose]) -> dict[str, De
     further than `STILL`: two weak signs, where a look-alike phantom is likelier than a moved
     object."""
     out: dict[str, Detection] = {}
-    for kind in sorted({object_type(o).kind for o in last}):
-        objects = [o for o in last if object_type(o).kind is kind]
-        found = [d for d in detections if OBJECT_TYPES[d.type_name].kind is kind]
+    for kind in sorted({KITCHEN.object_type(o).kind for o in last}):
+        objects = [o for o in last if KITCHEN.object_type(o).kind is kind]
+        found = [d for d in detections if KITCHEN.object_types[d.type_name].kind is kind]
         if not found:
             continue
         cost = np.empty((len(objects), len(found)))
@@ -237,7 +236,7 @@ def assigned(detections: list[Detection], last: dict[str, Pose]) -> dict[str, De
         for i, o in enumerate(objects):
             for j, d in enumerate(found):
                 far = float(np.linalg.norm(np.subtract(d.pose.position, last[o].position)))
-                same = d.type_name == type_of(o)
+                same = d.type_name == KITCHEN.type_of(o)
                 allowed[i, j] = same or far < (TRACK_DISTANCE if d.views > 1 else STILL)
                 cost[i, j] = min(far, STILL) + (0.0 if same else MISMATCH)
                 cost[i, j] += 1e-3 * far - 1e-2 * d.score

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen
 from hsgplan.perception.keypoints import PinholeCamera
@@ -135,7 +135,7 @@ def overlap(a: Detection, b: Detection) -> bool:
 
 def _footprint(d: Detection) -> tuple[np.ndarray, tuple[float, float]]:
     """A detection's footprint's corners [4, 2] and its bottom's and top's heights."""
-    sx, sy, sz = object_type(d.type_name).size
+    sx, sy, sz = KITCHEN.object_type(d.type_name).size
     m = d.pose.matrix()
     corners = [(i * sx / 2, j * sy / 2, 0.0) for i, j in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
     world = SHRINK * np.array(corners) @ m[:3, :3].T + m[:3, 3]

@@ -29,8 +29,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from hsgplan.domain.objects import object_type
-from hsgplan.domain.world import SHELVES, TABLE
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.scene_graph.geometry import Pose
 
 Ray = tuple[np.ndarray, np.ndarray]  # a line of sight: origin, unit direction (world)
@@ -86,7 +85,7 @@ def settle(
     pose) stay where they are and carry the others too: objects believed there, unseen."""
     rays = rays or [()] * len(poses)
     out = [upright(p) for p in poses]
-    heights = [object_type(t).size[2] for t in types]
+    heights = [KITCHEN.object_type(t).size[2] for t in types]
     order = sorted(range(len(out)), key=lambda i: out[i].position[2] - heights[i] / 2)
     settled: list[int] = []
     for i in order:
@@ -115,7 +114,7 @@ def same_place(a: str, pa: Pose, b: str, pb: Pose) -> bool:
     """Whether two estimates fill one space (an object found twice, once as a look-alike
     type): centres within `OVERLAP_XY` across and under a quarter of their heights apart up and
     down. Such a one is no support for the other."""
-    ha, hb = object_type(a).size[2], object_type(b).size[2]
+    ha, hb = KITCHEN.object_type(a).size[2], KITCHEN.object_type(b).size[2]
     across = math.dist(pa.position[:2], pb.position[:2])
     return across < OVERLAP_XY and abs(pa.position[2] - pb.position[2]) < (ha + hb) / 4
 
@@ -123,7 +122,9 @@ def same_place(a: str, pa: Pose, b: str, pb: Pose) -> bool:
 def _tops(x: float, y: float, carriers: list[tuple[str, Pose]]) -> list[float]:
     """The heights of the surfaces and carriers' top faces under (x, y)."""
     return surfaces_under(x, y) + [
-        p.position[2] + object_type(t).size[2] / 2 for t, p in carriers if _on_top_face(x, y, t, p)
+        p.position[2] + KITCHEN.object_type(t).size[2] / 2
+        for t, p in carriers
+        if _on_top_face(x, y, t, p)
     ]
 
 
@@ -134,7 +135,7 @@ def fits_height(type_name: str, centre: np.ndarray) -> bool:
     tops = [t for t in surfaces_under(centre[0], centre[1]) if t <= centre[2]]
     if not tops:
         return True
-    return bool(centre[2] >= max(tops) + object_type(type_name).size[2] / 2 - SINK)
+    return bool(centre[2] >= max(tops) + KITCHEN.object_type(type_name).size[2] / 2 - SINK)
 
 
 def _straight_down(
@@ -178,7 +179,7 @@ def _through(
     `PASS` up or down (a neighbour's edge is not under it)."""
     for t, p in carriers:
         if _on_top_face(x, y, t, p, -PASS):
-            half = object_type(t).size[2] / 2
+            half = KITCHEN.object_type(t).size[2] / 2
             low, high = p.position[2] - half, p.position[2] + half
             if min(high, base + height) - max(low, base) > PASS:
                 return True
@@ -193,9 +194,9 @@ def _along_ray(
     those, the one nearest the estimate."""
     origin, direction = ray
     candidates = []
-    for level in {round(t, 6) for t in [TABLE.z] + [s.top.z for s in SHELVES.values()]} | {
-        round(p.position[2] + object_type(t).size[2] / 2, 6) for t, p in carriers
-    }:
+    for level in {
+        round(t, 6) for t in [KITCHEN.table.z] + [s.top.z for s in KITCHEN.shelves.values()]
+    } | {round(p.position[2] + KITCHEN.object_type(t).size[2] / 2, 6) for t, p in carriers}:
         z = level + height / 2
         point = origin + direction * (z - origin[2]) / direction[2]
         if (z - origin[2]) / direction[2] > 0 and any(
@@ -209,12 +210,12 @@ def _along_ray(
 
 def surfaces_under(x: float, y: float) -> list[float]:
     """The heights of the table's and the shelves' top faces under (x, y)."""
-    tops = [TABLE.z] if TABLE.contains(x, y, EDGE) else []
-    return tops + [s.top.z for s in SHELVES.values() if s.top.contains(x, y, EDGE)]
+    tops = [KITCHEN.table.z] if KITCHEN.table.contains(x, y, EDGE) else []
+    return tops + [s.top.z for s in KITCHEN.shelves.values() if s.top.contains(x, y, EDGE)]
 
 
 def _on_top_face(x: float, y: float, carrier: str, pose: Pose, edge: float = CARRIER_EDGE) -> bool:
-    sx, sy, _ = object_type(carrier).size
+    sx, sy, _ = KITCHEN.object_type(carrier).size
     cx, cy, _ = pose.position
     r = pose.rotation
     dx, dy = x - cx, y - cy

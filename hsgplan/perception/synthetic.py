@@ -19,9 +19,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import draw_objects, object_type
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import inside, on
-from hsgplan.domain.world import INTERIOR_CAPACITY, Kind
+from hsgplan.domain.world import Kind
 from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, in_world
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -72,25 +73,25 @@ class ImageSample:
 
 def draw_state(rng: random.Random, p_elsewhere: float = P_ELSEWHERE) -> SymbolicSceneGraph:
     """A random arrangement of 2 to `MAX_OBJECTS` objects, some cans inside the shelves."""
-    objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng)
-    state = random_state(objects, rng, p_elsewhere=p_elsewhere)
-    inside_count = dict.fromkeys(INTERIOR_CAPACITY, 0)
+    objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng, KITCHEN)
+    state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=KITCHEN)
+    inside_count = dict.fromkeys(KITCHEN.interior_capacity, 0)
     literals = []
     for o in state.objects:
         where = state.location(o)
-        shelf = rng.choice(sorted(INTERIOR_CAPACITY))
+        shelf = rng.choice(sorted(KITCHEN.interior_capacity))
         if (
-            object_type(o).kind is Kind.CAN
+            KITCHEN.object_type(o).kind is Kind.CAN
             and where == on(o, "open_space")
             and not state.resting_on(o)
-            and inside_count[shelf] < INTERIOR_CAPACITY[shelf]
+            and inside_count[shelf] < KITCHEN.interior_capacity[shelf]
             and rng.random() < P_INSIDE
         ):
             inside_count[shelf] += 1
             literals.append(inside(o, shelf))
         else:
             literals.append(where)
-    return SymbolicSceneGraph.from_literals(objects, literals)
+    return SymbolicSceneGraph.from_literals(objects, literals, world=KITCHEN)
 
 
 def first_views(count: int) -> tuple[Camera, ...]:
@@ -107,7 +108,7 @@ def render_sample(
     could not be staged."""
     rng = random.Random(f"images-{seed}-{index}")
     state = draw_state(rng, p_elsewhere)
-    with Scene(state.objects, seed=rng.getrandbits(32)) as scene:
+    with Scene(state.objects, seed=rng.getrandbits(32), world=KITCHEN) as scene:
         if not stage(scene, state, rng):
             return None
         _randomise_fixtures(scene, rng)

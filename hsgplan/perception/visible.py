@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from hsgplan.domain.objects import object_type
-from hsgplan.domain.world import SHELVES, Board, shelf_boards
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import Board, shelf_boards
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.sensing import Box
@@ -42,7 +42,7 @@ class Cuboid:
     @staticmethod
     def of_object(type_name: str, pose: Pose, shrink: float = SHRINK) -> Cuboid:
         """An object's cuboid, its footprint shrunk by `shrink` across."""
-        sx, sy, sz = object_type(type_name).size
+        sx, sy, sz = KITCHEN.object_type(type_name).size
         return Cuboid(pose, (shrink * sx / 2, shrink * sy / 2, sz / 2))
 
     @staticmethod
@@ -60,7 +60,7 @@ class Cuboid:
 
 OCCLUDED = -2  # a pixel an occluder shows (`painted`)
 # the shelves' walls and boards: the fixed furniture that hides what stands behind or in it
-FURNITURE = tuple(Cuboid.of_board(b) for s in SHELVES.values() for b in shelf_boards(s))
+FURNITURE = tuple(Cuboid.of_board(b) for s in KITCHEN.shelves.values() for b in shelf_boards(s))
 
 
 def painted(

@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from hsgplan.domain.scene import ObjectType, World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometry import Pose
 
 if TYPE_CHECKING:
@@ -47,15 +46,15 @@ class GeometricSceneGraph:
 
     nodes: tuple[GeometricNode, ...]
     held: str | None = None
-    world: World = field(default=KITCHEN, compare=False, hash=False, repr=False)
+    world: World = field(kw_only=True, compare=False, hash=False, repr=False)
 
     @staticmethod
     def from_poses(
-        poses: dict[str, Pose], held: str | None = None, world: World = KITCHEN
+        poses: dict[str, Pose], held: str | None = None, *, world: World
     ) -> GeometricSceneGraph:
         names = world.sort_objects(poses)
         nodes = tuple(GeometricNode(n, world.object_type(n), poses[n]) for n in names)
-        return GeometricSceneGraph(nodes, held, world)
+        return GeometricSceneGraph(nodes, held, world=world)
 
     @property
     def objects(self) -> tuple[str, ...]:

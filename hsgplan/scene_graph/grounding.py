@@ -4,7 +4,7 @@ For place (`On(o, surface)`) each node is described relative to the target surfa
 (`In(o, shelf)`) relative to the pushed object and to the shelf, as the paper does. Every node
 carries, in this order (`NODE_DIM` numbers):
 
-- object type, one-hot over `OBJECT_TYPES` (6);
+- object type, one-hot over the kitchen's object types (6);
 - current region, one-hot over `REGION_CLASSES` (8): the surface it ultimately stands on (a
   tower's base decides), inside a shelf, or in the gripper;
 - whether it is the object the primitive moves (1);
@@ -18,8 +18,8 @@ carries, in this order (`NODE_DIM` numbers):
 
 Edges join every ordered pair of distinct objects (the geometric graph is fully connected);
 each carries the other object's offset (3) and horizontal distance (1). The subgoal is one
-vector `u` (`SUBGOAL_DIM`): the target entity, one-hot over `ENTITY_TYPES`, and the moved
-object's type, one-hot over `OBJECT_TYPES`. Lengths are in decimetres (`SCALE`), so that
+vector `u` (`SUBGOAL_DIM`): the target entity, one-hot over the kitchen's entity types, and the
+moved object's type, one-hot over its object types. Lengths are in decimetres (`SCALE`), so that
 every feature is of order one.
 
 These are the "names" features, the paper's: their one-hots are over the kitchen's names, so a
@@ -40,32 +40,25 @@ import torch
 from torch_geometric.data import Data
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import ENTITY_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PUSH_LEAD, place_xy, push_values
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.scene import Kind, World, check_features
-from hsgplan.domain.world import (
-    OBJECT_TYPES,
-    PLACE_BINS,
-    PUSH_ANGLE_BINS,
-    PUSH_DIST_BINS,
-    REGIONS,
-    SHELVES,
-)
+from hsgplan.domain.world import PLACE_BINS, PUSH_ANGLE_BINS, PUSH_DIST_BINS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
-TYPES = tuple(OBJECT_TYPES)
+TYPES = tuple(KITCHEN.object_types)
 REGION_CLASSES: tuple[str, ...] = (
-    *REGIONS,
-    *(f"top:{s}" for s in SHELVES),
-    *(f"in:{s}" for s in SHELVES),
+    *KITCHEN.regions,
+    *(f"top:{s}" for s in KITCHEN.shelves),
+    *(f"in:{s}" for s in KITCHEN.shelves),
     "held",
 )
 NODE_DIM = len(TYPES) + len(REGION_CLASSES) + 1 + 3 + 2 + 3 + 3
 EDGE_DIM = 4
-SUBGOAL_DIM = len(ENTITY_TYPES) + len(TYPES)
+SUBGOAL_DIM = len(KITCHEN.entity_types) + len(TYPES)
 KINDS = tuple(Kind)
 ROLES = ("region", "prepush", "top", "in", "held")
 TARGET_ROLES = ROLES[:4]
@@ -111,7 +104,7 @@ def _region_class(state: SymbolicSceneGraph, obj: str) -> str:
     if loc.predicate is Predicate.IN:
         return f"in:{loc.args[1]}"
     surface = loc.args[1]
-    return surface if surface in REGIONS else f"top:{surface}"
+    return surface if surface in state.world.regions else f"top:{surface}"
 
 
 def check_subgoal(subgoal: Literal, sg: GeometricSceneGraph) -> None:
@@ -199,8 +192,8 @@ def _subgoal(world: World, obj: str, target: str, place: bool, features: str) ->
     moved = world.object_type(obj)
     if features == "names":
         u = [0.0] * SUBGOAL_DIM
-        u[ENTITY_TYPES.index(target)] = 1.0
-        u[len(ENTITY_TYPES) + TYPES.index(moved.name)] = 1.0
+        u[KITCHEN.entity_types.index(target)] = 1.0
+        u[len(KITCHEN.entity_types) + TYPES.index(moved.name)] = 1.0
         return u
     role = _role(world, target) if place else "in"
     rect = world.surface_rect(target) if place else world.shelves[target].interior

@@ -15,12 +15,9 @@ from hsgplan.domain.errors import InfeasibleError
 from hsgplan.domain.feasibility import check_literals
 from hsgplan.domain.predicates import PREDICATES, Literal, Predicate, clear
 from hsgplan.domain.scene import OPEN_SPACE, EntityKind, World
-from hsgplan.domain.world import KITCHEN
 
 if TYPE_CHECKING:
     from torch_geometric.data import Data
-
-FIXTURES: tuple[str, ...] = KITCHEN.fixtures  # the kitchen's; a state's are `state.fixtures`
 
 
 @dataclass(frozen=True)
@@ -37,7 +34,7 @@ class SymbolicSceneGraph:
     objects: tuple[str, ...]
     literals: frozenset[Literal]
     _location: dict[str, Literal] = field(default=None, compare=False, hash=False, repr=False)
-    world: World = field(default=KITCHEN, compare=False, hash=False, repr=False)
+    world: World = field(kw_only=True, compare=False, hash=False, repr=False)
 
     @classmethod
     def from_literals(
@@ -45,7 +42,8 @@ class SymbolicSceneGraph:
         objects: Iterable[str],
         literals: Iterable[Literal],
         limits: bool = True,
-        world: World = KITCHEN,
+        *,
+        world: World,
     ) -> SymbolicSceneGraph:
         """A checked state from the placement literals (On / In / InGrasp) of every object.
 
@@ -75,7 +73,7 @@ class SymbolicSceneGraph:
 
     @classmethod
     def initial(
-        cls, objects: Iterable[str], region: str = OPEN_SPACE, world: World = KITCHEN
+        cls, objects: Iterable[str], region: str = OPEN_SPACE, *, world: World
     ) -> SymbolicSceneGraph:
         """Every object resting on one region, nothing held."""
         objs = world.sort_objects(objects)
@@ -189,7 +187,7 @@ class SymbolicSceneGraph:
     # --- consistency -------------------------------------------------------------------
 
     def _check(self, limits: bool) -> None:
-        check_literals(self.literals, limits, self.world)
+        check_literals(self.literals, limits, world=self.world)
         placed = {lit.subject for lit in self.literals if lit.predicate is not Predicate.CLEAR}
         missing = [o for o in self.objects if o not in placed]
         if missing:

@@ -17,7 +17,6 @@ import numpy as np
 
 from hsgplan.domain.parameters import PickParams, PlaceParams
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
@@ -32,7 +31,7 @@ class BeliefWorld:
     world: the arena and object types the robot knows its world by.
     """
 
-    def __init__(self, objects: Iterable[str], seed: int, world: World = KITCHEN) -> None:
+    def __init__(self, objects: Iterable[str], seed: int, world: World) -> None:
         self.scene = Scene(objects, seed, visuals=False, world=world)  # a model: never pictured
         self.holding: str | None = None
 

@@ -29,7 +29,7 @@ import numpy as np
 from hsgplan.domain.goals import Goal, parse_goal
 from hsgplan.domain.parameters import PickParams, PrimitiveParams
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN, MAX_STEPS
+from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
 from hsgplan.sim.actuation import holds_something
@@ -125,7 +125,8 @@ class KitchenStorageEnv(gymnasium.Env):
         observer: SceneObserver | CameraObserver | None = None,
         relook: bool = True,
         visuals: bool = True,
-        world: World = KITCHEN,
+        *,
+        world: World,
     ):
         self.scene_world = world
         if render_mode not in (None, *self.metadata["render_modes"]):
@@ -172,7 +173,11 @@ class KitchenStorageEnv(gymnasium.Env):
         self.close()
         self.goal = options.goal
         self.scene, _ = sample_scene(
-            options.objects(), scene_seed, options.p_elsewhere, self.visuals, options.goal.world
+            options.objects(),
+            scene_seed,
+            options.p_elsewhere,
+            self.visuals,
+            world=options.goal.world,
         )
         self.steps = 0
         self._checked.clear()
@@ -419,7 +424,9 @@ def _options(
     return ResetOptions(goal, float(options.get("p_elsewhere", ResetOptions.p_elsewhere)))
 
 
-gymnasium.register(id=ENV_ID, entry_point="hsgplan.sim.env:KitchenStorageEnv")
+# made in the kitchen unless `world=` is given: the id is an entry point, resolved where the
+# kitchen may be named
+gymnasium.register(id=ENV_ID, entry_point="hsgplan.evaluation.gym_env:kitchen_storage_env")
 
 
 def _sure(before: Seen | Observation, after: Seen | Observation) -> frozenset[str]:

@@ -24,7 +24,7 @@ from hsgplan.domain.parameters import (
     PushParams,
 )
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import KITCHEN, MAX_OBJECTS, World
+from hsgplan.domain.world import MAX_OBJECTS, World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -39,7 +39,7 @@ def _entities(world: World) -> int:
     return MAX_OBJECTS + len(world.fixtures)  # slots first, then the fixtures as graphs list them
 
 
-def observation_space(world: World = KITCHEN) -> spaces.Dict:
+def observation_space(world: World) -> spaces.Dict:
     """A fresh space of a world's scenes (each env seeds its own)."""
     return spaces.Dict(
         {
@@ -55,7 +55,7 @@ def observation_space(world: World = KITCHEN) -> spaces.Dict:
     )
 
 
-def action_space(world: World = KITCHEN) -> spaces.Dict:
+def action_space(world: World) -> spaces.Dict:
     """A fresh space of a world's scenes (each env seeds its own)."""
     return spaces.Dict(
         {
@@ -69,7 +69,7 @@ def action_space(world: World = KITCHEN) -> spaces.Dict:
     )
 
 
-def entity_names(objects: tuple[str, ...], world: World = KITCHEN) -> list[str | None]:
+def entity_names(objects: tuple[str, ...], world: World) -> list[str | None]:
     """The name at every entity index of a scene with these objects (None: an empty slot)."""
     return [*objects, *[None] * (MAX_OBJECTS - len(objects)), *world.fixtures]
 
@@ -103,7 +103,7 @@ def encode(
     return obs
 
 
-def decode(objects: tuple[str, ...], action: dict, world: World = KITCHEN) -> PrimitiveParams | str:
+def decode(objects: tuple[str, ...], action: dict, world: World) -> PrimitiveParams | str:
     """The typed primitive an action names, or why it names none (an empty slot)."""
     names = entity_names(objects, world)
     obj = names[int(action["object"])]

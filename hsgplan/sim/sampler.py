@@ -17,7 +17,7 @@ from hsgplan.domain.errors import UnsampledSceneError
 from hsgplan.domain.parameters import place_inset
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.scene import EntityKind
-from hsgplan.domain.world import KITCHEN, Kind, World, spot_cells
+from hsgplan.domain.world import Kind, World, spot_cells
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -39,7 +39,8 @@ def sample_scene(
     seed: int,
     p_elsewhere: float = 0.3,
     visuals: bool = True,
-    world: World = KITCHEN,
+    *,
+    world: World,
 ) -> tuple[Scene, SymbolicSceneGraph]:
     """A settled scene of `world` for the objects and the symbolic state it is in (`visuals`:
     `Scene`'s).

@@ -15,7 +15,6 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from hsgplan.domain.scene import World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.arena import Arena, build_arena
@@ -76,7 +75,8 @@ class Scene:
         seed: int = 0,
         poses: dict[str, Pose] | None = None,
         visuals: bool = True,
-        world: World = KITCHEN,
+        *,
+        world: World,
     ):
         self.world = world
         with _quiet_stdout():

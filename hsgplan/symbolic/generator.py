@@ -27,7 +27,6 @@ from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import Literal, inside, on
 from hsgplan.domain.room import Room
 from hsgplan.domain.scene import MAX_OBJECTS, OPEN_SPACE, Kind, World
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MIN_OBJECTS = 2
@@ -41,13 +40,13 @@ def check_size(n: int) -> None:
         )
 
 
-def random_objects(n: int, rng: random.Random, world: World = KITCHEN) -> tuple[str, ...]:
+def random_objects(n: int, rng: random.Random, world: World) -> tuple[str, ...]:
     """n object instances as the distribution above draws them, in canonical order."""
     check_size(n)
     return draw_objects(n, rng, world)
 
 
-def random_goal(n: int, rng: random.Random, stacking: bool = True, world: World = KITCHEN) -> Goal:
+def random_goal(n: int, rng: random.Random, stacking: bool = True, *, world: World) -> Goal:
     """One goal over n objects, drawn from the distribution in the module docstring."""
     objects = list(random_objects(n, rng, world))
     rng.shuffle(objects)
@@ -80,7 +79,7 @@ def random_goal(n: int, rng: random.Random, stacking: bool = True, world: World 
 
 
 def random_goals(
-    n: int, count: int, seed: int, stacking: bool = True, world: World = KITCHEN
+    n: int, count: int, seed: int, stacking: bool = True, *, world: World
 ) -> list[Goal]:
     """`count` goals over n objects; the same seed always gives the same goals."""
     if count < 0:
@@ -93,7 +92,8 @@ def random_state(
     objects: tuple[str, ...],
     rng: random.Random,
     p_elsewhere: float = 0.3,
-    world: World = KITCHEN,
+    *,
+    world: World,
 ) -> SymbolicSceneGraph:
     """A random start: most objects on the open space, some stacked or on a shelf top.
 

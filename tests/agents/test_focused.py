@@ -17,14 +17,17 @@ from hsgplan.agents.stream import StreamAgent
 from hsgplan.agents.stream_problem import aim, initial_problem
 from hsgplan.domain.actions import Pick, Place, Push
 from hsgplan.domain.goals import Goal, parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
 
-GOAL = parse_goal("On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)")
+GOAL = parse_goal(
+    "On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN
+)
 
 
 def _problem(goal, seed=4, goal_stacks=False):
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=seed, options=ResetOptions(goal))
     obs = info["observation"]
     env.close()
@@ -115,7 +118,7 @@ def test_a_failed_stream_certifies_nothing_and_its_dependants_wait():
 
 
 def test_plans_and_acts_a_three_object_goal_with_only_certified_objects():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=4, options=ResetOptions(GOAL))
     obs = info["observation"]
     agent = StreamAgent(FocusedPlanner(), "stream-focused")
@@ -125,16 +128,18 @@ def test_plans_and_acts_a_three_object_goal_with_only_certified_objects():
     assert len(actions) == 7 and d.task_seconds > 0
     assert {type(a) for a in actions} == {Pick, Place, Push}
     env.close()
-    record = run_episode(KitchenStorageEnv(), make_agent("stream-focused-goal"), GOAL, seed=4)
+    record = run_episode(
+        KitchenStorageEnv(world=KITCHEN), make_agent("stream-focused-goal"), GOAL, seed=4
+    )
     assert record.success, record.steps
 
 
 def test_a_goal_that_holds_needs_no_stream():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=4, options=ResetOptions(GOAL))
     obs = info["observation"]
     env.close()
-    holds = Goal(frozenset({obs.symbols.state.location("butter")}))
+    holds = Goal(frozenset({obs.symbols.state.location("butter")}), world=KITCHEN)
     found = FocusedPlanner().plan(obs.scene_graph, obs.symbols.state, holds, world=None)
     assert found.steps == () and found.levels == 0  # no world asked: no stream evaluated
 

@@ -8,6 +8,7 @@ import random
 import pytest
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT, shipped
 from hsgplan.planning.regression.paper_loop import PaperRegressionPlanner
@@ -38,8 +39,8 @@ def test_the_profiler_catches_a_call_into_the_transition_model():
     from hsgplan.symbolic.transition import applicable_actions
 
     calls: list[str] = []
-    goal = parse_goal(GOALS[0])
-    state = random_state(goal.objects, random.Random(0))
+    goal = parse_goal(GOALS[0], world=KITCHEN)
+    state = random_state(goal.objects, random.Random(0), world=KITCHEN)
     with rules_forbidden(calls):
         applicable_actions(state)
     assert any("applicable_actions" in c for c in calls)
@@ -51,7 +52,7 @@ def test_a_learned_planner_decides_without_the_rules(kind):
     # the forward planner searches with f_reach at every node: one seed and the two shorter
     # goals are its budget (under the profiler its six-object episode alone takes half a minute)
     for text in GOALS if kind != "forward" else GOALS[:2]:
-        goal = parse_goal(text)
+        goal = parse_goal(text, world=KITCHEN)
         for seed in range(2 if kind == "regression" else 1):
             calls: list[str] = []
             if kind == "regression":

@@ -14,6 +14,7 @@ from hsgplan.agents.registry import (
 from hsgplan.domain.actions import Pick, Place, Push
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams
 from hsgplan.domain.predicates import in_grasp, inside, on
 from hsgplan.motion.generator import RandomMotion
@@ -47,16 +48,16 @@ def test_the_parts_are_composed_and_reset_together():
 def _scene_graph(shift: float = 0.0):
     """Three objects standing on the table (poses only: no physics is needed to choose bins);
     `shift` moves the last one along x."""
-    from hsgplan.domain.objects import object_type
     from hsgplan.scene_graph.geometric import GeometricSceneGraph
     from hsgplan.scene_graph.geometry import Pose
 
     spots = {"cherries": (0.42, 0.05), "butter": (0.55, -0.10), "popcorn": (0.36 + shift, -0.12)}
     return GeometricSceneGraph.from_poses(
         {
-            name: Pose.from_xyz_yaw(x, y, object_type(name).height / 2, 0.0)
+            name: Pose.from_xyz_yaw(x, y, KITCHEN.object_type(name).height / 2, 0.0)
             for name, (x, y) in spots.items()
-        }
+        },
+        world=KITCHEN,
     )
 
 
@@ -85,10 +86,10 @@ def test_the_agent_passes_the_subgoal_and_the_action_to_the_motion_level():
         TaskDecision(None, None, 0.004, "regression stuck"),
     ]
     agent = HierarchicalAgent("test", _Script(decisions), RandomMotion())
-    goal = parse_goal(f"On({obj}, shelf_a)")
+    goal = parse_goal(f"On({obj}, shelf_a)", world=KITCHEN)
     agent.reset(goal, 7)
     assert agent.planner.resets == [7]
-    state = SymbolicSceneGraph.initial(sg.objects)
+    state = SymbolicSceneGraph.initial(sg.objects, world=KITCHEN)
     pick = agent.decide(sg, state, goal)
     assert pick.params == PickParams(obj) and pick.subgoal == in_grasp(obj)
     place = agent.decide(sg, state, goal)
@@ -137,30 +138,29 @@ def test_a_pick_that_failed_is_offered_again_for_the_task_level_to_judge():
 def test_a_push_with_no_parameters_left_takes_the_object_up_to_put_it_elsewhere():
     # the oracle's recovery: no push works from where the can stands, so it is picked up and
     # the next place before a push keeps away from that spot
-    from hsgplan.domain.objects import object_type
     from hsgplan.motion.sampler import AVOID_RADIUS, GeometricSampler, place_xy
     from hsgplan.scene_graph.geometric import GeometricSceneGraph
     from hsgplan.scene_graph.geometry import Pose
 
     can, spot = "alphabet_soup", (0.30, 0.38)
     standing = GeometricSceneGraph.from_poses(
-        {can: Pose.from_xyz_yaw(*spot, object_type(can).height / 2, 0.0)}
+        {can: Pose.from_xyz_yaw(*spot, KITCHEN.object_type(can).height / 2, 0.0)}, world=KITCHEN
     )
     push = TaskDecision(Push(can, "shelf_a"), inside(can, "shelf_a"), 0.001)
     sampler = GeometricSampler()
     agent = HierarchicalAgent("test", _Script([push] * 12), sampler)
-    goal = parse_goal(f"In({can}, shelf_a)")
+    goal = parse_goal(f"In({can}, shelf_a)", world=KITCHEN)
     agent.reset(goal, 0)
-    state = SymbolicSceneGraph.initial(standing.objects)
+    state = SymbolicSceneGraph.initial(standing.objects, world=KITCHEN)
     tried = []
     while isinstance((d := agent.decide(standing, state, goal)).params, PushParams):
         tried.append(d.params)
         agent.observe(d.params, Outcome(Status.NO_PATH, "the hand would hit something", 0.0))
     assert tried and len(set(tried)) == len(tried)  # every push once
     assert d.action == Pick(can) and d.params == PickParams(can) and d.subgoal == in_grasp(can)
-    held = GeometricSceneGraph(standing.nodes, held=can)
+    held = GeometricSceneGraph(standing.nodes, held=can, world=KITCHEN)
     place = sampler.propose(held, Place(can, "prepush_a"), Push(can, "shelf_a"))
-    x, y = place_xy(can, "prepush_a", place.x_bin, place.y_bin)
+    x, y = place_xy(can, "prepush_a", place.x_bin, place.y_bin, world=KITCHEN)
     assert ((x - spot[0]) ** 2 + (y - spot[1]) ** 2) ** 0.5 >= AVOID_RADIUS
 
 
@@ -169,7 +169,6 @@ def test_checkpoints_that_know_names_are_refused_a_scene_of_other_names(tmp_path
 
     from hsgplan.agents.registry import check_reads
     from hsgplan.domain.layouts import random_layout
-    from hsgplan.domain.world import KITCHEN
 
     new = random_layout(KITCHEN, 0, 0, new_objects=True)
     task, motion = tmp_path / "task", tmp_path / "place-gnn"

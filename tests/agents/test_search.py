@@ -6,6 +6,7 @@ import pytest
 from hsgplan.agents.search import SearchAgent, _Search
 from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
@@ -14,8 +15,10 @@ from hsgplan.sim.outcome import Outcome, Status
 
 @pytest.mark.slow
 def test_solves_a_three_object_goal():
-    goal = parse_goal("On(butter, shelf_b) & In(tomato_soup, shelf_a) & On(cherries, butter)")
-    record = run_episode(KitchenStorageEnv(), SearchAgent(), goal, seed=4)
+    goal = parse_goal(
+        "On(butter, shelf_b) & In(tomato_soup, shelf_a) & On(cherries, butter)", world=KITCHEN
+    )
+    record = run_episode(KitchenStorageEnv(world=KITCHEN), SearchAgent(), goal, seed=4)
     assert record.success, record.steps
     # one plan, refined once before the first step: later steps cost no planning time
     assert record.steps[0].task_seconds > 0 and record.steps[0].motion_seconds > 0
@@ -23,8 +26,8 @@ def test_solves_a_three_object_goal():
 
 
 def test_follows_its_plan_and_plans_again_when_a_step_fails():
-    goal = parse_goal("On(butter, shelf_b)")
-    env = KitchenStorageEnv()
+    goal = parse_goal("On(butter, shelf_b)", world=KITCHEN)
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=5, options=ResetOptions(goal))
     obs = info["observation"]
     assert not goal.satisfied_by(obs.symbols.state)
@@ -39,8 +42,8 @@ def test_follows_its_plan_and_plans_again_when_a_step_fails():
 
 
 def test_without_a_world_to_try_plans_in_it_offers_nothing():
-    goal = parse_goal("On(butter, shelf_b)")
-    env = KitchenStorageEnv()
+    goal = parse_goal("On(butter, shelf_b)", world=KITCHEN)
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=3, options=ResetOptions(goal))
     obs = info["observation"]
     d = SearchAgent().decide(obs.scene_graph, obs.symbols.state, goal, env.check)

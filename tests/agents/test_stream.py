@@ -19,6 +19,7 @@ from hsgplan.cli import app
 from hsgplan.domain.actions import Pick, Place, Push
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PushParams
 from hsgplan.domain.predicates import in_grasp, on
 from hsgplan.evaluation.episode import run_episode
@@ -45,7 +46,9 @@ def test_collision_test_keeps_towers_and_flags_crowding():
 
 def test_expected_state_moves_only_the_acting_object():
     state = SymbolicSceneGraph.from_literals(
-        ("butter", "cherries"), [on("butter", "open_space"), on("cherries", "shelf_a")]
+        ("butter", "cherries"),
+        [on("butter", "open_space"), on("cherries", "shelf_a")],
+        world=KITCHEN,
     )
     held = expected_after(state, Pick("butter"))
     assert held.holds(in_grasp("butter")) and held.holds(on("cherries", "shelf_a"))
@@ -54,8 +57,10 @@ def test_expected_state_moves_only_the_acting_object():
 
 
 def test_solves_a_three_object_goal():
-    goal = parse_goal("On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)")
-    record = run_episode(KitchenStorageEnv(), StreamAgent(), goal, seed=4)
+    goal = parse_goal(
+        "On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN
+    )
+    record = run_episode(KitchenStorageEnv(world=KITCHEN), StreamAgent(), goal, seed=4)
     assert record.success, record.steps
     assert any(s.action.startswith("push(tomato_soup") for s in record.steps)
     # planned once before the first step, streams and Fast Downward both timed
@@ -65,8 +70,8 @@ def test_solves_a_three_object_goal():
 
 
 def test_follows_its_plan_and_leaves_out_what_failed_in_that_scene():
-    goal = parse_goal("On(butter, shelf_b)")
-    env = KitchenStorageEnv()
+    goal = parse_goal("On(butter, shelf_b)", world=KITCHEN)
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=5, options=ResetOptions(goal))
     obs = info["observation"]
     agent = StreamAgent(IncrementalPlanner(IncrementalConfig(max_levels=3)))
@@ -85,8 +90,8 @@ def test_follows_its_plan_and_leaves_out_what_failed_in_that_scene():
 
 
 def test_without_the_world_offers_nothing():
-    goal = parse_goal("On(butter, shelf_b)")
-    env = KitchenStorageEnv()
+    goal = parse_goal("On(butter, shelf_b)", world=KITCHEN)
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=3, options=ResetOptions(goal))
     obs = info["observation"]
     d = StreamAgent().decide(obs.scene_graph, obs.symbols.state, goal, env.check)
@@ -115,8 +120,8 @@ def test_timing_refuses_an_unknown_baseline_in_one_line():
 
 
 def test_plans_a_push_from_a_prepush_pose():
-    goal = parse_goal("In(tomato_soup, shelf_a)")
-    env = KitchenStorageEnv()
+    goal = parse_goal("In(tomato_soup, shelf_a)", world=KITCHEN)
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=2, options=ResetOptions(goal))
     obs = info["observation"]
     agent = StreamAgent()
@@ -141,8 +146,10 @@ class _NoRobot:
 
 
 def test_goal_restricted_streams_stack_and_place_only_where_the_goal_leads():
-    goal = parse_goal("On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)")
-    env = KitchenStorageEnv()
+    goal = parse_goal(
+        "On(cherries, shelf_a) & On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN
+    )
+    env = KitchenStorageEnv(world=KITCHEN)
     _, info = env.reset(seed=4, options=ResetOptions(goal))
     obs = info["observation"]
     env.close()

@@ -14,7 +14,7 @@ from hsgplan.benchmarks.push_reach import summarize as reach_summary
 from hsgplan.benchmarks.push_settings import PushSetting, parse_setting
 from hsgplan.cli import app
 from hsgplan.data import motion_store, motion_trials
-from hsgplan.domain.objects import ENTITY_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PUSH_LEAD, MotionPrimitive
 from hsgplan.sim import motion_plans, primitives
 
@@ -73,7 +73,7 @@ def _trials_file(path, statuses):
         np.array(statuses, dtype=np.int8),
         small,
         small,
-        np.full(n, ENTITY_TYPES.index("shelf_a"), dtype=np.int8),
+        np.full(n, KITCHEN.entity_types.index("shelf_a"), dtype=np.int8),
         np.ones((n, 2), dtype=np.int8),
         poses,
     )

@@ -11,6 +11,7 @@ from hsgplan.collect import demos as record_demos
 from hsgplan.collect.demos import collect_demos
 from hsgplan.data.demos import TASKS, load_demos
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.symbolic.transition import apply
 
 SHIPPED = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
@@ -24,7 +25,7 @@ def test_the_paper_task_mix():
 
 
 def test_shipped_demos_replay_in_the_transition_model():
-    demos = load_demos(SHIPPED)
+    demos = load_demos(SHIPPED, world=KITCHEN)
     assert [d.task for d in demos] == [t for t, _ in TASKS]
     for d in demos:
         states, actions = d.symbolic_states(), d.symbolic_actions()
@@ -36,7 +37,7 @@ def test_shipped_demos_replay_in_the_transition_model():
 
 
 def test_demos_stay_out_of_the_evaluation_distribution():
-    for d in load_demos(SHIPPED):
+    for d in load_demos(SHIPPED, world=KITCHEN):
         goal = d.goal_literals()
         stacked = any(lit.args[-1] in goal.objects for lit in goal.literals)
         assert goal.size == 1 or (goal.size == 2 and stacked)
@@ -44,16 +45,16 @@ def test_demos_stay_out_of_the_evaluation_distribution():
 
 def test_corrupted_or_missing_datasets_are_refused(tmp_path):
     with pytest.raises(InvalidInputError, match="does not exist"):
-        load_demos(tmp_path / "nothing")
+        load_demos(tmp_path / "nothing", world=KITCHEN)
     bad = tmp_path / "bad"
     bad.mkdir()
     (bad / "meta.json").write_text((SHIPPED / "meta.json").read_text())
     (bad / "demos.jsonl").write_text('{"task": "x", "goal"\n')
     with pytest.raises(InvalidInputError, match="demos.jsonl:1: not a demonstration"):
-        load_demos(bad)
+        load_demos(bad, world=KITCHEN)
     (bad / "meta.json").write_text("{not json")
     with pytest.raises(InvalidInputError, match="not valid JSON"):
-        load_demos(bad)
+        load_demos(bad, world=KITCHEN)
 
 
 def test_collection_resumes_without_repeating(tmp_path, monkeypatch):
@@ -88,13 +89,11 @@ FULL_SCENE = SHIPPED.parent / "full-scene"
 
 
 def test_full_scene_demos_hold_every_type_and_replay_in_the_transition_model():
-    from hsgplan.domain.world import OBJECT_TYPES
-
-    demos = load_demos(FULL_SCENE)
+    demos = load_demos(FULL_SCENE, world=KITCHEN)
     assert [d.task for d in demos] == [t for t, _ in TASKS]
     assert json.loads((FULL_SCENE / "meta.json").read_text())["full_scene"] is True
     for d in demos:
-        assert sorted(d.objects) == sorted(OBJECT_TYPES), d.task
+        assert sorted(d.objects) == sorted(KITCHEN.object_types), d.task
         states, actions = d.symbolic_states(), d.symbolic_actions()
         assert d.goal_literals().satisfied_by(states[-1])
         for before, action, after in zip(states[:-1], actions, states[1:], strict=True):
@@ -102,9 +101,9 @@ def test_full_scene_demos_hold_every_type_and_replay_in_the_transition_model():
 
 
 def test_the_learning_curve_set_starts_with_the_full_scene_set_and_replays():
-    rounds = load_demos(FULL_SCENE.parent / "full-scene-rounds")
+    rounds = load_demos(FULL_SCENE.parent / "full-scene-rounds", world=KITCHEN)
     assert len(rounds) == 8 * len(TASKS)
-    assert rounds[: len(TASKS)] == load_demos(FULL_SCENE)
+    assert rounds[: len(TASKS)] == load_demos(FULL_SCENE, world=KITCHEN)
     assert len({d.seed for d in rounds}) == len(rounds)
     for d in rounds[len(TASKS) :]:
         states, actions = d.symbolic_states(), d.symbolic_actions()
@@ -126,7 +125,9 @@ def _stub_recorder(seeds: list[int]):
 
     def record(task, goal_text, seed, full_scene=False):
         seeds.append(seed)
-        return record_demos.Demo(task, goal_text, seed, ("butter",), ("a",), (("x",), ("y",)))
+        return record_demos.Demo(
+            task, goal_text, seed, ("butter",), ("a",), (("x",), ("y",)), world=KITCHEN
+        )
 
     return record
 

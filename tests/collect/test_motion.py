@@ -13,27 +13,27 @@ from hsgplan.collect.motion import CollectConfig, collect, work_folder
 from hsgplan.data import motion_store as store
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import SURFACE_CAPACITY
 
 PLACE, PUSH = MotionPrimitive.PLACE, MotionPrimitive.PUSH
 
 
 def test_tasks_are_drawn_from_their_index_alone():
     for i in range(40):
-        assert draw_task(PLACE, 3, i) == draw_task(PLACE, 3, i)
-        place = draw_task(PLACE, 3, i)
+        assert draw_task(PLACE, 3, i, world=KITCHEN) == draw_task(PLACE, 3, i, world=KITCHEN)
+        place = draw_task(PLACE, 3, i, world=KITCHEN)
         assert place.state.held() == place.obj
         assert len(place.state.resting_on(place.target)) == place.crowding
-        assert place.crowding < SURFACE_CAPACITY[place.target]
-        push = draw_task(PUSH, 3, i)
+        assert place.crowding < KITCHEN.surface_capacity[place.target]
+        push = draw_task(PUSH, 3, i, world=KITCHEN)
         assert push.state.location(push.obj).args == (push.obj, "prepush_a")
         assert len(push.state.inside("shelf_a")) == push.crowding
         assert push.subgoal.predicate is Predicate.IN
-    assert draw_task(PLACE, 3, 0) != draw_task(PLACE, 4, 0)
+    assert draw_task(PLACE, 3, 0, world=KITCHEN) != draw_task(PLACE, 4, 0, world=KITCHEN)
     with pytest.raises(InvalidInputError):
-        draw_task(PLACE, 0, -1)
+        draw_task(PLACE, 0, -1, world=KITCHEN)
 
 
 def _keys(data) -> list[tuple[int, int]]:
@@ -160,17 +160,16 @@ def test_an_object_walled_in_across_its_narrow_side_cannot_be_taken_up():
     # What the place labels rest on: the fingers close across a box's narrow side, so a
     # neighbour close beside that side takes the room they need; one beyond it does not.
     from hsgplan.data.motion_trials import pickable
-    from hsgplan.domain.objects import object_type
     from hsgplan.scene_graph.geometry import Pose
     from hsgplan.sim.scene import Scene
 
-    box, other = object_type("cream_cheese"), "butter"
+    box, other = KITCHEN.object_type("cream_cheese"), "butter"
     z = box.height / 2 + 0.001
-    with Scene(("cream_cheese", other), seed=0) as scene:
+    with Scene(("cream_cheese", other), seed=0, world=KITCHEN) as scene:
         scene.set_pose("cream_cheese", Pose.from_xyz_yaw(0.45, 0.0, z, 0.0))
         # the narrow side is the box's local x: the neighbour 5 mm beyond it, then 12 cm away
         for gap, expected in ((0.005, set()), (0.12, {"cream_cheese"})):
-            x = 0.45 + box.size[0] / 2 + gap + object_type(other).size[0] / 2
+            x = 0.45 + box.size[0] / 2 + gap + KITCHEN.object_type(other).size[0] / 2
             scene.set_pose(other, Pose.from_xyz_yaw(x, 0.0, z, 0.0))
             assert pickable(scene, ["cream_cheese"]) == expected, gap
 
@@ -192,9 +191,9 @@ def test_a_place_that_leaves_an_object_unable_to_be_taken_up_is_no_sample():
     from hsgplan.sim.scene import Scene
 
     seen = set()
-    with Scene((), seed=0) as scene:
+    with Scene((), seed=0, world=KITCHEN) as scene:
         for index in range(40):
-            task = draw_task(PLACE, 0, index)
+            task = draw_task(PLACE, 0, index, world=KITCHEN)
             trials = run_task(scene, task) or []
             labelled = [t for t in trials if t.status in (Status.SUCCESS, Status.BLOCKS_PICK)]
             if not labelled:
@@ -217,20 +216,20 @@ def test_some_push_tasks_start_where_a_short_push_leaves_the_can():
     from hsgplan.data.motion_tasks import FRONT_GAPS
     from hsgplan.data.motion_trials import release, stage_task
     from hsgplan.domain.parameters import place_xy
-    from hsgplan.domain.world import PLACE_BINS, SHELVES
+    from hsgplan.domain.world import PLACE_BINS
     from hsgplan.sim.scene import Scene
 
-    tasks = [draw_task(PUSH, 0, i) for i in range(30)]
+    tasks = [draw_task(PUSH, 0, i, world=KITCHEN) for i in range(30)]
     short = [t for t in tasks if t.front_gap is not None]
     assert 0 < len(short) < len(tasks)
     assert all(FRONT_GAPS[0] <= t.front_gap <= FRONT_GAPS[1] for t in short)
-    front = SHELVES["shelf_a"].interior.x_min
-    with Scene((), seed=0) as scene:
+    front = KITCHEN.shelves["shelf_a"].interior.x_min
+    with Scene((), seed=0, world=KITCHEN) as scene:
         for task in short[:3]:
             staged = stage_task(scene, task)
             assert staged is not None
             x = staged.before.node(task.obj).pose.position[0]
             assert x == pytest.approx(front - task.front_gap, abs=0.005)
-            farthest_place = place_xy(task.obj, "prepush_a", PLACE_BINS - 1, 0)[0]
+            farthest_place = place_xy(task.obj, "prepush_a", PLACE_BINS - 1, 0, world=KITCHEN)[0]
             assert x > farthest_place
             release(scene, staged)

@@ -23,22 +23,22 @@ from hsgplan.collect.reach import (
 )
 from hsgplan.data.world_trials import load_world_trials, trials_of
 from hsgplan.domain.actions import Pick, Place, Push
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import in_grasp, on
-from hsgplan.domain.world import INTERIOR_CAPACITY, SHELVES, SURFACE_CAPACITY
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.scene import Scene
 
-BOUNDED = [s for s in SURFACE_CAPACITY if s != "open_space"]  # shelf tops, prepush regions
+BOUNDED = [s for s in KITCHEN.surface_capacity if s != "open_space"]  # shelf tops, prepush regions
 
 
 def _situations(s: SymbolicSceneGraph) -> set[str]:
     found = set()
     if s.held() is not None:
         found.add("held")
-    if any(len(s.resting_on(x)) >= SURFACE_CAPACITY[x] for x in BOUNDED):
+    if any(len(s.resting_on(x)) >= KITCHEN.surface_capacity[x] for x in BOUNDED):
         found.add("full surface")
-    if any(len(s.inside(x)) >= INTERIOR_CAPACITY[x] for x in SHELVES):
+    if any(len(s.inside(x)) >= KITCHEN.interior_capacity[x] for x in KITCHEN.shelves):
         found.add("full interior")
     if any(s.resting_on(o) for o in s.objects):
         found.add("covered")
@@ -50,7 +50,9 @@ def test_drawn_states_are_reproducible_within_limits_and_often_hard():
     assert states == [draw_reach_state(3, i) for i in range(200)]
     assert states != [draw_reach_state(4, i) for i in range(200)]
     for s in states:  # the world's limits (capacities, towers, fit) accept every one
-        assert SymbolicSceneGraph.from_literals(s.objects, s.literals, limits=True) == s
+        assert (
+            SymbolicSceneGraph.from_literals(s.objects, s.literals, limits=True, world=KITCHEN) == s
+        )
     assert {len(s.objects) for s in states} == set(range(MIN_OBJECTS, MAX_OBJECTS + 1))
     situations = [_situations(s) for s in states]
     counts = {
@@ -79,21 +81,21 @@ def test_actions_are_the_heuristics_distinct_and_of_every_kind():
 
 def test_the_world_refuses_a_pick_while_the_hand_holds_another_object():
     state = SymbolicSceneGraph.from_literals(
-        ("cherries", "butter"), [in_grasp("butter"), on("cherries", "open_space")]
+        ("cherries", "butter"), [in_grasp("butter"), on("cherries", "open_space")], world=KITCHEN
     )
     # the place first: the pick after it starts from the staged hand again, not the empty one
     actions = [Place("butter", "open_space"), Pick("cherries"), Push("cherries", "shelf_a")]
-    with Scene(()) as scene:
+    with Scene((), world=KITCHEN) as scene:
         row = run_trials(scene, state, actions, random.Random(0))
-    placed, pick, push = trials_of(row)
+    placed, pick, push = trials_of(row, world=KITCHEN)
     assert placed.status == "success" and placed.after.holds(on("butter", "open_space"))
     assert pick.status == push.status == "invalid" and pick.after == push.after == state
 
 
 def test_a_state_is_recorded_the_same_whatever_its_process_ran_before():
-    with Scene(()) as scene:
+    with Scene((), world=KITCHEN) as scene:
         first = record_reach_state(scene, 0, 5)
-    with Scene(()) as scene:
+    with Scene((), world=KITCHEN) as scene:
         record_reach_state(scene, 0, 7)
         again = record_reach_state(scene, 0, 5)
     assert first == again and first["trials"]
@@ -122,7 +124,7 @@ def test_the_collector_never_asks_the_transition_model(monkeypatch):
         rows = [run_reach_item(ReachItem(1, i)) for i in range(2)]
     finally:
         sys.setprofile(None)
-    assert calls == [] and sum(len(trials_of(r)) for r in rows) > 0
+    assert calls == [] and sum(len(trials_of(r, world=KITCHEN)) for r in rows) > 0
 
 
 @pytest.mark.slow
@@ -134,7 +136,7 @@ def test_collect_reach_end_to_end_and_a_rerun_repeats_nothing(tmp_path):
     assert "; 2 run now" in r.stdout
     lines = (out / "episodes.jsonl").read_text().splitlines()
     assert sorted(json.loads(x)["key"] for x in lines) == ["0/0", "0/1"]
-    trials = load_world_trials(out)
+    trials = load_world_trials(out, world=KITCHEN)
     assert 0 < len(trials) <= 2 * ACTIONS_PER_STATE
     assert f"{len(trials)} primitives executed" in r.stdout
     r = CliRunner().invoke(app, args)

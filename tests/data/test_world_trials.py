@@ -19,6 +19,7 @@ from hsgplan.data.world_trials import (
 )
 from hsgplan.domain.actions import parse_action
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import Predicate, on
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -32,7 +33,9 @@ def _moved(state: SymbolicSceneGraph, obj: str) -> SymbolicSceneGraph:
     rest = [
         lit for lit in state.literals if lit.subject != obj and lit.predicate is not Predicate.CLEAR
     ]
-    return SymbolicSceneGraph.from_literals(state.objects, [*rest, on(obj, "open_space")], False)
+    return SymbolicSceneGraph.from_literals(
+        state.objects, [*rest, on(obj, "open_space")], False, world=KITCHEN
+    )
 
 
 @st.composite
@@ -59,21 +62,23 @@ def test_a_row_reads_back_as_it_was_written(row):
     state, trials = row
     written = json.loads(json.dumps(state_row(state, trials)))
     assert set(written) == {"objects", "state", "trials"}
-    assert trials_of(written) == trials
-    assert read_state(written["objects"], written["state"]) == state
+    assert trials_of(written, world=KITCHEN) == trials
+    assert read_state(written["objects"], written["state"], world=KITCHEN) == state
 
 
 def test_a_row_holds_the_trials_of_its_own_state_only():
     a, b = draw_reach_state(0, 1), draw_reach_state(0, 2)
     with pytest.raises(ValueError):
-        state_row(a, [WorldTrial(b, parse_action("pick(cherries)"), "invalid", b)])
-    trial = WorldTrial(a, parse_action("pick(cherries)"), "success", None)
+        state_row(a, [WorldTrial(b, parse_action("pick(cherries)", world=KITCHEN), "invalid", b)])
+    trial = WorldTrial(a, parse_action("pick(cherries)", world=KITCHEN), "success", None)
     assert not trial.succeeded  # the world toppled something: no clean state to read
     assert WorldTrial(a, trial.action, "success", a).succeeded
 
 
 def _row(state, status="invalid"):
-    return state_row(state, [WorldTrial(state, parse_action("pick(cherries)"), status, state)])
+    return state_row(
+        state, [WorldTrial(state, parse_action("pick(cherries)", world=KITCHEN), status, state)]
+    )
 
 
 def _write(folder, lines):
@@ -93,7 +98,7 @@ def test_a_collection_reads_in_key_order_past_cut_lines_and_unstaged_states(tmp_
             json.dumps({"key": "1/0", "result": _row(c)}),
         ],
     )
-    assert [t.state for t in load_world_trials(tmp_path)] == [a, b, c]  # 2 before 10
+    assert [t.state for t in load_world_trials(tmp_path, world=KITCHEN)] == [a, b, c]  # 2 before 10
 
 
 @pytest.mark.parametrize(
@@ -114,25 +119,25 @@ def test_a_collection_reads_in_key_order_past_cut_lines_and_unstaged_states(tmp_
 def test_a_damaged_collection_is_refused_in_one_line(tmp_path, line, match):
     _write(tmp_path, [line])
     with pytest.raises(InvalidInputError, match=match) as e:
-        load_world_trials(tmp_path)
+        load_world_trials(tmp_path, world=KITCHEN)
     assert "\n" not in str(e.value)
 
 
 def test_a_missing_or_unreadable_collection_is_refused(tmp_path):
     with pytest.raises(InvalidInputError, match="holds no collection"):
-        load_world_trials(tmp_path / "nowhere")
+        load_world_trials(tmp_path / "nowhere", world=KITCHEN)
     (tmp_path / "episodes.jsonl").write_bytes('{"key": "é"}\n'.encode("latin-1"))
     with pytest.raises(InvalidInputError, match="config.json' does not exist"):
-        load_world_trials(tmp_path)  # a folder that is no collection
+        load_world_trials(tmp_path, world=KITCHEN)  # a folder that is no collection
     (tmp_path / "config.json").write_text('{"kind": "eval"}')
     with pytest.raises(InvalidInputError, match="not a collection of executed primitives"):
-        load_world_trials(tmp_path)
+        load_world_trials(tmp_path, world=KITCHEN)
     (tmp_path / "config.json").write_text('{"kind": "reach"}')
     with pytest.raises(InvalidInputError, match="not UTF-8"):
-        load_world_trials(tmp_path)
+        load_world_trials(tmp_path, world=KITCHEN)
 
 
 def test_state_json_lists_placements_only():
     state = draw_reach_state(0, 5)
     assert all(not x.startswith("Clear") for x in state_json(state))
-    assert read_state(state.objects, state_json(state)) == state
+    assert read_state(state.objects, state_json(state), world=KITCHEN) == state

@@ -6,9 +6,9 @@ from typer.testing import CliRunner
 
 from hsgplan.cli import app
 from hsgplan.domain import layouts
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.scene import GRIPPER_MAX_OPENING, Kind
 from hsgplan.domain.scene_file import read_world
-from hsgplan.domain.world import KITCHEN
 
 runner = CliRunner()
 

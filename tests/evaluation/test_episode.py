@@ -9,6 +9,7 @@ from typer.testing import CliRunner
 from hsgplan.agents.registry import make_agent
 from hsgplan.cli import app
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.protocol import episode_specs, run_evaluation
@@ -19,7 +20,12 @@ GOAL = "On(butter, cherries) & On(cherries, shelf_a) & In(tomato_soup, shelf_a)"
 
 
 def test_oracle_episode_reaches_the_goal_and_records_everything():
-    record = run_episode(KitchenStorageEnv(), make_agent("oracle"), parse_goal(GOAL), seed=4)
+    record = run_episode(
+        KitchenStorageEnv(world=KITCHEN),
+        make_agent("oracle"),
+        parse_goal(GOAL, world=KITCHEN),
+        seed=4,
+    )
     assert record.success and record.failure is None
     assert record.subgoal_completion == 1.0
     assert record.seed == 4 and record.size == 3
@@ -30,10 +36,10 @@ def test_oracle_episode_reaches_the_goal_and_records_everything():
 
 
 def test_same_seed_same_episode():
-    goal = parse_goal("On(popcorn, shelf_b) & On(cream_cheese, shelf_a)")
+    goal = parse_goal("On(popcorn, shelf_b) & On(cream_cheese, shelf_a)", world=KITCHEN)
     finals = []
     for _ in range(2):
-        env = KitchenStorageEnv()
+        env = KitchenStorageEnv(world=KITCHEN)
         poses = {}
 
         def grab(record, obs, env=env, poses=poses):
@@ -53,7 +59,7 @@ def test_specs_are_seeded_and_leave_stacking_out_of_two_object_goals():
     assert len(specs) == 8 and len({s.seed for s in specs}) == 8
     for s in specs:
         if s.size == 2:
-            goal = parse_goal(s.goal)
+            goal = parse_goal(s.goal, world=KITCHEN)
             assert all(lit.args[-1] in ("shelf_a", "shelf_b") for lit in goal.literals)
 
 
@@ -148,7 +154,12 @@ def test_json_output_of_the_real_command_is_pure_json(tmp_path):
 
 def test_the_shipped_task_checkpoint_closes_the_loop_in_the_simulated_world():
     # what `make demo` runs: the learned regression planner, parameters from the sampler
-    record = run_episode(KitchenStorageEnv(), make_agent("regression"), parse_goal(GOAL), seed=4)
+    record = run_episode(
+        KitchenStorageEnv(world=KITCHEN),
+        make_agent("regression"),
+        parse_goal(GOAL, world=KITCHEN),
+        seed=4,
+    )
     assert record.success, [(s.action, s.status) for s in record.steps]
     assert "push(tomato_soup, shelf_a)" in [s.action for s in record.steps]
     assert record.seed == 4 and all(s.task_seconds > 0 for s in record.steps)
@@ -175,8 +186,8 @@ def test_a_last_decision_that_gave_nothing_to_execute_still_counts_its_seconds()
         def observe(self, params, outcome):
             pass
 
-    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)")
-    record = run_episode(KitchenStorageEnv(objects=2), _GivesUp(), goal, seed=0)
+    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)", world=KITCHEN)
+    record = run_episode(KitchenStorageEnv(objects=2, world=KITCHEN), _GivesUp(), goal, seed=0)
     assert not record.success and record.steps == ()
     assert record.task_seconds == 2.5 and record.motion_seconds == 0.75
     old = {k: v for k, v in record.to_json().items() if not k.startswith("unexecuted")}

@@ -1,6 +1,6 @@
 """What a misread scene is classed by, on hand-built truths and detections."""
 
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.perception_eval import MISREADS, score, summary
 from hsgplan.perception.detection import Detection
 from hsgplan.scene_graph.geometry import Pose
@@ -9,7 +9,7 @@ TABLE_Z = 0.0
 
 
 def _standing(name: str, x: float, y: float, z: float = TABLE_Z) -> Pose:
-    return Pose.from_xyz_yaw(x, y, z + object_type(name).height / 2, 0.0)
+    return Pose.from_xyz_yaw(x, y, z + KITCHEN.object_type(name).height / 2, 0.0)
 
 
 def _seen(type_name: str, pose: Pose) -> Detection:
@@ -19,7 +19,7 @@ def _seen(type_name: str, pose: Pose) -> Detection:
 TRUTH = {"cherries": _standing("cherries", 0.45, 0.0), "butter": _standing("butter", 0.45, 0.25)}
 STACK = {
     "cherries": _standing("cherries", 0.45, 0.0),
-    "butter": _standing("butter", 0.45, 0.0, object_type("cherries").height),
+    "butter": _standing("butter", 0.45, 0.0, KITCHEN.object_type("cherries").height),
 }
 
 
@@ -39,7 +39,7 @@ def test_an_object_nothing_was_found_at_is_unseen_or_a_stack_missed():
 
 
 def test_every_object_found_and_a_stack_read_apart_is_a_stack_relation():
-    beside = Pose.from_xyz_yaw(0.45, 0.06, object_type("butter").height / 2, 0.0)
+    beside = Pose.from_xyz_yaw(0.45, 0.06, KITCHEN.object_type("butter").height / 2, 0.0)
     detections = [_seen("cherries", STACK["cherries"]), _seen("butter", beside)]
     result = score(STACK, detections)
     assert result.found == 2 and result.misread == "stack_relation"

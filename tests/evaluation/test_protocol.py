@@ -8,6 +8,7 @@ import pytest
 from hsgplan.agents.base import Decision
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.domain.recovery import PERCEPTION_RULES, RecoveryRules
 from hsgplan.evaluation.config import EvalConfig
@@ -16,7 +17,7 @@ from hsgplan.evaluation.protocol import run_config
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, failure_class
 from hsgplan.sim.env import KitchenStorageEnv
 
-GOAL = parse_goal("On(butter, shelf_a) & On(popcorn, shelf_b)")
+GOAL = parse_goal("On(butter, shelf_a) & On(popcorn, shelf_b)", world=KITCHEN)
 
 
 class PicksAbsentObject:
@@ -38,14 +39,14 @@ class PicksAbsentObject:
 
 def test_a_failed_primitive_ends_a_paper_protocol_episode():
     agent = PicksAbsentObject()
-    record = run_episode(KitchenStorageEnv(), agent, GOAL, seed=3, end_at_failure=True)
+    record = run_episode(KitchenStorageEnv(world=KITCHEN), agent, GOAL, seed=3, end_at_failure=True)
     assert len(record.steps) == 1 and record.steps[0].status != "success"
     assert record.failure == "failed_primitive" and not record.success
     assert failure_class(record) == (EXECUTION, record.steps[0].status)
 
 
 def test_a_recovering_episode_out_of_steps_after_failures_is_overstep():
-    env = KitchenStorageEnv(max_steps=4)
+    env = KitchenStorageEnv(max_steps=4, world=KITCHEN)
     record = run_episode(env, PicksAbsentObject(), GOAL, seed=3)
     assert len(record.steps) == 4 and all(s.status != "success" for s in record.steps)
     assert record.failure == "overstep"

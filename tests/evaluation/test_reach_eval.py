@@ -1,6 +1,7 @@
 """Sorting f_reach's held-out questions into the situations that decide them, and scoring."""
 
 from hsgplan.domain.actions import Pick, Place, Push
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import in_grasp, inside, on
 from hsgplan.evaluation.reach_eval import QuestionKind, Scores, _add, kind_of_question
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -9,7 +10,7 @@ OBJECTS = ["cherries", "butter", "tomato_soup", "alphabet_soup", "popcorn", "cre
 
 
 def state(*literals):
-    return SymbolicSceneGraph.from_literals(OBJECTS, literals)
+    return SymbolicSceneGraph.from_literals(OBJECTS, literals, world=KITCHEN)
 
 
 def test_each_situation_is_named():

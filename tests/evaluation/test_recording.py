@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.recording import EpisodeRecording
 from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.detection import Detection
@@ -60,7 +61,7 @@ def _untimed(record) -> dict:
 def test_an_episode_recorded_holds_truth_belief_robot_cameras_and_every_step(tmp_path):
     from hsgplan.evaluation.demo import run_demo
 
-    goal = parse_goal(GOAL)
+    goal = parse_goal(GOAL, world=KITCHEN)
     kw = {"scale": 0.25, "frame_every": 1000}
     rrd = tmp_path / "rec" / "episode.rrd"
     recorded = run_demo("oracle", goal, 4, tmp_path / "rec", recording=rrd, **kw)
@@ -101,7 +102,7 @@ def test_a_look_is_recorded_with_its_images_keypoints_and_detected_cuboids(tmp_p
     detection = Detection("butter", pose, 0.9, 1, 0.5, keypoints=(seen_by,))
     images = np.zeros((2, cameras[0].height, cameras[0].width, 3), np.uint8)
     look = Look(images, cameras, np.zeros(7))
-    seen = Seen(GeometricSceneGraph.from_poses({"butter": pose}))
+    seen = Seen(GeometricSceneGraph.from_poses({"butter": pose}, world=KITCHEN))
 
     recording = EpisodeRecording(rrd, "On(butter, shelf_a)", 0)
     recording.observe(look, seen, (detection,))

@@ -6,13 +6,14 @@ import pytest
 from hsgplan.domain.actions import Place
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation import task_eval
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.task_eval import evaluate_task, run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT
 from hsgplan.planning.base import TaskDecision
 
-GOAL = parse_goal("On(cherries, shelf_a)")
+GOAL = parse_goal("On(cherries, shelf_a)", world=KITCHEN)
 
 
 class Stubborn:

@@ -5,18 +5,19 @@ import pytest
 
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.evaluation.observers import make_observer
 from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
 from hsgplan.sim.outcome import Status
 
-GOAL = parse_goal("On(butter, shelf_a) & On(tomato_soup, shelf_b)")
+GOAL = parse_goal("On(butter, shelf_a) & On(tomato_soup, shelf_b)", world=KITCHEN)
 SEED = 3
 
 
 @pytest.mark.slow
 def test_moving_the_true_objects_after_a_look_changes_neither_belief_nor_decision():
-    env = KitchenStorageEnv(observer=make_observer("rgb"))
+    env = KitchenStorageEnv(observer=make_observer("rgb"), world=KITCHEN)
     try:
         _, info = env.reset(seed=SEED, options=ResetOptions(GOAL))
         obs = info["observation"]

@@ -6,6 +6,7 @@ from __future__ import annotations
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.errors import UnsampledSceneError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.episode import EpisodeRecord, run_episode
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.summary import summarize
@@ -25,7 +26,9 @@ def test_an_unsampled_start_scene_is_recorded_as_such_and_nothing_is_tried(monke
         raise UnsampledSceneError(f"no collision-free arrangement (seed {seed})")
 
     monkeypatch.setattr(env_module, "sample_scene", no_scene)
-    record = run_episode(KitchenStorageEnv(), make_agent("oracle"), parse_goal(GOAL), 12)
+    record = run_episode(
+        KitchenStorageEnv(world=KITCHEN), make_agent("oracle"), parse_goal(GOAL, world=KITCHEN), 12
+    )
     assert record.failure == Failure.UNSAMPLED == "unsampled_scene"
     assert not record.success and record.steps == () and record.seed == 12
     assert EpisodeRecord.from_json(record.to_json()) == record  # logged and read back

@@ -6,7 +6,7 @@ from collections import Counter
 import torch
 
 from hsgplan.domain.actions import Pick, Place, Push
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import BINS, MotionPrimitive, PlaceParams, PushParams
 from hsgplan.motion.generator import PUSH_TRIES, LearnedMotion, RandomMotion, _BinGenerator
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -33,10 +33,12 @@ class _FixedScores(LearnedMotion):
 def _scene(held_at: tuple[float, float] = (0.0, 0.0), shift: float = 0.0) -> GeometricSceneGraph:
     """Cherries on the table, butter held (its pose is wherever the hand is)."""
     poses = {
-        "cherries": Pose.from_xyz_yaw(0.42 + shift, 0.05, object_type("cherries").height / 2, 0.0),
+        "cherries": Pose.from_xyz_yaw(
+            0.42 + shift, 0.05, KITCHEN.object_type("cherries").height / 2, 0.0
+        ),
         HELD: Pose.from_xyz_yaw(*held_at, 0.3, 0.0),
     }
-    return GeometricSceneGraph.from_poses(poses, held=HELD)
+    return GeometricSceneGraph.from_poses(poses, held=HELD, world=KITCHEN)
 
 
 def _place(x: int, y: int) -> PlaceParams:
@@ -90,10 +92,10 @@ def test_a_failure_is_remembered_by_the_scene_around_the_held_object():
 
 def test_after_failed_pushes_a_generator_gives_up_the_spot_and_draws_another_one_for_the_object():
     can = "cherries"
-    pose = {can: Pose.from_xyz_yaw(0.30, 0.38, object_type(can).height / 2, 0.0)}
+    pose = {can: Pose.from_xyz_yaw(0.30, 0.38, KITCHEN.object_type(can).height / 2, 0.0)}
     held, standing = (
-        GeometricSceneGraph.from_poses(pose, held=can),
-        GeometricSceneGraph.from_poses(pose),
+        GeometricSceneGraph.from_poses(pose, held=can, world=KITCHEN),
+        GeometricSceneGraph.from_poses(pose, world=KITCHEN),
     )
     motion = RandomMotion()
     motion.reset(0)
@@ -127,8 +129,8 @@ def test_without_the_recovery_rules_a_generator_neither_remembers_nor_gives_up()
         assert proposal == _place(0, 0)
         motion.observe(proposal, Outcome(Status.NO_IK, "", 0.0))
     can = "cherries"
-    pose = {can: Pose.from_xyz_yaw(0.30, 0.38, object_type(can).height / 2, 0.0)}
-    standing = GeometricSceneGraph.from_poses(pose)
+    pose = {can: Pose.from_xyz_yaw(0.30, 0.38, KITCHEN.object_type(can).height / 2, 0.0)}
+    standing = GeometricSceneGraph.from_poses(pose, world=KITCHEN)
     random_motion = RandomMotion(rules=rules)
     random_motion.reset(0)
     for _ in range(PUSH_TRIES + 2):  # a fresh uniform draw every step, never giving up

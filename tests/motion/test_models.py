@@ -5,6 +5,7 @@ import torch
 from torch_geometric.data import Batch
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import inside, on
 from hsgplan.motion.models import FlatMotionNet, MotionNetConfig, build
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -19,9 +20,9 @@ def _scene(order: list[str]) -> GeometricSceneGraph:
         "popcorn": Pose.from_xyz_yaw(0.40, 0.0, 0.35),
         "alphabet_soup": Pose.from_xyz_yaw(0.50, -0.1, 0.042),
     }
-    sg = GeometricSceneGraph.from_poses(poses, held="popcorn")
+    sg = GeometricSceneGraph.from_poses(poses, held="popcorn", world=KITCHEN)
     # the same scene with its nodes in another order
-    return GeometricSceneGraph(tuple(sg.node(n) for n in order), held="popcorn")
+    return GeometricSceneGraph(tuple(sg.node(n) for n in order), held="popcorn", world=KITCHEN)
 
 
 def _permuted_pair():
@@ -40,7 +41,9 @@ def test_shapes(model, head):
     out = build(config)(Batch.from_data_list([a, b, a]))
     assert out.shape == (3, 100)
     push = MotionNetConfig(model, "push", (21, 21), hidden=16, embed=8, head=head)
-    sg = GeometricSceneGraph.from_poses({"cherries": Pose.from_xyz_yaw(0.3, 0.38, 0.029)})
+    sg = GeometricSceneGraph.from_poses(
+        {"cherries": Pose.from_xyz_yaw(0.3, 0.38, 0.029)}, world=KITCHEN
+    )
     g = ground(sg, inside("cherries", "shelf_a"))  # a graph of one node and no edges
     assert build(push)(Batch.from_data_list([g])).shape == (1, 441)
 

@@ -9,8 +9,7 @@ import pytest
 import torch
 from scipy.spatial.transform import Rotation
 
-from hsgplan.domain.objects import type_of
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.perception_eval import rotation_error, score_scene, summary
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator, _apart, _fitted, _of_kind
@@ -22,7 +21,7 @@ from hsgplan.perception.synthetic import VIEWS, render_sample
 from hsgplan.perception.train import MIN_VISIBLE
 from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
 
-TYPES = list(OBJECT_TYPES)
+TYPES = list(KITCHEN.object_types)
 
 
 class _TrueMaps(torch.nn.Module):
@@ -33,7 +32,7 @@ class _TrueMaps(torch.nn.Module):
     def __init__(self, sample) -> None:
         super().__init__()
         views, height, width = sample.images.shape[:3]
-        kinds = np.array([TYPES.index(type_of(o)) for o in sample.objects])
+        kinds = np.array([TYPES.index(KITCHEN.type_of(o)) for o in sample.objects])
         maps = []
         for v in range(views):
             seen = sample.visible[v] >= MIN_VISIBLE
@@ -181,7 +180,7 @@ def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand()
 
         def detect(self, images, cams, arm=()):
             s = next(self.scenes)
-            found = [Detection(type_of(o), p, 1.0, 2, 0.0) for o, p in s.truth.items()]
+            found = [Detection(KITCHEN.type_of(o), p, 1.0, 2, 0.0) for o, p in s.truth.items()]
             if s.held is not None:
                 found.append(Detection("cherries", s.held, 1.0, 2, 0.0))
             return found

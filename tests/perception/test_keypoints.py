@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.perception_eval import rotation_error
 from hsgplan.perception.keypoints import (
     KEYPOINTS,
@@ -24,14 +24,16 @@ VIEWS = [PinholeCamera.of(FRONT), PinholeCamera.of(SIDE_A)]
 
 def _pose(rng: np.random.Generator, obj: str) -> Pose:
     x, y = rng.uniform(0.3, 0.65), rng.uniform(-0.18, 0.18)
-    return Pose.from_xyz_yaw(x, y, object_type(obj).height / 2, rng.uniform(-math.pi, math.pi))
+    return Pose.from_xyz_yaw(
+        x, y, KITCHEN.object_type(obj).height / 2, rng.uniform(-math.pi, math.pi)
+    )
 
 
 def test_the_cuboid_has_eight_corners_and_its_centroid():
     points = cuboid("cream_cheese")
     assert points.shape == (KEYPOINTS, 3)
     assert np.allclose(points[8], 0) and np.allclose(points[:8].mean(axis=0), 0)
-    assert np.allclose(points[:8].max(axis=0) * 2, object_type("cream_cheese").size)
+    assert np.allclose(points[:8].max(axis=0) * 2, KITCHEN.object_type("cream_cheese").size)
 
 
 @pytest.mark.parametrize("obj", ["butter", "popcorn", "tomato_soup"])
@@ -50,7 +52,7 @@ def test_pnp_gives_back_the_pose_that_was_projected(obj):
 
 @pytest.mark.parametrize(("obj", "turns"), [("butter", (math.pi,)), ("cherries", (0.7, 2.0, 4.0))])
 def test_look_alike_poses_have_the_same_keypoints_in_a_view(obj, turns):
-    pose = Pose.from_xyz_yaw(0.5, 0.1, object_type(obj).height / 2, 0.3)
+    pose = Pose.from_xyz_yaw(0.5, 0.1, KITCHEN.object_type(obj).height / 2, 0.3)
     for c in VIEWS:
         named = view_keypoints(obj, pose, c)
         for turn in turns:
@@ -87,8 +89,8 @@ def test_the_pinhole_model_projects_where_pybullet_renders():
     from hsgplan.sim.scene import Scene
 
     obj = "popcorn"
-    pose = Pose.from_xyz_yaw(0.5, 0.05, object_type(obj).height / 2 + 0.001, 0.4)
-    with Scene((obj,), seed=0) as scene:
+    pose = Pose.from_xyz_yaw(0.5, 0.05, KITCHEN.object_type(obj).height / 2 + 0.001, 0.4)
+    with Scene((obj,), seed=0, world=KITCHEN) as scene:
         scene.set_pose(obj, pose)
         # another size and field of view than the demo's, from the side
         side = Camera(320, 240, (0.55, -0.9, 0.7), (0.5, 0.0, 0.05), 45.0)

@@ -3,6 +3,7 @@ instance each, duplicates of a type apart."""
 
 import numpy as np
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.keypoints import PinholeCamera, in_world
 from hsgplan.perception.maps import decode, targets
 from hsgplan.perception.model import STRIDE
@@ -13,16 +14,12 @@ CAMERA = Camera(320, 240, (1.15, 0.0, 1.0), (0.42, 0.0, 0.05), 46.0)
 
 
 def _keypoints(obj: str, x: float, y: float, yaw: float) -> np.ndarray:
-    from hsgplan.domain.objects import object_type
-
-    pose = Pose.from_xyz_yaw(x, y, object_type(obj).height / 2, yaw)
+    pose = Pose.from_xyz_yaw(x, y, KITCHEN.object_type(obj).height / 2, yaw)
     return PinholeCamera.of(CAMERA).project(in_world(obj, pose))
 
 
 def test_maps_of_two_butters_and_a_can_decode_into_their_keypoints():
-    from hsgplan.domain.world import OBJECT_TYPES
-
-    types = list(OBJECT_TYPES)
+    types = list(KITCHEN.object_types)
     objects = [("butter", 0.40, -0.10, 0.3), ("butter", 0.55, 0.12, -1.0), ("cherries", 0.5, 0, 0)]
     keypoints = np.stack([_keypoints(o, x, y, yaw) for o, x, y, yaw in objects])
     kinds = np.array([types.index(o) for o, *_ in objects])
@@ -41,9 +38,7 @@ def test_maps_of_two_butters_and_a_can_decode_into_their_keypoints():
 def test_two_thin_boxes_stacked_are_two_peaks_at_stride_2_and_one_blob_at_stride_4():
     """Butter on cream cheese: their centroids are 2.4 cm apart, a few pixels in the view; a
     quarter-resolution grid holds one peak of them, a half-resolution grid two."""
-    from hsgplan.domain.world import OBJECT_TYPES
-
-    types = list(OBJECT_TYPES)
+    types = list(KITCHEN.object_types)
     low = _keypoints("cream_cheese", 0.45, 0.0, 0.2)
     high = low.copy()
     high[:, 1] -= 6.0  # pixels: the upper box, seen just above the lower one

@@ -12,9 +12,8 @@ import torch
 
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.objects import type_of
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
-from hsgplan.domain.world import OBJECT_TYPES
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.failures import Failure
 from hsgplan.perception.cameras import VIEWS
@@ -37,7 +36,7 @@ from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.outcome import Status
 from hsgplan.sim.sensing import Look, Seen
 
-TYPES = list(OBJECT_TYPES)
+TYPES = list(KITCHEN.object_types)
 
 
 def _at(type_name: str, x: float, y: float, score: float = 0.9) -> Detection:
@@ -98,7 +97,7 @@ class _SceneMaps(torch.nn.Module):
 
     def forward(self, images):
         poses = {o: p for o, p in self.scene.poses().items() if o != self.hidden}
-        kinds = np.array([TYPES.index(type_of(o)) for o in poses])
+        kinds = np.array([TYPES.index(KITCHEN.type_of(o)) for o in poses])
         height, width = images.shape[2] // STRIDE, images.shape[3] // STRIDE
         maps = []
         for camera in VIEWS:
@@ -129,14 +128,14 @@ class _Watching(RgbObserver):
 
 def _watched_env(**kwargs) -> tuple[KitchenStorageEnv, _Watching]:
     observer = _Watching(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer, **kwargs)
+    env = KitchenStorageEnv(observer=observer, **({"world": KITCHEN} | kwargs))
     observer.env = env
     return env, observer
 
 
 def test_the_loop_runs_on_what_the_cameras_make_of_the_scene_and_is_judged_on_the_truth():
     env, observer = _watched_env()
-    goal = parse_goal("On(butter, shelf_b) & On(cherries, butter)")
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, butter)", world=KITCHEN)
     record = run_episode(env, make_agent("oracle"), goal, seed=4)
     assert record.observer == "rgb"
     assert record.success and record.failure is None, record.steps
@@ -159,11 +158,11 @@ def test_the_robot_plans_in_its_belief_and_the_world_only_runs_the_joints():
             poses = {n.name: n.pose for n in seen.scene_graph.nodes}
             x, y, z = poses["butter"].position
             poses["butter"] = replace(poses["butter"], position=(x + 0.1, y, z))
-            sg = GeometricSceneGraph.from_poses(poses, held=seen.scene_graph.held)
+            sg = GeometricSceneGraph.from_poses(poses, held=seen.scene_graph.held, world=KITCHEN)
             return replace(seen, scene_graph=sg)
 
     observer = Shifted(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer)
+    env = KitchenStorageEnv(observer=observer, world=KITCHEN)
     observer.env = env
     _, info = env.reset(seed=4, options={"goal": "On(butter, shelf_b)"})
     believed = info["observation"].scene_graph.pose("butter")
@@ -195,9 +194,9 @@ def test_an_object_no_view_has_found_has_no_pose_and_ends_the_episode_as_never_s
             return super().look(look)
 
     observer = Blind(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer)
+    env = KitchenStorageEnv(observer=observer, world=KITCHEN)
     observer.env = env
-    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)")
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)", world=KITCHEN)
     record = run_episode(env, make_agent("oracle"), goal, seed=4)
     assert record.failure == Failure.NEVER_SEEN and record.steps == ()
 
@@ -205,14 +204,14 @@ def test_an_object_no_view_has_found_has_no_pose_and_ends_the_episode_as_never_s
 def test_tracks_start_from_the_first_look_never_from_a_staged_pose():
     observer = RgbObserver(PoseEstimator(_SceneMaps()))
     observer.start(("butter", "tomato_soup"))
-    soup = Pose.from_xyz_yaw(0.5, 0.1, OBJECT_TYPES["tomato_soup"].size[2] / 2)
+    soup = Pose.from_xyz_yaw(0.5, 0.1, KITCHEN.object_types["tomato_soup"].size[2] / 2)
     lone = Detection("tomato_soup", soup, 0.9, 1, 1.0)
     observer.estimator.detect = lambda images, cameras, arm: [lone]
     look = Look(np.zeros((1, 2, 2, 3), np.uint8), VIEWS[:1], np.zeros(7))
     seen = observer.look(look)
     assert seen.scene_graph.objects == ("tomato_soup",)
     assert seen.unknown == ("butter",) and set(seen.uncertain) == {"butter", "tomato_soup"}
-    butter = Pose.from_xyz_yaw(0.3, -0.2, OBJECT_TYPES["butter"].size[2] / 2)
+    butter = Pose.from_xyz_yaw(0.3, -0.2, KITCHEN.object_types["butter"].size[2] / 2)
     both = [replace(lone, views=3), Detection("butter", butter, 0.8, 2, 1.0)]
     observer.estimator.detect = lambda images, cameras, arm: both
     seen = observer.look(look)
@@ -244,10 +243,12 @@ def test_a_goal_only_seen_reached_is_a_failure_of_perception():
             x, y, _ = butter.pose.position
             poses = {n.name: n.pose for n in sg.nodes}
             poses["cherries"] = Pose((x, y, butter.top_z + lift), cherries.pose.orientation)
-            return Seen(GeometricSceneGraph.from_poses(poses, held=sg.held))
+            return Seen(GeometricSceneGraph.from_poses(poses, held=sg.held, world=KITCHEN))
 
-    env = KitchenStorageEnv(observer=Fooled())
-    record = run_episode(env, make_agent("oracle"), parse_goal("On(cherries, butter)"), seed=4)
+    env = KitchenStorageEnv(observer=Fooled(), world=KITCHEN)
+    record = run_episode(
+        env, make_agent("oracle"), parse_goal("On(cherries, butter)", world=KITCHEN), seed=4
+    )
     assert record.observer == "fooled" and record.steps == ()
     assert not record.success and record.failure == Failure.MISPERCEIVED
     assert record.subgoal_completion == 0.0
@@ -297,9 +298,9 @@ def test_a_lone_views_detection_of_another_type_far_from_where_an_object_was_is_
 
 
 def test_an_object_unseen_under_a_can_still_holds_the_can_up():
-    butter = Pose.from_xyz_yaw(0.5, 0.0, OBJECT_TYPES["butter"].size[2] / 2)
-    top = OBJECT_TYPES["butter"].size[2]
-    can_half = OBJECT_TYPES["tomato_soup"].size[2] / 2
+    butter = Pose.from_xyz_yaw(0.5, 0.0, KITCHEN.object_types["butter"].size[2] / 2)
+    top = KITCHEN.object_types["butter"].size[2]
+    can_half = KITCHEN.object_types["tomato_soup"].size[2] / 2
     measured = Pose.from_xyz_yaw(0.5, 0.005, top + can_half - 0.003)  # seen on it, nearly
     can = Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)
     (alone,) = PoseEstimator.rest([can])
@@ -314,8 +315,11 @@ def test_an_object_unseen_under_a_can_still_holds_the_can_up():
 
 
 def test_the_tracker_keeps_a_hidden_butter_where_it_was_and_the_can_on_it_up():
-    butter = Pose.from_xyz_yaw(0.5, 0.0, OBJECT_TYPES["butter"].size[2] / 2)
-    top, can_half = OBJECT_TYPES["butter"].size[2], OBJECT_TYPES["tomato_soup"].size[2] / 2
+    butter = Pose.from_xyz_yaw(0.5, 0.0, KITCHEN.object_types["butter"].size[2] / 2)
+    top, can_half = (
+        KITCHEN.object_types["butter"].size[2],
+        KITCHEN.object_types["tomato_soup"].size[2] / 2,
+    )
     measured = Pose.from_xyz_yaw(0.5, 0.005, top + can_half - 0.003)
     (seen,) = PoseEstimator.rest(
         [Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)]
@@ -333,17 +337,22 @@ def test_the_tracker_keeps_a_hidden_butter_where_it_was_and_the_can_on_it_up():
 
 
 def test_a_lone_views_butter_is_put_where_its_ray_passes_its_last_pose_and_holds_its_can_up():
-    from hsgplan.domain.world import SHELF_TOP_Z
-
-    half, can_half = OBJECT_TYPES["butter"].size[2] / 2, OBJECT_TYPES["tomato_soup"].size[2] / 2
-    butter = Pose.from_xyz_yaw(0.45, 0.35, SHELF_TOP_Z + half, 0.0)  # on shelf A's top
+    half, can_half = (
+        KITCHEN.object_types["butter"].size[2] / 2,
+        KITCHEN.object_types["tomato_soup"].size[2] / 2,
+    )
+    butter = Pose.from_xyz_yaw(
+        0.45, 0.35, KITCHEN.shelves["shelf_a"].top.z + half, 0.0
+    )  # on shelf A's top
     eye = np.array(VIEWS[1].eye)
     ray = (eye, (np.array(butter.position) - eye) / np.linalg.norm(butter.position - eye))
     # one view saw a strip of it; PnP put it far along that view's line of sight, on the table
     table = eye + ray[1] * (half - eye[2]) / ray[1][2]
     wrong = Pose.from_xyz_yaw(*table, 0.0)
     lone = Detection("butter", wrong, 0.9, 1, 1.0, rays=(ray,), measured=wrong)
-    measured = Pose.from_xyz_yaw(0.45, 0.35, SHELF_TOP_Z + 2 * half + can_half - 0.004)
+    measured = Pose.from_xyz_yaw(
+        0.45, 0.35, KITCHEN.shelves["shelf_a"].top.z + 2 * half + can_half - 0.004
+    )
     can = Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)
     found = PoseEstimator.rest([lone, can])
     assert found[0].pose.position[2] == pytest.approx(half)  # on the table, far off
@@ -351,7 +360,9 @@ def test_a_lone_views_butter_is_put_where_its_ray_passes_its_last_pose_and_holds
     tracks = tracked(found, last, PoseEstimator.rest)
     poses = tracks.poses
     assert tracks.unseen == () and np.allclose(poses["butter"].position, butter.position, atol=1e-6)
-    assert poses["tomato_soup"].position[2] == pytest.approx(SHELF_TOP_Z + 2 * half + can_half)
+    assert poses["tomato_soup"].position[2] == pytest.approx(
+        KITCHEN.shelves["shelf_a"].top.z + 2 * half + can_half
+    )
     # a lone view's ray far from where the object was leaves its estimate as it was measured
     moved = {**last, "butter": Pose.from_xyz_yaw(0.45, 0.0, half, 0.0)}
     poses = tracked(found, moved, PoseEstimator.rest).poses
@@ -371,9 +382,9 @@ def test_an_uncertain_object_is_looked_at_again_from_out_of_the_way_unless_the_r
     relook,
 ):
     observer = _Unsure(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer, relook=relook)
+    env = KitchenStorageEnv(observer=observer, relook=relook, world=KITCHEN)
     observer.env = env
-    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)")
+    goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)", world=KITCHEN)
     record = run_episode(env, make_agent("oracle"), goal, seed=4)
     assert record.success, record.steps
     looks = sum(s.relooks for s in record.steps)

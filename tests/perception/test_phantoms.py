@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
@@ -16,7 +16,7 @@ from hsgplan.perception.synthetic import VIEWS
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.sensing import Box
 
-TYPES = list(OBJECT_TYPES)
+TYPES = list(KITCHEN.object_types)
 OPEN = Pose.from_xyz_yaw(0.45, 0.0, 0.0415, 0.0)  # a soup on the open table, in every view
 EVERY = tuple(range(len(VIEWS)))
 INSIDE = Pose.from_xyz_yaw(0.52, 0.38, 0.0415, 0.0)  # a soup deep inside shelf A

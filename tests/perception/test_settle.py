@@ -6,8 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from hsgplan.domain.objects import object_type
-from hsgplan.domain.world import SHELF_TOP_Z
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.settle import NEAR_TOPS, fits_height, settle, upright
 from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
 
@@ -22,7 +21,7 @@ def _tilted(x, y, z, yaw, tilt) -> Pose:
 
 
 def _half(t: str) -> float:
-    return object_type(t).size[2] / 2
+    return KITCHEN.object_type(t).size[2] / 2
 
 
 def test_a_tilted_estimate_is_turned_upright_keeping_its_yaw_and_upside_down_counts_as_up():
@@ -45,14 +44,18 @@ def test_a_stack_lands_bottom_first_and_a_shelf_top_holds_what_is_near_it():
     poses = [
         _tilted(0.5, 0.0, 2 * _half("butter") + _half("cherries") + 0.008, 0.0, 0.05),  # on butter
         _tilted(0.5, 0.005, _half("butter") - 0.008, 0.3, 0.02),  # sunk into the table
-        _tilted(0.49, 0.38, SHELF_TOP_Z + _half("tomato_soup") + 0.01, 0.0, 0.0),  # shelf top
+        _tilted(
+            0.49, 0.38, KITCHEN.shelves["shelf_a"].top.z + _half("tomato_soup") + 0.01, 0.0, 0.0
+        ),  # shelf top
         _tilted(0.3, -0.1, _half("popcorn") + 0.2, 0.0, 0.0),  # in the air: nothing floats
         _tilted(0.5, -0.4, _half("alphabet_soup") + 0.005, 0.0, 0.0),  # inside shelf b
     ]
     out = settle(types, poses)
     assert out[1].position[2] == pytest.approx(_half("butter"))
     assert out[0].position[2] == pytest.approx(2 * _half("butter") + _half("cherries"))
-    assert out[2].position[2] == pytest.approx(SHELF_TOP_Z + _half("tomato_soup"))
+    assert out[2].position[2] == pytest.approx(
+        KITCHEN.shelves["shelf_a"].top.z + _half("tomato_soup")
+    )
     assert out[3].position[2] == pytest.approx(_half("popcorn"))
     assert out[4].position[2] == pytest.approx(_half("alphabet_soup"))  # not the top above it
 
@@ -122,7 +125,7 @@ def test_a_centre_a_centimetre_over_the_table_is_no_popcorn():
     assert fits_height("butter", thin) and fits_height("cream_cheese", thin)
     assert not fits_height("popcorn", thin) and not fits_height("alphabet_soup", thin)
     assert fits_height("popcorn", np.array([0.5, 0.0, 2 * _half("butter") + _half("popcorn")]))
-    on_shelf = np.array([0.49, 0.38, SHELF_TOP_Z + _half("butter")])
+    on_shelf = np.array([0.49, 0.38, KITCHEN.shelves["shelf_a"].top.z + _half("butter")])
     assert fits_height("butter", on_shelf) and not fits_height("popcorn", on_shelf)
     assert fits_height("popcorn", np.array([1.4, 0.0, 0.01]))  # over no surface: no say
 

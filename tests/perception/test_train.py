@@ -7,6 +7,7 @@ import torch
 
 from hsgplan.collect.images import ImagesConfig, collect_images
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.model import PerceptionNetConfig, build, load_perception_net
 from hsgplan.perception.synthetic import VIEWS
@@ -149,9 +150,7 @@ def test_examples_keep_the_keypoints_of_objects_in_sight_and_the_cuboids_of_all(
         "cameras": np.array([[[*c.eye, *c.target, c.fov]]], np.float32),
     }
     found = examples(data)
-    from hsgplan.domain.world import OBJECT_TYPES
-
-    names = list(OBJECT_TYPES)
+    names = list(KITCHEN.object_types)
     camera = PinholeCamera.of(c)
     assert [list(t) for t in found.types] == [[5]]  # the popcorn is barely in sight
     expected = view_keypoints(names[5], poses[2], camera)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import torch
 
-from hsgplan.domain.world import OBJECT_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.colour import MIN_REGION, features, pixel_vote
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
@@ -18,7 +18,7 @@ from hsgplan.perception.synthetic import VIEWS
 from hsgplan.perception.visible import painted, visible_masks
 from hsgplan.scene_graph.geometry import Pose
 
-TYPES = list(OBJECT_TYPES)
+TYPES = list(KITCHEN.object_types)
 LOWER = Pose.from_xyz_yaw(0.45, 0.1, 0.012, 0.3)  # a thin box on the table
 UPPER = Pose.from_xyz_yaw(0.45, 0.1, 0.036, 0.3)  # another on it
 
@@ -44,7 +44,7 @@ class _NearestColour(torch.nn.Module):
     """Type logits: how near the chromaticity is to each type's own colour."""
 
     def forward(self, x):
-        rgb = torch.tensor([OBJECT_TYPES[t].color[:3] for t in TYPES])
+        rgb = torch.tensor([KITCHEN.object_types[t].color[:3] for t in TYPES])
         chroma = rgb / rgb.sum(dim=1, keepdim=True)
         return -100 * torch.cdist(x[:, :3], chroma)
 
@@ -64,7 +64,7 @@ def _painted_images(types: list[str], poses: list[Pose]) -> np.ndarray:
         label = painted(types, poses, PinholeCamera.of(camera))
         image = np.full((camera.height, camera.width, 3), 128, dtype=np.uint8)
         for i, t in enumerate(types):
-            image[label == i] = np.array(OBJECT_TYPES[t].color[:3]) * 255
+            image[label == i] = np.array(KITCHEN.object_types[t].color[:3]) * 255
         images.append(image)
     return np.stack(images)
 
@@ -81,12 +81,17 @@ def test_a_box_under_another_is_named_by_the_colour_of_its_side_in_sight():
 
 
 def test_a_region_half_hidden_by_a_soup_is_named_by_its_own_pixels_not_their_mean():
-    soup, cheese = OBJECT_TYPES["tomato_soup"].color[:3], OBJECT_TYPES["cream_cheese"].color[:3]
+    soup, cheese = (
+        KITCHEN.object_types["tomato_soup"].color[:3],
+        KITCHEN.object_types["cream_cheese"].color[:3],
+    )
     image = np.zeros((4, 10, 3), dtype=np.uint8)
     image[:, :5] = np.array(soup) * 255
     image[:, 5:] = np.array(cheese) * 255
     mask = np.ones((4, 10), dtype=bool)
-    boxes = torch.tensor([OBJECT_TYPES[t].kind is OBJECT_TYPES["butter"].kind for t in TYPES])
+    boxes = torch.tensor(
+        [KITCHEN.object_types[t].kind is KITCHEN.object_types["butter"].kind for t in TYPES]
+    )
     colour = _NearestColour()
     mean = colour(torch.from_numpy(features(image, np.array([5, 2]))[None]))[0]
     assert TYPES[int(torch.where(boxes, mean, -torch.inf).argmax())] == "butter"  # the mixture
@@ -110,7 +115,7 @@ def test_two_thin_boxes_seen_as_one_are_split_and_each_named_by_its_colour():
     types = ["cream_cheese", "butter"]
     images = _painted_images(types, [LOWER, UPPER])
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
-    height = OBJECT_TYPES["butter"].size[2]
+    height = KITCHEN.object_types["butter"].size[2]
     blob = _blob("butter", height)  # half-way up the stack: a box's height over the table
     split = estimator._unstacked(images, VIEWS, [blob])
     assert [d.type_name for d in split] == types and all(d.stacked for d in split)
@@ -127,8 +132,8 @@ def test_two_thin_boxes_seen_as_one_are_split_and_each_named_by_its_colour():
 def test_a_thin_box_carrying_what_rests_on_one_box_is_not_split():
     images = _painted_images(["butter"], [LOWER])
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
-    height = OBJECT_TYPES["butter"].size[2]
-    can = OBJECT_TYPES["tomato_soup"].size[2]
+    height = KITCHEN.object_types["butter"].size[2]
+    can = KITCHEN.object_types["tomato_soup"].size[2]
     blob = _blob("butter", height)  # found a box's height up, as two stacked would be
     on_one = _blob("tomato_soup", height + can / 2)
     assert estimator._unstacked(images, VIEWS, [blob, on_one]) == [blob, on_one]
@@ -146,12 +151,14 @@ class _WithBackground(_NearestColour):
 
 
 def test_pixels_named_background_are_no_votes():
-    grey, cheese = (0.5, 0.5, 0.5), OBJECT_TYPES["cream_cheese"].color[:3]
+    grey, cheese = (0.5, 0.5, 0.5), KITCHEN.object_types["cream_cheese"].color[:3]
     image = np.zeros((4, 10, 3), dtype=np.uint8)
     image[:, :8] = np.array(grey) * 255  # mostly table: the mean would be no box's
     image[:, 8:] = np.array(cheese) * 255
     mask = np.ones((4, 10), dtype=bool)
-    boxes = torch.tensor([OBJECT_TYPES[t].kind is OBJECT_TYPES["butter"].kind for t in TYPES])
+    boxes = torch.tensor(
+        [KITCHEN.object_types[t].kind is KITCHEN.object_types["butter"].kind for t in TYPES]
+    )
     vote = pixel_vote(_WithBackground(), image, mask, boxes)
     assert vote is not None and vote.shape == (len(TYPES),)
     assert TYPES[int(vote.argmax())] == "cream_cheese" and float(vote.sum()) == pytest.approx(1)

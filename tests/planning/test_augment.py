@@ -4,6 +4,7 @@ import random
 from pathlib import Path
 
 from hsgplan.data.demos import load_demos
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import Predicate
 from hsgplan.planning.regression.augment import (
     Trajectory,
@@ -28,7 +29,7 @@ def _placements(state, objects):
 
 
 def test_added_objects_stay_put_and_the_demonstration_is_unchanged():
-    demos = load_demos(DEMOS)
+    demos = load_demos(DEMOS, world=KITCHEN)
     rng = random.Random(0)
     for demo in demos:
         base = Trajectory.of(demo)
@@ -46,14 +47,16 @@ def test_added_objects_stay_put_and_the_demonstration_is_unchanged():
 
 
 def test_trajectories_are_seeded():
-    demos = load_demos(DEMOS)
+    demos = load_demos(DEMOS, world=KITCHEN)
     a, b = trajectories(demos, 2, seed=3), trajectories(demos, 2, seed=3)
     assert len(a) == 3 * len(demos) and a == b
     assert trajectories(demos, 2, seed=4) != a
 
 
 def test_varied_states_hold_cover_or_move_only_what_they_say():
-    demo = next(d for d in load_demos(DEMOS) if d.task == "stack-butter-on-cherries-shelf_a")
+    demo = next(
+        d for d in load_demos(DEMOS, world=KITCHEN) if d.task == "stack-butter-on-cherries-shelf_a"
+    )
     rng = random.Random(1)
     copy = with_distractors(Trajectory.of(demo), 6, rng)
     s0 = copy.states[0]

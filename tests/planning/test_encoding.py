@@ -7,6 +7,7 @@ import torch
 from torch_geometric.data import Batch
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import PREDICATES, Predicate, clear, in_grasp, inside, on
 from hsgplan.domain.scene import FEATURES
 from hsgplan.planning.regression.encoding import (
@@ -21,20 +22,22 @@ from hsgplan.planning.regression.encoding import (
     touching,
 )
 from hsgplan.planning.regression.features import edge_dim, node_dim
-from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.symbolic.generator import random_goal, random_state
 
 
 def scene():
     return SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_a")]
+        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_a")], world=KITCHEN
     )
 
 
 def test_shapes_and_one_slot_per_literal():
     s = scene()
-    data = encode(s, parse_goal("In(cherries, shelf_a) & not Clear(butter)").literals)
-    n = 2 + len(FIXTURES)
+    data = encode(
+        s, parse_goal("In(cherries, shelf_a) & not Clear(butter)", world=KITCHEN).literals
+    )
+    n = 2 + len(KITCHEN.fixtures)
     assert data.x.shape == (n, node_dim("names"))
     assert data.edge_index.shape == (2, n * n)
     assert data.edge_attr.shape == (n * n, edge_dim("names"))
@@ -50,7 +53,9 @@ def test_shapes_and_one_slot_per_literal():
 
 def test_state_goal_and_validity_features():
     s = scene()
-    data = encode(s, parse_goal("In(cherries, shelf_a) & not Clear(butter)").literals)
+    data = encode(
+        s, parse_goal("In(cherries, shelf_a) & not Clear(butter)", world=KITCHEN).literals
+    )
     slots = Slots(tuple(data.names))
     e, p = slots.slot(on("butter", "cherries"))
     assert data.edge_attr[e, p] == 1.0  # holds in the state
@@ -67,13 +72,15 @@ def test_state_goal_and_validity_features():
 
 
 def test_decode_inverts_the_goal():
-    goal = parse_goal("On(butter, shelf_b) & InGrasp(cherries) & not On(butter, cherries)")
+    goal = parse_goal(
+        "On(butter, shelf_b) & InGrasp(cherries) & not On(butter, cherries)", world=KITCHEN
+    )
     data = encode(scene(), goal.literals)
     assert set(decode(data, data.goal)) == set(goal.literals)
 
 
 def test_duplicates_share_features_and_order_follows_nodes():
-    s = SymbolicSceneGraph.initial(["cherries", "cherries_2"])
+    s = SymbolicSceneGraph.initial(["cherries", "cherries_2"], world=KITCHEN)
     data = encode(s, [in_grasp("cherries_2")])
     assert torch.equal(data.x[0], data.x[1])
     slots = Slots(tuple(data.names))
@@ -84,8 +91,8 @@ def test_duplicates_share_features_and_order_follows_nodes():
 @pytest.mark.parametrize("features", FEATURES)
 def test_encode_many_equals_batching_single_encodings(features):
     rng = random.Random(0)
-    goal = random_goal(6, rng)
-    s = random_state(goal.objects, rng)
+    goal = random_goal(6, rng, world=KITCHEN)
+    s = random_state(goal.objects, rng, world=KITCHEN)
     lits = sorted(goal.literals)
     batched = Batch.from_data_list([encode(s, goal.literals, [lit], features) for lit in lits])
     many = encode_many(s, [goal.literals] * len(lits), [[lit] for lit in lits], features)
@@ -95,7 +102,9 @@ def test_encode_many_equals_batching_single_encodings(features):
 
 def test_active_edges_are_self_loops_and_related_pairs():
     s = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "open_space")]
+        ["cherries", "butter"],
+        [on("butter", "cherries"), on("cherries", "open_space")],
+        world=KITCHEN,
     )
     data = encode(s, [inside("cherries", "shelf_a")], [in_grasp("butter")])
     slots = Slots(tuple(data.names))
@@ -108,8 +117,8 @@ def test_active_edges_are_self_loops_and_related_pairs():
 @pytest.mark.parametrize("features", FEATURES)
 def test_encode_computed_is_encode_many_cut_to_the_computed_edges(features):
     rng = random.Random(3)
-    goal = random_goal(5, rng)
-    s = random_state(goal.objects, rng)
+    goal = random_goal(5, rng, world=KITCHEN)
+    s = random_state(goal.objects, rng, world=KITCHEN)
     lits = sorted(goal.literals)
     contexts = [frozenset(goal.literals)] * (len(lits) - 1) + [frozenset([clear(lits[0].subject)])]
     readout = touching(s.nodes, [lit.args for lit in lits])

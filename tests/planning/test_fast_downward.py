@@ -6,6 +6,7 @@ import pytest
 
 from hsgplan.domain.actions import Place
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import inside, on
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -28,11 +29,11 @@ def replay(plan, start, goal):
 def test_plans_for_random_goals_replay_in_the_transition_model(n):
     planner = FastDownwardPlanner()
     rng = random.Random(f"test-fd-{n}")
-    goals = random_goals(n, 12, seed=11)
-    starts = [random_state(g.objects, rng) for g in goals]
+    goals = random_goals(n, 12, seed=11, world=KITCHEN)
+    starts = [random_state(g.objects, rng, world=KITCHEN) for g in goals]
     for i, goal in enumerate(goals):
         # Half start with everything on the open space, half from a random arrangement.
-        start = SymbolicSceneGraph.initial(goal.objects) if i % 2 else starts[i]
+        start = SymbolicSceneGraph.initial(goal.objects, world=KITCHEN) if i % 2 else starts[i]
         replay(planner.plan(start, goal), start, goal)
 
 
@@ -41,24 +42,24 @@ def test_plans_for_random_goals_replay_in_the_transition_model(n):
 def test_generated_goals_up_to_twelve_objects_are_solved(n):
     planner = FastDownwardPlanner(optimal=False)
     rng = random.Random(f"test-fd-large-{n}")
-    for goal in random_goals(n, 8, seed=12):
-        start = random_state(goal.objects, rng)
+    for goal in random_goals(n, 8, seed=12, world=KITCHEN):
+        start = random_state(goal.objects, rng, world=KITCHEN)
         replay(planner.plan(start, goal), start, goal)
 
 
 @pytest.mark.slow
 def test_optimal_plans_are_never_longer():
     rng = random.Random(0)
-    for goal in random_goals(4, 6, seed=5):
-        start = random_state(goal.objects, rng)
+    for goal in random_goals(4, 6, seed=5, world=KITCHEN):
+        start = random_state(goal.objects, rng, world=KITCHEN)
         best = FastDownwardPlanner(optimal=True).plan(start, goal)
         fast = FastDownwardPlanner(optimal=False).plan(start, goal)
         assert len(best) <= len(fast)
 
 
 def test_known_plan():
-    goal = parse_goal("On(butter, cherries) & In(tomato_soup, shelf_a)")
-    start = SymbolicSceneGraph.initial(goal.objects)
+    goal = parse_goal("On(butter, cherries) & In(tomato_soup, shelf_a)", world=KITCHEN)
+    start = SymbolicSceneGraph.initial(goal.objects, world=KITCHEN)
     plan = FastDownwardPlanner(optimal=True).plan(start, goal)
     assert len(plan) == 5  # pick, place; pick, place on prepush_a, push
     assert [str(a) for a in plan.actions if "tomato_soup" in str(a)] == [
@@ -72,9 +73,11 @@ def test_banned_actions_are_left_out_of_the_plan():
     # butter must go somewhere before cream_cheese can be picked: banning where it went gives
     # a plan that puts it elsewhere
     start = SymbolicSceneGraph.from_literals(
-        ["cream_cheese", "butter"], [on("cream_cheese", "open_space"), on("butter", "cream_cheese")]
+        ["cream_cheese", "butter"],
+        [on("cream_cheese", "open_space"), on("butter", "cream_cheese")],
+        world=KITCHEN,
     )
-    goal = parse_goal("On(cream_cheese, shelf_b)")
+    goal = parse_goal("On(cream_cheese, shelf_b)", world=KITCHEN)
     planner = FastDownwardPlanner(optimal=True)
     first = planner.plan(start, goal)
     away = next(a for a in first.actions if isinstance(a, Place) and a.obj == "butter")
@@ -88,23 +91,25 @@ def test_banned_actions_are_left_out_of_the_plan():
 
 
 def test_goal_already_true_needs_no_plan():
-    start = SymbolicSceneGraph.initial(["butter", "cherries"])
-    plan = FastDownwardPlanner().plan(start, parse_goal("On(butter, open_space)"))
+    start = SymbolicSceneGraph.initial(["butter", "cherries"], world=KITCHEN)
+    plan = FastDownwardPlanner().plan(start, parse_goal("On(butter, open_space)", world=KITCHEN))
     assert len(plan) == 0 and plan.states == (start,)
 
 
 def test_unreachable_goal_is_reported():
     # An object inside a shelf can never come out again.
     start = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [inside("cherries", "shelf_a"), on("butter", "open_space")]
+        ["cherries", "butter"],
+        [inside("cherries", "shelf_a"), on("butter", "open_space")],
+        world=KITCHEN,
     )
     with pytest.raises(NoPlanError, match="no sequence"):
-        FastDownwardPlanner().plan(start, parse_goal("On(cherries, shelf_b)"))
+        FastDownwardPlanner().plan(start, parse_goal("On(cherries, shelf_b)", world=KITCHEN))
 
 
 def test_pddl_text_names_the_domain_actions():
-    goal = parse_goal("On(butter, cherries)")
-    domain, problem = to_pddl_text(SymbolicSceneGraph.initial(goal.objects), goal)
+    goal = parse_goal("On(butter, cherries)", world=KITCHEN)
+    domain, problem = to_pddl_text(SymbolicSceneGraph.initial(goal.objects, world=KITCHEN), goal)
     for name in (
         "pick_from_surface",
         "pick_from_object",

@@ -7,9 +7,9 @@ import pytest
 import torch
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.scene_file import read_world
-from hsgplan.domain.world import KITCHEN
 from hsgplan.planning.regression.encoding import encode, encode_computed, with_features
 from hsgplan.planning.regression.features import (
     GEOMETRY_NODE_DIM,
@@ -63,7 +63,7 @@ def test_a_shelf_and_its_prepush_region_are_joined_both_ways_and_nothing_else():
         ("prepush_b", "shelf_b"),
     }
     # and messages travel on them, though no literal relates the two
-    state = SymbolicSceneGraph.initial(["cherries"])
+    state = SymbolicSceneGraph.initial(["cherries"], world=KITCHEN)
     assert pairs <= _active_pairs(encode(state, [], features="geometry"))
     assert not pairs & _active_pairs(encode(state, []))
 
@@ -87,7 +87,7 @@ def test_geometry_encodes_a_scene_of_new_names_and_names_refuse_to():
 
 def test_training_examples_encoded_by_name_convert_to_geometry():
     state = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_b")]
+        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "shelf_b")], world=KITCHEN
     )
     goal, query = [inside("cherries", "shelf_a")], [on("butter", "open_space")]
     converted = with_features(encode(state, goal, query), KITCHEN, "geometry")
@@ -101,7 +101,7 @@ def test_equal_states_of_two_worlds_are_not_confused_by_the_caches():
         KITCHEN,
         type_list=tuple(replace(t, size=tuple(1.1 * s for s in t.size)) for t in KITCHEN.type_list),
     )
-    one = SymbolicSceneGraph.initial(["cherries"])
+    one = SymbolicSceneGraph.initial(["cherries"], world=KITCHEN)
     other = SymbolicSceneGraph.initial(["cherries"], world=resized)
     assert one == other  # states do not compare their worlds
     a = encode_computed(one, [frozenset()], [None], features="geometry")

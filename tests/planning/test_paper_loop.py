@@ -5,14 +5,17 @@ from pathlib import Path
 
 from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import Literal, in_grasp, on
 from hsgplan.paths import TASK_CHECKPOINT
 from hsgplan.planning.regression.paper_loop import TRIES, PaperRegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
-GOAL = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)")
+GOAL = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)", world=KITCHEN)
 START = SymbolicSceneGraph.from_literals(
-    ["cherries", "butter"], [on("cherries", "open_space"), on("butter", "open_space")]
+    ["cherries", "butter"],
+    [on("cherries", "open_space"), on("butter", "open_space")],
+    world=KITCHEN,
 )
 
 
@@ -63,7 +66,7 @@ def test_the_subgoal_is_drawn_uniformly_by_the_seed():
 
 def test_a_literal_whose_preimage_holds_is_not_taken_unless_f_reach_says_so():
     held = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [in_grasp("cherries"), on("butter", "shelf_b")]
+        ["cherries", "butter"], [in_grasp("cherries"), on("butter", "shelf_b")], world=KITCHEN
     )
     said_no = StandIns(set(), _preimage_of_places())
     decision = said_no.next_action(held, GOAL)

@@ -2,6 +2,7 @@
 
 import random
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.planning.regression.encoding import Slots, touching
 from hsgplan.planning.regression.planner import _order
 from hsgplan.symbolic.generator import random_goal, random_state
@@ -10,8 +11,8 @@ from hsgplan.symbolic.generator import random_goal, random_state
 def test_the_sort_key_is_the_literals_own_order():
     rng = random.Random(0)
     for _ in range(20):
-        goal = random_goal(rng.randint(2, 8), rng)
-        state = random_state(goal.objects, rng)
+        goal = random_goal(rng.randint(2, 8), rng, world=KITCHEN)
+        state = random_state(goal.objects, rng, world=KITCHEN)
         lits = list(goal.literals | state.literals | {lit.negated() for lit in state.literals})
         rng.shuffle(lits)
         assert sorted(lits, key=_order) == sorted(lits)
@@ -19,8 +20,8 @@ def test_the_sort_key_is_the_literals_own_order():
 
 def test_touching_marks_the_edges_at_a_literals_arguments():
     rng = random.Random(1)
-    goal = random_goal(4, rng)
-    nodes = random_state(goal.objects, rng).nodes
+    goal = random_goal(4, rng, world=KITCHEN)
+    nodes = random_state(goal.objects, rng, world=KITCHEN).nodes
     lits = sorted(goal.literals)
     marked = touching(nodes, [lit.args for lit in lits])
     slots = Slots.of(nodes)

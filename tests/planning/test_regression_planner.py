@@ -6,6 +6,7 @@ import random
 
 from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import in_grasp, on
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT
@@ -21,7 +22,7 @@ GOALS = [
 
 
 def test_the_shipped_planner_solves_three_object_goals_without_wandering():
-    for goal in map(parse_goal, GOALS):
+    for goal in (parse_goal(g, world=KITCHEN) for g in GOALS):
         for seed in range(3):  # start states with stacks and objects on shelf tops among them
             episode = run_task_episode(RegressionPlanner(TASK_CHECKPOINT, seed=seed), goal, seed, 0)
             assert episode.success, (str(goal), seed, episode.failure, episode.steps)
@@ -31,16 +32,16 @@ def test_the_shipped_planner_solves_three_object_goals_without_wandering():
 
 
 def test_the_same_seed_gives_the_same_decisions():
-    goal = parse_goal(GOALS[0])
-    start = random_state(goal.objects, random.Random(0))
+    goal = parse_goal(GOALS[0], world=KITCHEN)
+    start = random_state(goal.objects, random.Random(0), world=KITCHEN)
     assert _rollout(7, start, goal) == _rollout(7, start, goal)
 
 
 def test_a_reset_planner_decides_as_a_new_one():
-    goal, before = parse_goal(GOALS[1]), parse_goal(GOALS[0])
-    start = random_state(goal.objects, random.Random(3))
+    goal, before = parse_goal(GOALS[1], world=KITCHEN), parse_goal(GOALS[0], world=KITCHEN)
+    start = random_state(goal.objects, random.Random(3), world=KITCHEN)
     used = RegressionPlanner(TASK_CHECKPOINT, seed=1)
-    _rollout(1, random_state(before.objects, random.Random(1)), before, used)
+    _rollout(1, random_state(before.objects, random.Random(1), world=KITCHEN), before, used)
     used.reset(goal, 5)
     assert _rollout(5, start, goal, used) == _rollout(5, start, goal)
 
@@ -48,9 +49,13 @@ def test_a_reset_planner_decides_as_a_new_one():
 def test_a_stack_is_taken_apart_and_rebuilt_in_the_shortest_way():
     # butter sits on cherries, and the goal wants cherries on shelf A with butter on top
     start = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("cherries", "open_space"), on("butter", "cherries")]
+        ["cherries", "butter"],
+        [on("cherries", "open_space"), on("butter", "cherries")],
+        world=KITCHEN,
     )
-    actions = _rollout(0, start, parse_goal("On(cherries, shelf_a) & On(butter, cherries)"))
+    actions = _rollout(
+        0, start, parse_goal("On(cherries, shelf_a) & On(butter, cherries)", world=KITCHEN)
+    )
     assert actions[0] == str(Pick("butter")) and actions[1] != str(Place("butter", "cherries"))
     assert len(actions) == 6  # butter off, cherries up, butter back on
 
@@ -69,8 +74,8 @@ def _rollout(seed: int, state, goal, planner=None) -> list[str]:
 
 def test_an_action_the_world_refused_is_not_taken_again_from_the_same_state():
     # the planner is shown the state it acted from again: the action failed there
-    goal = parse_goal(GOALS[1])
-    state = random_state(goal.objects, random.Random(2))
+    goal = parse_goal(GOALS[1], world=KITCHEN)
+    state = random_state(goal.objects, random.Random(2), world=KITCHEN)
     for planner in (RegressionPlanner(TASK_CHECKPOINT, seed=0), ForwardPlanner(TASK_CHECKPOINT)):
         planner.reset(goal, 0)
         tried = []
@@ -86,8 +91,8 @@ def test_an_action_the_world_refused_is_not_taken_again_from_the_same_state():
 def test_when_everything_failed_the_planner_tries_again_rather_than_stopping():
     # In the world a failed primitive may pass with other parameters; a loop that never does
     # ends at the step limit (the paper's overstep), not in a planner with nothing to say.
-    goal = parse_goal("On(cherries, shelf_a)")
-    state = random_state(goal.objects, random.Random(0))
+    goal = parse_goal("On(cherries, shelf_a)", world=KITCHEN)
+    state = random_state(goal.objects, random.Random(0), world=KITCHEN)
     for planner in (RegressionPlanner(TASK_CHECKPOINT, seed=0), ForwardPlanner(TASK_CHECKPOINT)):
         planner.reset(goal, 0)
         actions = [planner.next_action(state, goal).action for _ in range(40)]
@@ -100,9 +105,11 @@ def test_an_action_that_keeps_failing_is_tried_again_as_often_as_the_detour():
     # Holding cream cheese, whose place on shelf B fails every time (the world refuses it);
     # the detour the planner finds (put it down, take it up again) comes back to the same
     # state. The failed place must keep its turn instead of being given up for the detour.
-    goal = parse_goal("On(cream_cheese, shelf_b) & On(popcorn, cream_cheese)")
+    goal = parse_goal("On(cream_cheese, shelf_b) & On(popcorn, cream_cheese)", world=KITCHEN)
     holding = SymbolicSceneGraph.from_literals(
-        ["popcorn", "cream_cheese"], [on("popcorn", "open_space"), in_grasp("cream_cheese")]
+        ["popcorn", "cream_cheese"],
+        [on("popcorn", "open_space"), in_grasp("cream_cheese")],
+        world=KITCHEN,
     )
     refused = Place("cream_cheese", "shelf_b")
     planner, state, actions = RegressionPlanner(TASK_CHECKPOINT, seed=0), holding, []

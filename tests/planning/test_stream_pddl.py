@@ -5,6 +5,7 @@ too little."""
 import pytest
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.planning.fast_downward import NoPlanError, solve_pddl
 from hsgplan.symbolic.stream_pddl import DOMAIN, STREAM_SEARCH, goal_text, problem_text
 
@@ -46,7 +47,9 @@ def _problem(goal: str, drop=(), extra=()) -> str:
         "conf": [f"q{i}" for i in range(6)],
         "push": [],
     }
-    return problem_text(objects, [f for f in init if f not in drop], parse_goal(goal))
+    return problem_text(
+        objects, [f for f in init if f not in drop], parse_goal(goal, world=KITCHEN)
+    )
 
 
 def _solve(problem: str) -> list[tuple[str, ...]]:
@@ -95,7 +98,7 @@ def test_no_plan_where_no_kinematics_was_certified():
 
 
 def test_goal_literals_become_derived_atoms():
-    goal = parse_goal("In(tomato_soup, shelf_a) & not On(butter, cherries)")
+    goal = parse_goal("In(tomato_soup, shelf_a) & not On(butter, cherries)", world=KITCHEN)
     assert sorted(goal_text(lit) for lit in goal.literals) == [
         "(in tomato_soup shelf_a)",
         "(not (on butter cherries))",

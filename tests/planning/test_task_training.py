@@ -11,6 +11,7 @@ from hsgplan.cli import app
 from hsgplan.data.demos import load_demos
 from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import clear, in_grasp, inside, on
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.planning.regression.examples import (
@@ -35,7 +36,9 @@ TINY = {
 
 
 def test_a_stack_demonstration_regresses_base_first():
-    demo = next(d for d in load_demos(DEMOS) if d.task == "stack-butter-on-cherries-shelf_a")
+    demo = next(
+        d for d in load_demos(DEMOS, world=KITCHEN) if d.task == "stack-butter-on-cherries-shelf_a"
+    )
     chain = regressed_subgoals(demo)
     assert chain[-1] == {on("cherries", "shelf_a"), on("butter", "cherries")}
     # before the last place: butter in the hand, the base on the shelf and clear
@@ -43,7 +46,9 @@ def test_a_stack_demonstration_regresses_base_first():
 
 
 def test_paper_reach_labels_come_from_demonstrated_changes_and_their_alterations():
-    demo = next(d for d in load_demos(DEMOS) if d.task == "stack-butter-on-cherries-shelf_a")
+    demo = next(
+        d for d in load_demos(DEMOS, world=KITCHEN) if d.task == "stack-butter-on-cherries-shelf_a"
+    )
     examples = paper_reach_examples([demo], singles=2)
     first = examples[0]  # the first step, every label at once: the pick of cherries
     from hsgplan.planning.regression.encoding import Slots
@@ -59,7 +64,7 @@ def test_paper_reach_labels_come_from_demonstrated_changes_and_their_alterations
 def test_predicate_only_alterations_keep_the_edge_and_change_its_predicate():
     from hsgplan.planning.regression.encoding import Slots
 
-    demo = next(d for d in load_demos(DEMOS) if d.task == "inside-cherries-shelf_a")
+    demo = next(d for d in load_demos(DEMOS, world=KITCHEN) if d.task == "inside-cherries-shelf_a")
     examples = paper_reach_examples([demo], singles=1, predicates_only=True)
     negatives, positives = set(), set()
     for ex in examples:
@@ -76,10 +81,12 @@ def test_world_labels_are_what_the_executed_action_made_hold():
     from hsgplan.data.world_trials import WorldTrial
 
     before = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "open_space")]
+        ["cherries", "butter"],
+        [on("butter", "cherries"), on("cherries", "open_space")],
+        world=KITCHEN,
     )
     after = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [in_grasp("butter"), on("cherries", "open_space")]
+        ["cherries", "butter"], [in_grasp("butter"), on("cherries", "open_space")], world=KITCHEN
     )
     labels = world_labels(WorldTrial(before, Pick("butter"), "success", after))
     assert labels == {
@@ -95,7 +102,9 @@ def test_world_labels_are_what_the_executed_action_made_hold():
 
 def test_action_heuristic_reads_the_state_and_checks_no_precondition():
     s = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "cherries"), on("cherries", "prepush_a")]
+        ["cherries", "butter"],
+        [on("butter", "cherries"), on("cherries", "prepush_a")],
+        world=KITCHEN,
     )
     assert str(action_for(clear("cherries"), s)) == "pick(butter)"
     assert str(action_for(in_grasp("butter"), s)) == "pick(butter)"
@@ -117,21 +126,21 @@ def test_training_writes_checkpoint_folders_and_resumes(tmp_path):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        train_task(config, tmp_path, stop_midway)
+        train_task(config, tmp_path, stop_midway, world=KITCHEN)
     assert (tmp_path / "preimage" / "model.safetensors").exists()
     seen.clear()
     # saved before f_reach's own epoch count existed: trained with its default, resumed
     saved = json.loads((tmp_path / "train_config.json").read_text())
     del saved["reach_epochs"]
     (tmp_path / "train_config.json").write_text(json.dumps(saved))
-    train_task(config, tmp_path, lambda n, e, loss: seen.append((n, e)))
+    train_task(config, tmp_path, lambda n, e, loss: seen.append((n, e)), world=KITCHEN)
     assert ("preimage", 1) not in seen  # finished before: not trained again
     for name in ("preimage", "reach", "forward"):
         net = load_network(tmp_path / name)
         assert json.loads((tmp_path / name / "config.json").read_text())["hidden"] == 16
         assert net.config.hidden == 16
     with pytest.raises(InvalidInputError, match="another configuration"):
-        train_task(TaskTrainConfig.from_json(TINY | {"seed": 9}), tmp_path)
+        train_task(TaskTrainConfig.from_json(TINY | {"seed": 9}), tmp_path, world=KITCHEN)
 
 
 def test_broken_checkpoints_are_refused(tmp_path):
@@ -206,7 +215,9 @@ def test_preimage_targets_of_a_stacks_last_step():
     from hsgplan.planning.regression.encoding import FALSE, TRUE, Slots, decode
     from hsgplan.planning.regression.examples import preimage_examples
 
-    demo = next(d for d in load_demos(DEMOS) if d.task == "stack-butter-on-cherries-shelf_a")
+    demo = next(
+        d for d in load_demos(DEMOS, world=KITCHEN) if d.task == "stack-butter-on-cherries-shelf_a"
+    )
     last = [
         e
         for e in preimage_examples([demo])
@@ -224,7 +235,7 @@ def test_preimage_targets_of_a_stacks_last_step():
 @pytest.mark.slow
 def test_eval_task_runs_a_trained_checkpoint_in_worker_processes(tmp_path):
     # The pool must not fork a process that has loaded torch: forked workers hung.
-    train_task(TaskTrainConfig.from_json(TINY), tmp_path)
+    train_task(TaskTrainConfig.from_json(TINY), tmp_path, world=KITCHEN)
     r = CliRunner().invoke(
         app,
         [
@@ -267,11 +278,17 @@ def test_a_demo_limit_trains_on_the_first_demonstrations_alone(tmp_path):
     lines = (DEMOS / "demos.jsonl").read_text().splitlines()
     (first / "demos.jsonl").write_text("\n".join(lines[:3]) + "\n")
     tiny = TINY | {"epochs": 1, "copies": 0}
-    train_task(TaskTrainConfig.from_json(tiny | {"demo_limit": 3}), tmp_path / "limited")
-    train_task(TaskTrainConfig.from_json(tiny | {"demos": str(first)}), tmp_path / "cut")
+    train_task(
+        TaskTrainConfig.from_json(tiny | {"demo_limit": 3}), tmp_path / "limited", world=KITCHEN
+    )
+    train_task(
+        TaskTrainConfig.from_json(tiny | {"demos": str(first)}), tmp_path / "cut", world=KITCHEN
+    )
     for name in ("preimage", "reach", "forward"):
         limited = json.loads((tmp_path / "limited" / name / "labels.json").read_text())
         assert limited == json.loads((tmp_path / "cut" / name / "labels.json").read_text())
     with pytest.raises(InvalidInputError, match="holds 18 demonstrations"):
-        train_task(TaskTrainConfig.from_json(tiny | {"demo_limit": 19}), tmp_path / "more")
+        train_task(
+            TaskTrainConfig.from_json(tiny | {"demo_limit": 19}), tmp_path / "more", world=KITCHEN
+        )
     assert not (tmp_path / "more").exists()

@@ -6,9 +6,8 @@ import pytest
 import torch
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.objects import ENTITY_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import clear, inside, on
-from hsgplan.domain.world import SHELVES, surface_rect
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.grounding import (
@@ -30,7 +29,7 @@ K = len(TYPES) + len(REGION_CLASSES)  # where the geometric features start
 
 
 def _top(shelf: str, dx: float = 0.0, dy: float = 0.0, height: float = 0.058):
-    r = surface_rect(shelf)
+    r = KITCHEN.surface_rect(shelf)
     cx, cy = r.center
     return Pose.from_xyz_yaw(cx + dx, cy + dy, r.z + height / 2)
 
@@ -43,6 +42,7 @@ def _place_scene() -> GeometricSceneGraph:
             "tomato_soup": Pose.from_xyz_yaw(0.4, 0.0, 0.4),  # in the gripper
         },
         held="tomato_soup",
+        world=KITCHEN,
     )
 
 
@@ -66,8 +66,8 @@ def test_place_grounding_shapes_and_attributes():
     assert torch.allclose(row[K + 9 : K + 11], torch.tensor([0.5, 0.5]), atol=1e-5)
     assert row[K + 11] == pytest.approx(SCALE * 0.029, abs=1e-4)
     # the subgoal names the target and the moved object's type
-    assert g.u[0, ENTITY_TYPES.index("shelf_a")] == 1
-    assert g.u[0, len(ENTITY_TYPES) + TYPES.index("tomato_soup")] == 1
+    assert g.u[0, KITCHEN.entity_types.index("shelf_a")] == 1
+    assert g.u[0, len(KITCHEN.entity_types) + TYPES.index("tomato_soup")] == 1
     assert g.u.sum() == 2
 
 
@@ -81,12 +81,13 @@ def test_edges_carry_offsets_in_both_directions():
 
 
 def test_push_grounding_is_relative_to_the_object_and_the_shelf():
-    front = SHELVES["shelf_a"].interior
+    front = KITCHEN.shelves["shelf_a"].interior
     scene = GeometricSceneGraph.from_poses(
         {
             "cherries": Pose.from_xyz_yaw(0.30, 0.38, 0.029),  # on prepush_a
             "alphabet_soup": Pose.from_xyz_yaw(front.x_min + 0.06, 0.30, 0.042),  # inside
-        }
+        },
+        world=KITCHEN,
     )
     g = ground(scene, inside("cherries", "shelf_a"))
     c, a = scene.objects.index("cherries"), scene.objects.index("alphabet_soup")
@@ -134,7 +135,7 @@ def test_geometry_grounding_reads_what_the_scene_says_not_names():
     names = ground(sg, on("tomato_soup", "shelf_a"))
     assert torch.equal(g.x[:, kinds + roles + 2 :], names.x[:, K:])
     # the subgoal: a shelf top, its sides and height, a can of the soup's size
-    top = surface_rect("shelf_a")
+    top = KITCHEN.surface_rect("shelf_a")
     u = g.u[0].tolist()
     assert u[: len(TARGET_ROLES)] == [0, 0, 1, 0]
     assert u[4:7] == pytest.approx([SCALE * top.width_x, SCALE * top.width_y, SCALE * top.z])
@@ -148,15 +149,18 @@ def test_geometry_grounding_reads_what_the_scene_says_not_names():
 
 
 def test_geometry_grounding_of_a_push_marks_the_target_interior_and_its_prepush_region():
-    prepush = surface_rect("prepush_a")
+    prepush = KITCHEN.surface_rect("prepush_a")
     sg = GeometricSceneGraph.from_poses(
         {
             "cherries": Pose.from_xyz_yaw(*prepush.center, 0.029),
             "alphabet_soup": Pose.from_xyz_yaw(
-                SHELVES["shelf_a"].interior.center[0], SHELVES["shelf_a"].interior.center[1], 0.042
+                KITCHEN.shelves["shelf_a"].interior.center[0],
+                KITCHEN.shelves["shelf_a"].interior.center[1],
+                0.042,
             ),
             "butter": _top("shelf_a", height=0.024),
-        }
+        },
+        world=KITCHEN,
     )
     g = ground(sg, inside("cherries", "shelf_a"), "geometry")
     i = {n: sg.objects.index(n) for n in sg.objects}

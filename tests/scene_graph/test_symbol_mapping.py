@@ -5,9 +5,10 @@ import random
 
 import pytest
 
-from hsgplan.domain.objects import object_type, objects_for_types
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.objects import objects_for_types
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.world import OBJECT_TYPES, REGIONS, SHELF_TOP_Z, SHELVES, TABLE, Kind
+from hsgplan.domain.world import Kind
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import (
@@ -18,16 +19,16 @@ from hsgplan.scene_graph.symbol_mapping import (
     map_symbols,
 )
 
-TOP = SHELF_TOP_Z
+TOP = KITCHEN.shelves["shelf_a"].top.z
 CONTACT = DEFAULT_TOLERANCES.contact_z
 MARGIN = DEFAULT_TOLERANCES.xy_margin
-R_CAN = OBJECT_TYPES["cherries"].size[0] / 2
-H_BUTTER = OBJECT_TYPES["butter"].height
-H_CHERRIES = OBJECT_TYPES["cherries"].height
+R_CAN = KITCHEN.object_types["cherries"].size[0] / 2
+H_BUTTER = KITCHEN.object_types["butter"].height
+H_CHERRIES = KITCHEN.object_types["cherries"].height
 
 
 def h(name: str) -> float:
-    return object_type(name).height
+    return KITCHEN.object_type(name).height
 
 
 def rest(name, x, y, bottom=0.0, yaw=0.0, tilt=0.0):
@@ -48,7 +49,7 @@ def _tilt_quat(t):
 
 
 def mapped(objs, held=None, tol=DEFAULT_TOLERANCES) -> SymbolMapping:
-    return map_symbols(GeometricSceneGraph.from_poses(dict(objs), held), tol)
+    return map_symbols(GeometricSceneGraph.from_poses(dict(objs), held, world=KITCHEN), tol)
 
 
 def case(id_, objs, expected, anomalies="", held=None):
@@ -211,7 +212,7 @@ SCENES = [
     *[
         case(
             f"region_edge_{d:+.3f}",
-            [rest("butter", REGIONS["open_space"].x_max + d, 0.0)],
+            [rest("butter", KITCHEN.regions["open_space"].x_max + d, 0.0)],
             oc("butter", "open_space"),
             "" if d <= MARGIN else "butter:off_region",
         )
@@ -219,12 +220,12 @@ SCENES = [
     ],
     case(
         "shelf_top_edge_inside_margin",
-        [rest(TS, 0.49, SHELVES["shelf_a"].top.y_max + MARGIN - 0.001, TOP)],
+        [rest(TS, 0.49, KITCHEN.shelves["shelf_a"].top.y_max + MARGIN - 0.001, TOP)],
         oc("tomato_soup", "shelf_a"),
     ),
     case(
         "shelf_top_edge_past_margin_floats",
-        [rest(TS, 0.49, SHELVES["shelf_a"].top.y_max + MARGIN + 0.001, TOP)],
+        [rest(TS, 0.49, KITCHEN.shelves["shelf_a"].top.y_max + MARGIN + 0.001, TOP)],
         oc("tomato_soup", "prepush_a"),
         "tomato_soup:unsupported",
     ),
@@ -249,7 +250,7 @@ SCENES = [
     ),
     case(
         "past_the_table_edge",
-        [rest("butter", TABLE.x_max + 0.05, -0.40, -0.02)],
+        [rest("butter", KITCHEN.table.x_max + 0.05, -0.40, -0.02)],
         oc("butter", "open_space"),
         "butter:off_table",
     ),
@@ -296,17 +297,20 @@ SCENES = [
         [
             rest(n, x, y, TOP)
             for n, (x, y) in zip(
-                objects_for_types(["cherries"] * 7),
+                objects_for_types(["cherries"] * 7, world=KITCHEN),
                 [(x, y) for x in (0.42, 0.56) for y in (0.26, 0.34, 0.42, 0.50)],
                 strict=False,
             )
         ],
-        " & ".join(oc(n, "shelf_a") for n in objects_for_types(["cherries"] * 7)),
+        " & ".join(oc(n, "shelf_a") for n in objects_for_types(["cherries"] * 7, world=KITCHEN)),
     ),
     case(
         "crowded_interior_past_capacity",
-        [rest(n, 0.45, 0.27 + 0.07 * i) for i, n in enumerate(objects_for_types(["cherries"] * 4))],
-        " & ".join(f"In({n}, shelf_a)" for n in objects_for_types(["cherries"] * 4)),
+        [
+            rest(n, 0.45, 0.27 + 0.07 * i)
+            for i, n in enumerate(objects_for_types(["cherries"] * 4, world=KITCHEN))
+        ],
+        " & ".join(f"In({n}, shelf_a)" for n in objects_for_types(["cherries"] * 4, world=KITCHEN)),
     ),
 ]
 
@@ -336,7 +340,7 @@ def test_stacking_cycle_degrades_instead_of_raising():
 
 
 def test_tolerances_change_the_reading():
-    objs = [rest("butter", REGIONS["open_space"].x_max + 0.005, 0.0)]
+    objs = [rest("butter", KITCHEN.regions["open_space"].x_max + 0.005, 0.0)]
     assert _anoms(mapped(objs)) == set()
     assert _anoms(mapped(objs, tol=MappingTolerances(xy_margin=0.0))) == {"butter:off_region"}
 
@@ -349,18 +353,22 @@ def test_held_object_must_be_in_the_scene():
 def test_default_tolerances_fit_the_world():
     """The reasons given for the defaults, checked against the world's constants."""
     tol = DEFAULT_TOLERANCES
-    assert tol.contact_z < min(t.height for t in OBJECT_TYPES.values())
-    space, pre_a, pre_b = REGIONS["open_space"], REGIONS["prepush_a"], REGIONS["prepush_b"]
+    assert tol.contact_z < min(t.height for t in KITCHEN.object_types.values())
+    space, pre_a, pre_b = (
+        KITCHEN.regions["open_space"],
+        KITCHEN.regions["prepush_a"],
+        KITCHEN.regions["prepush_b"],
+    )
     assert 2 * tol.xy_margin < min(pre_a.y_min - space.y_max, space.y_min - pre_b.y_max)
-    boxes = [t for t in OBJECT_TYPES.values() if t.kind is Kind.BOX]
+    boxes = [t for t in KITCHEN.object_types.values() if t.kind is Kind.BOX]
     assert tol.tilt_max < min(math.atan2(t.grasp_width, t.height) for t in boxes)
     assert tol.off_table_z < -tol.contact_z  # an object sunk within contact_z is on the table
 
 
 def _random_scene(rng: random.Random):
-    types = rng.choices(list(OBJECT_TYPES), k=rng.randint(1, 12))
+    types = rng.choices(list(KITCHEN.object_types), k=rng.randint(1, 12))
     poses = {}
-    for name in objects_for_types(types):
+    for name in objects_for_types(types, world=KITCHEN):
         yaw, tilt = rng.uniform(-math.pi, math.pi), rng.choice([0.0, 0.0, rng.uniform(0, 3.2)])
         q = Pose.from_xyz_yaw(0, 0, 0, yaw).compose(Pose((0, 0, 0), _tilt_quat(tilt)))
         xy = (rng.uniform(-0.4, 1.1), rng.uniform(-0.9, 0.9))
@@ -378,7 +386,7 @@ def _random_scene(rng: random.Random):
 def test_never_raises_and_places_every_object_once(seed):
     poses, held = _random_scene(random.Random(seed))
     tol = MappingTolerances(contact_z=0.03 if seed % 2 else 0.015)
-    m = map_symbols(GeometricSceneGraph.from_poses(poses, held), tol)
+    m = map_symbols(GeometricSceneGraph.from_poses(poses, held, world=KITCHEN), tol)
     placements = [lit for lit in m.state.literals if lit.predicate is not Predicate.CLEAR]
     assert sorted(lit.subject for lit in placements) == sorted(poses)
     assert m.state.held() == held

@@ -2,9 +2,9 @@ import pytest
 import torch
 
 from hsgplan.domain.errors import InfeasibleError
-from hsgplan.domain.objects import ENTITY_TYPES
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import PREDICATES, Predicate, clear, in_grasp, inside, on
-from hsgplan.scene_graph.symbolic import FIXTURES, SymbolicSceneGraph
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 
 def _stack_scene():
@@ -16,6 +16,7 @@ def _stack_scene():
             inside("tomato_soup", "shelf_a"),
             in_grasp("popcorn"),
         ],
+        world=KITCHEN,
     )
 
 
@@ -31,13 +32,19 @@ def test_clear_is_derived():
 
 def test_equality_and_hash_ignore_input_order():
     a = SymbolicSceneGraph.from_literals(
-        ["cherries", "butter"], [on("butter", "shelf_a"), on("cherries", "open_space")]
+        ["cherries", "butter"],
+        [on("butter", "shelf_a"), on("cherries", "open_space")],
+        world=KITCHEN,
     )
     b = SymbolicSceneGraph.from_literals(
-        ["butter", "cherries"], [on("cherries", "open_space"), on("butter", "shelf_a")]
+        ["butter", "cherries"],
+        [on("cherries", "open_space"), on("butter", "shelf_a")],
+        world=KITCHEN,
     )
     c = SymbolicSceneGraph.from_literals(
-        ["butter", "cherries"], [on("cherries", "open_space"), on("butter", "shelf_b")]
+        ["butter", "cherries"],
+        [on("cherries", "open_space"), on("butter", "shelf_b")],
+        world=KITCHEN,
     )
     assert a == b and hash(a) == hash(b)
     assert a != c
@@ -61,6 +68,7 @@ def test_given_clear_must_agree():
         SymbolicSceneGraph.from_literals(
             ["butter", "cherries"],
             [on("butter", "cherries"), on("cherries", "shelf_a"), clear("cherries")],
+            world=KITCHEN,
         )
 
 
@@ -77,17 +85,17 @@ def test_given_clear_must_agree():
 )
 def test_inconsistent_states_are_refused(literals):
     with pytest.raises(InfeasibleError):
-        SymbolicSceneGraph.from_literals(["butter", "cherries"], literals)
+        SymbolicSceneGraph.from_literals(["butter", "cherries"], literals, world=KITCHEN)
 
 
 def test_to_data_shapes_and_edges():
     s = _stack_scene()
     data = s.to_data()
-    n = len(s.objects) + len(FIXTURES)
-    assert data.x.shape == (n, len(ENTITY_TYPES))
+    n = len(s.objects) + len(KITCHEN.fixtures)
+    assert data.x.shape == (n, len(KITCHEN.entity_types))
     assert torch.equal(data.x.sum(1), torch.ones(n))
     assert data.edge_attr.shape == (data.edge_index.shape[1], len(PREDICATES))
-    assert data.names == list(s.objects) + list(FIXTURES)
+    assert data.names == list(s.objects) + list(KITCHEN.fixtures)
     edges = {
         (data.names[i], data.names[j], PREDICATES[k])
         for (i, j), row in zip(data.edge_index.t().tolist(), data.edge_attr.tolist(), strict=True)
@@ -104,20 +112,23 @@ def test_to_data_shapes_and_edges():
 
 
 def test_duplicate_instances_share_a_node_type():
-    s = SymbolicSceneGraph.initial(["cherries", "cherries_2"])
+    s = SymbolicSceneGraph.initial(["cherries", "cherries_2"], world=KITCHEN)
     data = s.to_data()
     assert torch.equal(data.x[0], data.x[1])
-    assert data.x[0, ENTITY_TYPES.index("cherries")] == 1
+    assert data.x[0, KITCHEN.entity_types.index("cherries")] == 1
 
 
 def test_observed_scenes_may_break_planning_limits_but_not_structure():
     tower = [on("butter", "cherries"), on("cherries", "tomato_soup"), on("tomato_soup", "shelf_a")]
     objs = ["butter", "cherries", "tomato_soup"]
     with pytest.raises(InfeasibleError, match="towers hold at most"):
-        SymbolicSceneGraph.from_literals(objs, tower)
-    observed = SymbolicSceneGraph.from_literals(objs, tower, limits=False)
+        SymbolicSceneGraph.from_literals(objs, tower, world=KITCHEN)
+    observed = SymbolicSceneGraph.from_literals(objs, tower, limits=False, world=KITCHEN)
     assert observed.level("butter") == 3
     with pytest.raises(InfeasibleError, match="one place"):
         SymbolicSceneGraph.from_literals(
-            ["butter"], [on("butter", "shelf_a"), on("butter", "shelf_b")], limits=False
+            ["butter"],
+            [on("butter", "shelf_a"), on("butter", "shelf_b")],
+            limits=False,
+            world=KITCHEN,
         )

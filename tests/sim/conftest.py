@@ -2,13 +2,13 @@
 
 import pytest
 
-from hsgplan.domain.objects import object_type
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.scene import Scene
 
 
 def standing(name, x, y, yaw=0.0, on_z=0.0):
-    return Pose.from_xyz_yaw(x, y, on_z + object_type(name).height / 2 + 0.001, yaw)
+    return Pose.from_xyz_yaw(x, y, on_z + KITCHEN.object_type(name).height / 2 + 0.001, yaw)
 
 
 @pytest.fixture
@@ -22,6 +22,7 @@ def scene():
             "popcorn": standing("popcorn", 0.36, -0.12),
             "tomato_soup": standing("tomato_soup", 0.305, 0.38),
         },
+        world=KITCHEN,
     )
     s.settle()
     yield s

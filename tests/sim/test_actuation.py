@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -34,7 +35,7 @@ def _low_hand(scene: Scene, x: float, y: float) -> np.ndarray:
 
 
 def test_an_arm_swept_through_a_resting_can_pushes_it():
-    with Scene((CAN,), seed=0, poses={CAN: standing(CAN, 0.5, 0.0)}) as scene:
+    with Scene((CAN,), seed=0, poses={CAN: standing(CAN, 0.5, 0.0)}, world=KITCHEN) as scene:
         scene.settle()
         start, end = _low_hand(scene, 0.5, 0.16), _low_hand(scene, 0.5, -0.16)
         scene.robot.set_q(start)
@@ -47,7 +48,7 @@ def test_an_arm_swept_through_a_resting_can_pushes_it():
 
 
 def test_a_path_into_the_table_is_stopped_and_says_so():
-    with Scene((CAN,), seed=0) as scene:
+    with Scene((CAN,), seed=0, world=KITCHEN) as scene:
         above = _low_hand(scene, 0.5, 0.0)
         scene.robot.set_q(above)
         into = scene.robot.ik(Pose((0.5, 0.0, -0.05), topdown(0.0)), scene.rng)
@@ -63,12 +64,12 @@ def _pick_believed_off(offset: tuple[float, float]):
     belief and run in the scene. Returns the scene, the plan and the can's pose before."""
     truth = standing(CAN, 0.5, 0.1)
     believed = Pose((0.5 + offset[0], 0.1 + offset[1], truth.position[2]), truth.orientation)
-    scene = Scene((CAN,), seed=0, poses={CAN: truth})
+    scene = Scene((CAN,), seed=0, poses={CAN: truth}, world=KITCHEN)
     scene.settle()
     start = scene.pose(CAN)
-    world = BeliefWorld((CAN,), seed=0)
+    world = BeliefWorld((CAN,), seed=0, world=KITCHEN)
     try:
-        world.believe(GeometricSceneGraph.from_poses({CAN: believed}))
+        world.believe(GeometricSceneGraph.from_poses({CAN: believed}, world=KITCHEN))
         plan = world.plan(PickParams(CAN))
     finally:
         world.close()
@@ -78,7 +79,7 @@ def _pick_believed_off(offset: tuple[float, float]):
 
 def _closing_direction(plan: MotionPlan) -> np.ndarray:
     """The horizontal direction the fingers close along, from the plan's hand at the grasp."""
-    with Scene((), seed=0) as model:
+    with Scene((), seed=0, world=KITCHEN) as model:
         model.robot.set_q(plan.q_at)
         axis = model.robot.tcp().rotation[:, 1]
     return axis[:2] / np.linalg.norm(axis[:2])
@@ -126,7 +127,7 @@ def test_fingers_closing_on_nothing_hold_nothing_and_read_closed():
 
 
 def test_fingers_both_on_top_of_a_can_are_no_grasp():
-    with Scene((CAN,), seed=0, poses={CAN: standing(CAN, 0.5, 0.0)}) as scene:
+    with Scene((CAN,), seed=0, poses={CAN: standing(CAN, 0.5, 0.0)}, world=KITCHEN) as scene:
         scene.settle()
         robot = scene.robot
         top = scene.pose(CAN).position[2] + 0.083 / 2

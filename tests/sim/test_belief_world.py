@@ -2,9 +2,9 @@
 
 import pytest
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.domain.predicates import in_grasp, on
-from hsgplan.domain.world import OBJECT_TYPES, REGIONS, TABLE
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.belief_world import BeliefWorld
@@ -15,14 +15,14 @@ from hsgplan.sim.scene import Scene
 
 
 def _on_table(name: str, x: float, y: float) -> Pose:
-    return Pose.from_xyz_yaw(x, y, TABLE.z + OBJECT_TYPES[name].size[2] / 2)
+    return Pose.from_xyz_yaw(x, y, KITCHEN.table.z + KITCHEN.object_types[name].size[2] / 2)
 
 
 def test_the_model_holds_only_what_is_believed_and_parks_what_was_never_seen():
-    world = BeliefWorld(("butter", "tomato_soup"), seed=0)
+    world = BeliefWorld(("butter", "tomato_soup"), seed=0, world=KITCHEN)
     try:
         butter = _on_table("butter", 0.5, 0.1)
-        world.believe(GeometricSceneGraph.from_poses({"butter": butter}))
+        world.believe(GeometricSceneGraph.from_poses({"butter": butter}, world=KITCHEN))
         assert world.scene.pose("butter").distance(butter) < 1e-6
         parked = world.scene.pose("tomato_soup")
         assert parked.position[0] < 0  # behind the robot: no obstacle, no pose
@@ -34,10 +34,10 @@ def test_the_model_holds_only_what_is_believed_and_parks_what_was_never_seen():
 def test_a_pick_planned_in_the_belief_takes_up_the_true_object_near_it():
     truth = _on_table("butter", 0.5, 0.1)
     off = Pose((0.5, 0.107, truth.position[2]), truth.orientation)  # 7 mm along its long side
-    with Scene(("butter",), seed=0, poses={"butter": truth}) as scene:
-        world = BeliefWorld(("butter",), seed=0)
+    with Scene(("butter",), seed=0, poses={"butter": truth}, world=KITCHEN) as scene:
+        world = BeliefWorld(("butter",), seed=0, world=KITCHEN)
         try:
-            world.believe(GeometricSceneGraph.from_poses({"butter": off}))
+            world.believe(GeometricSceneGraph.from_poses({"butter": off}, world=KITCHEN))
             plan = world.plan(PickParams("butter"))
             assert isinstance(plan, MotionPlan)
             run_plan(scene, plan)
@@ -54,16 +54,20 @@ def test_a_pick_planned_in_the_belief_takes_up_the_true_object_near_it():
 
 def test_a_step_is_judged_on_the_belief_before_and_after_it():
     butter, soup = _on_table("butter", 0.5, 0.1), _on_table("tomato_soup", 0.5, -0.2)
-    before = GeometricSceneGraph.from_poses({"butter": butter, "tomato_soup": soup})
+    before = GeometricSceneGraph.from_poses({"butter": butter, "tomato_soup": soup}, world=KITCHEN)
     lifted = Pose((0.5, 0.1, 0.3), butter.orientation)
-    held = GeometricSceneGraph.from_poses({"butter": lifted, "tomato_soup": soup}, held="butter")
+    held = GeometricSceneGraph.from_poses(
+        {"butter": lifted, "tomato_soup": soup}, held="butter", world=KITCHEN
+    )
     assert compare(before, held, "butter", in_grasp("butter"))[0] is Status.SUCCESS
     # the soup seen 3 cm from where it was believed: the pick disturbed it
     moved = Pose((0.5, -0.17, soup.position[2]), soup.orientation)
-    bumped = GeometricSceneGraph.from_poses({"butter": lifted, "tomato_soup": moved}, held="butter")
+    bumped = GeometricSceneGraph.from_poses(
+        {"butter": lifted, "tomato_soup": moved}, held="butter", world=KITCHEN
+    )
     assert compare(before, bumped, "butter", in_grasp("butter"))[0] is Status.DISTURBED
     # an object first seen after the step was not disturbed by it
-    alone = GeometricSceneGraph.from_poses({"butter": butter})
+    alone = GeometricSceneGraph.from_poses({"butter": butter}, world=KITCHEN)
     status, detail = compare(alone, before, "butter", on("butter", "open_space"))
     assert status is Status.SUCCESS, detail
 
@@ -74,8 +78,10 @@ def _soup_seen_at(dy: float) -> tuple[GeometricSceneGraph, GeometricSceneGraph]:
     lifted = Pose((0.5, 0.1, 0.3), butter.orientation)
     moved = Pose((0.5, -0.15 + dy, soup.position[2]), soup.orientation)
     return (
-        GeometricSceneGraph.from_poses({"butter": butter, "tomato_soup": soup}),
-        GeometricSceneGraph.from_poses({"butter": lifted, "tomato_soup": moved}, held="butter"),
+        GeometricSceneGraph.from_poses({"butter": butter, "tomato_soup": soup}, world=KITCHEN),
+        GeometricSceneGraph.from_poses(
+            {"butter": lifted, "tomato_soup": moved}, held="butter", world=KITCHEN
+        ),
     )
 
 
@@ -92,9 +98,9 @@ def test_a_belief_judges_only_moves_beyond_its_own_spread_and_of_what_it_is_sure
     unsure = frozenset({"butter"})
     assert compare(before, after, "butter", pick, SEEN_DISTURB_TOL, unsure)[0] is Status.SUCCESS
     # seen in another region now: moved out of place, sure of it or not
-    elsewhere = _on_table("tomato_soup", *REGIONS["prepush_b"].center)
+    elsewhere = _on_table("tomato_soup", *KITCHEN.regions["prepush_b"].center)
     onto = GeometricSceneGraph.from_poses(
-        {"butter": after.pose("butter"), "tomato_soup": elsewhere}, held="butter"
+        {"butter": after.pose("butter"), "tomato_soup": elsewhere}, held="butter", world=KITCHEN
     )
     assert compare(before, onto, "butter", pick, SEEN_DISTURB_TOL, unsure)[0] is Status.DISTURBED
 

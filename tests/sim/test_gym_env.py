@@ -7,8 +7,9 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
-from hsgplan.domain.world import KITCHEN, MAX_OBJECTS
+from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.sim.env import ENV_ID, KitchenStorageEnv, ResetOptions
 from hsgplan.sim.gym_spaces import decode, encode, entity_names
 
@@ -23,7 +24,7 @@ def _same(a: dict, b: dict) -> bool:
 # A bare env has no spec, so the checker cannot try other render modes; `made` below does.
 @pytest.mark.filterwarnings("ignore:.*alternative render modes")
 def test_check_env_passes():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     try:
         check_env(env)
     finally:
@@ -36,7 +37,7 @@ def test_check_env_passes():
 
 
 def test_reset_without_arguments_and_with_a_seed():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     try:
         obs, info = env.reset()
         assert env.observation_space.contains(obs) and env.goal is not None
@@ -51,7 +52,7 @@ def test_reset_without_arguments_and_with_a_seed():
 
 
 def test_the_numeric_observation_says_what_the_typed_one_does():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     try:
         obs, info = env.reset(seed=3, options={"goal": GOAL})
         typed = info["observation"]
@@ -66,9 +67,9 @@ def test_the_numeric_observation_says_what_the_typed_one_does():
 
 
 def test_a_sampled_action_steps_and_an_empty_slot_is_an_invalid_step():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     try:
-        env.reset(seed=0, options=ResetOptions(parse_goal(GOAL)))
+        env.reset(seed=0, options=ResetOptions(parse_goal(GOAL, world=KITCHEN)))
         env.action_space.seed(0)
         obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
         assert env.observation_space.contains(obs) and env.steps == 1
@@ -86,20 +87,20 @@ def test_a_sampled_action_steps_and_an_empty_slot_is_an_invalid_step():
 def test_actions_decode_to_the_papers_primitives():
     objects = ("cherries", "butter")
     base = {"object": 1, "target": 0, "place_bins": np.array([3, 4]), "push_bins": [5, 6]}
-    assert decode(objects, base | {"primitive": 0}) == PickParams("butter")
-    stacked = decode(objects, base | {"primitive": 1})
+    assert decode(objects, base | {"primitive": 0}, KITCHEN) == PickParams("butter")
+    stacked = decode(objects, base | {"primitive": 1}, KITCHEN)
     assert (stacked.obj, stacked.target, stacked.x_bin) == ("butter", "cherries", None)
-    shelf_a = entity_names(objects).index("shelf_a")
-    shelf = decode(objects, base | {"primitive": 1, "target": shelf_a})
+    shelf_a = entity_names(objects, world=KITCHEN).index("shelf_a")
+    shelf = decode(objects, base | {"primitive": 1, "target": shelf_a}, KITCHEN)
     assert (shelf.target, shelf.x_bin, shelf.y_bin) == ("shelf_a", 3, 4)
-    push = decode(objects, base | {"primitive": 2})
+    push = decode(objects, base | {"primitive": 2}, KITCHEN)
     assert (push.obj, push.angle_bin, push.dist_bin) == ("butter", 5, 6)
 
 
 def test_the_typed_path_of_the_agents_still_works():
-    env = KitchenStorageEnv()
+    env = KitchenStorageEnv(world=KITCHEN)
     try:
-        _, info = env.reset(seed=0, options=ResetOptions(parse_goal(GOAL)))
+        _, info = env.reset(seed=0, options=ResetOptions(parse_goal(GOAL, world=KITCHEN)))
         before = info["observation"].scene_graph
         _, _, _, _, info = env.step(PickParams("butter"))
         assert info["outcome"].ok, info["outcome"]
@@ -119,15 +120,13 @@ def test_registered_with_gymnasium():
 
 
 def test_reward_and_termination_are_what_the_observer_sees_and_the_truth_is_in_info():
-    from hsgplan.domain.objects import object_type
-    from hsgplan.domain.world import surface_rect
     from hsgplan.scene_graph.geometric import GeometricSceneGraph
     from hsgplan.scene_graph.geometry import Pose
     from hsgplan.sim.observer import Seen
 
-    top = surface_rect("shelf_a")
+    top = KITCHEN.surface_rect("shelf_a")
     on_top = ((top.x_min + top.x_max) / 2, (top.y_min + top.y_max) / 2)
-    on_top += (top.z + object_type("butter").height / 2,)
+    on_top += (top.z + KITCHEN.object_type("butter").height / 2,)
 
     class Fooled:  # sees the butter on shelf A's top, wherever it is
         name = "fooled"
@@ -139,11 +138,11 @@ def test_reward_and_termination_are_what_the_observer_sees_and_the_truth_is_in_i
             sg = scene.scene_graph()
             poses = {n.name: n.pose for n in sg.nodes}
             poses["butter"] = Pose(on_top, poses["butter"].orientation)
-            return Seen(GeometricSceneGraph.from_poses(poses, held=sg.held))
+            return Seen(GeometricSceneGraph.from_poses(poses, held=sg.held, world=KITCHEN))
 
-    env = KitchenStorageEnv(observer=Fooled())
+    env = KitchenStorageEnv(observer=Fooled(), world=KITCHEN)
     try:
-        goal = parse_goal("On(butter, shelf_a) & On(cherries, open_space)")
+        goal = parse_goal("On(butter, shelf_a) & On(cherries, open_space)", world=KITCHEN)
         env.reset(seed=4, options=ResetOptions(goal))
         _, reward, terminated, truncated, info = env.step(PickParams("alphabet_soup"))
         assert info["outcome"].status.value == "invalid"  # not in the scene: nothing moved

@@ -10,10 +10,10 @@ from typer.testing import CliRunner
 
 from hsgplan.cli import app
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.layouts import random_layout
 from hsgplan.domain.predicates import on
 from hsgplan.domain.scene_file import scene_data, to_toml
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -48,7 +48,7 @@ def test_f_m_reads_the_surfaces_of_the_graphs_world():
     assert laid_out.state.holds(on("butter", "shelf_a")) and not laid_out.anomalies
     kitchen_top = KITCHEN.shelves["shelf_a"].top
     if not kitchen_top.contains(x, y) or abs(kitchen_top.z - shelf.top.z) > 0.005:
-        in_kitchen = map_symbols(GeometricSceneGraph.from_poses({"butter": pose}))
+        in_kitchen = map_symbols(GeometricSceneGraph.from_poses({"butter": pose}, world=KITCHEN))
         assert not in_kitchen.state.holds(on("butter", "shelf_a"))
 
 
@@ -62,7 +62,9 @@ def test_an_episode_runs_in_its_goals_world_and_the_spaces_are_the_worlds():
         assert env.observation_space.contains(obs)
         assert obs["types"][0] == list(NEW.object_types).index(can) + 1
         with pytest.raises(ValueError, match="another world"):
-            env.reset(seed=4, options=ResetOptions(parse_goal("On(cherries, shelf_a)")))
+            env.reset(
+                seed=4, options=ResetOptions(parse_goal("On(cherries, shelf_a)", world=KITCHEN))
+            )
     finally:
         env.close()
 

@@ -5,6 +5,7 @@ import contextlib
 import numpy as np
 import pytest
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams, place_xy
 from hsgplan.domain.world import PLACE_BINS, PUSH_DIST_BINS
 from hsgplan.scene_graph.geometry import Pose
@@ -27,6 +28,7 @@ def scene():
             "butter": standing("butter", 0.55, -0.10),
             "tomato_soup": standing("tomato_soup", 0.305, 0.38),
         },
+        world=KITCHEN,
     )
     s.settle()
     yield s
@@ -71,7 +73,9 @@ def test_placing_where_a_neighbour_stands_fails_without_moving_anything(scene):
     bx, by, _ = scene.pose("butter").position
     bins = min(
         ((i, j) for i in range(PLACE_BINS) for j in range(PLACE_BINS)),
-        key=lambda b: np.hypot(*(np.subtract(place_xy("cherries", "open_space", *b), (bx, by)))),
+        key=lambda b: np.hypot(
+            *(np.subtract(place_xy("cherries", "open_space", *b, KITCHEN), (bx, by)))
+        ),
     )
     before = scene.poses()
     out = execute(scene, PlaceParams("cherries", "open_space", *bins))

@@ -2,6 +2,7 @@
 
 import pytest
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams, nearest_push_bins
 from hsgplan.domain.predicates import clear, in_grasp, inside, on
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -83,7 +84,7 @@ def test_pick_while_holding_is_invalid(scene):
 
 
 def test_out_of_reach_pick_fails_with_no_ik():
-    far = Scene(["butter"], seed=0, poses={"butter": standing("butter", 0.95, 0.7)})
+    far = Scene(["butter"], seed=0, poses={"butter": standing("butter", 0.95, 0.7)}, world=KITCHEN)
     try:
         out = execute(far, PickParams("butter"))
         assert out.status is Status.NO_IK, out.detail

@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.outcome import Status
@@ -30,7 +31,7 @@ def test_a_pick_runs_the_same_with_and_without_visuals():
     ends = []
     for visuals in (True, False):
         poses = {CAN: standing(CAN, 0.5, 0.05)}
-        with Scene((CAN,), seed=3, poses=poses, visuals=visuals) as scene:
+        with Scene((CAN,), seed=3, poses=poses, visuals=visuals, world=KITCHEN) as scene:
             scene.settle()
             outcome = execute(scene, PickParams(CAN))
             ends.append((outcome.status, scene.robot.q(), scene.pose(CAN).position))
@@ -39,8 +40,11 @@ def test_a_pick_runs_the_same_with_and_without_visuals():
 
 
 def test_an_env_nothing_pictures_resets_without_visuals_and_a_rendering_one_with_them():
-    goal = parse_goal("In(cherries, shelf_a)")
-    quiet, rendering = KitchenStorageEnv(visuals=False), KitchenStorageEnv(render=True)
+    goal = parse_goal("In(cherries, shelf_a)", world=KITCHEN)
+    quiet, rendering = (
+        KitchenStorageEnv(visuals=False, world=KITCHEN),
+        KitchenStorageEnv(render=True, world=KITCHEN),
+    )
     try:
         for env in (quiet, rendering):
             env.reset(seed=1, options={"goal": goal})

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.sim.env import KitchenStorageEnv, ResetOptions
@@ -13,7 +14,7 @@ OBJECTS = ("cherries", "alphabet_soup", "popcorn", "cream_cheese", "butter")
 
 
 def test_sampled_scene_is_at_rest_and_reads_back_as_drawn():
-    scene, state = sample_scene(OBJECTS, seed=3)
+    scene, state = sample_scene(OBJECTS, seed=3, world=KITCHEN)
     try:
         assert scene.at_rest()
         mapping = map_symbols(scene.scene_graph())
@@ -41,7 +42,7 @@ def test_scenes_of_many_sizes_can_be_drawn(n, seed):
         "popcorn_2",
         "butter_3",
     )
-    scene, state = sample_scene(objects[:n], seed=seed)
+    scene, state = sample_scene(objects[:n], seed=seed, world=KITCHEN)
     try:
         assert len(scene.objects) == n and state.held() is None
     finally:
@@ -49,9 +50,9 @@ def test_scenes_of_many_sizes_can_be_drawn(n, seed):
 
 
 def test_same_seed_same_scene_other_seed_other_scene():
-    a, _ = sample_scene(OBJECTS, seed=5)
-    b, _ = sample_scene(OBJECTS, seed=5)
-    c, _ = sample_scene(OBJECTS, seed=6)
+    a, _ = sample_scene(OBJECTS, seed=5, world=KITCHEN)
+    b, _ = sample_scene(OBJECTS, seed=5, world=KITCHEN)
+    c, _ = sample_scene(OBJECTS, seed=6, world=KITCHEN)
     try:
         pa, pb, pc = a.poses(), b.poses(), c.poses()
         assert all(pa[o] == pb[o] for o in OBJECTS)
@@ -62,8 +63,8 @@ def test_same_seed_same_scene_other_seed_other_scene():
 
 
 def test_env_reset_step_render():
-    env = KitchenStorageEnv(render=True)
-    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)")
+    env = KitchenStorageEnv(render=True, world=KITCHEN)
+    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)", world=KITCHEN)
     _, info = env.reset(seed=2, options=ResetOptions(goal))
     obs = info["observation"]
     try:
@@ -82,4 +83,4 @@ def test_env_reset_step_render():
 
 def test_step_before_reset_is_refused():
     with pytest.raises(RuntimeError, match="reset"):
-        KitchenStorageEnv().step(PickParams("cherries"))
+        KitchenStorageEnv(world=KITCHEN).step(PickParams("cherries"))

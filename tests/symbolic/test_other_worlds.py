@@ -13,10 +13,10 @@ from hsgplan.cli import app
 from hsgplan.domain.actions import Pick, Place, Push
 from hsgplan.domain.errors import InfeasibleError, InvalidInputError, UnknownNameError
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.layouts import random_layout
 from hsgplan.domain.predicates import on
 from hsgplan.domain.scene_file import scene_data, to_toml, world_of
-from hsgplan.domain.world import KITCHEN
 from hsgplan.paths import KITCHEN_SCENE
 from hsgplan.planning.fast_downward import FastDownwardPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -43,7 +43,7 @@ def test_a_wider_shelf_top_holds_more_in_goals_and_in_the_transition_model():
     wide = _world(_deep_shelf_a)
     assert wide.surface_capacity["shelf_a"] == 6 and KITCHEN.surface_capacity["shelf_a"] == 4
     with pytest.raises(InfeasibleError, match="holds at most 4"):
-        parse_goal(FIVE_ON_A)
+        parse_goal(FIVE_ON_A, world=KITCHEN)
     goal = parse_goal(FIVE_ON_A, world=wide)
     four = [on(o, "shelf_a") for o in ("cherries", "alphabet_soup", "tomato_soup", "popcorn")]
     objects = (*goal.objects, "cream_cheese")
@@ -64,7 +64,7 @@ def test_objects_of_a_new_scene_are_named_drawn_and_planned_for():
     new = random_layout(KITCHEN, 0, 0, new_objects=True)
     can = next(t.name for t in new.type_list if t.kind == "can")
     with pytest.raises(UnknownNameError):
-        parse_goal(f"On({can}, shelf_a)")
+        parse_goal(f"On({can}, shelf_a)", world=KITCHEN)
     assert parse_goal(f"On({can}, shelf_a)", world=new).objects == (can,)
     goals = random_goals(4, 5, seed=1, world=new)
     assert all(set(g.objects) <= set(new.object_types) for g in goals)

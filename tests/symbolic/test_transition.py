@@ -1,14 +1,15 @@
 import pytest
 
 from hsgplan.domain.actions import Pick, Place, Push, parse_action
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import clear, in_grasp, inside, on
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph as G
 from hsgplan.symbolic.transition import InapplicableActionError, applicable_actions, apply, why_not
 
 
 def state(*literals, objects=None):
-    objs = objects or sorted({o for lit in literals for o in lit.objects()})
-    return G.from_literals(objs, literals)
+    objs = objects or sorted({o for lit in literals for o in lit.objects(KITCHEN)})
+    return G.from_literals(objs, literals, world=KITCHEN)
 
 
 def test_pick_from_a_stack_frees_the_object_below():
@@ -88,4 +89,4 @@ def test_applicable_actions_are_exactly_those_that_apply():
 
 def test_parse_action_round_trip():
     for a in (Pick("butter"), Place("butter", "cherries_2"), Push("cherries", "shelf_a")):
-        assert parse_action(str(a)) == a
+        assert parse_action(str(a), world=KITCHEN) == a

@@ -3,9 +3,9 @@
 from pathlib import Path
 
 from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.scene_file import read_world
-from hsgplan.domain.world import KITCHEN
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.viz.scene_graph_drawing import draw_symbolic, fixture_x
 

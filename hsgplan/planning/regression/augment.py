@@ -21,18 +21,11 @@ import random
 from dataclasses import dataclass
 
 from hsgplan.data.demos import Demo
-from hsgplan.domain.objects import objects_for_types, type_of
+from hsgplan.domain.objects import objects_for_types
 from hsgplan.domain.predicates import Literal, Predicate, inside, on
 from hsgplan.domain.room import Room, can_carry
-from hsgplan.domain.world import (
-    GOAL_INTERIOR,
-    GOAL_SHELF_TOPS,
-    MAX_OBJECTS,
-    OBJECT_TYPES,
-    SHELVES,
-    SURFACE_CAPACITY,
-    SURFACES,
-)
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 
@@ -45,6 +38,10 @@ class Trajectory:
     extra_goal: frozenset[Literal] = frozenset()
     added: tuple[str, ...] = ()
 
+    @property
+    def world(self) -> World:
+        return self.states[0].world
+
     @staticmethod
     def of(demo: Demo) -> Trajectory:
         goal = frozenset(lit for lit in demo.goal_literals().literals if lit.positive)
@@ -53,10 +50,12 @@ class Trajectory:
 
 def _places(objects: list[str], states, rng: random.Random) -> list[Literal]:
     """Where each added object rests, unchanged through the trajectory."""
+    world = states[0].world
     # what is free in every state at once
     room = Room.left(
-        on_top={s: max(len(x.resting_on(s)) for x in states) for s in SURFACES},
-        inside={s: max(len(x.inside(s)) for x in states) for s in SHELVES},
+        on_top={s: max(len(x.resting_on(s)) for x in states) for s in world.surfaces},
+        inside={s: max(len(x.inside(s)) for x in states) for s in world.shelves},
+        world=world,
     )
     out = []
     for o in objects:
@@ -76,15 +75,17 @@ def _places(objects: list[str], states, rng: random.Random) -> list[Literal]:
     return out
 
 
-def _extra_goals(objects: list[str], goal: frozenset[Literal], rng: random.Random):
+def _extra_goals(objects: list[str], goal: frozenset[Literal], rng: random.Random, world: World):
     """Goal literals for some added objects, within the capacities the task goal leaves."""
+    tops, interior = world.goal_shelf_tops, world.goal_interior
     # An In literal on shelf A also takes a place of its top here (its last argument is the
     # shelf): stricter than needed, kept so that the copies stay as they were drawn.
     room = Room.left(
-        GOAL_SHELF_TOPS,
-        (GOAL_INTERIOR,),
-        on_top={s: sum(lit.args[-1] == s for lit in goal) for s in GOAL_SHELF_TOPS},
-        inside={GOAL_INTERIOR: sum(lit.predicate is Predicate.IN for lit in goal)},
+        tops,
+        (interior,),
+        on_top={s: sum(lit.args[-1] == s for lit in goal) for s in tops},
+        inside={interior: sum(lit.predicate is Predicate.IN for lit in goal)},
+        world=world,
     )
     out = []
     for o in objects:
@@ -96,7 +97,7 @@ def _extra_goals(objects: list[str], goal: frozenset[Literal], rng: random.Rando
         lit = rng.choice(options)
         out.append(lit)
         if lit.predicate is Predicate.IN:
-            room.put_inside(o, GOAL_INTERIOR)
+            room.put_inside(o, interior)
         else:
             room.put_on(o, lit.args[1])
     return frozenset(out)
@@ -104,20 +105,21 @@ def _extra_goals(objects: list[str], goal: frozenset[Literal], rng: random.Rando
 
 def with_distractors(traj: Trajectory, extra: int, rng: random.Random) -> Trajectory:
     """A copy of the trajectory with `extra` added objects (fewer if the scene would overflow)."""
-    objects = traj.states[0].objects
+    objects, world = traj.states[0].objects, traj.world
     extra = min(extra, MAX_OBJECTS - len(objects))
-    types = [type_of(o) for o in objects] + rng.choices(list(OBJECT_TYPES), k=extra)
-    added = list(objects_for_types(types)[len(objects) :])
+    types = [world.type_of(o) for o in objects] + rng.choices(list(world.object_types), k=extra)
+    added = list(objects_for_types(types, world)[len(objects) :])
     rng.shuffle(added)
     places = _places(added, traj.states, rng)
     states = tuple(
         SymbolicSceneGraph.from_literals(
             objects + tuple(added),
             [lit for lit in s.literals if lit.predicate is not Predicate.CLEAR] + places,
+            world=world,
         )
         for s in traj.states
     )
-    return Trajectory(states, traj.goal, _extra_goals(added, traj.goal, rng), tuple(added))
+    return Trajectory(states, traj.goal, _extra_goals(added, traj.goal, rng, world), tuple(added))
 
 
 def varied(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
@@ -146,7 +148,7 @@ def _moved(state: SymbolicSceneGraph, o: str, where: Literal) -> SymbolicSceneGr
     placements = [
         lit for lit in state.literals if lit.predicate is not Predicate.CLEAR and lit.subject != o
     ]
-    return SymbolicSceneGraph.from_literals(state.objects, placements + [where])
+    return SymbolicSceneGraph.from_literals(state.objects, placements + [where], world=state.world)
 
 
 def relocating_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random):
@@ -157,17 +159,23 @@ def relocating_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Rand
         for o in state.objects
         if o not in traj.added
         and state.holds(Literal(Predicate.CLEAR, (o,)))
-        and state.location(o).args[-1] in SURFACES
+        and state.location(o).args[-1] in state.world.surfaces
     ]
     if not movable:
         return None
     o = rng.choice(movable)
     here = state.location(o).args[-1]
-    options = [s for s in SURFACES if s != here and len(state.resting_on(s)) < SURFACE_CAPACITY[s]]
+    world = state.world
+    options = [
+        s
+        for s in world.surfaces
+        if s != here and len(state.resting_on(s)) < world.surface_capacity[s]
+    ]
     options += [
         b
         for b in traj.added
-        if state.holds(Literal(Predicate.CLEAR, (b,))) and can_carry(type_of(b), state.level(b))
+        if state.holds(Literal(Predicate.CLEAR, (b,)))
+        and can_carry(state.world.type_of(b), state.level(b), state.world)
     ]
     if not options:
         return None
@@ -181,7 +189,8 @@ def covering_one(traj: Trajectory, state: SymbolicSceneGraph, rng: random.Random
     bases = [
         b
         for b in demo
-        if state.holds(Literal(Predicate.CLEAR, (b,))) and can_carry(type_of(b), state.level(b))
+        if state.holds(Literal(Predicate.CLEAR, (b,)))
+        and can_carry(state.world.type_of(b), state.level(b), state.world)
     ]
     tops = [
         o

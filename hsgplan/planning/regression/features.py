@@ -17,9 +17,9 @@ from functools import cache
 
 import torch
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import PREDICATES, Predicate
 from hsgplan.domain.scene import EntityKind, Kind, World, check_features
-from hsgplan.domain.world import KITCHEN
 
 KINDS = tuple(EntityKind)
 OBJECT_KINDS = tuple(Kind)

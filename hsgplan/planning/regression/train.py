@@ -25,7 +25,7 @@ from hsgplan.checkpoint import fingerprint
 from hsgplan.data.world_trials import load_world_trials
 from hsgplan.domain.checks import BOUNDS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.world import KITCHEN
+from hsgplan.domain.scene import World
 from hsgplan.files import write_atomically
 from hsgplan.paths import DEMOS, REACH_DATA, shipped
 from hsgplan.planning.regression.augment import trajectories
@@ -101,7 +101,9 @@ class TaskTrainConfig:
         return from_settings(TaskTrainConfig, d)
 
 
-def _examples(name: str, demos, trajs, config: TaskTrainConfig) -> dict[str, list[Example]]:
+def _examples(
+    name: str, demos, trajs, config: TaskTrainConfig, world: World
+) -> dict[str, list[Example]]:
     """A network's training examples by where their labels come from."""
     n = len(demos)  # the demonstrations come first, then copy after copy
     if name == "reach":
@@ -117,7 +119,7 @@ def _examples(name: str, demos, trajs, config: TaskTrainConfig) -> dict[str, lis
                     demos, config.seed, config.reach_singles
                 )
             }
-        trials = load_world_trials(shipped(config.world_trials))
+        trials = load_world_trials(shipped(config.world_trials), world)
         return {
             "primitives executed in the simulated world": world_reach_examples(trials, []),
             "demonstrated changes": world_reach_examples([], demos),
@@ -148,12 +150,15 @@ def train_task(
     config: TaskTrainConfig,
     out: Path,
     on_epoch: Callable[[str, int, float], None] | None = None,
+    *,
+    world: World,
 ) -> None:
-    """Train (or go on training) the three networks into the checkpoint folder `out`; each
-    network's folder gets `labels.json`, its label counts by source."""
+    """Train (or go on training) the three networks into the checkpoint folder `out` on the
+    demonstrations (and executed primitives) recorded in `world`; each network's folder gets
+    `labels.json`, its label counts by source."""
     from hsgplan.data.demos import load_demos
 
-    demos = load_demos(Path(config.demos))
+    demos = load_demos(Path(config.demos), world)
     if config.demo_limit is not None:
         if config.demo_limit > len(demos):
             raise InvalidInputError(
@@ -170,16 +175,23 @@ def train_task(
     for name, classes in NETWORKS.items():
         if training.finished(out / name):
             continue  # finished earlier
-        by_source = _examples(name, demos, trajs, config)
+        by_source = _examples(name, demos, trajs, config, world)
         (out / name).mkdir(exist_ok=True)
         counts = {source: label_counts(ex) for source, ex in by_source.items()}
         write_atomically(out / name / "labels.json", json.dumps(counts, indent=2) + "\n")
         examples = [e for ex in by_source.values() for e in ex]
-        _train_one(name, classes, examples, config, out / name, on_epoch, data)
+        _train_one(name, classes, examples, config, out / name, on_epoch, data, world)
 
 
 def _train_one(
-    name, classes, examples, config: TaskTrainConfig, folder: Path, on_epoch, data: str
+    name,
+    classes,
+    examples,
+    config: TaskTrainConfig,
+    folder: Path,
+    on_epoch,
+    data: str,
+    world: World,
 ) -> None:
     folder.mkdir(exist_ok=True)
     if training.finished(folder):
@@ -198,7 +210,7 @@ def _train_one(
     model = EdgeClassifier(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start = training.resume(folder, model, optim, data)
-    graphs = [with_features(e.as_data(), KITCHEN, config.features) for e in examples]
+    graphs = [with_features(e.as_data(), world, config.features) for e in examples]
     epochs = config.reach_epochs if name == "reach" and config.reach_epochs else config.epochs
     for epoch in range(start, epochs):
         rng = random.Random(f"{config.seed}-{name}-{epoch}")

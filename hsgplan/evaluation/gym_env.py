@@ -1,0 +1,11 @@
+"""`gymnasium.make("hsgplan/KitchenStorage-v0")`'s entry point: the env in the kitchen unless
+a `world` is given. The sim layer takes its world; the default is resolved here, above it."""
+
+from __future__ import annotations
+
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.sim.env import KitchenStorageEnv
+
+
+def kitchen_storage_env(**kwargs) -> KitchenStorageEnv:
+    return KitchenStorageEnv(**({"world": KITCHEN} | kwargs))
