@@ -66,13 +66,15 @@ def _sampler(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
     return GeometricSampler()
 
 
-def _learned(model: str) -> Callable[[Path, RecoveryRules], MotionGenerator]:
+def _learned(
+    model: str, place_for_push: bool = False
+) -> Callable[[Path, RecoveryRules], MotionGenerator]:
     def make(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
         from hsgplan.domain.parameters import MotionPrimitive
         from hsgplan.motion.generator import LearnedMotion
 
         folders = {kind: checkpoints / f"{kind.value}-{model}" for kind in MotionPrimitive}
-        return LearnedMotion(model, folders, rules)
+        return LearnedMotion(model, folders, rules, place_for_push)
 
     return make
 
@@ -88,6 +90,8 @@ def _random(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
 MOTION_GENERATORS: dict[str, Callable[[Path, RecoveryRules], MotionGenerator]] = {
     "sampler": _sampler,
     "gnn": _learned("gnn"),
+    # the same GNNs; a place before a push asks the push network where to put the object
+    "gnn-next": _learned("gnn", place_for_push=True),
     "mlp": _learned("mlp"),
     "random": _random,
 }
@@ -165,7 +169,8 @@ def agent_parts(name: str) -> tuple[str, str]:
 
 
 LEARNED_PLANNERS = ("regression", "regression-paper", "forward")
-LEARNED_MOTION = ("gnn", "mlp")
+# learned motion generator -> the model whose networks it reads (`KIND-MODEL` folders)
+LEARNED_MOTION = {"gnn": "gnn", "gnn-next": "gnn", "mlp": "mlp"}
 
 
 def agent_checkpoints(
@@ -179,7 +184,8 @@ def agent_checkpoints(
     if motion in LEARNED_MOTION:
         from hsgplan.domain.parameters import MotionPrimitive
 
-        folders += [motion_checkpoints / f"{kind.value}-{motion}" for kind in MotionPrimitive]
+        model = LEARNED_MOTION[motion]
+        folders += [motion_checkpoints / f"{kind.value}-{model}" for kind in MotionPrimitive]
     return folders
 
 

@@ -3,6 +3,7 @@ and a network stand-in with fixed scores: no checkpoint, no physics."""
 
 from collections import Counter
 
+import pytest
 import torch
 
 from hsgplan.domain.actions import Pick, Place, Push
@@ -137,3 +138,73 @@ def test_without_the_recovery_rules_a_generator_neither_remembers_nor_gives_up()
         push = random_motion.propose(standing, Push(can, "shelf_a"))
         assert isinstance(push, PushParams)
         random_motion.observe(push, Outcome(Status.NO_PATH, "", 0.0))
+
+
+class _PushStandIn:
+    """A push network's stand-in: the k-th scene it is shown rates its best push `best[k]`;
+    it keeps the scenes it saw."""
+
+    class config:
+        features = "names"
+
+    def __init__(self, best: list[float]) -> None:
+        self.best, self.seen = best, []
+
+    def __call__(self, batch) -> torch.Tensor:
+        self.seen.append(batch)
+        return torch.tensor([[v, v - 1.0] for v in self.best[: batch.num_graphs]])
+
+
+def _can_held(place_for_push: bool, push_best: list[float]) -> tuple[LearnedMotion, _PushStandIn]:
+    # sigmoid(3.0) and sigmoid(2.95) are 0.0023 apart, sigmoid(0.0) is 0.45 below: two candidates
+    gen = _FixedScores(_logits(b_0_0=3.0, b_0_8=2.95, b_5_5=0.0))
+    gen.place_for_push, gen._success = place_for_push, {}
+    gen.nets = {MotionPrimitive.PUSH: _PushStandIn(push_best)}
+    return gen, gen.nets[MotionPrimitive.PUSH]
+
+
+def _can_scene() -> GeometricSceneGraph:
+    poses = {
+        "cherries": Pose.from_xyz_yaw(0.42, 0.05, KITCHEN.object_type("cherries").height / 2),
+        "tomato_soup": Pose.from_xyz_yaw(0.0, 0.0, 0.3),
+    }
+    return GeometricSceneGraph.from_poses(poses, held="tomato_soup", world=KITCHEN)
+
+
+def test_a_place_before_a_push_takes_of_its_likeliest_bins_the_one_the_push_network_rates_best():
+    place, push = Place("tomato_soup", "prepush_a"), Push("tomato_soup", "shelf_a")
+    gen, net = _can_held(True, push_best=[0.1, 0.9])
+    chosen = gen.propose(_can_scene(), place, following=push)
+    assert chosen == PlaceParams("tomato_soup", "prepush_a", 0, 8)
+    (batch,) = net.seen  # one batch: the two bins within the margin, (5, 5) left out
+    assert batch.num_graphs == 2
+
+
+def test_a_place_asks_the_push_network_only_before_its_own_push_and_only_when_told_to():
+    place, push = Place("tomato_soup", "prepush_a"), Push("tomato_soup", "shelf_a")
+    best = PlaceParams("tomato_soup", "prepush_a", 0, 0)
+    off, off_net = _can_held(False, push_best=[0.1, 0.9])
+    assert off.propose(_can_scene(), place, following=push) == best and not off_net.seen
+    on, on_net = _can_held(True, push_best=[0.1, 0.9])
+    assert on.propose(_can_scene(), place, following=None) == best
+    assert on.propose(_can_scene(), place, following=Push("cherries", "shelf_a")) == best
+    assert not on_net.seen
+    # equal pushes keep the place network's order
+    tie, _ = _can_held(True, push_best=[0.5, 0.5])
+    assert tie.propose(_can_scene(), place, following=push) == best
+
+
+def test_the_scene_after_a_place_has_the_object_set_down_at_the_bins_centre():
+    from hsgplan.domain.parameters import place_xy
+    from hsgplan.motion.generator import placed_at
+
+    params = PlaceParams("tomato_soup", "prepush_a", 3, 7)
+    after = placed_at(_can_scene(), params)
+    assert after.held is None
+    pose = next(n.pose for n in after.nodes if n.name == "tomato_soup").position
+    x, y = place_xy("tomato_soup", "prepush_a", 3, 7, KITCHEN)
+    z = KITCHEN.surface_rect("prepush_a").z + KITCHEN.object_type("tomato_soup").height / 2
+    assert pose == pytest.approx((x, y, z))
+    assert next(n.pose for n in after.nodes if n.name == "cherries") == next(
+        n.pose for n in _can_scene().nodes if n.name == "cherries"
+    )
