@@ -115,6 +115,7 @@ def demo(
     from hsgplan.domain.goals import parse_goal
     from hsgplan.domain.kitchen import KITCHEN
     from hsgplan.domain.scene_file import read_world
+    from hsgplan.evaluation.config import check_seen
     from hsgplan.evaluation.demo import demo_goal, run_demo
     from hsgplan.evaluation.observers import make_observer
     from hsgplan.evaluation.protocol import check_agent_world
@@ -127,6 +128,7 @@ def demo(
         shipped(motion_checkpoints) if motion_checkpoints else MOTION_CHECKPOINTS,
     )
     check_agent_world(agent, world, scene, *folders)
+    check_seen(perception.value, [world], scene)
     made = make_agent(agent, *folders)  # an unknown name or a missing checkpoint: before work
     observer = make_observer(
         perception.value, perception_checkpoint and shipped(perception_checkpoint)

@@ -4,6 +4,7 @@ line takes its options' defaults from here."""
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -23,6 +24,16 @@ OBSERVERS = ("gt", "rgb")
 def check_observer(name: str) -> None:
     if name not in OBSERVERS:
         raise InvalidInputError(f"--perception '{name}': one of {', '.join(OBSERVERS)}")
+
+
+def check_seen(perception: str, worlds: Iterable[World], scene: str | Path | None) -> None:
+    """Refuse f_p in a scene other than the kitchen, in one line: its network knows the
+    kitchen's six looks, and it places what it sees by the kitchen's cameras and fixtures."""
+    if perception == "rgb" and any(w != KITCHEN for w in worlds):
+        raise InvalidInputError(
+            f"--perception rgb: f_p knows the kitchen's objects, cameras and fixtures alone, "
+            f"not those of scene '{scene}'; see it with --perception gt"
+        )
 
 
 # the tables of an `eval world` run (`table1.tables`), in their order
@@ -54,7 +65,7 @@ class EvalConfig:
         if self.protocol == PAPER and self.rules_off:
             raise InvalidInputError("the paper protocol has no recovery rule to switch off")
         self.rules()  # an unknown rule's name is refused here
-        self.worlds()  # a bad scene file, too
+        check_seen(self.perception, self.worlds().values(), self.scene)  # a bad scene, too
 
     def worlds(self) -> dict[str | None, World]:
         """The worlds its episodes run in, by scene file ({None: the kitchen} without one)."""

@@ -14,6 +14,7 @@ from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.layouts import random_layout
 from hsgplan.domain.predicates import on
 from hsgplan.domain.scene_file import scene_data, to_toml
+from hsgplan.paths import KITCHEN_SCENE
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -84,6 +85,26 @@ def test_an_agent_with_learned_parts_is_refused_a_world_of_other_names(tmp_path)
         assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
         assert "know the kitchen's objects" in r.output
     assert not (tmp_path / "d").exists()
+
+
+def test_f_p_is_refused_a_scene_other_than_the_kitchen_and_the_kitchens_file_is_the_kitchen(
+    tmp_path,
+):
+    from hsgplan.evaluation.config import EvalConfig
+
+    scene = tmp_path / "layout.toml"
+    scene.write_text(to_toml(scene_data(LAYOUT)))
+    evaluation = ["eval", "world", "--agent", "oracle", "--sizes", "2", "--goals", "1"]
+    for args in (
+        ["demo", "--agent", "oracle", "--perception", "rgb", "--out", str(tmp_path / "d")],
+        [*evaluation, "--perception", "gt,rgb", "--out", str(tmp_path / "e")],
+    ):
+        r = runner.invoke(app, [*args, "--scene", str(scene)])
+        assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
+        assert "f_p knows the kitchen's" in r.output
+    assert not (tmp_path / "d").exists() and not (tmp_path / "e").exists()
+    kitchen = EvalConfig("oracle", (2,), 1, 0, perception="rgb", scene=str(KITCHEN_SCENE))
+    assert list(kitchen.worlds().values()) == [KITCHEN]
 
 
 @pytest.mark.slow
