@@ -86,10 +86,12 @@ def compare_task(runs: Sequence[Path], names: Sequence[str]) -> TextTable:
         (name, *(_task_cell(s.get(str(n))) for n in sizes))
         for name, s in zip(names, summaries, strict=True)
     ]
-    title = (
-        f"Success rate / subgoal completion in the symbolic loop by run ({protocol}): "
-        f"{per_size} goals per size"
-    )
+    # a folder of scenes runs the same goals in each, its episodes keyed by scene first
+    scenes = {str(row["key"]).split("/", 1)[0] for row in logged_rows(runs[0])}
+    source = f"{per_size} goals per size"
+    if len(scenes) > 1 and not any(k.isdigit() for k in scenes):
+        source = f"{per_size // len(scenes)} goals per size in each of {len(scenes)} scenes"
+    title = f"Success rate / subgoal completion in the symbolic loop by run ({protocol}): {source}"
     return TextTable(title, ("run", *(f"{n} objects" for n in sizes)), tuple(rows))
 
 

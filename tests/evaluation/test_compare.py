@@ -82,17 +82,19 @@ def test_a_missing_method_or_a_name_short_is_one_line_exit_2(tmp_path):
     assert r.exit_code == 0 and "| a | 1.00 / " in r.stdout
 
 
-def _task_run(folder, successes, protocol="paper", seeds=(1, 2)):
+def _task_run(folder, successes, protocol="paper", seeds=(1, 2), scenes=("",)):
     from hsgplan.evaluation.task_eval import TaskEpisode
 
     folder.mkdir()
     config = {"kind": "eval-task", "planner": "regression", "checkpoint": "c"}
     (folder / "config.json").write_text(json.dumps(config | {"protocol": protocol}))
     lines = []
-    for seed, ok in zip(seeds, successes, strict=True):
-        goal = "On(cherries, shelf_a) & On(butter, shelf_b)"
-        episode = TaskEpisode(2, seed, goal, ok, None if ok else "no_subgoal", 3, 3, 1.0, (1.0,))
-        lines.append(json.dumps({"key": f"{seed}/{goal}", "result": asdict(episode)}))
+    for scene in scenes:  # a folder of scenes keys its episodes by scene first
+        for seed, ok in zip(seeds, successes, strict=True):
+            goal = "On(cherries, shelf_a) & On(butter, shelf_b)"
+            ep = TaskEpisode(2, seed, goal, ok, None if ok else "no_subgoal", 3, 3, 1.0, (1.0,))
+            key = f"{scene}/{seed}/{goal}" if scene else f"{seed}/{goal}"
+            lines.append(json.dumps({"key": key, "result": asdict(ep)}))
     (folder / "episodes.jsonl").write_text("\n".join(lines) + "\n")
     return folder
 
@@ -104,7 +106,9 @@ def test_task_runs_are_compared_on_the_same_episodes(tmp_path):
     assert all_task_runs([a, b])
     table = compare_task([a, b], ["theirs", "ours"])
     assert [row[1].split(" / ")[0] for row in table.rows] == ["0.50", "1.00"]
-    assert "paper protocol" in table.title
+    assert "paper protocol" in table.title and table.title.endswith(": 2 goals per size")
+    folders = [_task_run(tmp_path / n, (True, True), scenes=("s1", "s2", "s3")) for n in "ef"]
+    assert compare_task(folders, ["e", "f"]).title.endswith("2 goals per size in each of 3 scenes")
     other = _task_run(tmp_path / "c", (True, True), seeds=(1, 3))
     with pytest.raises(InvalidInputError, match="differ in episodes"):
         compare_task([a, other], ["a", "c"])

@@ -88,19 +88,6 @@ def test_evaluation_resumes_without_repeating_work(tmp_path):
     assert [r.goal for r in second] == [s.goal for s in episode_specs(config)]
 
 
-def test_eval_cli_json_shape(tmp_path):
-    r = CliRunner().invoke(
-        app,
-        [*["eval", "world", "--agent", "oracle", "--sizes", "2", "--goals", "1", "--json"]]
-        + ["--out", str(tmp_path / "run")],
-    )
-    assert r.exit_code == 0, r.output
-    report = json.loads(r.stdout)
-    entry = report["methods"]["oracle"]["by_size"]["2"]
-    assert set(entry) >= {"success_rate", "subgoal_completion", "episodes"}
-    assert entry["episodes"] == 1
-
-
 @pytest.mark.slow
 def test_demo_writes_pictures_and_a_record(tmp_path):
     out = tmp_path / "demo"
@@ -121,7 +108,7 @@ def test_demo_writes_pictures_and_a_record(tmp_path):
 
 
 @pytest.mark.slow
-def test_json_output_of_the_real_command_is_pure_json(tmp_path):
+def test_json_output_of_the_real_command_is_pure_json_of_the_reports_shape(tmp_path):
     # PyBullet's C code prints to the process's stdout; only a real process shows it.
     import subprocess
     import sys
@@ -149,7 +136,9 @@ def test_json_output_of_the_real_command_is_pure_json(tmp_path):
         text=True,
         check=True,
     )
-    assert json.loads(result.stdout)["methods"]["oracle"]["by_size"]["2"]["episodes"] == 1
+    entry = json.loads(result.stdout)["methods"]["oracle"]["by_size"]["2"]
+    assert set(entry) >= {"success_rate", "subgoal_completion", "episodes"}
+    assert entry["episodes"] == 1
 
 
 def test_the_shipped_task_checkpoint_closes_the_loop_in_the_simulated_world():

@@ -229,16 +229,16 @@ def data_loss_cases() -> list[Case]:
     return [
         case(
             "collect place",
-            "default --out over the shipped dataset (--samples 20)",
-            "collect place --samples 20 --workers 1 --tasks-per-chunk 4",
+            "default --out over the shipped dataset (--samples 4)",
+            "collect place --samples 4 --workers 1 --tasks-per-chunk 4",
             *home,
             own_home=True,
             keep=SHIPPED,
         ),
         case(
             "collect push",
-            "default --out over the shipped dataset (--samples 20)",
-            "collect push --samples 20 --workers 1 --tasks-per-chunk 4",
+            "default --out over the shipped dataset (--samples 4)",
+            "collect push --samples 4 --workers 1 --tasks-per-chunk 4",
             *home,
             own_home=True,
             keep=SHIPPED,
