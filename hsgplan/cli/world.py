@@ -409,7 +409,10 @@ def compare(
         str | None,
         typer.Option(help="The rows' names, comma-separated (default: the folders' names)."),
     ] = None,
-    method: Annotated[str, typer.Option(help="The column compared (gnn, mlp, ...).")] = "gnn",
+    method: Annotated[
+        str,
+        typer.Option(help="The column compared (gnn, mlp, ...), or one per run, comma-separated."),
+    ] = "gnn",
     markdown: MarkdownFlag = False,
 ) -> None:
     """One method's success per size across eval world runs, one row each: a ladder from one
@@ -423,5 +426,5 @@ def compare(
     if all_task_runs(runs):
         t = compare_task(runs, row_names)
     else:
-        t = compare_runs(runs, row_names, method)
+        t = compare_runs(runs, row_names, [m.strip() for m in method.split(",")])
     print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

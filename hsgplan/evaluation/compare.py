@@ -20,20 +20,33 @@ from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable, cell, label, prot
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 
 # what rows must share; the checkpoints are what a ladder's rows change
-LIKE_FOR_LIKE = ("protocol", "rules_off", "goals", "goals_file", "repeats", "seed", "sizes")
+LIKE_FOR_LIKE = (
+    "protocol",
+    "rules_off",
+    "goals",
+    "goals_file",
+    "repeats",
+    "seed",
+    "sizes",
+    "scene",
+)
 
 
-def compare(runs: Sequence[Path], names: Sequence[str], method: str) -> TextTable:
-    """One row per run folder (`names[i]` for `runs[i]`): `method`'s success rate and subgoal
-    completion per size, and the paper's row where it reports `method`.
+def compare(runs: Sequence[Path], names: Sequence[str], methods: Sequence[str]) -> TextTable:
+    """One row per run folder (`names[i]` for `runs[i]`): its method's success rate and subgoal
+    completion per size (`methods`: one for every run, or one per run), and the paper's row
+    where it reports the one method compared.
 
-    Raises InvalidInputError for a folder that is no finished eval world run, one without
-    `method`, or runs that are not like for like (the first setting that differs is named)."""
+    Raises InvalidInputError for a folder that is no finished eval world run, one without its
+    method, or runs that are not like for like (the first setting that differs is named)."""
     if len(names) != len(runs):
         raise InvalidInputError(f"{len(runs)} runs and {len(names)} names: name each run once")
+    if len(methods) not in (1, len(runs)):
+        raise InvalidInputError(f"{len(runs)} runs and {len(methods)} methods: one, or one per run")
+    methods = list(methods) * len(runs) if len(methods) == 1 else list(methods)
     summaries = [read_summary(run) for run in runs]
     settings = [_settings(run) for run in runs]
-    for run, summary, s in zip(runs, summaries, settings, strict=True):
+    for run, summary, s, method in zip(runs, summaries, settings, methods, strict=True):
         if method not in summary["methods"]:
             known = ", ".join(summary["methods"])
             raise InvalidInputError(f"'{run}' holds no method '{method}' (it holds {known})")
@@ -43,19 +56,23 @@ def compare(runs: Sequence[Path], names: Sequence[str], method: str) -> TextTabl
                     f"'{run}' and '{runs[0]}' differ in {key} ({s.get(key)} against "
                     f"{settings[0].get(key)}): a comparison's rows must be like for like"
                 )
-    sizes = sorted({int(n) for s in summaries for n in s["methods"][method]["by_size"]})
+    by_run = [s["methods"][m]["by_size"] for s, m in zip(summaries, methods, strict=True)]
+    sizes = sorted({int(n) for by_size in by_run for n in by_size})
     rows = []
-    for name, summary in zip(names, summaries, strict=True):
-        by_size = summary["methods"][method]["by_size"]
+    for name, by_size in zip(names, by_run, strict=True):
         rows.append((name, *(cell(by_size[str(n)]) if str(n) in by_size else "—" for n in sizes)))
-    if paper := PAPER_TABLE1.get(method):
+    one = len(set(methods)) == 1
+    method = methods[0] if one else ""
+    if one and (paper := PAPER_TABLE1.get(method)):
         cells = (f"{paper[n][0]:.2f} / {paper[n][1]:.2f}" if n in paper else "—" for n in sizes)
         rows.append((f"{label(method)} (paper)", *cells))
     first = summaries[0]
     source = first["goals_file"] or f"{first['goals']} random goals per size"
     repeats = "each run once" if first["repeats"] == 1 else f"each run {first['repeats']} times"
+    what = label(method) if one else "each run's method"
     title = (
-        f"Success rate / subgoal completion of {label(method)} by run ({protocol_name(first)}): "
+        f"Success rate / subgoal completion of {what} "
+        f"by run ({protocol_name(first)}): "
         f"{source}, {repeats}, seed {first['seed']}"
     )
     header = ("run", *(f"{n} objects" for n in sizes))

@@ -23,19 +23,19 @@ def _record(seed: int, size: int, success: bool) -> EpisodeRecord:
     )
 
 
-def _run(folder, wins: dict[int, tuple[bool, ...]], seed=0, protocol="paper", motion="m"):
-    """A finished table folder whose `gnn` column won `wins[size]`."""
+def _run(folder, wins, seed=0, protocol="paper", motion="m", method="gnn", scene=None):
+    """A finished table folder whose `method` column won `wins[size]`."""
     folder.mkdir(parents=True)
     records = [_record(k, n, won) for n, outcomes in wins.items() for k, won in enumerate(outcomes)]
     settings = {"kind": "eval-table", "goals": len(next(iter(wins.values()))), "seed": seed}
     settings |= {"protocol": protocol, "rules_off": [], "repeats": 1, "goals_file": None}
-    settings |= {"sizes": sorted(wins), "motion_checkpoints": motion}
+    settings |= {"sizes": sorted(wins), "motion_checkpoints": motion, "scene": scene}
     (folder / CONFIG).write_text(json.dumps(settings))
     summary = {
         "protocol": protocol,
         "rules_off": [],
         "methods": {
-            "gnn": {"agent": "learned", "wall_seconds": 1.0, "sittings": []} | summarize(records)
+            method: {"agent": "learned", "wall_seconds": 1.0, "sittings": []} | summarize(records)
         },
         "goals": settings["goals"],
         "goals_file": None,
@@ -50,7 +50,7 @@ def _run(folder, wins: dict[int, tuple[bool, ...]], seed=0, protocol="paper", mo
 def test_each_run_is_a_row_of_its_success_per_size_and_the_paper_is_the_last(tmp_path):
     a = _run(tmp_path / "a", {2: (True, False), 3: (False, False)}, motion="ladder/a")
     b = _run(tmp_path / "b", {2: (True, True), 3: (True, False)}, motion="ladder/b")
-    table = compare([a, b], ["theirs", "ours"], "gnn")
+    table = compare([a, b], ["theirs", "ours"], ["gnn"])
     assert table.header == ("run", "2 objects", "3 objects")
     assert [r[0] for r in table.rows] == ["theirs", "ours", "GNN (paper)"]
     assert table.rows[0][1].startswith("0.50") and table.rows[1][1].startswith("1.00")
@@ -63,19 +63,32 @@ def test_each_run_is_a_row_of_its_success_per_size_and_the_paper_is_the_last(tmp
     [
         ({"seed": 1}, "differ in seed"),
         ({"protocol": "recovering"}, "differ in protocol"),
+        ({"scene": "scenes/layouts"}, "differ in scene"),
     ],
 )
 def test_runs_that_are_not_like_for_like_are_refused(tmp_path, other, says):
     a = _run(tmp_path / "a", {2: (True,)})
     b = _run(tmp_path / "b", {2: (True,)}, **other)
     with pytest.raises(InvalidInputError, match=says):
-        compare([a, b], ["a", "b"], "gnn")
+        compare([a, b], ["a", "b"], ["gnn"])
+
+
+def test_each_run_may_name_its_own_method_and_then_no_paper_row_is_set_beside(tmp_path):
+    a = _run(tmp_path / "a", {2: (True, False)})
+    b = _run(tmp_path / "b", {2: (True, True)}, method="gnn-next")
+    table = compare([a, b], ["gnn", "gnn-next"], ["gnn", "gnn-next"])
+    assert [r[:2] for r in table.rows] == [("gnn", "0.50 / 0.50"), ("gnn-next", "1.00 / 0.50")]
+    assert "each run's method" in table.title
+    with pytest.raises(InvalidInputError, match="one, or one per run"):
+        compare([a, b], ["a", "b"], ["gnn", "gnn", "gnn"])
+    r = CliRunner().invoke(app, ["eval", "compare", str(a), str(b), "--method", "gnn,gnn-next"])
+    assert r.exit_code == 0 and "1.00 / 0.50" in r.stdout
 
 
 def test_a_missing_method_or_a_name_short_is_one_line_exit_2(tmp_path):
     a = _run(tmp_path / "a", {2: (True,)})
     with pytest.raises(InvalidInputError, match="holds no method 'mlp'"):
-        compare([a], ["a"], "mlp")
+        compare([a], ["a"], ["mlp"])
     r = CliRunner().invoke(app, ["eval", "compare", str(a), str(a), "--names", "x"])
     assert r.exit_code == 2 and "2 runs and 1 names" in r.stderr
     r = CliRunner().invoke(app, ["eval", "compare", str(a), "--markdown"])
