@@ -16,7 +16,7 @@ from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.report import read_summary
 from hsgplan.evaluation.seeds import marked
-from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable, cell, label, protocol_name
+from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable, cell, label, protocol_name, where
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 
 # what rows must share; the checkpoints are what a ladder's rows change
@@ -73,7 +73,7 @@ def compare(runs: Sequence[Path], names: Sequence[str], methods: Sequence[str]) 
     title = (
         f"Success rate / subgoal completion of {what} "
         f"by run ({protocol_name(first)}): "
-        f"{source}, {repeats}, seed {first['seed']}"
+        f"{source}, {repeats}, seed {first['seed']}{where(first)}"
     )
     header = ("run", *(f"{n} objects" for n in sizes))
     return TextTable(marked(title, first["seed"]), header, tuple(rows))

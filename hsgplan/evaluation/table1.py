@@ -46,6 +46,14 @@ TABLE_KIND = "eval-table"
 COUNTED = ("failed_primitives", "overstep_after_failures")  # a failure table's last columns
 
 
+def where(report: dict) -> str:
+    """Where a run's episodes ran, for a title: "" in the kitchen without a scene file."""
+    scenes = report.get("scenes", [])
+    if len(scenes) > 1:
+        return f", in each of {len(scenes)} scene files"
+    return f", in {scenes[0]}" if scenes else ""
+
+
 def label(method: str) -> str:
     base, seen, observer = method.rpartition("-")
     if seen and observer == "rgb":  # a column seeing with f_p (`--perception rgb`)
@@ -217,14 +225,9 @@ def _results(report: dict) -> TextTable:
         if report["repeats"] > 1
         else ", each run once"
     )
-    scenes = report.get("scenes", [])
-    where = (
-        f", in each of {len(scenes)} scene files" if len(scenes) > 1 else
-        f", in {scenes[0]}" if scenes else ""
-    )  # fmt: skip
     title = (
         f"Success rate / subgoal completion ({protocol_name(report)}): {source}{repeats}, "
-        f"seed {report['seed']}{where}"
+        f"seed {report['seed']}{where(report)}"
     )
     if unsampled := _unsampled(report):
         title += (
