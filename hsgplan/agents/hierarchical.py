@@ -24,7 +24,7 @@ class HierarchicalAgent:
     """Args:
     name: what episodes record as the agent.
     planner: the task level (`hsgplan.planning.base.TaskPlanner`).
-    motion: the motion level (`hsgplan.motion.generator.MotionGenerator`).
+    motion: the motion level (`hsgplan.motion.interface.MotionGenerator`).
     rules: the recovery rules in force (`hsgplan.domain.recovery`); this class applies the
         task half of `push_give_up` (a push with no parameters becomes a pick).
     """

@@ -415,16 +415,19 @@ def compare(
     ] = "gnn",
     markdown: MarkdownFlag = False,
 ) -> None:
-    """One method's success per size across eval world runs, one row each: a ladder from one
+    """A method's success per size across eval world runs, one row each: a ladder from one
     recipe to another, one change per row. The runs must be like for like (protocol, goals,
-    repeats, seed, sizes); only their checkpoints may differ. Eval task runs (the symbolic
-    loop) are compared the same way, on the same episodes."""
+    repeats, seed, sizes, scene); only their checkpoints, and the method when one is named per
+    run, may differ. Eval task runs (the symbolic loop) are compared the same way, on the same
+    episodes."""
     from hsgplan.evaluation.compare import all_task_runs, compare_task
     from hsgplan.evaluation.compare import compare as compare_runs
 
-    row_names = _names(names, "--names", "run") if names else tuple(r.name for r in runs)
+    methods = [m.strip() for m in method.split(",")]
+    default = methods if len(set(methods)) == len(runs) > 1 else [r.name for r in runs]
+    row_names = _names(names, "--names", "run") if names else tuple(default)
     if all_task_runs(runs):
         t = compare_task(runs, row_names)
     else:
-        t = compare_runs(runs, row_names, [m.strip() for m in method.split(",")])
+        t = compare_runs(runs, row_names, methods)
     print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

@@ -15,9 +15,9 @@ States (`draw_reach_state`), from `random.Random(f"reach-{seed}-{index}")`:
   shelf tops, the two prepush regions and the two shelf interiors;
 - the others, in uniformly shuffled order, go: to the crowded place with probability `P_CROWD`
   while it has room (and, for an interior, the object fits); otherwise onto a bare object that
-  can carry it with probability `P_STACK` (towers of at most `MAX_TOWER_LEVELS`); otherwise to
-  a kind of place uniform among the open space, a shelf top, a prepush region and a shelf
-  interior (those with room for it), and within the kind uniformly.
+  can carry it with probability `P_STACK` (towers of at most the world's `max_tower_levels`);
+  otherwise to a kind of place uniform among the open space, a shelf top, a prepush region and
+  a shelf interior (those with room for it), and within the kind uniformly.
 Every state is within the world's limits (capacities, towers, fit), counted with `Room`.
 
 Per staged state, up to `ACTIONS_PER_STATE` distinct actions among those the heuristic names for

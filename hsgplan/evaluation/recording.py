@@ -28,8 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from hsgplan.agents.base import Decision
-from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.world import Kind
+from hsgplan.domain.world import Kind, ObjectType
 from hsgplan.perception.draw import EDGES, cuboid_pixels
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.scene_graph.geometry import Pose
@@ -82,11 +81,10 @@ def _shape(part: VisualPart):
     return rr.Asset3D(path=part.mesh, albedo_factor=colour)
 
 
-def _object_shape(name: str, colour, label: str | None = None):
+def _object_shape(t: ObjectType, colour, label: str | None = None):
     """An object as its type's box or cylinder, centred on its pose."""
     import rerun as rr
 
-    t = KITCHEN.object_type(name)
     labels = None if label is None else [label]
     if t.kind is Kind.CAN:
         return rr.Cylinders3D(
@@ -151,8 +149,8 @@ class EpisodeRecording:
                 path = f"world/arena/body_{k}/part_{j}"
                 self._log(path, _transform(_compose(pose, part.local)), _shape(part), static=True)
         for name in scene.objects:
-            colour = _rgba(KITCHEN.object_type(name).color)
-            self._log(f"world/true/{name}", _object_shape(name, colour, name), static=True)
+            t = scene.world.object_type(name)
+            self._log(f"world/true/{name}", _object_shape(t, _rgba(t.color), name), static=True)
         parts = visual_parts(scene.bc, scene.robot.body)
         self._links = links_of(parts)
         for j, part in enumerate(parts):
@@ -265,10 +263,11 @@ class EpisodeRecording:
         unsure = set(obs.uncertain)
         now = set()
         for node in obs.scene_graph.nodes:
-            colour = UNSURE if node.name in unsure else _rgba(KITCHEN.object_type(node.name).color)
+            t = obs.scene_graph.world.object_type(node.name)
+            colour = UNSURE if node.name in unsure else _rgba(t.color)
             label = f"{node.name} (unsure)" if node.name in unsure else node.name
             path = f"world/believed/{node.name}"
-            self._log(path, _transform(node.pose), _object_shape(node.name, colour, label))
+            self._log(path, _transform(node.pose), _object_shape(t, colour, label))
             now.add(node.name)
         for gone in self._believed - now:
             self._log(f"world/believed/{gone}", rr.Clear(recursive=True))
@@ -294,7 +293,7 @@ class EpisodeRecording:
             self._log("robot/path", rr.Clear(recursive=False))
             return
         if self._kinematics is None:
-            self._kinematics = Scene((), visuals=False, world=KITCHEN)
+            self._kinematics = Scene((), visuals=False, world=self.env.scene.world)
         robot = self._kinematics.robot
         joints = (*plan.path, plan.q_above, *plan.descent, plan.q_at, *plan.line)
         points = []

@@ -17,7 +17,7 @@ from pathlib import Path
 from hsgplan.domain.recovery import RECOVERING
 from hsgplan.evaluation.config import TABLES, EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import check_runs, episode_specs, run_evaluation
+from hsgplan.evaluation.protocol import check_runs, check_world, episode_specs, run_evaluation
 from hsgplan.evaluation.seeds import is_tuning, marked
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
 from hsgplan.files import write_atomically
@@ -96,6 +96,8 @@ def run_table(
     """Every method's episodes (`config` with the method's agent) into `out/METHOD/`; the
     summary, also written as `summary.json`, `table1.md` and `table1.png` in `out`."""
     table, refusal = check_table(methods, config, out)
+    for m in methods:  # an agent refused a scene is refused before the folder is claimed
+        check_world(replace(config, agent=m.agent, perception=m.perception))
     claim(out, TABLE_KIND, table, refusal)
     records = {}
     for m in methods:

@@ -30,6 +30,8 @@ import torch
 from torch_geometric.data import Batch
 
 from hsgplan.domain.actions import Action, Pick, Place, Push, intended_literal
+from hsgplan.domain.checks import read_json
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import (
     BINS,
     MotionPrimitive,
@@ -170,9 +172,24 @@ def _all_params(kind: MotionPrimitive, subgoal: Literal, flat: list[int]):
 
 # A place before a push weighs its bins by what the push network makes of them: of the bins the
 # place network rates within PLACE_MARGIN of its best (predicted success), at most
-# PLACE_CANDIDATES, the one leaving the push it rates highest. Chosen on tuning seed 900.
+# PLACE_CANDIDATES, the one leaving the push it rates highest. Both chosen on tuning seed 900;
+# the shipped networks rate most bins of a free region within the margin, so there the count
+# decides: the place network's 30 best bins, taken in the push network's order.
 PLACE_MARGIN = 0.02
 PLACE_CANDIDATES = 30
+
+
+def _check_success_scores(folder: Path) -> None:
+    """Refuse, in one line, a network whose scores are no chances of success: a place that
+    looks ahead compares them across bins and scenes, which only the `bce` loss (every trial,
+    success or not) makes meaningful; `ce`'s scores are each scene's softmax logits."""
+    settings = folder / "train_config.json"
+    loss = read_json(settings, "training settings").get("loss") if settings.exists() else None
+    if loss != "bce":
+        raise InvalidInputError(
+            f"a place that looks ahead reads scores as chances of success, which networks "
+            f"trained with loss bce give; '{folder}' was trained with {loss or 'an unknown loss'}"
+        )
 
 
 class LearnedMotion(_BinGenerator):
@@ -203,6 +220,9 @@ class LearnedMotion(_BinGenerator):
             kind: load_motion_net(folder, kind.value, name.split("_")[0])
             for kind, folder in folders.items()
         }
+        if place_for_push:
+            for folder in folders.values():
+                _check_success_scores(folder)
 
     def scores(self, sg: GeometricSceneGraph, subgoal: Literal) -> torch.Tensor:
         """Logits over the flattened bin pairs: [bins[0] * bins[1]]."""

@@ -41,7 +41,7 @@ class Instance:
     """One object instance found in one image.
 
     Attributes:
-        type_index: index into `OBJECT_TYPES`.
+        type_index: index into the kitchen's object types (f_p's classes).
         pixels: [9, 2] keypoints (8 corners, then the centroid), NaN for a corner not found.
         score: the centroid's belief.
     """

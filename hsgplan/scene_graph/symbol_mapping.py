@@ -60,7 +60,7 @@ _XY_WEIGHT = 0.1
 
 class AnomalyKind(StrEnum):
     TOPPLED = "toppled"  # tilted past tilt_max; placed by where its centre lies
-    OFF_TABLE = "off_table"  # centre below off_table_z or outside TABLE; nearest region
+    OFF_TABLE = "off_table"  # centre below off_table_z or outside the world's table; nearest region
     OFF_REGION = "off_region"  # on the table but outside every region and interior
     UNSUPPORTED = "unsupported"  # not held and resting on nothing the state can name
     SHARED_CARRIER = "shared_carrier"  # rests on an object that a better match already occupies

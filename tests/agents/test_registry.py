@@ -180,3 +180,27 @@ def test_checkpoints_that_know_names_are_refused_a_scene_of_other_names(tmp_path
     check_reads([task, motion], KITCHEN, None)  # the kitchen's names: any network reads them
     with pytest.raises(InvalidInputError, match="place-gnn' know the kitchen's objects"):
         check_reads([task, motion], new, "new.toml")
+
+
+def test_gnn_next_reads_the_gnns_folders_and_refuses_networks_not_trained_on_every_trial(
+    tmp_path,
+):
+    import shutil
+
+    from hsgplan.agents.registry import agent_checkpoints, make_motion
+    from hsgplan.paths import MOTION_CHECKPOINTS, shipped
+
+    motion = shipped(MOTION_CHECKPOINTS)
+    assert make_motion("gnn-next", motion).place_for_push
+    assert not make_motion("gnn", motion).place_for_push
+    reads = agent_checkpoints("regression+gnn-next", motion_checkpoints=motion)
+    assert reads[1:] == agent_checkpoints("regression+gnn", motion_checkpoints=motion)[1:]
+    assert {p.name for p in reads[1:]} == {"place-gnn", "push-gnn"}
+    # the paper's cross-entropy networks: scores are per-scene logits, no chances of success
+    for kind in ("place", "push"):
+        shutil.copytree(motion / f"{kind}-gnn", tmp_path / f"{kind}-gnn")
+    shutil.rmtree(tmp_path / "place-gnn")
+    shutil.copytree(motion / "place-gnn-paper", tmp_path / "place-gnn")
+    with pytest.raises(InvalidInputError, match="trained with ce"):
+        make_motion("gnn-next", tmp_path)
+    assert make_motion("gnn", tmp_path).name == "gnn"

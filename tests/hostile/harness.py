@@ -42,7 +42,7 @@ REPO = Path(__file__).resolve().parents[2]
 KINDS = ("refused", "traceback", "hang", "accepted", "usage-box", "other")
 TIMEOUT = 30.0  # seconds before a case counts as a hang
 # A data-loss case runs its whole job when it rightly writes elsewhere (18 demonstrations, a
-# collection of 20 samples): seconds alone, but minutes on a loaded machine.
+# collection of 4 samples): seconds alone, but minutes on a loaded machine.
 JOB_TIMEOUT = TIMEOUT * 4
 
 

@@ -84,7 +84,17 @@ def test_an_agent_with_learned_parts_is_refused_a_world_of_other_names(tmp_path)
         r = runner.invoke(app, [*args, "--scene", str(scene)])
         assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
         assert "know the kitchen's objects" in r.output
-    assert not (tmp_path / "d").exists()
+    assert not (tmp_path / "d").exists() and not (tmp_path / "e").exists()
+
+
+def test_the_stream_baselines_are_refused_a_layout_before_anything_is_written(tmp_path):
+    scene = tmp_path / "layout.toml"
+    scene.write_text(to_toml(scene_data(LAYOUT)))
+    args = ["eval", "world", "--agent", "stream-goal", "--sizes", "2", "--goals", "1"]
+    r = runner.invoke(app, [*args, "--scene", str(scene), "--out", str(tmp_path / "e")])
+    assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
+    assert "its streams know the kitchen's shelves" in r.output
+    assert not (tmp_path / "e").exists()
 
 
 def test_f_p_is_refused_a_scene_other_than_the_kitchen_and_the_kitchens_file_is_the_kitchen(
