@@ -72,3 +72,12 @@ def intended_literal(action: Action) -> Literal:
     if isinstance(action, Place):
         return on(action.obj, action.target)
     return inside(action.obj, action.shelf)
+
+
+def push_after(action: Action, world: World) -> Push | None:
+    """The paper's heuristic from subgoal to primitive, one step on: an object placed on a
+    shelf's prepush region is there to be pushed into that shelf."""
+    if isinstance(action, Place):
+        shelves = world.shelves.values()
+        return next((Push(action.obj, s.name) for s in shelves if s.prepush == action.target), None)
+    return None

@@ -29,7 +29,7 @@ from pathlib import Path
 import torch
 from torch_geometric.data import Batch
 
-from hsgplan.domain.actions import Action, Pick, Place, Push, intended_literal
+from hsgplan.domain.actions import Action, Pick, Place, Push, intended_literal, push_after
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import (
@@ -145,13 +145,7 @@ class _BinGenerator(SingleShotMemory):
 def _place_before_push(sg: GeometricSceneGraph, action: Action, following: Action | None) -> bool:
     """A place onto a shelf's prepush region, with the push of the same object into that shelf
     next (the task planner's plan says so)."""
-    return (
-        isinstance(action, Place)
-        and isinstance(following, Push)
-        and following.obj == action.obj
-        and following.shelf in sg.world.shelves
-        and sg.world.shelves[following.shelf].prepush == action.target
-    )
+    return following is not None and following == push_after(action, sg.world)
 
 
 def placed_at(sg: GeometricSceneGraph, params: PlaceParams) -> GeometricSceneGraph:

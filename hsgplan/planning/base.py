@@ -11,10 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
-from hsgplan.domain.actions import Action, Place, Push
+from hsgplan.domain.actions import Action
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal
-from hsgplan.domain.scene import World
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 
@@ -39,12 +38,3 @@ class TaskPlanner(Protocol):
         """A new episode towards `goal`, seeded."""
 
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision: ...
-
-
-def push_after(action: Action, world: World) -> Push | None:
-    """The paper's heuristic from subgoal to primitive, one step on: an object placed on a
-    shelf's prepush region is there to be pushed into that shelf."""
-    if isinstance(action, Place):
-        shelves = world.shelves.values()
-        return next((Push(action.obj, s.name) for s in shelves if s.prepush == action.target), None)
-    return None

@@ -23,13 +23,13 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from hsgplan.domain.actions import Action
+from hsgplan.domain.actions import Action, push_after
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.domain.scene import World
-from hsgplan.planning.base import TaskDecision, push_after
+from hsgplan.planning.base import TaskDecision
 from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.encoding import (
     DONT_CARE,
