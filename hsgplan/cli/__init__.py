@@ -22,6 +22,7 @@ from hsgplan.cli import (
     learn,
     motion,
     perception,
+    runs,
     scenes,
     symbolic,
     world,
@@ -45,7 +46,7 @@ eval_app.command("task")(learn.eval_task)
 eval_app.command("reach")(learn.eval_reach)
 eval_app.command("motion")(motion.eval_motion)
 eval_app.command("perception")(perception.eval_perception)
-eval_app.command("compare")(world.compare)
+eval_app.command("compare")(runs.compare)
 eval_app.command("curve")(learn.eval_curve)
 
 app.command()(symbolic.plan)
@@ -53,7 +54,7 @@ app.command()(symbolic.goals)
 app.command()(world.demo)
 app.command()(scenes.scenes)
 app.add_typer(eval_app, name="eval")
-app.command()(world.report)
+app.command()(runs.report)
 app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
 app.add_typer(bench.app, name="bench")

@@ -12,7 +12,6 @@ from rich.progress import Progress
 from hsgplan.agents.registry import agent_name, agent_parts
 from hsgplan.cli.common import (
     AgentName,
-    MarkdownFlag,
     MotionName,
     PerceptionCheckpoint,
     PlannerName,
@@ -275,7 +274,7 @@ def evaluate(
         name = agent_name(agent.value, planner_name)
         methods = [Method(name, name)]
     else:
-        motions = _names(motion, "--motion", "generator")
+        motions = names_of(motion, "--motion", "generator")
         agents = [agent_name(agent.value, planner_name, m) for m in motions]
         # a column is named by its generator (and set beside the paper's) only where the task
         # planner is the paper's; other planners' columns carry their agent's whole name
@@ -283,7 +282,7 @@ def evaluate(
         methods = [
             Method(m if paper_planner else a, a) for m, a in zip(motions, agents, strict=True)
         ]
-    seeing = _names(perception, "--perception", "observer")
+    seeing = names_of(perception, "--perception", "observer")
     methods = [
         Method(m.name if p == "gt" else f"{m.name}-{p}", m.agent, p)
         for m in methods
@@ -300,7 +299,7 @@ def evaluate(
         motion_checkpoints and str(shipped(motion_checkpoints)),
         perception_checkpoint=perception_checkpoint and str(shipped(perception_checkpoint)),
         protocol=protocol.value,
-        rules_off=_names(rules_off, "--rules-off", "rule", none=True),
+        rules_off=names_of(rules_off, "--rules-off", "rule", none=True),
         scene=str(scene) if scene else None,
     )
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
@@ -308,7 +307,7 @@ def evaluate(
     total = len(episode_specs(config)) * len(methods)
     folder = run_dir or RUNS / (_run_name(methods, config) + ("-ablation" if ablate_rules else ""))
     check_ray(ray)
-    which = _names(shown_tables, "--tables", "table")
+    which = names_of(shown_tables, "--tables", "table")
     if unknown := sorted(set(which) - set(TABLES)):
         raise InvalidInputError(f"--tables: no table '{unknown[0]}' ({', '.join(TABLES)})")
     if ablate_rules:  # the cheap refusals first: loading agents takes seconds
@@ -332,7 +331,7 @@ def evaluate(
         out.print(f"wrote {shown(folder)}/table1.md, table1.png, summary.json", highlight=False)
 
 
-def _names(text: str, option: str, what: str, none: bool = False) -> tuple[str, ...]:
+def names_of(text: str, option: str, what: str, none: bool = False) -> tuple[str, ...]:
     """A comma-separated list of names, each once; with `none`, '' names none."""
     if none and not text.strip():
         return ()
@@ -352,82 +351,3 @@ def _run_name(methods, config) -> str:
     protocol += "".join(f"-no_{rule}" for rule in config.rules_off)
     where = f"-{Path(config.scene).stem}" if config.scene else ""
     return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}{where}"
-
-
-@refuses_bad_input
-def report(
-    run_dir: Annotated[
-        Path,
-        typer.Argument(help="An eval run folder (holding summary.json).", parser=input_path),
-    ],
-    failures: Annotated[
-        int,
-        bounded_option("failures", "Failed episodes re-simulated and shown, GIF and graphs."),
-    ] = 6,
-    rerun: Annotated[
-        bool,
-        typer.Option(
-            "--rerun",
-            help="Also write each re-simulated episode as a rerun recording (episode.rrd). "
-            "Needs the rerun extra.",
-            metavar="",
-        ),
-    ] = False,
-) -> None:
-    """One self-contained HTML page for an eval run: its tables and plot, and failed episodes
-    re-simulated from their seeds (a GIF with each decision, the scene graphs around the
-    failing step; with --rerun, a 3D recording). Writes RUN_DIR/report.html."""
-    from hsgplan.evaluation.recording import available
-    from hsgplan.evaluation.report import build_report
-
-    if rerun and not available():
-        raise InvalidInputError(NO_RERUN)
-
-    with Progress(console=err, transient=True) as progress:
-        task = progress.add_task("re-simulating failed episodes", total=None)
-        path = build_report(
-            run_dir,
-            failures,
-            on_rollout=lambda r: progress.advance(task),
-            on_sample=lambda n: progress.update(task, total=n),
-            recordings=rerun,
-        )
-    size = path.stat().st_size / 1e6
-    out.print(f"wrote {shown(path)} ({size:.1f} MB)", highlight=False)
-
-
-@refuses_bad_input
-def compare(
-    runs: Annotated[
-        list[Path],
-        typer.Argument(
-            help="Finished eval world (or eval task) run folders, one row each.",
-            parser=input_path,
-        ),
-    ],
-    names: Annotated[
-        str | None,
-        typer.Option(help="The rows' names, comma-separated (default: the folders' names)."),
-    ] = None,
-    method: Annotated[
-        str,
-        typer.Option(help="The column compared (gnn, mlp, ...), or one per run, comma-separated."),
-    ] = "gnn",
-    markdown: MarkdownFlag = False,
-) -> None:
-    """A method's success per size across eval world runs, one row each: a ladder from one
-    recipe to another, one change per row. The runs must be like for like (protocol, goals,
-    repeats, seed, sizes, scene); only their checkpoints, and the method when one is named per
-    run, may differ. Eval task runs (the symbolic loop) are compared the same way, on the same
-    episodes."""
-    from hsgplan.evaluation.compare import all_task_runs, compare_task
-    from hsgplan.evaluation.compare import compare as compare_runs
-
-    methods = [m.strip() for m in method.split(",")]
-    default = methods if len(set(methods)) == len(runs) > 1 else [r.name for r in runs]
-    row_names = _names(names, "--names", "run") if names else tuple(default)
-    if all_task_runs(runs):
-        t = compare_task(runs, row_names)
-    else:
-        t = compare_runs(runs, row_names, methods)
-    print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

@@ -1,0 +1,101 @@
+"""Commands on finished runs: a run's HTML report, and runs side by side."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.progress import Progress
+
+from hsgplan.cli.common import (
+    MarkdownFlag,
+    bounded_option,
+    err,
+    input_path,
+    out,
+    print_table,
+    refuses_bad_input,
+    shown,
+)
+from hsgplan.cli.world import NO_RERUN, names_of
+from hsgplan.domain.errors import InvalidInputError
+
+
+@refuses_bad_input
+def report(
+    run_dir: Annotated[
+        Path,
+        typer.Argument(help="An eval run folder (holding summary.json).", parser=input_path),
+    ],
+    failures: Annotated[
+        int,
+        bounded_option("failures", "Failed episodes re-simulated and shown, GIF and graphs."),
+    ] = 6,
+    rerun: Annotated[
+        bool,
+        typer.Option(
+            "--rerun",
+            help="Also write each re-simulated episode as a rerun recording (episode.rrd). "
+            "Needs the rerun extra.",
+            metavar="",
+        ),
+    ] = False,
+) -> None:
+    """One self-contained HTML page for an eval run: its tables and plot, and failed episodes
+    re-simulated from their seeds (a GIF with each decision, the scene graphs around the
+    failing step; with --rerun, a 3D recording). Writes RUN_DIR/report.html."""
+    from hsgplan.evaluation.recording import available
+    from hsgplan.evaluation.report import build_report
+
+    if rerun and not available():
+        raise InvalidInputError(NO_RERUN)
+
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task("re-simulating failed episodes", total=None)
+        path = build_report(
+            run_dir,
+            failures,
+            on_rollout=lambda r: progress.advance(task),
+            on_sample=lambda n: progress.update(task, total=n),
+            recordings=rerun,
+        )
+    size = path.stat().st_size / 1e6
+    out.print(f"wrote {shown(path)} ({size:.1f} MB)", highlight=False)
+
+
+@refuses_bad_input
+def compare(
+    runs: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Finished eval world (or eval task) run folders, one row each.",
+            parser=input_path,
+        ),
+    ],
+    names: Annotated[
+        str | None,
+        typer.Option(help="The rows' names, comma-separated (default: the folders' names)."),
+    ] = None,
+    method: Annotated[
+        str,
+        typer.Option(help="The column compared (gnn, mlp, ...), or one per run, comma-separated."),
+    ] = "gnn",
+    markdown: MarkdownFlag = False,
+) -> None:
+    """A method's success per size across eval world runs, one row each: a ladder from one
+    recipe to another, one change per row. The runs must be like for like (protocol, goals,
+    repeats, seed, sizes, scene); only their checkpoints, and the method when one is named per
+    run, may differ. Eval task runs (the symbolic loop) are compared the same way, on the same
+    episodes."""
+    from hsgplan.evaluation.compare import all_task_runs, compare_task
+    from hsgplan.evaluation.compare import compare as compare_runs
+
+    methods = [m.strip() for m in method.split(",")]
+    default = methods if len(set(methods)) == len(runs) > 1 else [r.name for r in runs]
+    row_names = names_of(names, "--names", "run") if names else tuple(default)
+    if all_task_runs(runs):
+        t = compare_task(runs, row_names)
+    else:
+        t = compare_runs(runs, row_names, methods)
+    print_table(t.title, t.header, [list(r) for r in t.rows], markdown)
