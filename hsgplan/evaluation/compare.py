@@ -103,10 +103,11 @@ def compare_task(runs: Sequence[Path], names: Sequence[str]) -> TextTable:
         (name, *(_task_cell(s.get(str(n))) for n in sizes))
         for name, s in zip(names, summaries, strict=True)
     ]
-    # a folder of scenes runs the same goals in each, its episodes keyed by scene first
+    # a folder of scenes runs the same goals in each; a run with a scene keys its episodes by
+    # the scene file's stem first
     scenes = {str(row["key"]).split("/", 1)[0] for row in logged_rows(runs[0])}
     source = f"{per_size} goals per size"
-    if len(scenes) > 1 and not any(k.isdigit() for k in scenes):
+    if _settings(runs[0]).get("scene") and len(scenes) > 1:
         source = f"{per_size // len(scenes)} goals per size in each of {len(scenes)} scenes"
     title = f"Success rate / subgoal completion in the symbolic loop by run ({protocol}): {source}"
     return TextTable(title, ("run", *(f"{n} objects" for n in sizes)), tuple(rows))

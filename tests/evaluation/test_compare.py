@@ -100,6 +100,7 @@ def _task_run(folder, successes, protocol="paper", seeds=(1, 2), scenes=("",)):
 
     folder.mkdir()
     config = {"kind": "eval-task", "planner": "regression", "checkpoint": "c"}
+    config |= {"scene": "scenes" if scenes != ("",) else None}
     (folder / "config.json").write_text(json.dumps(config | {"protocol": protocol}))
     lines = []
     for scene in scenes:  # a folder of scenes keys its episodes by scene first
@@ -120,7 +121,7 @@ def test_task_runs_are_compared_on_the_same_episodes(tmp_path):
     table = compare_task([a, b], ["theirs", "ours"])
     assert [row[1].split(" / ")[0] for row in table.rows] == ["0.50", "1.00"]
     assert "paper protocol" in table.title and table.title.endswith(": 2 goals per size")
-    folders = [_task_run(tmp_path / n, (True, True), scenes=("s1", "s2", "s3")) for n in "ef"]
+    folders = [_task_run(tmp_path / n, (True, True), scenes=("s1", "s2", "3")) for n in "ef"]
     assert compare_task(folders, ["e", "f"]).title.endswith("2 goals per size in each of 3 scenes")
     other = _task_run(tmp_path / "c", (True, True), seeds=(1, 3))
     with pytest.raises(InvalidInputError, match="differ in episodes"):
