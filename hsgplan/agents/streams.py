@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.parameters import PickParams, PushParams, extent_along, place_xy
+from hsgplan.domain.parameters import PickParams, PushParams, extent_along, place_centre, place_xy
 from hsgplan.domain.world import PLACE_BINS, PLACE_LONG_AXIS_YAW, REACH_MAX_Z, Kind, spot_cells
 from hsgplan.motion.sampler import (
     HAND_DROP,
@@ -110,8 +110,7 @@ def bin_order(obj: str, surface: str, rng: np.random.Generator) -> list[tuple[in
 
 def surface_pose(obj: str, surface: str, bins: tuple[int, int]) -> PoseValue:
     """The pose a place at these bins puts the object in (standing, long side along y)."""
-    x, y = place_xy(obj, surface, *bins, KITCHEN)
-    z = KITCHEN.surface_rect(surface).z + KITCHEN.object_type(obj).height / 2
+    x, y, z = place_centre(obj, surface, *bins, KITCHEN)
     return PoseValue(obj, x, y, z, PLACE_LONG_AXIS_YAW, "supported", surface, bins)
 
 

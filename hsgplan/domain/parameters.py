@@ -105,6 +105,15 @@ def place_xy(obj: str, target: str, x_bin: int, y_bin: int, world: World) -> tup
     )
 
 
+def place_centre(
+    obj: str, target: str, x_bin: int, y_bin: int, world: World
+) -> tuple[float, float, float]:
+    """Where a place at these bins stands the object's centre: over the bin's centre, resting
+    on the surface (long side along y, `PLACE_LONG_AXIS_YAW`)."""
+    x, y = place_xy(obj, target, x_bin, y_bin, world)
+    return x, y, world.surface_rect(target).z + world.object_type(obj).height / 2
+
+
 def push_values(angle_bin: int, dist_bin: int) -> tuple[float, float]:
     """(direction in radians from +x, distance in metres) of a push's bins."""
     _check_bin(angle_bin, PUSH_ANGLE_BINS, "angle_bin")

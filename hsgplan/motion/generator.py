@@ -40,7 +40,7 @@ from hsgplan.domain.parameters import (
     PrimitiveParams,
     PushParams,
     params_for,
-    place_xy,
+    place_centre,
 )
 from hsgplan.domain.predicates import Literal
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
@@ -150,12 +150,10 @@ def _place_before_push(sg: GeometricSceneGraph, action: Action, following: Actio
 
 def placed_at(sg: GeometricSceneGraph, params: PlaceParams) -> GeometricSceneGraph:
     """The scene as it would be with the held object set down at a place bin's centre."""
-    world = sg.world
-    x, y = place_xy(params.obj, params.target, params.x_bin, params.y_bin, world)
-    z = world.surface_rect(params.target).z + world.object_type(params.obj).height / 2
+    centre = place_centre(params.obj, params.target, params.x_bin, params.y_bin, sg.world)
     poses = {n.name: n.pose for n in sg.nodes}
-    poses[params.obj] = Pose.from_xyz_yaw(x, y, z, PLACE_LONG_AXIS_YAW)
-    return GeometricSceneGraph.from_poses(poses, None, world=world)
+    poses[params.obj] = Pose.from_xyz_yaw(*centre, PLACE_LONG_AXIS_YAW)
+    return GeometricSceneGraph.from_poses(poses, None, world=sg.world)
 
 
 def _all_params(kind: MotionPrimitive, subgoal: Literal, flat: list[int]):
