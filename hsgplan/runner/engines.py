@@ -133,7 +133,9 @@ class LocalEngine:
             self._start(h)
 
     def close(self) -> None:
-        self.pool.shutdown(wait=False, cancel_futures=True)
+        # Waiting costs nothing: the interpreter's exit joins the pool's manager thread anyway,
+        # and one still closing its wake-up pipe when the exit wakes it raises EBADF there.
+        self.pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _succeeded(future: Future) -> bool:
