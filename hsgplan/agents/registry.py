@@ -67,14 +67,15 @@ def _sampler(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
 
 
 def _learned(
-    model: str, place_for_push: bool = False
+    model: str, place_for_push: bool = False, checked: bool = False
 ) -> Callable[[Path, RecoveryRules], MotionGenerator]:
     def make(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
         from hsgplan.domain.parameters import MotionPrimitive
         from hsgplan.motion.generator import LearnedMotion
+        from hsgplan.motion.interface import DRY_RUNS
 
         folders = {kind: checkpoints / f"{kind.value}-{model}" for kind in MotionPrimitive}
-        return LearnedMotion(model, folders, rules, place_for_push)
+        return LearnedMotion(model, folders, rules, place_for_push, DRY_RUNS if checked else 0)
 
     return make
 
@@ -92,6 +93,9 @@ MOTION_GENERATORS: dict[str, Callable[[Path, RecoveryRules], MotionGenerator]] =
     "gnn": _learned("gnn"),
     # the same GNNs; a place before a push asks the push network where to put the object
     "gnn-next": _learned("gnn", place_for_push=True),
+    # the same, each proposal planned before it is made (the sampler's budget of dry runs)
+    "gnn-checked": _learned("gnn", checked=True),
+    "gnn-next-checked": _learned("gnn", place_for_push=True, checked=True),
     "mlp": _learned("mlp"),
     "random": _random,
 }
@@ -170,7 +174,13 @@ def agent_parts(name: str) -> tuple[str, str]:
 
 LEARNED_PLANNERS = ("regression", "regression-paper", "forward")
 # learned motion generator -> the model whose networks it reads (`KIND-MODEL` folders)
-LEARNED_MOTION = {"gnn": "gnn", "gnn-next": "gnn", "mlp": "mlp"}
+LEARNED_MOTION = {
+    "gnn": "gnn",
+    "gnn-next": "gnn",
+    "gnn-checked": "gnn",
+    "gnn-next-checked": "gnn",
+    "mlp": "mlp",
+}
 
 
 def agent_checkpoints(

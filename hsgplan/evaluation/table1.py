@@ -29,7 +29,14 @@ PAPER_TABLE1: dict[str, dict[int, tuple[float, float]]] = {
     "mlp": {2: (0.85, 0.91), 3: (0.75, 0.87), 4: (0.69, 0.84), 5: (0.56, 0.76), 6: (0.44, 0.67)},
     "gnn": {2: (0.92, 0.95), 3: (0.89, 0.95), 4: (0.84, 0.92), 5: (0.73, 0.87), 6: (0.67, 0.84)},
 }
-LABELS = {"gnn": "GNN", "gnn-next": "GNN (place for push)", "mlp": "MLP", "random": "Random"}
+LABELS = {
+    "gnn": "GNN",
+    "gnn-next": "GNN (place for push)",
+    "gnn-checked": "GNN (dry runs)",
+    "gnn-next-checked": "GNN (place for push, dry runs)",
+    "mlp": "MLP",
+    "random": "Random",
+}
 
 
 @dataclass(frozen=True)

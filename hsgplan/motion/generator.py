@@ -7,7 +7,11 @@ has no parameters, and a stack takes its position from the object below, so only
 a surface and a push are chosen over bins.
 
 `propose` is what an agent calls, once per step. The learned generators are single shot as in
-the paper: one proposal, no dry run (they ignore the one an agent may offer). The recovery rule
+the paper: one proposal, no dry run (they ignore the one an agent may offer). Beyond the paper,
+a generator made with `dry_runs` checks its proposal first: its first choice, then the others
+not failed in this scene in its own order, up to `dry_runs` of them, each planned without
+executing it (`Feasibility`: the motion planner in the robot's model of the scene, no domain
+rule); the first that plans is proposed, else the first choice as without checks. The recovery rule
 `failed_bins` (`hsgplan.domain.recovery`; without it a generator proposes its first choice in
 every scene): parameters whose execution failed for good (`DO_NOT_RETRY`) are remembered with the
 scene they failed in (`scene_key`: the held object and every pose to the centimetre). In a
@@ -73,8 +77,9 @@ class _BinGenerator(SingleShotMemory):
 
     name = "bins"
 
-    def __init__(self, rules: RecoveryRules = ALL_RULES) -> None:
+    def __init__(self, rules: RecoveryRules = ALL_RULES, dry_runs: int = 0) -> None:
         super().__init__(rules)
+        self.dry_runs = dry_runs
         self.rng = random.Random(f"{self.name}-motion-0")
         self._placed: dict[str, tuple[tuple, PlaceParams]] = {}
         self._push_failures: dict[str, int] = {}
@@ -138,8 +143,13 @@ class _BinGenerator(SingleShotMemory):
                 ranked = self.for_push(sg, ranked, following)
         untried = self.untried(sg, ranked)
         if not untried or len(untried) == len(ranked):
-            return ranked[0]
-        return self.redraw(untried)
+            first = ranked[0]
+        else:
+            first = self.redraw(untried)
+        if not self.dry_runs or feasible is None or len(untried) < 2:
+            return first
+        options = [first, *(p for p in untried if p != first)][: self.dry_runs]
+        return next((p for p in options if feasible(p)), first)
 
 
 def _place_before_push(sg: GeometricSceneGraph, action: Action, following: Action | None) -> bool:
@@ -194,6 +204,7 @@ class LearnedMotion(_BinGenerator):
         place_for_push: a place onto a shelf's prepush region, with the push into that shelf
             next, takes of its likeliest bins the one from which the push network rates its
             best push highest (beyond the paper, whose primitives are chosen one by one).
+        dry_runs: proposals planned before one is made (0: single shot, as in the paper).
     """
 
     def __init__(
@@ -202,9 +213,10 @@ class LearnedMotion(_BinGenerator):
         folders: dict[MotionPrimitive, Path],
         rules: RecoveryRules = ALL_RULES,
         place_for_push: bool = False,
+        dry_runs: int = 0,
     ) -> None:
         self.name = name
-        super().__init__(rules)
+        super().__init__(rules, dry_runs)
         self.place_for_push = place_for_push
         self._weights: dict[PlaceParams | PushParams, float] = {}
         self._success: dict[PlaceParams | PushParams, float] = {}

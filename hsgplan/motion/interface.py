@@ -20,6 +20,10 @@ from hsgplan.sim.outcome import Outcome, Status
 Feasibility = Callable[[PrimitiveParams], bool]
 # Failures that say these parameters will not work here; anything else may be tried again.
 DO_NOT_RETRY = frozenset({Status.NO_IK, Status.NO_PATH, Status.EFFECT_NOT_REACHED, Status.INVALID})
+# Candidates a generator that checks its proposals dry-runs per decision (best first) before it
+# proposes its first choice regardless: the geometric sampler, and the learned generators'
+# `-checked` variants, with the same budget.
+DRY_RUNS = 30
 # Failed pushes of an object since it was put down, after which a bin generator gives up on the
 # spot (see `_BinGenerator`).
 PUSH_TRIES = 3

@@ -31,7 +31,7 @@ from hsgplan.domain.world import (
     Rect,
     spot_cells,
 )
-from hsgplan.motion.interface import DO_NOT_RETRY, Feasibility, SingleShotMemory
+from hsgplan.motion.interface import DO_NOT_RETRY, DRY_RUNS, Feasibility, SingleShotMemory
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.sim.outcome import Outcome
 
@@ -196,12 +196,10 @@ def candidates(
 
 # A place before a push stays this far from where a push of the object failed (m).
 AVOID_RADIUS = 0.04
-# Candidates dry-run per decision before the best-ranked one is tried regardless.
-MAX_CHECKS = 30
 
 
 class GeometricSampler(SingleShotMemory):
-    """The best-ranked candidate that passes a dry run (at most `MAX_CHECKS` are checked) and
+    """The best-ranked candidate that passes a dry run (at most `DRY_RUNS` are checked) and
     has not failed for good in this scene; without a dry run, the best-ranked one. None when
     every candidate has failed here.
 
@@ -237,6 +235,6 @@ class GeometricSampler(SingleShotMemory):
         avoid = tuple(self.push_failed_at.get(action.obj, ()))
         options = self.untried(sg, candidates(sg, action, following, avoid))
         return next(
-            (c for c in options[:MAX_CHECKS] if feasible is None or feasible(c)),
+            (c for c in options[:DRY_RUNS] if feasible is None or feasible(c)),
             options[0] if options else None,
         )

@@ -193,6 +193,11 @@ def test_gnn_next_reads_the_gnns_folders_and_refuses_networks_not_trained_on_eve
     motion = shipped(MOTION_CHECKPOINTS)
     assert make_motion("gnn-next", motion).place_for_push
     assert not make_motion("gnn", motion).place_for_push
+    from hsgplan.motion.interface import DRY_RUNS
+
+    assert make_motion("gnn-next-checked", motion).dry_runs == DRY_RUNS
+    assert make_motion("gnn-checked", motion).dry_runs == DRY_RUNS
+    assert make_motion("gnn-next", motion).dry_runs == 0
     reads = agent_checkpoints("regression+gnn-next", motion_checkpoints=motion)
     assert reads[1:] == agent_checkpoints("regression+gnn", motion_checkpoints=motion)[1:]
     assert {p.name for p in reads[1:]} == {"place-gnn", "push-gnn"}

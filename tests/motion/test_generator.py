@@ -208,3 +208,54 @@ def test_the_scene_after_a_place_has_the_object_set_down_at_the_bins_centre():
     assert next(n.pose for n in after.nodes if n.name == "cherries") == next(
         n.pose for n in _can_scene().nodes if n.name == "cherries"
     )
+
+
+class _Planner:
+    """A dry run's stand-in: the bins it plans, and every call it was asked."""
+
+    def __init__(self, plans: set[PlaceParams]) -> None:
+        self.plans, self.asked = plans, []
+
+    def __call__(self, params) -> bool:
+        self.asked.append(params)
+        return params in self.plans
+
+
+def test_a_checked_generator_proposes_its_first_choice_that_plans_within_its_budget():
+    logits = _logits(b_0_0=10.0, b_0_1=9.0, b_5_5=8.0, b_7_2=7.0)
+    place = Place(HELD, "shelf_a")
+    motion = _FixedScores(logits)
+    motion.dry_runs = 3
+    motion.reset(0)
+    planner = _Planner({_place(5, 5), _place(7, 2)})
+    assert motion.propose(_scene(), place, feasible=planner) == _place(5, 5)
+    assert planner.asked == [_place(0, 0), _place(0, 1), _place(5, 5)]  # in the network's order
+    # nothing within the budget plans: the first choice, as without checks
+    late = _Planner({_place(7, 2)})
+    assert motion.propose(_scene(), place, feasible=late) == _place(0, 0)
+    assert len(late.asked) == 3
+    # single shot: a generator without dry runs never asks, nor does a checked one not offered
+    # a dry run
+    single = _FixedScores(logits)
+    single.reset(0)
+    assert single.propose(_scene(), place, feasible=planner) == _place(0, 0)
+    assert len(planner.asked) == 3
+    assert motion.propose(_scene(), place) == _place(0, 0)
+
+
+def test_a_checked_generator_starts_from_its_draw_after_a_failure_and_skips_failed_bins():
+    logits = _logits(b_0_0=10.0, b_0_1=9.0, b_5_5=8.0)
+    place = Place(HELD, "shelf_a")
+    motion = _FixedScores(logits)
+    motion.dry_runs = 30
+    motion.reset(3)
+    motion.observe(motion.propose(_scene(), place), Outcome(Status.NO_IK, "", 0.0))
+    twin = _FixedScores(logits)
+    twin.reset(3)
+    twin.observe(twin.propose(_scene(), place), Outcome(Status.NO_IK, "", 0.0))
+    drawn = twin.propose(_scene(), place)  # what the unchecked generator draws now
+    planner = _Planner(set())
+    assert motion.propose(_scene(), place, feasible=planner) == drawn
+    assert planner.asked[0] == drawn
+    assert _place(0, 0) not in planner.asked
+    assert len(planner.asked) == motion.dry_runs  # the budget, of the bins not failed
