@@ -142,10 +142,8 @@ class _BinGenerator(SingleShotMemory):
             if _place_before_push(sg, action, following):
                 ranked = self.for_push(sg, ranked, following)
         untried = self.untried(sg, ranked)
-        if not untried or len(untried) == len(ranked):
-            first = ranked[0]
-        else:
-            first = self.redraw(untried)
+        take_first = not untried or len(untried) == len(ranked)  # none failed here, or all
+        first = ranked[0] if take_first else self.redraw(untried)
         if not self.dry_runs or feasible is None or len(untried) < 2:
             return first
         options = [first, *(p for p in untried if p != first)][: self.dry_runs]

@@ -21,19 +21,18 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import gymnasium
 import numpy as np
 
-from hsgplan.domain.goals import Goal, parse_goal
+from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PickParams, PrimitiveParams
 from hsgplan.domain.scene import World
 from hsgplan.domain.world import MAX_STEPS
-from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.scene_graph.symbol_mapping import SymbolMapping, map_symbols
+from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.sim.actuation import holds_something
 from hsgplan.sim.belief_world import BeliefWorld
+from hsgplan.sim.env_types import Observation, ResetOptions, reset_options
 from hsgplan.sim.gym_spaces import action_space, decode, encode, observation_space
 from hsgplan.sim.lookahead import Lookahead
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive, plan_transit
@@ -51,42 +50,9 @@ from hsgplan.sim.render import Camera
 from hsgplan.sim.robot import REST
 from hsgplan.sim.sampler import sample_scene
 from hsgplan.sim.scene import Scene
-from hsgplan.symbolic.generator import check_size, random_goals
+from hsgplan.symbolic.generator import check_size
 
 ENV_ID = "hsgplan/KitchenStorage-v0"
-
-
-@dataclass(frozen=True)
-class Observation:
-    """What the agent gets (`scene_graph`, `symbols`: the observer's), and the truth.
-
-    Attributes:
-        true_symbols: f_m of the simulator's poses; the same object as `symbols` when the
-            observer is the ground truth.
-        unseen: objects the observer did not see this time (their poses carried over).
-    """
-
-    scene_graph: GeometricSceneGraph
-    symbols: SymbolMapping
-    rgb: np.ndarray | None
-    true_symbols: SymbolMapping
-    unseen: tuple[str, ...] = ()
-    unknown: tuple[str, ...] = ()
-    uncertain: tuple[str, ...] = ()
-
-
-@dataclass(frozen=True)
-class ResetOptions:
-    """What an episode is about: the goal, and the scene's objects: the goal's, and `others`
-    (objects no goal literal names, placed by the same sampler: the full scene a demonstration
-    may be recorded in)."""
-
-    goal: Goal
-    p_elsewhere: float = 0.3
-    others: tuple[str, ...] = ()
-
-    def objects(self) -> tuple[str, ...]:
-        return self.goal.world.sort_objects({*self.goal.objects, *self.others})
 
 
 class KitchenStorageEnv(gymnasium.Env):
@@ -167,7 +133,7 @@ class KitchenStorageEnv(gymnasium.Env):
         `objects` objects drawn from the scene's seed."""
         super().reset(seed=seed)
         scene_seed = seed if seed is not None else int(self.np_random.integers(2**31))
-        options = _options(options, self.objects, scene_seed, self.scene_world)
+        options = reset_options(options, self.objects, scene_seed, self.scene_world)
         if options.goal.world.entity_types != self.scene_world.entity_types:
             raise ValueError("the goal names another world's objects than the env's spaces hold")
         self.close()
@@ -406,22 +372,6 @@ class KitchenStorageEnv(gymnasium.Env):
 
     def _encode(self, typed: Observation) -> dict:
         return encode(self.scene.objects, typed.scene_graph, typed.symbols.state)
-
-
-def _options(
-    options: ResetOptions | dict | None, objects: int, seed: int, world: World
-) -> ResetOptions:
-    if isinstance(options, ResetOptions):
-        return options
-    options = options or {}
-    goal = options.get("goal")
-    if goal is None:
-        goal = random_goals(objects, 1, seed, world=world)[0]
-    if isinstance(goal, str):
-        goal = parse_goal(goal, world=world)
-    if not isinstance(goal, Goal):
-        raise ValueError("options['goal']: a Goal or goal text")
-    return ResetOptions(goal, float(options.get("p_elsewhere", ResetOptions.p_elsewhere)))
 
 
 # made in the kitchen unless `world=` is given: the id is an entry point, resolved where the
