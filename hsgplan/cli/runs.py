@@ -81,13 +81,21 @@ def compare(
         str,
         typer.Option(help="The column compared (gnn, mlp, ...), or one per run, comma-separated."),
     ] = "gnn",
+    across_scenes: Annotated[
+        bool,
+        typer.Option(
+            "--across-scenes",
+            help="Runs of one agent in different scenes: the scene and the goals per scene file "
+            "may differ, the episodes per size may not.",
+        ),
+    ] = False,
     markdown: MarkdownFlag = False,
 ) -> None:
     """A method's success per size across eval world runs, one row each: a ladder from one
     recipe to another, one change per row. The runs must be like for like (protocol, goals,
     repeats, seed, sizes, scene); only their checkpoints, and the method when one is named per
-    run, may differ. Eval task runs (the symbolic loop) are compared the same way, on the same
-    episodes."""
+    run, may differ (and with --across-scenes the scene). Eval task runs (the symbolic loop)
+    are compared the same way, on the same episodes."""
     from hsgplan.evaluation.compare import all_task_runs, compare_task
     from hsgplan.evaluation.compare import compare as compare_runs
 
@@ -95,7 +103,9 @@ def compare(
     default = methods if len(set(methods)) == len(runs) > 1 else [r.name for r in runs]
     row_names = names_of(names, "--names", "run") if names else tuple(default)
     if all_task_runs(runs):
+        if across_scenes:
+            raise InvalidInputError("--across-scenes compares eval world runs only")
         t = compare_task(runs, row_names)
     else:
-        t = compare_runs(runs, row_names, methods)
+        t = compare_runs(runs, row_names, methods, across_scenes)
     print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

@@ -30,12 +30,22 @@ LIKE_FOR_LIKE = (
     "sizes",
     "scene",
 )
+# what runs of one agent in different worlds may differ in besides the scene: the goals per scene
+# file (a folder of 20 scenes with 5 goals each against the kitchen's 100), as long as every
+# size has as many episodes in each run
+ACROSS_SCENES = ("scene", "goals")
 
 
-def compare(runs: Sequence[Path], names: Sequence[str], methods: Sequence[str]) -> TextTable:
+def compare(
+    runs: Sequence[Path],
+    names: Sequence[str],
+    methods: Sequence[str],
+    across_scenes: bool = False,
+) -> TextTable:
     """One row per run folder (`names[i]` for `runs[i]`): its method's success rate and subgoal
     completion per size (`methods`: one for every run, or one per run), and the paper's row
-    where it reports the one method compared.
+    where it reports the one method compared. With `across_scenes`, the runs may have run in
+    different scenes (and so with different goals per scene file), as many episodes per size.
 
     Raises InvalidInputError for a folder that is no finished eval world run, one without its
     method, or runs that are not like for like (the first setting that differs is named)."""
@@ -51,6 +61,8 @@ def compare(runs: Sequence[Path], names: Sequence[str], methods: Sequence[str]) 
             known = ", ".join(summary["methods"])
             raise InvalidInputError(f"'{run}' holds no method '{method}' (it holds {known})")
         for key in LIKE_FOR_LIKE:
+            if across_scenes and key in ACROSS_SCENES:
+                continue
             if s.get(key) != settings[0].get(key):
                 raise InvalidInputError(
                     f"'{run}' and '{runs[0]}' differ in {key} ({s.get(key)} against "
@@ -58,6 +70,8 @@ def compare(runs: Sequence[Path], names: Sequence[str], methods: Sequence[str]) 
                 )
     by_run = [s["methods"][m]["by_size"] for s, m in zip(summaries, methods, strict=True)]
     sizes = sorted({int(n) for by_size in by_run for n in by_size})
+    if across_scenes:
+        _check_episodes(runs, by_run)
     rows = []
     for name, by_size in zip(names, by_run, strict=True):
         rows.append((name, *(cell(by_size[str(n)]) if str(n) in by_size else "—" for n in sizes)))
@@ -70,13 +84,30 @@ def compare(runs: Sequence[Path], names: Sequence[str], methods: Sequence[str]) 
     source = first["goals_file"] or f"{first['goals']} random goals per size"
     repeats = "each run once" if first["repeats"] == 1 else f"each run {first['repeats']} times"
     what = label(method) if one else "each run's method"
+    if across_scenes:
+        episodes = next(iter(by_run[0].values()))["episodes"]
+        source, by, place = f"{episodes} episodes per size in each run's scenes", "scene", ""
+    else:
+        by, place = "run", where(first)
     title = (
         f"Success rate / subgoal completion of {what} "
-        f"by run ({protocol_name(first)}): "
-        f"{source}, {repeats}, seed {first['seed']}{where(first)}"
+        f"by {by} ({protocol_name(first)}): "
+        f"{source}, {repeats}, seed {first['seed']}{place}"
     )
     header = ("run", *(f"{n} objects" for n in sizes))
     return TextTable(marked(title, first["seed"]), header, tuple(rows))
+
+
+def _check_episodes(runs: Sequence[Path], by_run: list[dict]) -> None:
+    """Runs in different scenes stand side by side only with as many episodes of every size."""
+    for run, by_size in zip(runs, by_run, strict=True):
+        for n, size in by_size.items():
+            theirs = by_run[0].get(n, {}).get("episodes")
+            if size["episodes"] != theirs:
+                raise InvalidInputError(
+                    f"'{run}' ran {size['episodes']} episodes of {n} objects and '{runs[0]}' "
+                    f"{theirs or 0}: runs in different scenes compare on as many episodes"
+                )
 
 
 def _settings(run: Path) -> dict:

@@ -129,3 +129,23 @@ def test_task_runs_are_compared_on_the_same_episodes(tmp_path):
     recovering = _task_run(tmp_path / "d", (True, True), protocol="recovering")
     with pytest.raises(InvalidInputError, match="differ in protocol"):
         compare_task([a, recovering], ["a", "d"])
+
+
+def test_runs_of_one_agent_in_different_scenes_stand_side_by_side_on_as_many_episodes(tmp_path):
+    kitchen = _run(tmp_path / "kitchen", {2: (True, True, True, True)})
+    layouts = _run(tmp_path / "layouts", {2: (True, False)}, scene="scenes/layouts")
+    summary = json.loads((layouts / "summary.json").read_text())
+    summary["methods"]["gnn"]["by_size"]["2"]["episodes"] = 4  # 2 goals in each of 2 scenes
+    (layouts / "summary.json").write_text(json.dumps(summary))
+    table = compare([kitchen, layouts], ["kitchen", "layouts"], ["gnn"], across_scenes=True)
+    assert [r[0] for r in table.rows[:2]] == ["kitchen", "layouts"]
+    assert table.rows[0][1].startswith("1.00") and table.rows[1][1].startswith("0.50")
+    assert "by scene" in table.title and "4 episodes per size" in table.title
+    with pytest.raises(InvalidInputError, match="differ in goals"):  # like for like, unless told
+        compare([kitchen, layouts], ["kitchen", "layouts"], ["gnn"])
+    fewer = _run(tmp_path / "fewer", {2: (True, False)}, scene="scenes/layouts")
+    with pytest.raises(InvalidInputError, match="ran 2 episodes of 2 objects"):
+        compare([kitchen, fewer], ["kitchen", "fewer"], ["gnn"], across_scenes=True)
+    other = _run(tmp_path / "other", {2: (True, True, True, True)}, seed=3, scene="x")
+    with pytest.raises(InvalidInputError, match="differ in seed"):
+        compare([kitchen, other], ["kitchen", "other"], ["gnn"], across_scenes=True)
