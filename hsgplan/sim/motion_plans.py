@@ -128,8 +128,12 @@ def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
         if q_at is None:
             continue
         descent = _descent(scene, above, target, q_above)
-        chain = [q_above, *(descent or ()), q_at]
-        if descent is not None and all(
+        if descent is None:
+            continue
+        chain = [q_above, *descent, q_at]
+        # q_at is solved from q_above and may land on another branch than the descent's last
+        # point: the arm would swing between them through what a pick ignores, its object.
+        if np.max(np.abs(q_at - chain[-2])) <= MAX_JOINT_JUMP and all(
             near.segment_free(a, b) for a, b in zip(chain, chain[1:], strict=False)
         ):
             return q_above, q_at, descent

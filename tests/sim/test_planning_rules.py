@@ -147,3 +147,33 @@ def test_tree_search_gives_up_after_its_budget_of_checks():
     from hsgplan.sim.motion import RRT_CHECKS
 
     assert RRT_CHECKS <= wall.calls < 2 * RRT_CHECKS
+
+
+def test_a_grasp_on_another_branch_than_its_descent_is_not_planned(scene, monkeypatch):
+    """The pose at the object is solved from the one above it; a solution on another branch
+    would swing the arm between the descent's last point and it, through the object a pick's
+    checks leave out."""
+    from hsgplan.sim import motion_plans
+
+    robot, solve = scene.robot, scene.robot.ik
+    asked = []
+
+    def recorded(target, *args, **kwargs):
+        asked.append(target.position[2])
+        return solve(target, *args, **kwargs)
+
+    def flipped(target, *args, **kwargs):
+        q = solve(target, *args, **kwargs)
+        if q is not None and abs(target.position[2] - min(asked)) < 1e-9:
+            q = q.copy()
+            q[6] += motion_plans.MAX_JOINT_JUMP + 0.1  # the hand turned about the object
+        return q
+
+    q0 = robot.q()
+    monkeypatch.setattr(robot, "ik", recorded)
+    plan = motion_plans.plan_primitive(scene, PickParams("cherries"))
+    assert plan.params == PickParams("cherries")  # the lowest pose asked is the grasp's
+    robot.set_q(q0)
+    monkeypatch.setattr(robot, "ik", flipped)
+    refused = motion_plans.plan_primitive(scene, PickParams("cherries"))
+    assert refused.status is Status.NO_IK
