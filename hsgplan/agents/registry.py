@@ -77,6 +77,7 @@ def _learned(
         folders = {kind: checkpoints / f"{kind.value}-{model}" for kind in MotionPrimitive}
         return LearnedMotion(model, folders, rules, place_for_push, DRY_RUNS if checked else 0)
 
+    make.model = model  # the networks it reads: `LEARNED_MOTION`
     return make
 
 
@@ -175,11 +176,7 @@ def agent_parts(name: str) -> tuple[str, str]:
 LEARNED_PLANNERS = ("regression", "regression-paper", "forward")
 # learned motion generator -> the model whose networks it reads (`KIND-MODEL` folders)
 LEARNED_MOTION = {
-    "gnn": "gnn",
-    "gnn-next": "gnn",
-    "gnn-checked": "gnn",
-    "gnn-next-checked": "gnn",
-    "mlp": "mlp",
+    name: make.model for name, make in MOTION_GENERATORS.items() if hasattr(make, "model")
 }
 
 
