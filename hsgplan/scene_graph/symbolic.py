@@ -117,6 +117,18 @@ class SymbolicSceneGraph:
             o for o in self.objects if self.location(o) == Literal(Predicate.IN, (o, shelf))
         )
 
+    def moved(self, lit: Literal) -> SymbolicSceneGraph:
+        """The state with `lit`'s object placed where `lit` (On, In or InGrasp) says, every other
+        placement as it is: a state imagined, not checked (what rested on the object stays on
+        it, a second object may be in the hand)."""
+        kept = {self.location(o) for o in self.objects if o != lit.subject}
+        placements = kept | {lit}
+        return SymbolicSceneGraph(
+            self.objects,
+            frozenset(placements | _derive_clear(self.objects, placements)),
+            world=self.world,
+        )
+
     def level(self, obj: str) -> int:
         """1 for an object on a surface, one more for each object beneath it; 0 if not stacked."""
         loc = self.location(obj)

@@ -46,7 +46,7 @@ def test_the_profiler_catches_a_call_into_the_transition_model():
     assert any("applicable_actions" in c for c in calls)
 
 
-@pytest.mark.parametrize("kind", ["regression", "regression-paper", "forward"])
+@pytest.mark.parametrize("kind", ["regression", "regression-ahead", "regression-paper", "forward"])
 def test_a_learned_planner_decides_without_the_rules(kind):
     checkpoint = shipped(TASK_CHECKPOINT)
     # the forward planner searches with f_reach at every node: one seed and the shortest goal
@@ -55,7 +55,9 @@ def test_a_learned_planner_decides_without_the_rules(kind):
         goal = parse_goal(text, world=KITCHEN)
         for seed in range(2 if kind == "regression" else 1):
             calls: list[str] = []
-            if kind == "regression":
+            if kind == "regression-ahead":
+                planner = RegressionPlanner(checkpoint, seed=seed, look_ahead=True)
+            elif kind == "regression":
                 planner = RegressionPlanner(checkpoint, seed=seed)
             elif kind == "regression-paper":
                 planner = PaperRegressionPlanner(checkpoint, seed=seed)

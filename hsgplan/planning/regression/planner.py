@@ -40,6 +40,7 @@ from hsgplan.planning.regression.encoding import (
     touching,
 )
 from hsgplan.planning.regression.gnn import load_network
+from hsgplan.planning.regression.lookahead import AHEAD_REACH, imagined
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MAX_DEPTH = 8
@@ -117,6 +118,10 @@ class RegressionPlanner:
     `avoid_taken`, `least_taken`, `likeliest_literal`, `failed_goal_waits`); with all of them
     off it is the paper's planner: the shallowest reachable literal, drawn uniformly, or
     "regression stuck".
+
+    With `look_ahead` (beyond the paper, `lookahead.py`) a subgoal is passed over while another
+    is found when f_reach, asked in the state with the subgoal imagined achieved, finds the
+    literal it serves out of reach (a place onto a full shelf top, before the pick).
     """
 
     name = "regression"
@@ -127,7 +132,9 @@ class RegressionPlanner:
         seed: int = 0,
         max_depth: int = MAX_DEPTH,
         rules: RecoveryRules = ALL_RULES,
+        look_ahead: bool = False,
     ) -> None:
+        self.look_ahead = look_ahead
         self.preimage, self.reach = _inference_networks(str(checkpoint))
         self.features = self.preimage.config.features
         if self.reach.config.features != self.features:
@@ -224,10 +231,15 @@ class RegressionPlanner:
         if rules.least_taken:
             passes.append((set(), taken))
         for avoid, counts in passes or [(set(), None)]:
+            vetoed: list[_Node] = []
             for frontier in (free, [x for x in pairs if x not in free]):
-                found = self._search(state, frontier, avoid, seen, counts)
+                found = self._search(state, frontier, avoid, seen, counts, vetoed)
                 if found is not None:
                     return self._take(state, goal, *found, taken, start)
+            # every subgoal found serves a literal out of reach once it is achieved: the first
+            # ones found, as the planner takes them without looking ahead
+            if (found := self._choose(state, vetoed, avoid, counts)) is not None:
+                return self._take(state, goal, *found, taken, start)
             if not rules.likeliest_literal:
                 continue
             # Nothing reached: the literal f_reach finds likeliest (it learned the physical
@@ -262,7 +274,30 @@ class RegressionPlanner:
         self._plan = None
         return None
 
-    def _search(self, state, frontier, avoid, seen, counts=None):
+    def _chain_reachable(self, state, node: _Node) -> bool:
+        """Whether every literal up the node's chain stays reachable (f_reach above
+        AHEAD_REACH) once the ones below it are imagined achieved, in turn."""
+        below = node.lit
+        for lit, _ in reversed(node.chain):
+            state = imagined(state, below)
+            if state is None:  # a literal that places nothing: no further look
+                return True
+            if self.reach_scores(state, [lit])[0] <= AHEAD_REACH:
+                return False
+            below = lit
+        return True
+
+    def _ahead(self, state, nodes: list[_Node], vetoed: list[_Node]) -> list[_Node]:
+        """The nodes whose chain stays reachable (all of them without the look-ahead); the
+        first nodes passed over are kept in `vetoed`."""
+        if not self.look_ahead:
+            return nodes
+        kept = [n for n in nodes if self._chain_reachable(state, n)]
+        if not vetoed:
+            vetoed.extend(n for n in nodes if n not in kept)
+        return kept
+
+    def _search(self, state, frontier, avoid, seen, counts, vetoed):
         """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
 
         A node is reached when f_reach says so, or when its whole preimage already holds
@@ -281,11 +316,12 @@ class RegressionPlanner:
                 reach.update(zip(ask, self.reach_scores(state, ask), strict=True))
             for n, _ in frontier:
                 seen.setdefault(n.lit, (reach[n.lit], n))
-            hits = [n for n, _ in frontier if reach[n.lit] > 0.5]
+            hits = self._ahead(state, [n for n, _ in frontier if reach[n.lit] > 0.5], vetoed)
             if found := self._choose(state, hits, avoid, counts):
                 return found
             frontier = self._with_preimages(state, frontier)
             done = [n for n, pre in frontier if all(state.holds(m) for m in pre)]
+            done = self._ahead(state, done, vetoed)
             if found := self._choose(state, done, avoid, counts):
                 return found
             frontier = children if known else self._children(state, frontier)

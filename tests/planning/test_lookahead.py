@@ -1,0 +1,99 @@
+"""The regression planner's look-ahead (`regression-ahead`): a subgoal whose chain leads to a
+literal f_reach finds out of reach once the subgoal is imagined achieved is passed over while
+another is found. f_reach is replaced by a hand-written stand-in here, so that what is tested
+is the mechanism, not what the shipped network learned."""
+
+from hsgplan.domain.actions import Pick
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.predicates import Literal, Predicate, clear, in_grasp, on
+from hsgplan.paths import TASK_CHECKPOINT
+from hsgplan.planning.regression.lookahead import AHEAD_REACH, imagined
+from hsgplan.planning.regression.planner import RegressionPlanner, _Node
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+
+# shelf_a's top holds four objects, its capacity; butter waits on the open space
+FULL = SymbolicSceneGraph.from_literals(
+    ["cherries", "alphabet_soup", "tomato_soup", "popcorn", "butter"],
+    [
+        on("cherries", "shelf_a"),
+        on("alphabet_soup", "shelf_a"),
+        on("tomato_soup", "shelf_a"),
+        on("popcorn", "shelf_a"),
+        on("butter", "open_space"),
+    ],
+    world=KITCHEN,
+)
+
+
+def test_a_state_imagined_moves_one_object_and_derives_what_is_clear():
+    start = SymbolicSceneGraph.from_literals(
+        ["cherries", "butter"],
+        [on("cherries", "open_space"), on("butter", "cherries")],
+        world=KITCHEN,
+    )
+    after = imagined(start, in_grasp("butter"))
+    assert after.location("butter") == in_grasp("butter")
+    assert after.location("cherries") == start.location("cherries")
+    assert after.holds(clear("cherries")) and not after.holds(clear("butter"))
+    assert start.location("butter") == on("butter", "cherries")  # the state itself is kept
+
+
+def test_a_literal_that_places_nothing_is_not_imagined():
+    assert imagined(FULL, clear("cherries")) is None
+    assert imagined(FULL, Literal(Predicate.ON, ("butter", "open_space"), False)) is None
+
+
+def _reach_refusing_full_tops(asked: list):
+    """f_reach's stand-in: a place is in reach when its object is held and the top it goes to
+    holds fewer than four objects; a pick when the hand is empty; nothing else."""
+
+    def reachable(state, lit) -> bool:
+        if lit.predicate is Predicate.ON:
+            return state.held() == lit.subject and len(state.resting_on(lit.args[1])) < 4
+        return lit.predicate is Predicate.IN_GRASP and state.held() is None
+
+    def scores(state, lits):
+        asked.append((state, lits))
+        return [float(reachable(state, lit)) for lit in lits]
+
+    return scores
+
+
+def test_a_chain_is_checked_link_by_link_in_the_state_imagined_below_it():
+    planner = RegressionPlanner(TASK_CHECKPOINT, look_ahead=True)
+    asked: list = []
+    planner.reach_scores = _reach_refusing_full_tops(asked)
+    serves = on("butter", "shelf_a")
+    node = _Node(
+        in_grasp("butter"), frozenset(), (serves, in_grasp("butter")), ((serves, frozenset()),)
+    )
+    assert not planner._chain_reachable(FULL, node)
+    state, lits = asked[-1]
+    assert lits == [serves] and state.location("butter") == in_grasp("butter")
+    # the same chain towards shelf_b, whose top is empty, stays reachable
+    other = on("butter", "shelf_b")
+    assert planner._chain_reachable(
+        FULL, _Node(in_grasp("butter"), frozenset(), (other,), ((other, frozenset()),))
+    )
+    assert 0.0 < AHEAD_REACH < 0.5
+
+
+def test_the_look_ahead_empties_a_full_top_before_it_fills_it():
+    # the goal moves cherries off shelf_a's full top and butter onto it: picking butter first
+    # would leave it in the hand with nowhere to go
+    goal = parse_goal("On(cherries, shelf_b) & On(butter, shelf_a)", world=KITCHEN)
+    for seed in range(4):
+        planner = RegressionPlanner(TASK_CHECKPOINT, seed=seed, look_ahead=True)
+        planner.reach_scores = _reach_refusing_full_tops([])
+        planner.reset(goal, seed)
+        assert planner.next_action(FULL, goal).action == Pick("cherries"), seed
+
+
+def test_without_anything_else_to_do_the_planner_takes_a_subgoal_it_doubts():
+    # nothing can leave the full top: the place is tried, as without the look-ahead
+    goal = parse_goal("On(butter, shelf_a)", world=KITCHEN)
+    planner = RegressionPlanner(TASK_CHECKPOINT, look_ahead=True)
+    planner.reach_scores = _reach_refusing_full_tops([])
+    planner.reset(goal, 0)
+    assert planner.next_action(FULL, goal).action == Pick("butter")
