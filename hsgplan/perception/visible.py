@@ -114,8 +114,8 @@ def visible_masks(label: np.ndarray, count: int, apart: int = 0) -> list[np.ndar
     Painted from estimates, an edge between two objects is off by a pixel or two, more where
     the two are not turned alike (a box stacked askew on another, painted with the stack's one
     yaw): the lower box's strip of side then shows the upper one's colour along that edge, and
-    named a butter under a cream cheese cream cheese (4 of 8 look-alikes on 300 tuning scenes,
-    seeds 900 to 902, all four named right 2 pixels apart, not all at 4)."""
+    named a butter under a cream cheese cream cheese (4 of the 6 look-alikes on 300 tuning
+    scenes, seeds 900 to 902; all four named right at 2 pixels apart, not all at 4)."""
     kernel = np.ones((3, 3), np.uint8)
     grow = np.ones((2 * apart + 1, 2 * apart + 1), np.uint8)
     out = []

@@ -163,3 +163,29 @@ def test_pixels_named_background_are_no_votes():
     assert vote is not None and vote.shape == (len(TYPES),)
     assert TYPES[int(vote.argmax())] == "cream_cheese" and float(vote.sum()) == pytest.approx(1)
     assert pixel_vote(_WithBackground(), image, mask & (np.arange(10) < 8), boxes) is None
+
+
+def test_pixels_near_another_objects_are_left_out_of_a_vote():
+    kept = 0
+    for view in VIEWS:
+        label = painted(["cream_cheese", "butter"], [LOWER, UPPER], PinholeCamera.of(view))
+        lower, upper = visible_masks(label, 2)
+        apart_lower, apart_upper = visible_masks(label, 2, apart=2)
+        assert (apart_lower <= lower).all() and (apart_upper <= upper).all()
+        near = np.argwhere(apart_lower)
+        kept += len(near)
+        if len(near):
+            butter = np.argwhere(label == 1)
+            gaps = np.abs(near[:, None] - butter[None]).max(axis=2)  # a 5 x 5 square around
+            assert gaps.min() > 2
+    assert kept >= MIN_REGION  # the lower box's side keeps pixels in some view
+
+
+def test_a_stack_askew_is_split_and_each_box_named_by_its_own_pixels():
+    askew = Pose.from_xyz_yaw(*UPPER.position, 0.3 + 0.5)  # turned against the lower box
+    types = ["cream_cheese", "butter"]
+    images = _painted_images(types, [LOWER, askew])
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    blob = _blob("butter", KITCHEN.object_types["butter"].size[2])  # at the lower one's yaw
+    split = estimator._unstacked(images, VIEWS, [blob])
+    assert [d.type_name for d in split] == types
