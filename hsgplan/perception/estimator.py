@@ -164,6 +164,7 @@ class PoseEstimator:
             pinhole = PinholeCamera.of(camera)
             label = painted(types, poses, pinhole, whole=by_pixels)
             masks = visible_masks(label, len(found), APART_PX)
+            near: list[np.ndarray] | None = None  # the masks with every pixel in sight
             for i, (d, mask) in enumerate(zip(found, masks, strict=True)):
                 if not any(np.allclose(k.camera.eye, pinhole.eye) for k in d.keypoints):
                     continue  # a view that did not find it: a phantom's pixels there are not its
@@ -171,6 +172,11 @@ class PoseEstimator:
                 own = 0 <= v < label.shape[0] and 0 <= u < label.shape[1] and label[v, u] == i
                 if not own or i in by_pixels:
                     vote = pixel_vote(self.colour, image, mask, kinds[i])
+                    if vote is None and APART_PX > 0:
+                        # a split stack's lower box shows a strip of side a few pixels tall,
+                        # none `APART_PX` from the upper one's: unvoted, it kept the upper's name
+                        near = near or visible_masks(label, len(found))
+                        vote = pixel_vote(self.colour, image, near[i], kinds[i])
                 elif (row := features(image, np.array([u, v]))) is not None:
                     vote = type_probs(self.colour, row[None])[0]
                 else:
@@ -266,9 +272,10 @@ def _inside_table(pose: Pose) -> bool:
 def _stack_of_two(d: Detection, found: list[Detection]) -> bool:
     """Whether a detection is two thin boxes stacked: a thin box where several views' rays
     meet, its centre within `STACK_BAND` of its heights over the surface under it, and no other
-    detection within `OVERLAP_XY` across either lower (a carrier, or the lower box found) or
-    resting on it with its bottom under one and a half boxes up (it stands on one box: seed 1's
-    scene 11 split a butter under a soup into two boxes, the upper one where the soup stood)."""
+    detection centred over that surface within `OVERLAP_XY` across either lower (a carrier, or
+    the lower box found) or resting on it with its bottom under one and a half boxes up (it
+    stands on one box: seed 1's scene 11 split a butter under a soup). One centred under it is
+    no carrier: a lone view's soup inside a shelf kept a stack on its top one box (seed 903)."""
     height = KITCHEN.object_type(d.type_name).size[2]
     if height > THIN or len(d.rays) < 2:
         return False
@@ -280,6 +287,8 @@ def _stack_of_two(d: Detection, found: list[Detection]) -> bool:
     base = max(tops)
     for k in found:
         if k is d or math.dist(k.pose.position[:2], (x, y)) >= OVERLAP_XY:
+            continue
+        if k.pose.position[2] <= base:
             continue
         if k.pose.position[2] < z:
             return False  # a carrier, or the lower box found

@@ -9,6 +9,7 @@ import pytest
 import torch
 
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.perception import estimator as estimator_module
 from hsgplan.perception.colour import MIN_REGION, features, pixel_vote
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
@@ -101,14 +102,13 @@ def test_a_region_half_hidden_by_a_soup_is_named_by_its_own_pixels_not_their_mea
     assert pixel_vote(colour, image[:1, :6], mask[:1, :6], boxes) is None  # too few pixels
 
 
-def _blob(name: str, z: float) -> Detection:
-    """A detection where several views' rays meet at (LOWER's x, y, z)."""
-    centre = np.array([*LOWER.position[:2], z])
+def _blob(name: str, z: float, at: Pose = LOWER) -> Detection:
+    """A detection where several views' rays meet at (`at`'s x, y, z), at its yaw."""
+    centre = np.array([*at.position[:2], z])
     rays = tuple(
         (np.array(c.eye), (centre - c.eye) / np.linalg.norm(centre - c.eye)) for c in VIEWS
     )
-    at = Pose(tuple(centre), LOWER.orientation)
-    return replace(_detection(name, at), rays=rays)
+    return replace(_detection(name, Pose(tuple(centre), at.orientation)), rays=rays)
 
 
 def test_two_thin_boxes_seen_as_one_are_split_and_each_named_by_its_colour():
@@ -189,3 +189,31 @@ def test_a_stack_askew_is_split_and_each_box_named_by_its_own_pixels():
     blob = _blob("butter", KITCHEN.object_types["butter"].size[2])  # at the lower one's yaw
     split = estimator._unstacked(images, VIEWS, [blob])
     assert [d.type_name for d in split] == types
+
+
+def test_a_detection_under_the_surface_a_stack_stands_on_does_not_keep_it_one_box():
+    # two thin boxes on shelf A's top, seen as one blob; a can found inside the shelf under them
+    top = KITCHEN.shelves["shelf_a"].top.z
+    height = KITCHEN.object_types["butter"].size[2]
+    x, y = 0.49, 0.38
+    lower, upper = (Pose.from_xyz_yaw(x, y, top + k * height, 0.3) for k in (0.5, 1.5))
+    images = _painted_images(["cream_cheese", "butter"], [lower, upper])
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    blob = _blob("butter", top + height, lower)
+    inside = _detection("tomato_soup", Pose.from_xyz_yaw(x, y, 0.042, 0.0))
+    split = estimator._unstacked(images, VIEWS, [inside, blob])
+    assert inside in split and sum(d.stacked for d in split) == 2
+    on_top = _detection("butter", lower)  # the lower box, found over the shelf's top
+    assert estimator._unstacked(images, VIEWS, [on_top, blob]) == [on_top, blob]
+
+
+def test_a_box_whose_pixels_all_lie_near_another_ones_edge_is_named_by_them(monkeypatch):
+    types, poses = ["cream_cheese", "butter"], [LOWER, UPPER]
+    monkeypatch.setattr(estimator_module, "APART_PX", 20)
+    for view in VIEWS:  # none of the lower box's pixels lies that far from the butter's
+        assert not visible_masks(painted(types, poses, PinholeCamera.of(view)), 2, 20)[0].any()
+    images = _painted_images(types, poses)
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    found = [_detection("butter", LOWER), _detection("butter", UPPER)]  # as the centroids say
+    named = estimator._retyped(images, VIEWS, found)
+    assert [d.type_name for d in named] == types
