@@ -188,3 +188,12 @@ def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand()
     results = evaluate_loop(Oracle(first), 2, 3, views=1)
     # every object found where it is, the hand's detection not counted against precision
     assert all(r.found == r.objects == r.detections and r.symbolic_match for r in results)
+
+
+def test_a_lone_views_box_in_the_space_of_a_can_several_views_saw_is_not_kept():
+    soup = Detection("alphabet_soup", Pose.from_xyz_yaw(0.54, -0.14, 0.042, 0.0), 0.8, 5, 0.0)
+    soup = Detection(soup.type_name, soup.pose, 0.8, 5, 0.0, (), 0.51)  # a butter on it, above
+    lone = Detection("butter", Pose.from_xyz_yaw(0.54, -0.13, 0.06, 0.0), 0.5, 1, 0.0, (), 0.95)
+    assert _apart([lone, soup]) == [soup]
+    several = Detection(lone.type_name, lone.pose, 0.5, 2, 0.0, (), 0.95)
+    assert _apart([several, soup]) == [several]  # two views against five: the colour decides

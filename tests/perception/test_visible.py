@@ -9,6 +9,7 @@ import pytest
 import torch
 
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.perception import estimator as estimator_module
 from hsgplan.perception.colour import MIN_REGION, features, pixel_vote
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
@@ -101,14 +102,13 @@ def test_a_region_half_hidden_by_a_soup_is_named_by_its_own_pixels_not_their_mea
     assert pixel_vote(colour, image[:1, :6], mask[:1, :6], boxes) is None  # too few pixels
 
 
-def _blob(name: str, z: float) -> Detection:
-    """A detection where several views' rays meet at (LOWER's x, y, z)."""
-    centre = np.array([*LOWER.position[:2], z])
+def _blob(name: str, z: float, at: Pose = LOWER) -> Detection:
+    """A detection where several views' rays meet at (`at`'s x, y, z), at its yaw."""
+    centre = np.array([*at.position[:2], z])
     rays = tuple(
         (np.array(c.eye), (centre - c.eye) / np.linalg.norm(centre - c.eye)) for c in VIEWS
     )
-    at = Pose(tuple(centre), LOWER.orientation)
-    return replace(_detection(name, at), rays=rays)
+    return replace(_detection(name, Pose(tuple(centre), at.orientation)), rays=rays)
 
 
 def test_two_thin_boxes_seen_as_one_are_split_and_each_named_by_its_colour():
@@ -163,3 +163,57 @@ def test_pixels_named_background_are_no_votes():
     assert vote is not None and vote.shape == (len(TYPES),)
     assert TYPES[int(vote.argmax())] == "cream_cheese" and float(vote.sum()) == pytest.approx(1)
     assert pixel_vote(_WithBackground(), image, mask & (np.arange(10) < 8), boxes) is None
+
+
+def test_pixels_near_another_objects_are_left_out_of_a_vote():
+    kept = 0
+    for view in VIEWS:
+        label = painted(["cream_cheese", "butter"], [LOWER, UPPER], PinholeCamera.of(view))
+        lower, upper = visible_masks(label, 2)
+        apart_lower, apart_upper = visible_masks(label, 2, apart=2)
+        assert (apart_lower <= lower).all() and (apart_upper <= upper).all()
+        near = np.argwhere(apart_lower)
+        kept += len(near)
+        if len(near):
+            butter = np.argwhere(label == 1)
+            gaps = np.abs(near[:, None] - butter[None]).max(axis=2)  # a 5 x 5 square around
+            assert gaps.min() > 2
+    assert kept >= MIN_REGION  # the lower box's side keeps pixels in some view
+
+
+def test_a_stack_askew_is_split_and_each_box_named_by_its_own_pixels():
+    askew = Pose.from_xyz_yaw(*UPPER.position, 0.3 + 0.5)  # turned against the lower box
+    types = ["cream_cheese", "butter"]
+    images = _painted_images(types, [LOWER, askew])
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    blob = _blob("butter", KITCHEN.object_types["butter"].size[2])  # at the lower one's yaw
+    split = estimator._unstacked(images, VIEWS, [blob])
+    assert [d.type_name for d in split] == types
+
+
+def test_a_detection_under_the_surface_a_stack_stands_on_does_not_keep_it_one_box():
+    # two thin boxes on shelf A's top, seen as one blob; a can found inside the shelf under them
+    top = KITCHEN.shelves["shelf_a"].top.z
+    height = KITCHEN.object_types["butter"].size[2]
+    x, y = 0.49, 0.38
+    lower, upper = (Pose.from_xyz_yaw(x, y, top + k * height, 0.3) for k in (0.5, 1.5))
+    images = _painted_images(["cream_cheese", "butter"], [lower, upper])
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    blob = _blob("butter", top + height, lower)
+    inside = _detection("tomato_soup", Pose.from_xyz_yaw(x, y, 0.042, 0.0))
+    split = estimator._unstacked(images, VIEWS, [inside, blob])
+    assert inside in split and sum(d.stacked for d in split) == 2
+    on_top = _detection("butter", lower)  # the lower box, found over the shelf's top
+    assert estimator._unstacked(images, VIEWS, [on_top, blob]) == [on_top, blob]
+
+
+def test_a_box_whose_pixels_all_lie_near_another_ones_edge_is_named_by_them(monkeypatch):
+    types, poses = ["cream_cheese", "butter"], [LOWER, UPPER]
+    monkeypatch.setattr(estimator_module, "APART_PX", 20)
+    for view in VIEWS:  # none of the lower box's pixels lies that far from the butter's
+        assert not visible_masks(painted(types, poses, PinholeCamera.of(view)), 2, 20)[0].any()
+    images = _painted_images(types, poses)
+    estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
+    found = [_detection("butter", LOWER), _detection("butter", UPPER)]  # as the centroids say
+    named = estimator._retyped(images, VIEWS, found)
+    assert [d.type_name for d in named] == types
