@@ -47,7 +47,9 @@ def check_claim(run_dir: Path, kind: str, config: dict, refusal: str) -> bool:
             raise InvalidInputError(
                 f"'{run_dir}' is not {a(kind)} run folder (it holds {what}); use another --out"
             )
-        if other != config:
+        # A setting added since the folder was claimed, at its default of None (which keeps
+        # what runs did before it existed: `scene` None is the kitchen), is no difference.
+        if other != {k: v for k, v in config.items() if k in other or v is not None}:
             raise InvalidInputError(refusal)
         return True
     if run_dir.is_dir() and has_files(run_dir):
