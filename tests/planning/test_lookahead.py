@@ -8,8 +8,8 @@ from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import Literal, Predicate, clear, in_grasp, on
 from hsgplan.paths import TASK_CHECKPOINT
-from hsgplan.planning.regression.lookahead import AHEAD_REACH, imagined
-from hsgplan.planning.regression.planner import RegressionPlanner, _Node
+from hsgplan.planning.regression.lookahead import AHEAD_REACH, chain_reachable, imagined
+from hsgplan.planning.regression.planner import RegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 # shelf_a's top holds four objects, its capacity; butter waits on the open space
@@ -61,21 +61,19 @@ def _reach_refusing_full_tops(asked: list):
 
 
 def test_a_chain_is_checked_link_by_link_in_the_state_imagined_below_it():
-    planner = RegressionPlanner(TASK_CHECKPOINT, look_ahead=True)
     asked: list = []
-    planner.reach_scores = _reach_refusing_full_tops(asked)
-    serves = on("butter", "shelf_a")
-    node = _Node(
-        in_grasp("butter"), frozenset(), (serves, in_grasp("butter")), ((serves, frozenset()),)
-    )
-    assert not planner._chain_reachable(FULL, node)
+    reach = _reach_refusing_full_tops(asked)
+    # InGrasp(butter) <- On(butter, shelf_a): the top is full once butter is in the hand
+    assert not chain_reachable(FULL, in_grasp("butter"), [on("butter", "shelf_a")], reach)
     state, lits = asked[-1]
-    assert lits == [serves] and state.location("butter") == in_grasp("butter")
+    assert lits == [on("butter", "shelf_a")] and state.location("butter") == in_grasp("butter")
     # the same chain towards shelf_b, whose top is empty, stays reachable
-    other = on("butter", "shelf_b")
-    assert planner._chain_reachable(
-        FULL, _Node(in_grasp("butter"), frozenset(), (other,), ((other, frozenset()),))
-    )
+    assert chain_reachable(FULL, in_grasp("butter"), [on("butter", "shelf_b")], reach)
+    # each link is asked in the state with the ones below achieved: butter on shelf_b, then
+    # stacked on cherries (a place onto an object is in reach while it is held: not here)
+    up = [on("butter", "shelf_b"), on("butter", "cherries")]
+    assert not chain_reachable(FULL, in_grasp("butter"), up, reach)
+    assert asked[-1][0].location("butter") == on("butter", "shelf_b")
     assert 0.0 < AHEAD_REACH < 0.5
 
 

@@ -16,6 +16,8 @@ a literal that places no object (Clear, a negation) is not imagined.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -31,3 +33,23 @@ def imagined(state: SymbolicSceneGraph, lit: Literal) -> SymbolicSceneGraph | No
     if not lit.positive or lit.predicate not in PLACEMENTS:
         return None
     return state.moved(lit)
+
+
+def chain_reachable(
+    state: SymbolicSceneGraph,
+    lit: Literal,
+    up: Sequence[Literal],
+    reach: Callable[[SymbolicSceneGraph, list[Literal]], list[float]],
+) -> bool:
+    """Whether each literal of `up` (the chain above `lit`, nearest first) stays reachable, by
+    `reach` (f_reach's chances) above AHEAD_REACH, once the ones below it are imagined
+    achieved in turn; a literal that places nothing ends the look there."""
+    below = lit
+    for above in up:
+        state = imagined(state, below)
+        if state is None:
+            return True
+        if reach(state, [above])[0] <= AHEAD_REACH:
+            return False
+        below = above
+    return True

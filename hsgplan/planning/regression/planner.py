@@ -40,7 +40,7 @@ from hsgplan.planning.regression.encoding import (
     touching,
 )
 from hsgplan.planning.regression.gnn import load_network
-from hsgplan.planning.regression.lookahead import AHEAD_REACH, imagined
+from hsgplan.planning.regression.lookahead import chain_reachable
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MAX_DEPTH = 8
@@ -120,8 +120,8 @@ class RegressionPlanner:
     "regression stuck".
 
     With `look_ahead` (beyond the paper, `lookahead.py`) a subgoal is passed over while another
-    is found when f_reach, asked in the state with the subgoal imagined achieved, finds the
-    literal it serves out of reach (a place onto a full shelf top, before the pick).
+    is found when f_reach finds a literal up its chain out of reach once those below it are
+    imagined achieved (a place onto a full shelf top, before the pick).
     """
 
     name = "regression"
@@ -274,25 +274,18 @@ class RegressionPlanner:
         self._plan = None
         return None
 
-    def _chain_reachable(self, state, node: _Node) -> bool:
-        """Whether every literal up the node's chain stays reachable (f_reach above
-        AHEAD_REACH) once the ones below it are imagined achieved, in turn."""
-        below = node.lit
-        for lit, _ in reversed(node.chain):
-            state = imagined(state, below)
-            if state is None:  # a literal that places nothing: no further look
-                return True
-            if self.reach_scores(state, [lit])[0] <= AHEAD_REACH:
-                return False
-            below = lit
-        return True
-
     def _ahead(self, state, nodes: list[_Node], vetoed: list[_Node]) -> list[_Node]:
         """The nodes whose chain stays reachable (all of them without the look-ahead); the
         first nodes passed over are kept in `vetoed`."""
         if not self.look_ahead:
             return nodes
-        kept = [n for n in nodes if self._chain_reachable(state, n)]
+        kept = [
+            n
+            for n in nodes
+            if chain_reachable(
+                state, n.lit, [lit for lit, _ in reversed(n.chain)], self.reach_scores
+            )
+        ]
         if not vetoed:
             vetoed.extend(n for n in nodes if n not in kept)
         return kept
