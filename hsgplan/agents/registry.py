@@ -38,6 +38,12 @@ def _regression_ahead(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     return RegressionPlanner(checkpoint, rules=rules, look_ahead=True)
 
 
+def _regression_ahead_chain(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
+    from hsgplan.planning.regression.planner import RegressionPlanner
+
+    return RegressionPlanner(checkpoint, rules=rules, look_ahead=True, sideways=False)
+
+
 def _regression_paper(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     from hsgplan.planning.regression.paper_loop import PaperRegressionPlanner
 
@@ -61,7 +67,9 @@ def _fast_downward(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
 TASK_PLANNERS: dict[str, Callable[[Path, RecoveryRules], TaskPlanner]] = {
     "regression": _regression,
     # the same networks; a subgoal is taken only if what it serves stays reachable (f_reach)
+    # and the picks other goal literals still need stay likely
     "regression-ahead": _regression_ahead,
+    "regression-ahead-chain": _regression_ahead_chain,  # the look up the chain alone
     "regression-paper": _regression_paper,  # the paper's loop (`paper_loop.py`), no rules
     "forward": _forward,
     "fd": _fast_downward,
@@ -181,7 +189,13 @@ def agent_parts(name: str) -> tuple[str, str]:
     return AGENTS[name]
 
 
-LEARNED_PLANNERS = ("regression", "regression-ahead", "regression-paper", "forward")
+LEARNED_PLANNERS = (
+    "regression",
+    "regression-ahead",
+    "regression-ahead-chain",
+    "regression-paper",
+    "forward",
+)
 # learned motion generator -> the model whose networks it reads (`KIND-MODEL` folders)
 LEARNED_MOTION = {
     name: make.model for name, make in MOTION_GENERATORS.items() if hasattr(make, "model")

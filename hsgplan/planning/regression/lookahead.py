@@ -12,19 +12,27 @@ achieved, is the literal it was regressed from reachable? A subgoal whose answer
 passed over while another is found. Imagining a subgoal achieved moves its object to where
 the literal says and nothing else (`SymbolicSceneGraph.moved`); it reads no precondition, and
 a literal that places no object (Clear, a negation) is not imagined.
+
+It also looks sideways: a chain is passed over when, with all of it imagined achieved, the
+pick of an object another goal literal still has to move falls from likely to unlikely by
+f_reach. Put a can beside a flat box on a shelf top and the box may no longer be picked (the
+hand is wider than the box along its closing axis); f_reach learned that from the world, and
+the box is moved first while it still can be.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.predicates import Literal, Predicate, in_grasp
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 # f_reach's chance at or below which a literal up the chain counts as out of reach. Lower than
 # the planner's 0.5: f_reach learned the world's odds, in which a top's last free spot is a
 # coin toss and a full one near zero. Chosen on tuning seed 900 (docs/decisions.md).
 AHEAD_REACH = 0.1
+# The planner's own line between likely and unlikely, for the pick of an object still to move.
+PICK_REACH = 0.5
 PLACEMENTS = (Predicate.ON, Predicate.IN, Predicate.IN_GRASP)
 
 
@@ -53,3 +61,26 @@ def chain_reachable(
             return False
         below = above
     return True
+
+
+def keeps_picks(
+    state: SymbolicSceneGraph,
+    chain: Sequence[Literal],
+    pending: Sequence[str],
+    reach: Callable[[SymbolicSceneGraph, list[Literal]], list[float]],
+) -> bool:
+    """Whether every object of `pending` (objects other goal literals still have to move) that
+    f_reach finds likely to be picked now stays so once `chain` (the subgoal first, its root
+    last) is imagined achieved literal by literal."""
+    others = [o for o in pending if all(o not in lit.args for lit in chain)]
+    if not others:
+        return True
+    after = state
+    for lit in chain:
+        after = imagined(after, lit)
+        if after is None:
+            return True
+    picks = [in_grasp(o) for o in others]
+    before = reach(state, picks)
+    now = reach(after, picks)
+    return not any(b > PICK_REACH >= a for b, a in zip(before, now, strict=True))

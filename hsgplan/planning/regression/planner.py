@@ -40,7 +40,7 @@ from hsgplan.planning.regression.encoding import (
     touching,
 )
 from hsgplan.planning.regression.gnn import load_network
-from hsgplan.planning.regression.lookahead import chain_reachable
+from hsgplan.planning.regression.lookahead import chain_reachable, keeps_picks
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MAX_DEPTH = 8
@@ -121,7 +121,9 @@ class RegressionPlanner:
 
     With `look_ahead` (beyond the paper, `lookahead.py`) a subgoal is passed over while another
     is found when f_reach finds a literal up its chain out of reach once those below it are
-    imagined achieved (a place onto a full shelf top, before the pick).
+    imagined achieved (a place onto a full shelf top, before the pick), and, with `sideways`,
+    when the pick of an object another goal literal still has to move falls from likely to
+    unlikely once the whole chain is imagined achieved (a can put down beside a flat box).
     """
 
     name = "regression"
@@ -133,8 +135,10 @@ class RegressionPlanner:
         max_depth: int = MAX_DEPTH,
         rules: RecoveryRules = ALL_RULES,
         look_ahead: bool = False,
+        sideways: bool = True,
     ) -> None:
         self.look_ahead = look_ahead
+        self.sideways = sideways
         self.preimage, self.reach = _inference_networks(str(checkpoint))
         self.features = self.preimage.config.features
         if self.reach.config.features != self.features:
@@ -155,6 +159,7 @@ class RegressionPlanner:
         # failed there; the goal literal it served is tried after the others from then on
         self._last: tuple[SymbolicSceneGraph, Action, Literal] | None = None
         self._failed_roots: set[Literal] = set()
+        self._pending: list[str] = []
 
     def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
         # Read out the edges of the query's objects: a preimage names them (the active edges
@@ -211,6 +216,8 @@ class RegressionPlanner:
             self._last = (state, step[1], step[2])
             return _decision(step[1], step[0], start, state.world)
         context = frozenset(goal.literals)
+        # objects other goal literals still have to move, whose picks the look-ahead keeps
+        self._pending = list(dict.fromkeys(lit.args[0] for lit in unsatisfied if lit.positive))
         roots = [_Node(lit, context, (lit,)) for lit in unsatisfied]
         preimages = self._preimages(state, roots)
         # A goal literal waits while its preimage names another unsatisfied goal literal; if
@@ -279,13 +286,16 @@ class RegressionPlanner:
         first nodes passed over are kept in `vetoed`."""
         if not self.look_ahead:
             return nodes
-        kept = [
-            n
-            for n in nodes
-            if chain_reachable(
-                state, n.lit, [lit for lit, _ in reversed(n.chain)], self.reach_scores
-            )
-        ]
+        kept = []
+        for n in nodes:
+            up = [lit for lit, _ in reversed(n.chain)]
+            if not chain_reachable(state, n.lit, up, self.reach_scores):
+                continue
+            if self.sideways and not keeps_picks(
+                state, [n.lit, *up], self._pending, self.reach_scores
+            ):
+                continue
+            kept.append(n)
         if not vetoed:
             vetoed.extend(n for n in nodes if n not in kept)
         return kept
