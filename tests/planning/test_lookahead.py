@@ -1,14 +1,21 @@
 """The regression planner's look-ahead (`regression-ahead`): a subgoal whose chain leads to a
-literal f_reach finds out of reach once the subgoal is imagined achieved is passed over while
-another is found. f_reach is replaced by a hand-written stand-in here, so that what is tested
-is the mechanism, not what the shipped network learned."""
+literal f_reach finds out of reach once the subgoal is imagined achieved, or whose chain makes
+the pick of an object still to move unlikely, is passed over while another is found. f_reach is
+replaced by a hand-written stand-in here, so that what is tested is the mechanism, not what the
+shipped network learned."""
 
 from hsgplan.domain.actions import Pick
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import Literal, Predicate, clear, in_grasp, on
 from hsgplan.paths import TASK_CHECKPOINT
-from hsgplan.planning.regression.lookahead import AHEAD_REACH, chain_reachable, imagined
+from hsgplan.planning.regression.lookahead import (
+    AHEAD_REACH,
+    PICK_REACH,
+    chain_reachable,
+    imagined,
+    keeps_picks,
+)
 from hsgplan.planning.regression.planner import RegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -95,3 +102,80 @@ def test_without_anything_else_to_do_the_planner_takes_a_subgoal_it_doubts():
     planner.reach_scores = _reach_refusing_full_tops([])
     planner.reset(goal, 0)
     assert planner.next_action(FULL, goal).action == Pick("butter")
+
+
+# butter lies on shelf_b's top, cherries on the open space
+BESIDE = SymbolicSceneGraph.from_literals(
+    ["cherries", "butter"],
+    [on("cherries", "open_space"), on("butter", "shelf_b")],
+    world=KITCHEN,
+)
+
+
+def _reach_trapping_butter(asked: list):
+    """f_reach's stand-in: a pick is likely with the hand empty, unless it is butter's and a can
+    shares butter's top (the hand would meet it); a place is likely while its object is held."""
+
+    def reachable(state, lit) -> bool:
+        if lit.predicate is Predicate.IN_GRASP:
+            if state.held() is not None:
+                return False
+            where = state.location(lit.subject)
+            beside = [] if where is None else state.resting_on(where.args[1])
+            return lit.subject != "butter" or "cherries" not in beside
+        return state.held() == lit.subject
+
+    def scores(state, lits):
+        asked.append((state, lits))
+        return [float(reachable(state, lit)) for lit in lits]
+
+    return scores
+
+
+def test_a_chain_that_makes_a_pending_pick_unlikely_is_refused():
+    asked: list = []
+    reach = _reach_trapping_butter(asked)
+    to_b = [in_grasp("cherries"), on("cherries", "shelf_b")]
+    assert not keeps_picks(BESIDE, to_b, ["butter"], reach)
+    # the pick is asked before and after, with cherries imagined on butter's top
+    before, after = asked[-2][0], asked[-1][0]
+    assert asked[-1][1] == [in_grasp("butter")]
+    assert before.location("cherries") == on("cherries", "open_space")
+    assert after.location("cherries") == on("cherries", "shelf_b")
+    assert keeps_picks(BESIDE, [in_grasp("cherries"), on("cherries", "shelf_a")], ["butter"], reach)
+    # the chain's own objects are not its pending ones, and nothing pending asks nothing
+    n = len(asked)
+    assert keeps_picks(BESIDE, to_b, ["cherries"], reach) and len(asked) == n
+    assert 0.0 < PICK_REACH <= 0.5
+
+
+def test_a_pick_already_unlikely_vetoes_nothing():
+    trapped = SymbolicSceneGraph.from_literals(
+        ["cherries", "butter", "tomato_soup"],
+        [on("cherries", "open_space"), on("butter", "shelf_b"), on("tomato_soup", "shelf_b")],
+        world=KITCHEN,
+    )
+
+    def scores(state, lits):  # butter's pick is a long shot whatever happens
+        return [0.2 if lit == in_grasp("butter") else 1.0 for lit in lits]
+
+    chain = [in_grasp("cherries"), on("cherries", "shelf_b")]
+    assert keeps_picks(trapped, chain, ["butter"], scores)
+
+
+def test_looking_sideways_moves_a_flat_box_before_a_can_is_put_beside_it():
+    # both literals are free; without looking sideways the uniform draw sometimes puts
+    # cherries beside butter first, after which butter cannot be taken up
+    goal = parse_goal("On(cherries, shelf_b) & On(butter, shelf_a)", world=KITCHEN)
+    firsts = {}
+    for sideways in (True, False):
+        firsts[sideways] = set()
+        for seed in range(8):
+            planner = RegressionPlanner(
+                TASK_CHECKPOINT, seed=seed, look_ahead=True, sideways=sideways
+            )
+            planner.reach_scores = _reach_trapping_butter([])
+            planner.reset(goal, seed)
+            firsts[sideways].add(planner.next_action(BESIDE, goal).action)
+    assert firsts[True] == {Pick("butter")}
+    assert Pick("cherries") in firsts[False]
