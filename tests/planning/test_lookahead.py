@@ -51,6 +51,17 @@ def test_a_literal_that_places_nothing_is_not_imagined():
     assert imagined(FULL, Literal(Predicate.ON, ("butter", "open_space"), False)) is None
 
 
+def _recording(reachable, asked: list):
+    """f_reach's stand-in from a rule: 1 where `reachable` says so, else 0; every question is
+    kept in `asked` as (state, literals)."""
+
+    def scores(state, lits):
+        asked.append((state, lits))
+        return [float(reachable(state, lit)) for lit in lits]
+
+    return scores
+
+
 def _reach_refusing_full_tops(asked: list):
     """f_reach's stand-in: a place is in reach when its object is held and the top it goes to
     holds fewer than four objects; a pick when the hand is empty; nothing else."""
@@ -60,11 +71,7 @@ def _reach_refusing_full_tops(asked: list):
             return state.held() == lit.subject and len(state.resting_on(lit.args[1])) < 4
         return lit.predicate is Predicate.IN_GRASP and state.held() is None
 
-    def scores(state, lits):
-        asked.append((state, lits))
-        return [float(reachable(state, lit)) for lit in lits]
-
-    return scores
+    return _recording(reachable, asked)
 
 
 def test_a_chain_is_checked_link_by_link_in_the_state_imagined_below_it():
@@ -125,11 +132,7 @@ def _reach_trapping_butter(asked: list):
             return lit.subject != "butter" or "cherries" not in beside
         return state.held() == lit.subject
 
-    def scores(state, lits):
-        asked.append((state, lits))
-        return [float(reachable(state, lit)) for lit in lits]
-
-    return scores
+    return _recording(reachable, asked)
 
 
 def test_a_chain_that_makes_a_pending_pick_unlikely_is_refused():
