@@ -146,10 +146,24 @@ def test_a_chain_that_makes_a_pending_pick_unlikely_is_refused():
     assert before.location("cherries") == on("cherries", "open_space")
     assert after.location("cherries") == on("cherries", "shelf_b")
     assert keeps_picks(BESIDE, [in_grasp("cherries"), on("cherries", "shelf_a")], ["butter"], reach)
-    # the chain's own objects are not its pending ones, and nothing pending asks nothing
+    # the objects the chain moves are not its pending ones, and nothing pending asks nothing
     n = len(asked)
     assert keeps_picks(BESIDE, to_b, ["cherries"], reach) and len(asked) == n
     assert 0.0 < PICK_REACH <= 0.5
+
+
+def test_stacking_onto_a_base_that_still_has_to_move_is_refused():
+    # butter goes onto cherries, which another goal literal still has to move: once butter is
+    # on it, cherries cannot be taken up (a stand-in for f_reach that asks for a clear object)
+    def reachable(state, lit) -> bool:
+        if lit.predicate is Predicate.IN_GRASP:
+            return state.held() is None and state.holds(clear(lit.subject))
+        return state.held() == lit.subject
+
+    reach = _recording(reachable, [])
+    onto = [in_grasp("butter"), on("butter", "cherries")]
+    assert not keeps_picks(BESIDE, onto, ["cherries"], reach)
+    assert keeps_picks(BESIDE, onto, [], reach)
 
 
 def test_a_pick_already_unlikely_vetoes_nothing():

@@ -17,7 +17,8 @@ It also looks sideways: a chain is passed over when, with all of it imagined ach
 pick of an object another goal literal still has to move falls from likely to unlikely by
 f_reach. Put a can beside a flat box on a shelf top and the box may no longer be picked (the
 hand is wider than the box along its closing axis); f_reach learned that from the world, and
-the box is moved first while it still can be.
+the box is moved first while it still can be. The same holds for a base stacked onto before it
+has moved.
 """
 
 from __future__ import annotations
@@ -71,8 +72,9 @@ def keeps_picks(
 ) -> bool:
     """Whether every object of `pending` (objects other goal literals still have to move) that
     f_reach finds likely to be picked now stays so once `chain` (the subgoal first, its root
-    last) is imagined achieved literal by literal."""
-    others = [o for o in pending if all(o not in lit.args for lit in chain)]
+    last) is imagined achieved literal by literal. The objects the chain moves are left out; a
+    base it stacks onto is not (stacked on before it moves, it is trapped as well)."""
+    others = [o for o in pending if all(o != lit.args[0] for lit in chain)]
     if not others:
         return True
     after = state
