@@ -51,7 +51,7 @@ def _regression_paper(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
 
 
 def _forward(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
-    from hsgplan.planning.regression.planner import ForwardPlanner
+    from hsgplan.planning.regression.forward import ForwardPlanner
 
     return ForwardPlanner(checkpoint)
 

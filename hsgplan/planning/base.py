@@ -2,8 +2,8 @@
 with the subgoal it serves.
 
 Task planners are the learned regression planner and the forward baseline
-(`planning/regression/planner.py`) and Fast Downward (`planning/fast_downward.py`); the
-registry (`hsgplan.agents.registry`) names them.
+(`planning/regression/planner.py`, `forward.py`) and Fast Downward
+(`planning/fast_downward.py`); the registry (`hsgplan.agents.registry`) names them.
 """
 
 from __future__ import annotations

@@ -11,8 +11,9 @@ from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT, shipped
+from hsgplan.planning.regression.forward import ForwardPlanner
 from hsgplan.planning.regression.paper_loop import PaperRegressionPlanner
-from hsgplan.planning.regression.planner import ForwardPlanner, RegressionPlanner
+from hsgplan.planning.regression.planner import RegressionPlanner
 from tests.forbidden_calls import rules_forbidden
 
 GOALS = [

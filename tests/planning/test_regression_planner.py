@@ -10,7 +10,8 @@ from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import in_grasp, on
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.paths import TASK_CHECKPOINT
-from hsgplan.planning.regression.planner import GIVE_UP_AFTER, ForwardPlanner, RegressionPlanner
+from hsgplan.planning.regression.forward import GIVE_UP_AFTER, ForwardPlanner
+from hsgplan.planning.regression.planner import RegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.symbolic.generator import random_state
 from hsgplan.symbolic.transition import apply, why_not
