@@ -150,6 +150,7 @@ class RegressionPlanner:
         self._last: tuple[SymbolicSceneGraph, Action, Literal] | None = None
         self._failed_roots: set[Literal] = set()
         self._pending: list[str] = []
+        self._asked: dict[tuple[SymbolicSceneGraph, Literal], float] = {}
 
     def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
         # Read out the edges of the query's objects: a preimage names them (the active edges
@@ -208,6 +209,7 @@ class RegressionPlanner:
         context = frozenset(goal.literals)
         # objects other goal literals still have to move, whose picks the look-ahead keeps
         self._pending = list(dict.fromkeys(lit.args[0] for lit in unsatisfied if lit.positive))
+        self._asked.clear()
         roots = [_Node(lit, context, (lit,)) for lit in unsatisfied]
         preimages = self._preimages(state, roots)
         # A goal literal waits while its preimage names another unsatisfied goal literal; if
@@ -279,16 +281,27 @@ class RegressionPlanner:
         kept = []
         for n in nodes:
             up = [lit for lit, _ in reversed(n.chain)]
-            if not chain_reachable(state, n.lit, up, self.reach_scores):
+            if not chain_reachable(state, n.lit, up, self._reach_once):
                 continue
             if self.sideways and not keeps_picks(
-                state, [n.lit, *up], self._pending, self.reach_scores
+                state, [n.lit, *up], self._pending, self._reach_once
             ):
                 continue
             kept.append(n)
         if not vetoed:
             vetoed.extend(n for n in nodes if n not in kept)
         return kept
+
+    def _reach_once(self, state: SymbolicSceneGraph, lits: list[Literal]) -> list[float]:
+        """`reach_scores`, each (state, literal) asked once per decision: the look-ahead asks
+        every candidate's chain about the same current and imagined states (f_reach reads each
+        literal alone, so an answer does not depend on what it is asked with)."""
+        asked = self._asked
+        new = [lit for lit in dict.fromkeys(lits) if (state, lit) not in asked]
+        if new:
+            scores = self.reach_scores(state, new)
+            asked.update(((state, lit), p) for lit, p in zip(new, scores, strict=True))
+        return [asked[state, lit] for lit in lits]
 
     def _search(self, state, frontier, avoid, seen, counts, vetoed):
         """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
