@@ -146,3 +146,25 @@ def test_nothing_rests_through_an_object_several_views_saw_but_a_lone_views_may_
     beside = Pose.from_xyz_yaw(0.5 + 0.053 / 2 + 0.005, 0.0, _half("cream_cheese"), 0.0)
     next_to = settle(types, [beside, low], [(ray, ray), (ray, ray)], costs)[1]
     assert next_to.position[2] == pytest.approx(_half("popcorn"))
+
+
+def test_an_object_found_twice_a_few_centimetres_apart_is_no_carrier_of_itself():
+    from hsgplan.perception.settle import one_level, same_place
+
+    top = KITCHEN.shelves["shelf_b"].top.z + _half("butter")
+    near = Pose.from_xyz_yaw(0.555, -0.33, top, 0.0)
+    far = Pose.from_xyz_yaw(0.594, -0.33, top - 0.007, 0.0)  # 3.9 cm on along its narrow side
+    assert one_level("butter", near, "butter", far) and not same_place(
+        "butter", near, "butter", far
+    )
+    # rested together, neither is carried by the other, even where the keypoints would
+    # rather have the nearer one a box up
+    one_up = top + 2 * _half("butter")
+    costs = [None, lambda centre: abs(centre[2] - one_up)]
+    out = settle(["butter", "butter"], [far, near], [((), ())] * 2, costs)
+    assert [p.position[2] for p in out] == pytest.approx([top, top])
+    # one found on the other, a box's height up, is carried
+    above = Pose.from_xyz_yaw(0.57, -0.33, one_up - 0.004, 0.0)
+    _, rests = settle(["butter", "butter"], [near, above], [((), ())] * 2)
+    assert not one_level("butter", near, "butter", above)
+    assert rests.position[2] == pytest.approx(one_up)
