@@ -8,12 +8,14 @@ Task planners are the learned regression planner and the forward baseline
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from typing import Protocol
 
-from hsgplan.domain.actions import Action
+from hsgplan.domain.actions import Action, push_after
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal
+from hsgplan.domain.scene import World
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 
@@ -29,6 +31,13 @@ class TaskDecision:
     seconds: float
     note: str = ""
     following: Action | None = None
+
+    @staticmethod
+    def taken(action: Action, subgoal: Literal, start: float, world: World) -> TaskDecision:
+        """`action` for `subgoal`, decided since `start` (`time.perf_counter`), with the push
+        that follows it where it is a place onto a prepush region."""
+        seconds = time.perf_counter() - start
+        return TaskDecision(action, subgoal, seconds, following=push_after(action, world))
 
 
 class TaskPlanner(Protocol):

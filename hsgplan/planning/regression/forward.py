@@ -15,7 +15,6 @@ from hsgplan.planning.base import TaskDecision
 from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.encoding import TRUE, Slots, encode
 from hsgplan.planning.regression.gnn import load_network
-from hsgplan.planning.regression.planner import _decision
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 # A primitive can fail for motion reasons in the simulated world and succeed when tried again;
@@ -74,4 +73,4 @@ class ForwardPlanner:
         lit, action = fresh[0]
         taken.add(action)
         self._last = (state, action)
-        return _decision(action, lit, start, state.world)
+        return TaskDecision.taken(action, lit, start, state.world)

@@ -27,7 +27,6 @@ from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.planner import (
     MAX_DEPTH,
     RegressionPlanner,
-    _decision,
     _goal_holds,
     _Node,
     _order,
@@ -56,7 +55,7 @@ class PaperRegressionPlanner(RegressionPlanner):
             return _goal_holds(start)
         for _ in range(TRIES):
             if found := self._descend(state, goal, unsatisfied):
-                return _decision(found[1], found[0], start, state.world)
+                return TaskDecision.taken(found[1], found[0], start, state.world)
         return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
 
     def _descend(self, state, goal: Goal, candidates: list):

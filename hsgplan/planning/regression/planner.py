@@ -23,12 +23,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from hsgplan.domain.actions import Action, push_after
+from hsgplan.domain.actions import Action
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
-from hsgplan.domain.scene import World
 from hsgplan.planning.base import TaskDecision
 from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.encoding import (
@@ -42,11 +41,6 @@ from hsgplan.planning.regression.lookahead import chain_reachable, keeps_picks
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MAX_DEPTH = 8
-
-
-def _decision(action: Action, subgoal: Literal, start: float, world: World) -> TaskDecision:
-    seconds = time.perf_counter() - start
-    return TaskDecision(action, subgoal, seconds, following=push_after(action, world))
 
 
 @lru_cache(maxsize=4)
@@ -205,7 +199,7 @@ class RegressionPlanner:
         if (step := self._follow(state, goal, taken if rules.avoid_taken else ())) is not None:
             taken[step[1]] += 1
             self._last = (state, step[1], step[2])
-            return _decision(step[1], step[0], start, state.world)
+            return TaskDecision.taken(step[1], step[0], start, state.world)
         context = frozenset(goal.literals)
         # objects other goal literals still have to move, whose picks the look-ahead keeps
         self._pending = list(dict.fromkeys(lit.args[0] for lit in unsatisfied if lit.positive))
@@ -257,7 +251,7 @@ class RegressionPlanner:
         taken[action] += 1
         self._plan = (goal, list(reversed(node.chain)), node.path[0])
         self._last = (state, action, node.path[0])
-        return _decision(action, node.lit, start, state.world)
+        return TaskDecision.taken(action, node.lit, start, state.world)
 
     def _follow(self, state, goal, avoid) -> tuple[Literal, Action, Literal] | None:
         """The next step up the kept chain, if its preimage holds now, and the chain's root."""
