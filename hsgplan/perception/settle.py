@@ -122,7 +122,7 @@ def one_level(a: str, pa: Pose, b: str, pb: Pose) -> bool:
     """Whether two estimates' centres are under a quarter of their heights apart up and down:
     neither carries the other. A stacked object's centre is found a centimetre or two off, not
     a carrier's height; an object found twice a few centimetres apart was a carrier for itself
-    (a butter at a shelf top's front edge, found 3 and 4 cm apart by two groups of views,
+    (a butter at a shelf top's back edge, found 3 and 4 cm apart by two groups of views,
     rested on its own duplicate one box up, and the robot judged its place failed: tuning
     seed 900)."""
     ha, hb = KITCHEN.object_type(a).size[2], KITCHEN.object_type(b).size[2]
