@@ -33,6 +33,11 @@ class TaskDecision:
     following: Action | None = None
 
     @staticmethod
+    def none(note: str, start: float) -> TaskDecision:
+        """No action, and why, decided since `start` (`time.perf_counter`)."""
+        return TaskDecision(None, None, time.perf_counter() - start, note)
+
+    @staticmethod
     def taken(action: Action, subgoal: Literal, start: float, world: World) -> TaskDecision:
         """`action` for `subgoal`, decided since `start` (`time.perf_counter`), with the push
         that follows it where it is a place onto a prepush region."""

@@ -226,9 +226,9 @@ class FastDownwardTaskPlanner:
             try:
                 plan = self.plan = self.planner.plan(state, goal)
             except NoPlanError as e:
-                return TaskDecision(None, None, time.perf_counter() - start, f"no plan: {e}")
+                return TaskDecision.none(f"no plan: {e}", start)
         if not plan.actions:
-            return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
+            return TaskDecision.none("the goal holds", start)
         action = plan.actions[0]
         following = plan.actions[1] if len(plan.actions) > 1 else None
         seconds = time.perf_counter() - start

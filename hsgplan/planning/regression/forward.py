@@ -53,7 +53,7 @@ class ForwardPlanner:
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
         if goal.satisfied_by(state):
-            return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
+            return TaskDecision.none("the goal holds", start)
         data = encode(state, goal.literals, features=self.net.config.features)
         probs = self.net(data).softmax(-1)[..., TRUE].masked_fill(~data.valid, 0.0)
         slots = Slots(tuple(data.names))
@@ -69,7 +69,7 @@ class ForwardPlanner:
         fresh = [(lit, a) for lit, a in ranked if a not in taken]
         fresh = fresh or [(lit, a) for lit, a in ranked if a not in failed_here] or ranked
         if not fresh:
-            return TaskDecision(None, None, time.perf_counter() - start, "no subgoal")
+            return TaskDecision.none("no subgoal", start)
         lit, action = fresh[0]
         taken.add(action)
         self._last = (state, action)

@@ -27,7 +27,6 @@ from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.planner import (
     MAX_DEPTH,
     RegressionPlanner,
-    _goal_holds,
     _Node,
     _order,
     _unsatisfied,
@@ -52,11 +51,11 @@ class PaperRegressionPlanner(RegressionPlanner):
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
         if not (unsatisfied := _unsatisfied(state, goal)):
-            return _goal_holds(start)
+            return TaskDecision.none("the goal holds", start)
         for _ in range(TRIES):
             if found := self._descend(state, goal, unsatisfied):
                 return TaskDecision.taken(found[1], found[0], start, state.world)
-        return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
+        return TaskDecision.none("regression stuck", start)
 
     def _descend(self, state, goal: Goal, candidates: list):
         """One path down from the goal: (literal, action) where f_reach says "reachable", or

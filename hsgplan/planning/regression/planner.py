@@ -56,10 +56,6 @@ def _unsatisfied(state: SymbolicSceneGraph, goal: Goal) -> list[Literal]:
     return [lit for lit in _in_order(goal) if not state.holds(lit)]
 
 
-def _goal_holds(start: float) -> TaskDecision:
-    return TaskDecision(None, None, time.perf_counter() - start, "the goal holds")
-
-
 @lru_cache(maxsize=64)
 def _in_order(goal: Goal) -> list[Literal]:
     """A goal's literals, sorted (once per goal: a decision needs them in order)."""
@@ -191,7 +187,7 @@ class RegressionPlanner:
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
         if not (unsatisfied := _unsatisfied(state, goal)):
-            return _goal_holds(start)
+            return TaskDecision.none("the goal holds", start)
         rules = self.rules
         if rules.failed_goal_waits and self._last is not None and self._last[0] == state:
             self._failed_roots.add(self._last[2])
@@ -245,7 +241,7 @@ class RegressionPlanner:
             if likely:
                 *_, node, action = min(likely, key=lambda x: x[:3])
                 return self._take(state, goal, node, action, taken, start)
-        return TaskDecision(None, None, time.perf_counter() - start, "regression stuck")
+        return TaskDecision.none("regression stuck", start)
 
     def _take(self, state, goal, node: _Node, action: Action, taken, start) -> TaskDecision:
         taken[action] += 1
