@@ -96,6 +96,17 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         # primitives that truly moved an object besides their own (physics: a swept arm, a
         # carried object, a push), whatever their status
         "disturbing_steps": sum(1 for r in rs for s in r.steps if s.disturbed),
+        # each object so moved, by primitive and the phase it moved in ("place:retreat")
+        "disturbed_in": dict(
+            sorted(
+                Counter(
+                    f"{s.action.split('(')[0]}:{d.phase or 'unknown'}"
+                    for r in rs
+                    for s in r.steps
+                    for d in s.disturbed
+                ).items()
+            )
+        ),
         "still_seen_moved": still_seen_moved(rs),
         # looks taken again before a primitive or the goal's end, seeing through f_p (`relook`)
         "relooks": sum(s.relooks for r in rs for s in r.steps) + sum(r.closing_relooks for r in rs),

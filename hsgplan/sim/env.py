@@ -168,10 +168,15 @@ class KitchenStorageEnv(gymnasium.Env):
         )
         true_before = self.scene.poses()
         self.last_plan = None
+        phases: list[tuple[str, dict]] = []  # the record's: where each phase left the objects
+
+        def ended(name: str) -> None:
+            phases.append((name, self.scene.poses()))
+
         if isinstance(params, str):  # nothing to execute: a step spent, nothing moved
             outcome = Outcome(Status.INVALID, params, 0.0)
         elif self.believing:
-            outcome = self._step_believed(params, on_frame)
+            outcome = self._step_believed(params, on_frame, ended)
         else:
             plan, plan_seconds = self._checked_plan(params)
             if plan is None:
@@ -180,7 +185,7 @@ class KitchenStorageEnv(gymnasium.Env):
                 plan_seconds = time.perf_counter() - start
             if isinstance(plan, MotionPlan):
                 self.last_plan = plan
-            outcome = execute(self.scene, params, on_frame, plan)
+            outcome = execute(self.scene, params, on_frame, plan, ended)
             # The plan is part of this primitive's cost: its time is added back.
             outcome = Outcome(outcome.status, outcome.detail, outcome.seconds + plan_seconds)
         self._checked.clear()
@@ -195,7 +200,7 @@ class KitchenStorageEnv(gymnasium.Env):
             "outcome": outcome,
             "observation": typed,
             # what the primitive truly moved besides its object: the record's, not the agent's
-            "disturbed": disturbances(true_before, self.scene.poses(), acted_on),
+            "disturbed": disturbances(true_before, self.scene.poses(), acted_on, phases),
             # the largest move the robot saw of an object besides its own, of those it was
             # sure of before and after (its observer's)
             "seen_moved": largest_move(
@@ -247,7 +252,7 @@ class KitchenStorageEnv(gymnasium.Env):
         """Where primitives are planned: the robot's model of its belief, or the scene."""
         return self.world.scene if self.world is not None else self.scene
 
-    def _step_believed(self, params: PrimitiveParams, on_frame) -> Outcome:
+    def _step_believed(self, params: PrimitiveParams, on_frame, on_phase) -> Outcome:
         """One primitive planned in the model of the belief, run in the scene, judged on what
         the gripper feels and on the belief before and after it."""
         start = time.perf_counter()
@@ -268,7 +273,7 @@ class KitchenStorageEnv(gymnasium.Env):
             seconds = time.perf_counter() - start - watch.seconds + plan_seconds
             return Outcome(plan.status, plan.detail, seconds, relooks)
         self.last_plan = plan
-        stopped = run_plan(self.scene, plan, on_frame)
+        stopped = run_plan(self.scene, plan, on_frame, on_phase)
         holds = holds_something(self.scene.robot)  # the gripper's width
         self._released = world.executed(plan, holds)
         if world.holding is not None and not holds:

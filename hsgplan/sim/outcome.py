@@ -58,23 +58,33 @@ class Outcome:
 
 @dataclass(frozen=True)
 class Disturbance:
-    """An object a primitive moved that it was not acting on, and how far (m)."""
+    """An object a primitive moved that it was not acting on, how far (m), and in which of the
+    primitive's phases it first moved that far ("" where no phase was told)."""
 
     obj: str
     moved: float
+    phase: str = ""
 
 
 def disturbances(
-    before: dict[str, Pose], after: dict[str, Pose], acted_on: str
+    before: dict[str, Pose],
+    after: dict[str, Pose],
+    acted_on: str,
+    phases: list[tuple[str, dict[str, Pose]]] | tuple = (),
 ) -> tuple[Disturbance, ...]:
     """The objects other than `acted_on` that moved more than DISTURB_RECORD between two sets
-    of poses (the simulator's: what a primitive truly did, for the episode's record)."""
-    moved = (
-        Disturbance(o, round(before[o].distance(after[o]), 4))
-        for o in sorted(before)
-        if o != acted_on and o in after
-    )
-    return tuple(d for d in moved if d.moved > DISTURB_RECORD)
+    of poses (the simulator's: what a primitive truly did, for the episode's record), each
+    with the first of `phases` (a phase's name and the poses as it ended) by whose end it had
+    moved more than DISTURB_RECORD."""
+    out = []
+    for o in sorted(before):
+        if o == acted_on or o not in after:
+            continue
+        moved = round(before[o].distance(after[o]), 4)
+        if moved > DISTURB_RECORD:
+            first = (n for n, poses in phases if before[o].distance(poses[o]) > DISTURB_RECORD)
+            out.append(Disturbance(o, moved, next(first, "")))
+    return tuple(out)
 
 
 def largest_move(

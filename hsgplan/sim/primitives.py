@@ -25,6 +25,15 @@ from hsgplan.sim.scene import TIME_STEP, Scene
 PUSH_SUBSTEPS = 3  # physics steps per 5 mm of push: 0.4 m/s (docs/decisions.md)
 
 Frame = Callable[[], None]
+# Called with a phase's name as each phase of a primitive ends: "path" (the transit or transfer
+# path), "approach" (the straight final approach), "grasp", "release" or "push" (the contact),
+# "retreat". What moved in which phase is the episode record's (`sim.outcome.disturbances`).
+Phase = Callable[[str], None]
+
+
+def _ended(on_phase: Phase | None, name: str) -> None:
+    if on_phase is not None:
+        on_phase(name)
 
 
 class Watch:
@@ -47,12 +56,13 @@ def execute(
     params: PrimitiveParams,
     on_frame: Frame | None = None,
     plan: MotionPlan | PlanFailure | None = None,
+    on_phase: Phase | None = None,
 ) -> Outcome:
     """Plan (unless a plan made for this scene, or its failure, is given) and run one
     primitive.
 
     `on_frame` is called along the way, for pictures; the time it takes is not counted in the
-    outcome's seconds.
+    outcome's seconds. `on_phase` is told as each phase ends (`Phase`).
     """
     start = time.perf_counter()
     watch = Watch(on_frame)
@@ -60,7 +70,7 @@ def execute(
     planned = plan if plan is not None else plan_primitive(scene, params)
     if isinstance(planned, PlanFailure):
         return Outcome(planned.status, planned.detail, time.perf_counter() - start)
-    stopped = run_plan(scene, planned, watch.frame)
+    stopped = run_plan(scene, planned, watch.frame, on_phase)
     status, detail = verify(scene, before, params.obj, planned.expected)
     status, detail = stopped_outcome(status, detail, stopped)
     return Outcome(status, detail, time.perf_counter() - start - watch.seconds)
@@ -74,8 +84,11 @@ def stopped_outcome(status: Status, detail: str, stopped: str | None) -> tuple[S
     return Status.BLOCKED, stopped
 
 
-def run_plan(scene: Scene, plan: MotionPlan, on_frame: Frame | None = None) -> str | None:
-    """Run a planned primitive's joint motions in the scene under physics.
+def run_plan(
+    scene: Scene, plan: MotionPlan, on_frame: Frame | None = None, on_phase: Phase | None = None
+) -> str | None:
+    """Run a planned primitive's joint motions in the scene under physics, telling `on_phase`
+    as each phase ends.
 
     The plan may have been made in the robot's model of the scene rather than in this one (a
     camera observer's belief): a pick holds whatever its closing fingers hold, if anything.
@@ -86,10 +99,10 @@ def run_plan(scene: Scene, plan: MotionPlan, on_frame: Frame | None = None) -> s
     held = scene.held()
     with scene.asleep(awake=() if held is None else (held,)):
         if isinstance(plan.params, PickParams):
-            return _run_pick(scene, plan, on_frame)
+            return _run_pick(scene, plan, on_frame, on_phase)
         if isinstance(plan.params, PlaceParams):
-            return _run_place(scene, plan, on_frame)
-        return _run_push(scene, plan, on_frame)
+            return _run_place(scene, plan, on_frame, on_phase)
+        return _run_push(scene, plan, on_frame, on_phase)
 
 
 def run_path(scene: Scene, path, on_frame: Frame | None = None) -> bool:
@@ -98,53 +111,63 @@ def run_path(scene: Scene, path, on_frame: Frame | None = None) -> bool:
     return drive_path(scene.robot, path, TIME_STEP, on_frame).reached
 
 
-def _approach(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
-    if not run_path(scene, plan.path, on_frame):
+def _approach(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
+    reached = run_path(scene, plan.path, on_frame)
+    _ended(on_phase, "path")
+    if not reached:
         return "the arm was stopped on its way by something it met"
     down = [scene.robot.q(), plan.q_above, *plan.descent, plan.q_at]
-    if not run_path(scene, down, on_frame):
+    reached = run_path(scene, down, on_frame)
+    _ended(on_phase, "approach")
+    if not reached:
         return "the arm was stopped on its final approach by something it met"
     return None
 
 
-def _retreat(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
-    if not run_path(scene, [scene.robot.q(), *reversed(plan.descent), plan.q_above], on_frame):
+def _retreat(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
+    up = [scene.robot.q(), *reversed(plan.descent), plan.q_above]
+    reached = run_path(scene, up, on_frame)
+    _ended(on_phase, "retreat")
+    if not reached:
         return "the arm was stopped on its retreat by something it met"
     return None
 
 
-def _run_pick(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
+def _run_pick(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
     robot = scene.robot
     drive_fingers(robot, plan.opening)
-    if stopped := _approach(scene, plan, on_frame):
-        _retreat(scene, plan, on_frame)  # the fingers stay open: nothing is taken up
+    if stopped := _approach(scene, plan, on_frame, on_phase):
+        _retreat(scene, plan, on_frame, on_phase)  # the fingers stay open: nothing is taken up
         return stopped
     # The fingers close until they stop; what they hold from opposite sides is held.
     drive_fingers(robot, 0.0)
     if (body := body_in_grasp(robot, tuple(scene.bodies.values()))) is not None:
         robot.attach(body)
-    return _retreat(scene, plan, on_frame)
+    _ended(on_phase, "grasp")
+    return _retreat(scene, plan, on_frame, on_phase)
 
 
-def _run_place(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
+def _run_place(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
     robot = scene.robot
-    if stopped := _approach(scene, plan, on_frame):
+    if stopped := _approach(scene, plan, on_frame, on_phase):
         return stopped
     robot.detach()
     drive_fingers(robot, GRIPPER_MAX_OPENING)
     scene.settle()
-    return _retreat(scene, plan, on_frame)
+    _ended(on_phase, "release")
+    return _retreat(scene, plan, on_frame, on_phase)
 
 
-def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
+def _run_push(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
     robot = scene.robot
     drive_fingers(robot, 0.0)
-    if stopped := _approach(scene, plan, on_frame):
+    if stopped := _approach(scene, plan, on_frame, on_phase):
         return stopped
     for q in plan.line:
         press_towards(robot, q, PUSH_SUBSTEPS)
         if on_frame:
             on_frame()
+    _ended(on_phase, "push")
     # Back out the way it came (joints checked against the shelves while planning; the
     # object is ahead of the fingers now), then up to where the approach began: from the
     # line's point the hand got to, since it lags behind the line's end and catching up
@@ -156,4 +179,5 @@ def _run_push(scene: Scene, plan: MotionPlan, on_frame) -> str | None:
     stopped = None if run_path(scene, back, on_frame) else "stopped backing out of a push"
     scene.settle()
     drive_fingers(robot, GRIPPER_MAX_OPENING)
+    _ended(on_phase, "retreat")
     return stopped

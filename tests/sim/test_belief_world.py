@@ -9,7 +9,14 @@ from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.belief_world import BeliefWorld
 from hsgplan.sim.motion_plans import MotionPlan
-from hsgplan.sim.outcome import SEEN_DISTURB_TOL, Status, compare, largest_move
+from hsgplan.sim.outcome import (
+    SEEN_DISTURB_TOL,
+    Disturbance,
+    Status,
+    compare,
+    disturbances,
+    largest_move,
+)
 from hsgplan.sim.primitives import run_plan
 from hsgplan.sim.scene import Scene
 
@@ -110,3 +117,21 @@ def test_the_largest_move_seen_leaves_out_the_object_acted_on_and_the_unsure():
     assert largest_move(before, after, "butter") == pytest.approx(0.04)
     assert largest_move(before, after, "tomato_soup") > 0.2  # the butter, lifted
     assert largest_move(before, after, "butter", frozenset({"butter"})) == 0.0
+
+
+def test_a_disturbance_is_put_in_the_phase_by_whose_end_it_had_moved():
+    still, moved = _on_table("butter", 0.5, 0.1), _on_table("butter", 0.5, 0.12)
+    soup = _on_table("tomato_soup", 0.5, -0.2)
+    before = {"butter": still, "tomato_soup": soup, "cherries": soup}
+    phases = [
+        ("path", {"butter": still, "tomato_soup": soup, "cherries": soup}),
+        ("approach", {"butter": moved, "tomato_soup": soup, "cherries": soup}),
+        ("retreat", {"butter": moved, "tomato_soup": soup, "cherries": moved}),
+    ]
+    after = {"butter": moved, "tomato_soup": soup, "cherries": moved}
+    # cherries is the primitive's own object: never a disturbance
+    assert disturbances(before, after, "cherries", phases) == (
+        Disturbance("butter", 0.02, "approach"),
+    )
+    # without phases told, where it moved is unknown
+    assert disturbances(before, after, "cherries") == (Disturbance("butter", 0.02, ""),)

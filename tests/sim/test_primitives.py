@@ -33,6 +33,19 @@ def test_pick_then_place_on_a_shelf_top(scene):
     assert max(abs(a - b) for a, b in zip(let_go.position, rest, strict=True)) < 0.01
 
 
+def test_each_primitive_tells_its_phases_in_order(scene):
+    told = []
+    assert execute(scene, PickParams("cherries"), on_phase=told.append).ok
+    assert told == ["path", "approach", "grasp", "retreat"]
+    told.clear()
+    assert execute(scene, PlaceParams("cherries", "shelf_a", 2, 3), on_phase=told.append).ok
+    assert told == ["path", "approach", "release", "retreat"]
+    told.clear()
+    angle, dist = nearest_push_bins(0.0, 0.14)
+    assert execute(scene, PushParams("tomato_soup", angle, dist), on_phase=told.append).ok
+    assert told == ["path", "approach", "push", "retreat"]
+
+
 def test_stack_a_box_on_a_can(scene):
     assert execute(scene, PickParams("butter")).ok
     out = execute(scene, PlaceParams("butter", "cherries"))
