@@ -4,7 +4,7 @@ import random
 
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.planning.regression.encoding import Slots, touching
-from hsgplan.planning.regression.planner import _order
+from hsgplan.planning.regression.planner import literal_key
 from hsgplan.symbolic.generator import random_goal, random_state
 
 
@@ -15,7 +15,7 @@ def test_the_sort_key_is_the_literals_own_order():
         state = random_state(goal.objects, rng, world=KITCHEN)
         lits = list(goal.literals | state.literals | {lit.negated() for lit in state.literals})
         rng.shuffle(lits)
-        assert sorted(lits, key=_order) == sorted(lits)
+        assert sorted(lits, key=literal_key) == sorted(lits)
 
 
 def test_touching_marks_the_edges_at_a_literals_arguments():

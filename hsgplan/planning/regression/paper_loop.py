@@ -26,10 +26,10 @@ from hsgplan.planning.base import TaskDecision
 from hsgplan.planning.heuristic import action_for
 from hsgplan.planning.regression.planner import (
     MAX_DEPTH,
+    Node,
     RegressionPlanner,
-    _Node,
-    _order,
-    _unsatisfied,
+    literal_key,
+    unsatisfied_literals,
 )
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -50,7 +50,7 @@ class PaperRegressionPlanner(RegressionPlanner):
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
-        if not (unsatisfied := _unsatisfied(state, goal)):
+        if not (unsatisfied := unsatisfied_literals(state, goal)):
             return TaskDecision.none("the goal holds", start)
         for _ in range(TRIES):
             if found := self._descend(state, goal, unsatisfied):
@@ -64,13 +64,13 @@ class PaperRegressionPlanner(RegressionPlanner):
         path = ()
         for _ in range(self.max_depth):
             lit = self.rng.choice(candidates)
-            node = _Node(lit, context, (*path, lit))
+            node = Node(lit, context, (*path, lit))
             if self.reachable(state, [lit])[0] and (action := action_for(lit, state)):
                 return lit, action
             (pre,) = self._preimages(state, [node])
             context = frozenset((context - {lit}) | {m for m in pre if m.positive})
             candidates = sorted(
-                (m for m in pre if not state.holds(m) and m not in node.path), key=_order
+                (m for m in pre if not state.holds(m) and m not in node.path), key=literal_key
             )
             if not candidates:
                 return None

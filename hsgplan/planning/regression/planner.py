@@ -51,7 +51,7 @@ def _inference_networks(checkpoint: str):
     return load_network(folder / "preimage").script(), load_network(folder / "reach").script()
 
 
-def _unsatisfied(state: SymbolicSceneGraph, goal: Goal) -> list[Literal]:
+def unsatisfied_literals(state: SymbolicSceneGraph, goal: Goal) -> list[Literal]:
     """The goal's literals that do not hold, in order."""
     return [lit for lit in _in_order(goal) if not state.holds(lit)]
 
@@ -59,18 +59,18 @@ def _unsatisfied(state: SymbolicSceneGraph, goal: Goal) -> list[Literal]:
 @lru_cache(maxsize=64)
 def _in_order(goal: Goal) -> list[Literal]:
     """A goal's literals, sorted (once per goal: a decision needs them in order)."""
-    return sorted(goal.literals, key=_order)
+    return sorted(goal.literals, key=literal_key)
 
 
 @lru_cache(maxsize=65536)
-def _order(lit: Literal) -> tuple:
+def literal_key(lit: Literal) -> tuple:
     """The sort key of `Literal`'s own order (predicate, args, sign), without its slow
     generated comparisons; a planner sorts many small sets."""
     return lit.predicate.value, lit.args, lit.positive
 
 
 @dataclass(frozen=True)
-class _Node:
+class Node:
     """A literal met while regressing, the subgoal it was regressed within, and its path."""
 
     lit: Literal
@@ -142,7 +142,7 @@ class RegressionPlanner:
         self._pending: list[str] = []
         self._asked: dict[tuple[SymbolicSceneGraph, Literal], float] = {}
 
-    def _preimages(self, state, nodes: list[_Node]) -> list[frozenset[Literal]]:
+    def _preimages(self, state, nodes: list[Node]) -> list[frozenset[Literal]]:
         # Read out the edges of the query's objects: a preimage names them (the active edges
         # are computed anyway).
         readout = touching(state.nodes, [n.lit.args for n in nodes])
@@ -186,7 +186,7 @@ class RegressionPlanner:
     @torch.inference_mode()
     def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
         start = time.perf_counter()
-        if not (unsatisfied := _unsatisfied(state, goal)):
+        if not (unsatisfied := unsatisfied_literals(state, goal)):
             return TaskDecision.none("the goal holds", start)
         rules = self.rules
         if rules.failed_goal_waits and self._last is not None and self._last[0] == state:
@@ -200,7 +200,7 @@ class RegressionPlanner:
         # objects other goal literals still have to move, whose picks the look-ahead keeps
         self._pending = list(dict.fromkeys(lit.args[0] for lit in unsatisfied if lit.positive))
         self._asked.clear()
-        roots = [_Node(lit, context, (lit,)) for lit in unsatisfied]
+        roots = [Node(lit, context, (lit,)) for lit in unsatisfied]
         preimages = self._preimages(state, roots)
         # A goal literal waits while its preimage names another unsatisfied goal literal; if
         # nothing is reached from the free ones (a dependency the network got wrong, or a
@@ -215,12 +215,12 @@ class RegressionPlanner:
         # ever. A loop that never passes ends at the step limit, the paper's overstep.
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
-        seen: dict[Literal, tuple[float, _Node]] = {}
+        seen: dict[Literal, tuple[float, Node]] = {}
         passes = [(set(taken), None)] if rules.avoid_taken else []
         if rules.least_taken:
             passes.append((set(), taken))
         for avoid, counts in passes or [(set(), None)]:
-            vetoed: list[_Node] = []
+            vetoed: list[Node] = []
             for frontier in (free, [x for x in pairs if x not in free]):
                 found = self._search(state, frontier, avoid, seen, counts, vetoed)
                 if found is not None:
@@ -234,7 +234,7 @@ class RegressionPlanner:
             # Nothing reached: the literal f_reach finds likeliest (it learned the physical
             # world, which refuses more than some other world would), before repeating
             likely = [
-                (counts[a] if counts else 0, -p, _order(n.lit), n, a)
+                (counts[a] if counts else 0, -p, literal_key(n.lit), n, a)
                 for p, n in seen.values()
                 if (a := action_for(n.lit, state)) is not None and a not in avoid
             ]
@@ -243,7 +243,7 @@ class RegressionPlanner:
                 return self._take(state, goal, node, action, taken, start)
         return TaskDecision.none("regression stuck", start)
 
-    def _take(self, state, goal, node: _Node, action: Action, taken, start) -> TaskDecision:
+    def _take(self, state, goal, node: Node, action: Action, taken, start) -> TaskDecision:
         taken[action] += 1
         self._plan = (goal, list(reversed(node.chain)), node.path[0])
         self._last = (state, action, node.path[0])
@@ -263,7 +263,7 @@ class RegressionPlanner:
         self._plan = None
         return None
 
-    def _ahead(self, state, nodes: list[_Node], vetoed: list[_Node]) -> list[_Node]:
+    def _ahead(self, state, nodes: list[Node], vetoed: list[Node]) -> list[Node]:
         """The nodes whose chain stays reachable (all of them without the look-ahead); the
         first nodes passed over are kept in `vetoed`."""
         if not self.look_ahead:
@@ -323,7 +323,7 @@ class RegressionPlanner:
             frontier = children if known else self._children(state, frontier)
         return None
 
-    def _choose(self, state, nodes: list[_Node], avoid, counts: Counter[Action] | None = None):
+    def _choose(self, state, nodes: list[Node], avoid, counts: Counter[Action] | None = None):
         """One of the nodes' actions not in `avoid`: with `counts` (how often each was taken
         here), one of the least taken."""
         hits = [
@@ -349,10 +349,10 @@ class RegressionPlanner:
         seen, out = set(), []
         for node, pre in frontier:
             context = frozenset((node.context - {node.lit}) | {m for m in pre if m.positive})
-            for m in sorted(pre, key=_order):
+            for m in sorted(pre, key=literal_key):
                 if state.holds(m) or m in node.path or m in seen:
                     continue
                 seen.add(m)
                 chain = node.chain + ((node.lit, pre),)
-                out.append((_Node(m, context, node.path + (m,), chain), None))
+                out.append((Node(m, context, node.path + (m,), chain), None))
         return out
