@@ -187,7 +187,10 @@ class EpisodeRecording:
 
         self.frame += 1
         self._at()
-        moved = ", ".join(f"{m.obj} {100 * m.moved:.1f} cm" for m in record.disturbed)
+        moved = ", ".join(
+            f"{m.obj} {100 * m.moved:.1f} cm" + (f" ({m.phase})" if m.phase else "")
+            for m in record.disturbed
+        )
         line = f"step {record.step}: {record.params} -> {record.status}"
         line += f" ({record.detail})" if record.detail else ""
         line += f"; disturbed {moved}" if moved else ""
