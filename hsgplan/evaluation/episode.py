@@ -47,6 +47,8 @@ class StepRecord:
     disturbed: tuple[Disturbance, ...] = ()
     # the largest move (m) its observer saw of an object besides its own, look before to after
     seen_moved: float = 0.0
+    # how far (m) its own object truly moved after the hand let it go (`sim.outcome.dragged`)
+    dragged: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -187,6 +189,7 @@ def run_episode(
             outcome.relooks,
             info["disturbed"],
             round(info["seen_moved"], 4),
+            info["dragged"],
         )
         records.append(record)
         if on_step:

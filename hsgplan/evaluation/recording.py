@@ -194,6 +194,7 @@ class EpisodeRecording:
         line = f"step {record.step}: {record.params} -> {record.status}"
         line += f" ({record.detail})" if record.detail else ""
         line += f"; disturbed {moved}" if moved else ""
+        line += f"; dragged {100 * record.dragged:.1f} cm after release" if record.dragged else ""
         level = "INFO" if record.status == "success" else "WARN"
         self._log("log/steps", rr.TextLog(line, level=level))
         self._path()

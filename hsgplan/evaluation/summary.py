@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.failures import Failure
-from hsgplan.sim.outcome import DISTURB_TOL, SEEN_DISTURB_TOL, Status
+from hsgplan.sim.outcome import DISTURB_RECORD, DISTURB_TOL, SEEN_DISTURB_TOL, Status
 
 EXECUTION = "execution"
 OVERSTEP = "overstep"
@@ -107,6 +107,8 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
                 ).items()
             )
         ),
+        # places and pushes whose own object the retreating hand dragged on after letting go
+        "dragged_steps": sum(1 for r in rs for s in r.steps if s.dragged > DISTURB_RECORD),
         "still_seen_moved": still_seen_moved(rs),
         # looks taken again before a primitive or the goal's end, seeing through f_p (`relook`)
         "relooks": sum(s.relooks for r in rs for s in r.steps) + sum(r.closing_relooks for r in rs),

@@ -43,6 +43,7 @@ from hsgplan.sim.outcome import (
     Status,
     compare,
     disturbances,
+    dragged,
     largest_move,
 )
 from hsgplan.sim.primitives import Watch, execute, run_path, run_plan, stopped_outcome
@@ -196,11 +197,13 @@ class KitchenStorageEnv(gymnasium.Env):
         done = self.goal.satisfied_by(typed.symbols.state)
         truncated = not done and self.steps >= self.max_steps
         acted_on = getattr(params, "obj", "")  # an undecodable action acts on nothing
+        true_after = self.scene.poses()
         info = {
             "outcome": outcome,
             "observation": typed,
             # what the primitive truly moved besides its object: the record's, not the agent's
-            "disturbed": disturbances(true_before, self.scene.poses(), acted_on, phases),
+            "disturbed": disturbances(true_before, true_after, acted_on, phases),
+            "dragged": dragged(phases, true_after, acted_on),
             # the largest move the robot saw of an object besides its own, of those it was
             # sure of before and after (its observer's)
             "seen_moved": largest_move(

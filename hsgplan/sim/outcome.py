@@ -87,6 +87,16 @@ def disturbances(
     return tuple(out)
 
 
+def dragged(phases: list[tuple[str, dict[str, Pose]]], after: dict[str, Pose], obj: str) -> float:
+    """How far (m) a primitive's own object moved from when the hand let it go (the end of a
+    place's `release` or a push's `push` phase) to the primitive's end: the retreat dragging
+    it. 0 for a pick, or where no phase was told."""
+    let_go = next((poses for name, poses in phases if name in ("release", "push")), None)
+    if let_go is None or obj not in let_go or obj not in after:
+        return 0.0
+    return round(let_go[obj].distance(after[obj]), 4)
+
+
 def largest_move(
     before: GeometricSceneGraph,
     after: GeometricSceneGraph,

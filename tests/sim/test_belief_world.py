@@ -15,6 +15,7 @@ from hsgplan.sim.outcome import (
     Status,
     compare,
     disturbances,
+    dragged,
     largest_move,
 )
 from hsgplan.sim.primitives import run_plan
@@ -122,16 +123,22 @@ def test_the_largest_move_seen_leaves_out_the_object_acted_on_and_the_unsure():
 def test_a_disturbance_is_put_in_the_phase_by_whose_end_it_had_moved():
     still, moved = _on_table("butter", 0.5, 0.1), _on_table("butter", 0.5, 0.12)
     soup = _on_table("tomato_soup", 0.5, -0.2)
-    before = {"butter": still, "tomato_soup": soup, "cherries": soup}
+    held, put = _on_table("cherries", 0.3, 0.0), _on_table("cherries", 0.3, 0.02)
+    before = {"butter": still, "tomato_soup": soup, "cherries": held}
     phases = [
-        ("path", {"butter": still, "tomato_soup": soup, "cherries": soup}),
-        ("approach", {"butter": moved, "tomato_soup": soup, "cherries": soup}),
-        ("retreat", {"butter": moved, "tomato_soup": soup, "cherries": moved}),
+        ("path", {"butter": still, "tomato_soup": soup, "cherries": held}),
+        ("approach", {"butter": moved, "tomato_soup": soup, "cherries": held}),
+        ("retreat", {"butter": moved, "tomato_soup": soup, "cherries": put}),
     ]
-    after = {"butter": moved, "tomato_soup": soup, "cherries": moved}
+    after = {"butter": moved, "tomato_soup": soup, "cherries": put}
     # cherries is the primitive's own object: never a disturbance
     assert disturbances(before, after, "cherries", phases) == (
         Disturbance("butter", 0.02, "approach"),
     )
     # without phases told, where it moved is unknown
     assert disturbances(before, after, "cherries") == (Disturbance("butter", 0.02, ""),)
+    # the retreat dragged cherries 2 cm after a release let it go; a pick lets nothing go
+    released = [phases[0], ("release", phases[0][1]), ("retreat", after)]
+    assert dragged(released, after, "cherries") == pytest.approx(0.02)
+    assert dragged(released, after, "tomato_soup") == 0.0
+    assert dragged(phases, after, "cherries") == 0.0
