@@ -47,7 +47,7 @@ class StepRecord:
     disturbed: tuple[Disturbance, ...] = ()
     # the largest move (m) its observer saw of an object besides its own, look before to after
     seen_moved: float = 0.0
-    # how far (m) its own object truly moved after the hand let it go (`sim.outcome.dragged`)
+    # how far (m) a place's object truly moved after the hand let it go (`sim.outcome.dragged`)
     dragged: float = 0.0
 
 

@@ -107,8 +107,13 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
                 ).items()
             )
         ),
-        # places and pushes whose own object the retreating hand dragged on after letting go
-        "dragged_steps": sum(1 for r in rs for s in r.steps if s.dragged > DISTURB_RECORD),
+        # places whose object the retreating hand dragged on after letting it go
+        "dragged_steps": sum(
+            1
+            for r in rs
+            for s in r.steps
+            if s.action.startswith("place") and s.dragged > DISTURB_RECORD
+        ),
         "still_seen_moved": still_seen_moved(rs),
         # looks taken again before a primitive or the goal's end, seeing through f_p (`relook`)
         "relooks": sum(s.relooks for r in rs for s in r.steps) + sum(r.closing_relooks for r in rs),

@@ -88,10 +88,10 @@ def disturbances(
 
 
 def dragged(phases: list[tuple[str, dict[str, Pose]]], after: dict[str, Pose], obj: str) -> float:
-    """How far (m) a primitive's own object moved from when the hand let it go (the end of a
-    place's `release` or a push's `push` phase) to the primitive's end: the retreat dragging
-    it. 0 for a pick, or where no phase was told."""
-    let_go = next((poses for name, poses in phases if name in ("release", "push")), None)
+    """How far (m) a place's object moved from when the hand let it go (the end of its
+    `release` phase) to the primitive's end: the retreat dragging it. 0 for a pick or a push
+    (whose object slides on after the stroke by design), or where no phase was told."""
+    let_go = next((poses for name, poses in phases if name == "release"), None)
     if let_go is None or obj not in let_go or obj not in after:
         return 0.0
     return round(let_go[obj].distance(after[obj]), 4)

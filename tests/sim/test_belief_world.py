@@ -142,3 +142,5 @@ def test_a_disturbance_is_put_in_the_phase_by_whose_end_it_had_moved():
     assert dragged(released, after, "cherries") == pytest.approx(0.02)
     assert dragged(released, after, "tomato_soup") == 0.0
     assert dragged(phases, after, "cherries") == 0.0
+    pushed = [phases[0], ("push", phases[0][1]), ("retreat", after)]
+    assert dragged(pushed, after, "cherries") == 0.0  # a pushed object slides on by design
