@@ -218,6 +218,24 @@ def test_steps_that_truly_moved_another_object_are_counted_and_read_back():
     assert "| GNN | 2 | 2 | 0 | 0 | 0 | 0 | 0 | 1 |" in text
 
 
+def test_moves_are_counted_by_primitive_and_phase_and_dragged_places_apart():
+    from hsgplan.sim.outcome import Disturbance
+
+    nudged = replace(
+        _step("success"),
+        disturbed=(Disturbance("cherries", 0.031, "approach"), Disturbance("popcorn", 0.01)),
+    )
+    place = replace(_step("success", 2), action="place(butter, shelf_a)", dragged=0.02)
+    barely = replace(_step("success", 3), action="place(butter, shelf_b)", dragged=0.004)
+    pushed = replace(_step("success", 4), action="push(butter, shelf_a)", dragged=0.015)
+    record = replace(_record(True), steps=(nudged, place, barely, pushed))
+    again = EpisodeRecord.from_json(json.loads(json.dumps(record.to_json())))
+    assert again == record
+    row = summarize([record])["by_size"]["2"]
+    assert row["disturbed_in"] == {"pick:approach": 1, "pick:unknown": 1}
+    assert row["dragged_steps"] == 1  # past 5 mm, and a place's (a push's slide is no drag)
+
+
 def test_what_the_observer_saw_move_is_summed_over_steps_that_truly_moved_nothing():
     from hsgplan.sim.outcome import Disturbance
 
