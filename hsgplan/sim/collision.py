@@ -16,8 +16,8 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.robot import Panda
 
 # Checked paths keep this far from obstacles, so that contacts between the checks spaced STEP
-# apart stay shallow. Transit and transfer motions are kinematic (a graze moves nothing), and
-# the approach poses at the ends of a path must pass the same margin: 5 cm measured too strict
+# apart stay shallow; the arm runs them under physics, so a graze pushes what it touches. The
+# approach poses at the ends of a path must pass the same margin: 5 cm measured too strict
 # there, failing grasps beside close neighbours.
 SAFETY_MARGIN = 0.002
 STEP = 0.02  # rad between collision checks along a joint-space segment
