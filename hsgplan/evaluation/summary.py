@@ -107,7 +107,8 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
                 ).items()
             )
         ),
-        # places whose object the retreating hand dragged on after letting it go
+        # places whose object the retreating hand dragged on after letting it go (a drag is a
+        # place's: a record of another primitive with one counts none)
         "dragged_steps": sum(
             1
             for r in rs

@@ -31,9 +31,8 @@ Frame = Callable[[], None]
 Phase = Callable[[str], None]
 
 
-def _ended(on_phase: Phase | None, name: str) -> None:
-    if on_phase is not None:
-        on_phase(name)
+def _untold(name: str) -> None:
+    """The `Phase` of a caller that records no phases."""
 
 
 class Watch:
@@ -56,7 +55,7 @@ def execute(
     params: PrimitiveParams,
     on_frame: Frame | None = None,
     plan: MotionPlan | PlanFailure | None = None,
-    on_phase: Phase | None = None,
+    on_phase: Phase = _untold,
 ) -> Outcome:
     """Plan (unless a plan made for this scene, or its failure, is given) and run one
     primitive.
@@ -85,7 +84,7 @@ def stopped_outcome(status: Status, detail: str, stopped: str | None) -> tuple[S
 
 
 def run_plan(
-    scene: Scene, plan: MotionPlan, on_frame: Frame | None = None, on_phase: Phase | None = None
+    scene: Scene, plan: MotionPlan, on_frame: Frame | None = None, on_phase: Phase = _untold
 ) -> str | None:
     """Run a planned primitive's joint motions in the scene under physics, telling `on_phase`
     as each phase ends.
@@ -113,12 +112,12 @@ def run_path(scene: Scene, path, on_frame: Frame | None = None) -> bool:
 
 def _approach(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
     reached = run_path(scene, plan.path, on_frame)
-    _ended(on_phase, "path")
+    on_phase("path")
     if not reached:
         return "the arm was stopped on its way by something it met"
     down = [scene.robot.q(), plan.q_above, *plan.descent, plan.q_at]
     reached = run_path(scene, down, on_frame)
-    _ended(on_phase, "approach")
+    on_phase("approach")
     if not reached:
         return "the arm was stopped on its final approach by something it met"
     return None
@@ -127,7 +126,7 @@ def _approach(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
 def _retreat(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
     up = [scene.robot.q(), *reversed(plan.descent), plan.q_above]
     reached = run_path(scene, up, on_frame)
-    _ended(on_phase, "retreat")
+    on_phase("retreat")
     if not reached:
         return "the arm was stopped on its retreat by something it met"
     return None
@@ -143,7 +142,7 @@ def _run_pick(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
     drive_fingers(robot, 0.0)
     if (body := body_in_grasp(robot, tuple(scene.bodies.values()))) is not None:
         robot.attach(body)
-    _ended(on_phase, "grasp")
+    on_phase("grasp")
     return _retreat(scene, plan, on_frame, on_phase)
 
 
@@ -154,7 +153,7 @@ def _run_place(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None
     robot.detach()
     drive_fingers(robot, GRIPPER_MAX_OPENING)
     scene.settle()
-    _ended(on_phase, "release")
+    on_phase("release")
     return _retreat(scene, plan, on_frame, on_phase)
 
 
@@ -167,7 +166,7 @@ def _run_push(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
         press_towards(robot, q, PUSH_SUBSTEPS)
         if on_frame:
             on_frame()
-    _ended(on_phase, "push")
+    on_phase("push")
     # Back out the way it came (joints checked against the shelves while planning; the
     # object is ahead of the fingers now), then up to where the approach began: from the
     # line's point the hand got to, since it lags behind the line's end and catching up
@@ -179,5 +178,5 @@ def _run_push(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
     stopped = None if run_path(scene, back, on_frame) else "stopped backing out of a push"
     scene.settle()
     drive_fingers(robot, GRIPPER_MAX_OPENING)
-    _ended(on_phase, "retreat")
+    on_phase("retreat")
     return stopped
