@@ -16,6 +16,7 @@ import statistics
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,7 @@ import torch
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.observer import tracked
 from hsgplan.perception.synthetic import VIEWS, render_sample
+from hsgplan.perception.vocabulary import TRAINING_WORLD
 from hsgplan.scene_graph.geometry import Pose
 
 # objects in a scene, grouped: what a row of the table covers
@@ -57,7 +59,8 @@ def bench_observe(
     of sizes that holds any, then one over all of them."""
     torch.set_num_threads(1)
     estimator = PoseEstimator.load(checkpoint)
-    rest = estimator.rest if estimator.settled else None
+    world = TRAINING_WORLD  # the staged scenes' (`render_sample`)
+    rest = partial(estimator.rest, world) if estimator.settled else None
     times: list[tuple[int, float, float, float]] = []
     for index in range(scenes):
         start = time.perf_counter()
@@ -69,10 +72,10 @@ def bench_observe(
                 for o, p in zip(sample.objects, sample.poses, strict=True)
             }
             start = time.perf_counter()
-            detections = estimator.detect(sample.images, sample.cameras)
+            detections = estimator.detect(sample.images, sample.cameras, world)
             detected = time.perf_counter() - start
             start = time.perf_counter()
-            tracked(detections, known, rest)
+            tracked(detections, known, world, rest)
             times.append((len(sample.objects), rendered, detected, time.perf_counter() - start))
         if on_scene:
             on_scene()

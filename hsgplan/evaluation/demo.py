@@ -90,7 +90,7 @@ def run_demo(
         if seeing:
             from hsgplan.perception.draw import draw_cuboids
 
-            image = draw_cuboids(image, camera, believed)
+            image = draw_cuboids(image, camera, believed, goal.world)
         return image
 
     def snapshot():

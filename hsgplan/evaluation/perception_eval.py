@@ -161,7 +161,9 @@ def evaluate(
     for index in range(scenes):
         sample = render_sample(seed, index, views=views)
         if sample is not None:
-            out.append(score_scene(sample, estimator.detect(sample.images, sample.cameras)))
+            out.append(
+                score_scene(sample, estimator.detect(sample.images, sample.cameras, KITCHEN))
+            )
         if on_scene:
             on_scene()
     return out
@@ -182,7 +184,7 @@ def evaluate_loop(
     cameras = first_views(views)
     out = []
     for scene in loop_scenes(scenes, seed, cameras):
-        detections = estimator.detect(scene.images, cameras, scene.arm)
+        detections = estimator.detect(scene.images, cameras, KITCHEN, scene.arm)
         # the robot knows where its hand is: what is there is not f_p's to find
         detections = away_from_hand(detections, scene.held)
         out.append(score(scene.truth, detections))

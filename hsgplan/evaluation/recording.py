@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from hsgplan.agents.base import Decision
-from hsgplan.domain.world import Kind, ObjectType
+from hsgplan.domain.world import Kind, ObjectType, World
 from hsgplan.perception.draw import EDGES, cuboid_pixels
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.scene_graph.geometry import Pose
@@ -206,6 +206,7 @@ class EpisodeRecording:
         import rerun as rr
 
         self._at()
+        world = seen.scene_graph.world
         for k, (image, camera) in enumerate(zip(look.images, look.cameras, strict=True)):
             base = f"cameras/view_{k}/image"
             self._log(base, rr.Image(image).compress(jpeg_quality=JPEG))
@@ -217,7 +218,7 @@ class EpisodeRecording:
                         seen_px = v.pixels[~np.isnan(v.pixels).any(axis=1)]
                         points.extend(seen_px.tolist())
                         labels.extend([d.type_name] * len(seen_px))
-                px = cuboid_pixels(d.type_name, d.pose, pinhole)
+                px = cuboid_pixels(world.object_type(d.type_name), d.pose, pinhole)
                 if px is not None:
                     strips.extend([px[a], px[b]] for a, b in EDGES)
             self._log(f"{base}/keypoints", rr.Points2D(points, labels=labels or None, radii=2.0))
@@ -369,8 +370,8 @@ class RecordedLooks:
         self.name = observer.name
         self.cameras = observer.cameras
 
-    def start(self, objects: tuple[str, ...]) -> None:
-        self.inner.start(objects)
+    def start(self, objects: tuple[str, ...], world: World) -> None:
+        self.inner.start(objects, world)
 
     def look(self, look: Look) -> Seen:
         seen = self.inner.look(look)

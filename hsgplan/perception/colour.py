@@ -32,14 +32,14 @@ from torch import nn
 
 from hsgplan.checkpoint import load_trained
 from hsgplan.domain.checks import BOUNDS, check_fields, from_settings, setting
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.perception.vocabulary import TYPES
 
 PATCH = 3  # pixels each side of the centroid's pixel
 FEATURES = 4  # chromaticity r, g, b and brightness
 MIN_REGION = 12  # pixels of an object in sight for their colour to name it
 MIN_VOTES = 6  # of them named a type of the object's kind, for `pixel_vote` to say
 FOLDER = "colour"
-TYPE_COUNT = len(KITCHEN.object_types)
+TYPE_COUNT = len(TYPES)
 BACKGROUND = TYPE_COUNT  # the background's class index (a network of `TYPE_COUNT + 1` classes)
 
 

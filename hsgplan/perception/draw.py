@@ -5,6 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from hsgplan.domain.world import ObjectType, World
 from hsgplan.perception.keypoints import CORNER_SIGNS, PinholeCamera, in_world
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -19,17 +20,20 @@ EDGES = tuple(
 COLOR = (40, 220, 60)
 
 
-def cuboid_pixels(obj: str, pose: Pose, pinhole: PinholeCamera) -> np.ndarray | None:
-    """The object's 9 keypoints where `pose` puts it, in `pinhole`'s pixels: [9, 2]; None
-    where any of them is behind the camera."""
-    points = in_world(obj, pose)
+def cuboid_pixels(t: ObjectType, pose: Pose, pinhole: PinholeCamera) -> np.ndarray | None:
+    """An object of type `t`: its 9 keypoints where `pose` puts it, in `pinhole`'s pixels:
+    [9, 2]; None where any of them is behind the camera."""
+    points = in_world(t, pose)
     if (pinhole.to_camera(points)[:, 2] <= 0).any():
         return None
     return pinhole.project(points)
 
 
-def draw_cuboids(image: np.ndarray, camera: Camera, poses: dict[str, Pose]) -> np.ndarray:
-    """A copy of `image` (taken by `camera`) with each object's cuboid at its pose drawn on it.
+def draw_cuboids(
+    image: np.ndarray, camera: Camera, poses: dict[str, Pose], world: World
+) -> np.ndarray:
+    """A copy of `image` (taken by `camera`) with each object's cuboid (its type's in `world`)
+    at its pose drawn on it.
 
     Shapes:
         image: [H, W, 3] uint8; returns the same shape.
@@ -38,7 +42,7 @@ def draw_cuboids(image: np.ndarray, camera: Camera, poses: dict[str, Pose]) -> n
     pinhole = PinholeCamera.of(camera)
     thickness = max(1, round(camera.height / 240))
     for obj, pose in poses.items():
-        projected = cuboid_pixels(obj, pose, pinhole)
+        projected = cuboid_pixels(world.object_type(obj), pose, pinhole)
         if projected is None:  # behind the camera
             continue
         pixels = np.round(projected).astype(int)

@@ -24,8 +24,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.world import Kind
+from hsgplan.domain.world import Kind, ObjectType, World
 from hsgplan.paths import shipped
 from hsgplan.perception import phantoms
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
@@ -46,11 +45,11 @@ from hsgplan.perception.settle import (
     surfaces_under,
 )
 from hsgplan.perception.visible import painted, visible_masks
+from hsgplan.perception.vocabulary import TYPES
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sensing import Box
 
-TYPES = tuple(KITCHEN.object_types)
 # A free (tilted) fit stands for a toppled object only where its reprojection cost is at most
 # this fraction of the best upright fit's. At 1 (no preference for upright), a thin box half
 # hidden under a can was often fitted a little better tilted, was no carrier to settle on,
@@ -82,6 +81,10 @@ class PoseEstimator:
     settled: make the fused poses rest on their supports (`perception.settle`).
     colour: the colour network that names each object's type (`perception.colour`); without
         it, the keypoint network's type is kept.
+    pruned: drop what a lone view found that the other views contradict.
+
+    What it knows of the scene it looks at (its object types' sizes and kinds, its table and
+    shelves) is that scene's `World`, given with each look.
     """
 
     def __init__(
@@ -104,7 +107,7 @@ class PoseEstimator:
         colour = load_colour(shipped(folder) / COLOUR_FOLDER)
         return PoseEstimator(net, settled, colour, pruned)
 
-    def _typed(self, images: np.ndarray, members: list[Seen]) -> tuple[int, float]:
+    def _typed(self, world: World, images: np.ndarray, members: list[Seen]) -> tuple[int, float]:
         """The type of an object its members saw, and its probability: by the colour network
         over the members' views, among the types of the kind (can or box) the keypoint network
         saw, which it tells apart well, that fit the height where their rays meet; else the
@@ -117,10 +120,14 @@ class PoseEstimator:
         probs = type_probs(self.colour, np.stack(rows)).mean(dim=0)
         rays = [line_of_sight(s) for s in members]
         centre = meeting_point(rays) if len(rays) > 1 else None
-        return _of_kind(probs, TYPES[members[0].type_index], centre)
+        return _of_kind(world, probs, TYPES[members[0].type_index], centre)
 
     def _retyped(
-        self, images: np.ndarray, cameras: tuple[Camera, ...], found: list[Detection]
+        self,
+        world: World,
+        images: np.ndarray,
+        cameras: tuple[Camera, ...],
+        found: list[Detection],
     ) -> list[Detection]:
         """Each detection named again, in the views that found it, by the colour of the pixels
         it keeps in sight once every detection is painted where it was found
@@ -128,18 +135,20 @@ class PoseEstimator:
         vote of those pixels, `colour.pixel_vote`; else by that pixel's patch, as before);
         among the types of its kind that fit its height, and refitted if renamed. One in sight
         nowhere keeps its name."""
-        rows = self._votes(images, cameras, found)
+        rows = self._votes(world, images, cameras, found)
         out = []
         for d, seen in zip(found, rows, strict=True):
             if not seen:
                 out.append(d)
                 continue
             centre = np.array(d.pose.position) if len(d.rays) > 1 else None
-            best, confidence = _of_kind(torch.stack(seen).mean(dim=0), d.type_name, centre)
+            probs = torch.stack(seen).mean(dim=0)
+            best, confidence = _of_kind(world, probs, d.type_name, centre)
             if TYPES[best] == d.type_name:
                 out.append(replace(d, type_confidence=confidence))
                 continue
-            pose, error = _fitted(TYPES[best], list(d.keypoints), list(d.rays))
+            t = world.object_type(TYPES[best])
+            pose, error = _fitted(t, list(d.keypoints), list(d.rays))
             if pose is not None:
                 d = replace(d, type_name=TYPES[best], pose=pose, reprojection_px=error)
             out.append(replace(d, type_confidence=confidence))
@@ -147,6 +156,7 @@ class PoseEstimator:
 
     def _votes(
         self,
+        world: World,
         images: np.ndarray,
         cameras: tuple[Camera, ...],
         found: list[Detection],
@@ -157,8 +167,9 @@ class PoseEstimator:
         for those indexed in `by_pixels`) by a vote of the pixels it keeps in sight (see
         `_retyped`)."""
         assert self.colour is not None
-        types, poses = [d.type_name for d in found], [d.pose for d in found]
-        kinds = [_same_kind(d.type_name) for d in found]
+        types = [world.object_type(d.type_name) for d in found]
+        poses = [d.pose for d in found]
+        kinds = [_same_kind(world, d.type_name) for d in found]
         rows: list[list[torch.Tensor]] = [[] for _ in found]
         for image, camera in zip(images, cameras, strict=True):
             pinhole = PinholeCamera.of(camera)
@@ -186,42 +197,52 @@ class PoseEstimator:
         return rows
 
     def _unstacked(
-        self, images: np.ndarray, cameras: tuple[Camera, ...], found: list[Detection]
+        self,
+        world: World,
+        images: np.ndarray,
+        cameras: tuple[Camera, ...],
+        found: list[Detection],
     ) -> list[Detection]:
         """Each detection that is two thin boxes stacked (`STACK_BAND`) as the two, one on the
         other on the surface under it, each named by the colour it keeps in sight once both
         are painted (the upper one by its top face, the lower one by its sides). Without a
         colour network (which names the two) nothing is split."""
-        split = [k for k, d in enumerate(found) if _stack_of_two(d, found)]
+        split = [k for k, d in enumerate(found) if _stack_of_two(d, found, world)]
         if not split or self.colour is None:
             return found
         out = [d for k, d in enumerate(found) if k not in split]
         halves = []
         for d in (found[k] for k in split):
             x, y, z = d.pose.position
-            base = max(t for t in surfaces_under(x, y) if t <= z)
-            height = KITCHEN.object_type(d.type_name).size[2]
+            base = max(t for t in surfaces_under(world, x, y) if t <= z)
+            height = world.object_type(d.type_name).size[2]
             for level in (0.5, 1.5):
                 halves.append(len(out))
                 at = Pose((x, y, base + level * height), d.pose.orientation)
                 out.append(replace(d, pose=at, stacked=True))
         # a half's centroid patch spans both boxes (2.4 cm is a few pixels): its pixels vote
-        votes = self._votes(images, cameras, out, by_pixels=set(halves))
+        votes = self._votes(world, images, cameras, out, by_pixels=set(halves))
         for k in halves:
             if votes[k]:
                 d = out[k]
                 probs = torch.stack(votes[k]).mean(dim=0)
-                best, confidence = _of_kind(probs, d.type_name, np.array(d.pose.position))
-                if KITCHEN.object_type(TYPES[best]).size[2] <= THIN:  # the same cuboid but for a mm
+                centre = np.array(d.pose.position)
+                best, confidence = _of_kind(world, probs, d.type_name, centre)
+                if world.object_type(TYPES[best]).size[2] <= THIN:  # the same cuboid but for a mm
                     out[k] = replace(d, type_name=TYPES[best], type_confidence=confidence)
         return out
 
     @torch.inference_mode()
     def detect(
-        self, images: np.ndarray, cameras: tuple[Camera, ...], arm: tuple[Box, ...] = ()
+        self,
+        images: np.ndarray,
+        cameras: tuple[Camera, ...],
+        world: World,
+        arm: tuple[Box, ...] = (),
     ) -> list[Detection]:
-        """Objects in the views: images [V, H, W, 3] uint8, taken by `cameras`, with the arm's
-        links at `arm` (`sim.sensing.Box`; they may hide objects from a view)."""
+        """Objects in the views: images [V, H, W, 3] uint8, taken by `cameras`, of a scene of
+        `world`, with the arm's links at `arm` (`sim.sensing.Box`; they may hide objects from a
+        view)."""
         batch = torch.from_numpy(images).permute(0, 3, 1, 2).float() / 255.0
         beliefs, fields = self.net(batch)[-1]
         found: list[Seen] = []
@@ -229,20 +250,24 @@ class PoseEstimator:
             pinhole = PinholeCamera.of(camera)
             for inst in decode(beliefs[v].numpy(), fields[v].numpy(), self.net.stride):
                 seen = ViewKeypoints(pinhole, inst.pixels)
-                single = estimate_pose(TYPES[inst.type_index], [seen])
+                single = estimate_pose(world.object_type(TYPES[inst.type_index]), [seen])
                 if single is not None:
                     found.append(Seen(inst.type_index, inst.score, v, seen, single.pose))
-        fused = _apart(_fuse(found, lambda members: self._typed(images, members)))
+        typed = partial(self._typed, world, images)
+        fused = _apart(_fuse(found, typed, world), world)
         if self.colour is not None:
-            fused = _apart(self._retyped(images, cameras, fused))
+            fused = _apart(self._retyped(world, images, cameras, fused), world)
         if not self.settled:
             return fused
-        fused = self._unstacked(images, cameras, fused)
-        rested = self.rest([replace(d, measured=d.pose) for d in fused])
-        return phantoms.pruned(rested, found, cameras, arm) if self.pruned else rested
+        fused = self._unstacked(world, images, cameras, fused)
+        rested = self.rest(world, [replace(d, measured=d.pose) for d in fused])
+        if not self.pruned:
+            return rested
+        return phantoms.pruned(rested, found, cameras, world, arm)
 
     @staticmethod
     def rest(
+        world: World,
         found: list[Detection],
         fixed: Sequence[tuple[str, Pose]] = (),
         near: Mapping[int, Pose] | None = None,
@@ -253,34 +278,36 @@ class PoseEstimator:
         that nothing could hold: no object can be there). `near` (by index in `found`): where
         the object a lone view's detection is was believed before (`along_ray_near`)."""
         # a split stack's keypoints are its blob's: they say nothing of either box's height
-        costs = [None if d.stacked or not d.keypoints else partial(_cost_at, d) for d in found]
+        costs = [
+            None if d.stacked or not d.keypoints else partial(_cost_at, d, world) for d in found
+        ]
         measured = [d.measured or d.pose for d in found]
         for k, before in (near or {}).items():
             if len(found[k].rays) == 1:
                 measured[k] = along_ray_near(found[k].rays[0], measured[k], before)
         types, rays = [d.type_name for d in found], [d.rays for d in found]
-        poses = settle(types, measured, rays, costs, fixed)
+        poses = settle(world, types, measured, rays, costs, fixed)
         out = [replace(d, pose=p) for d, p in zip(found, poses, strict=True)]
-        return [d for d in out if not _inside_table(d.pose)]
+        return [d for d in out if not _inside_table(d.pose, world)]
 
 
-def _inside_table(pose: Pose) -> bool:
+def _inside_table(pose: Pose, world: World) -> bool:
     x, y, z = pose.position
-    return KITCHEN.table.contains(x, y) and z < KITCHEN.table.z
+    return world.table.contains(x, y) and z < world.table.z
 
 
-def _stack_of_two(d: Detection, found: list[Detection]) -> bool:
+def _stack_of_two(d: Detection, found: list[Detection], world: World) -> bool:
     """Whether a detection is two thin boxes stacked: a thin box where several views' rays
     meet, its centre within `STACK_BAND` of its heights over the surface under it, and no other
     detection centred over that surface within `OVERLAP_XY` across either lower (a carrier, or
     the lower box found) or resting on it with its bottom under one and a half boxes up (it
     stands on one box: seed 1's scene 11 split a butter under a soup). One centred under it is
     no carrier: a lone view's soup inside a shelf kept a stack on its top one box (seed 903)."""
-    height = KITCHEN.object_type(d.type_name).size[2]
+    height = world.object_type(d.type_name).size[2]
     if height > THIN or len(d.rays) < 2:
         return False
     x, y, z = d.pose.position
-    tops = [t for t in surfaces_under(x, y) if t <= z]
+    tops = [t for t in surfaces_under(world, x, y) if t <= z]
     low, high = STACK_BAND
     if not tops or not low * height <= z - max(tops) <= high * height:
         return False
@@ -292,46 +319,51 @@ def _stack_of_two(d: Detection, found: list[Detection]) -> bool:
             continue
         if k.pose.position[2] < z:
             return False  # a carrier, or the lower box found
-        if k.pose.position[2] - KITCHEN.object_type(k.type_name).size[2] / 2 < base + 1.5 * height:
+        if k.pose.position[2] - world.object_type(k.type_name).size[2] / 2 < base + 1.5 * height:
             return False  # what it carries rests on one box, not on two
     return True
 
 
-def _cost_at(d: Detection, centre: np.ndarray) -> float:
+def _cost_at(d: Detection, world: World, centre: np.ndarray) -> float:
     """How badly the detection's pose, moved to `centre`, explains its keypoints."""
-    return robust_cost(d.type_name, list(d.keypoints), Pose(tuple(centre), d.pose.orientation))
+    t, at = world.object_type(d.type_name), Pose(tuple(centre), d.pose.orientation)
+    return robust_cost(t, list(d.keypoints), at)
 
 
-def _same_kind(type_name: str) -> torch.Tensor:
+def _same_kind(world: World, type_name: str) -> torch.Tensor:
     """Which types [types] (bool) are of `type_name`'s kind (can or box)."""
-    kind = KITCHEN.object_types[type_name].kind
-    return torch.tensor([KITCHEN.object_types[t].kind is kind for t in TYPES])
+    kind = world.object_type(type_name).kind
+    return torch.tensor([world.object_type(t).kind is kind for t in TYPES])
 
 
 def _of_kind(
-    probs: torch.Tensor, type_name: str, centre: np.ndarray | None = None
+    world: World, probs: torch.Tensor, type_name: str, centre: np.ndarray | None = None
 ) -> tuple[int, float]:
     """The likeliest type of `type_name`'s kind (can or box) by the colour network's
     probabilities [types], and its probability; with `centre` (where several views' rays
     meet), among those whose height fits it (`settle.fits_height`) if any does."""
-    same = _same_kind(type_name)
+    same = _same_kind(world, type_name)
     if centre is not None:
-        fits = same & torch.tensor([fits_height(t, centre) for t in TYPES])
+        fits = same & torch.tensor(
+            [fits_height(world, world.object_type(t), centre) for t in TYPES]
+        )
         same = fits if bool(fits.any()) else same
     best = int(torch.where(same, probs, torch.full_like(probs, -1.0)).argmax())  # of the kind
     return best, float(probs[best])
 
 
-def _fuse(found: list[Seen], typed: Callable[[list[Seen]], tuple[int, float]]) -> list[Detection]:
+def _fuse(
+    found: list[Seen], typed: Callable[[list[Seen]], tuple[int, float]], world: World
+) -> list[Detection]:
     """One detection per object that the views' lines of sight group (`fusion.grouped`),
-    named by `typed` and fitted to every member's keypoints."""
+    named by `typed` and fitted to every member's keypoints (its type's cuboid in `world`)."""
     out = []
-    for members in grouped(found):
+    for members in grouped(found, world.table):
         kind, confidence = typed(members)
         name = TYPES[kind]
         rays = [line_of_sight(s) for s in members]
         views = [s.keypoints for s in members]
-        pose, error = _fitted(name, views, rays)
+        pose, error = _fitted(world.object_type(name), views, rays)
         if pose is None:
             continue
         score = members[0].score
@@ -341,10 +373,12 @@ def _fuse(found: list[Seen], typed: Callable[[list[Seen]], tuple[int, float]]) -
     return out
 
 
-def _fitted(name: str, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[Pose | None, float]:
-    """The pose of an object of type `name` from the keypoints of the views that saw it, and
+def _fitted(
+    t: ObjectType, views: list[ViewKeypoints], rays: list[Ray]
+) -> tuple[Pose | None, float]:
+    """The pose of an object of type `t` from the keypoints of the views that saw it, and
     its RMS reprojection error (pixels); None if PnP finds none."""
-    fused = estimate_pose(name, views)
+    fused = estimate_pose(t, views)
     if fused is None:
         return None, math.inf
     pose = fused.pose
@@ -352,9 +386,9 @@ def _fitted(name: str, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[Pos
         pose = Pose(tuple(map(float, meeting_point(rays))), pose.orientation)
     # Objects here rest upright: the best upright yaw, unless a free pose explains several
     # views' keypoints much better (a toppled object; see `TOPPLED_COST`).
-    level = upright_fit(name, views, pose.position)
-    cost = robust_cost(name, views, level)
-    if len(views) > 1 and (free := robust_cost(name, views, pose)) < TOPPLED_COST * cost:
+    level = upright_fit(t, views, pose.position)
+    cost = robust_cost(t, views, level)
+    if len(views) > 1 and (free := robust_cost(t, views, pose)) < TOPPLED_COST * cost:
         cost = free
     else:
         pose = level
@@ -362,7 +396,7 @@ def _fitted(name: str, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[Pos
     return pose, math.sqrt(cost / max(points, 1))
 
 
-def _apart(detections: list[Detection]) -> list[Detection]:
+def _apart(detections: list[Detection], world: World) -> list[Detection]:
     """Two objects cannot fill one space. Detections that fill one (`settle.same_place`) are
     one object found twice, mostly once in each look-alike type's maps; the one whose type the
     colour network is surest of, among every type, is kept (then the stronger). Choosing among
@@ -382,19 +416,24 @@ def _apart(detections: list[Detection]) -> list[Detection]:
     several = [d for d in detections if d.views > 1]
     kept: list[Detection] = []
     for d in sorted(detections, key=lambda d: (-d.type_confidence, -d.score)):
-        if d.views == 1 and any(_found_again(d, k) for k in several):
+        if d.views == 1 and any(_found_again(d, k, world) for k in several):
             continue
-        if not any(same_place(d.type_name, d.pose, k.type_name, k.pose) for k in kept):
+        if not any(_same_place(d, k, world) for k in kept):
             kept.append(d)
     return kept
 
 
-def _found_again(d: Detection, k: Detection) -> bool:
+def _same_place(d: Detection, k: Detection, world: World) -> bool:
+    a, b = world.object_type(d.type_name), world.object_type(k.type_name)
+    return same_place(a, d.pose, b, k.pose)
+
+
+def _found_again(d: Detection, k: Detection, world: World) -> bool:
     """Whether a lone view's `d` is `k`, which several views saw, found again: in its space, a
     can of its type or anything of the other kind."""
-    if not same_place(d.type_name, d.pose, k.type_name, k.pose):
+    if not _same_place(d, k, world):
         return False
-    kind = KITCHEN.object_types[d.type_name].kind
-    if kind is not KITCHEN.object_types[k.type_name].kind:
+    kind = world.object_type(d.type_name).kind
+    if kind is not world.object_type(k.type_name).kind:
         return True
     return kind is Kind.CAN and k.type_name == d.type_name

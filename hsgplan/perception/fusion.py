@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import Rect
 from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.settle import Ray
 from hsgplan.scene_graph.geometry import Pose
@@ -58,9 +58,9 @@ def line_of_sight(s: Seen) -> Ray:
     return camera.eye, direction / np.linalg.norm(direction)
 
 
-def ray_gap(a: Seen, b: Seen) -> float:
+def ray_gap(a: Seen, b: Seen, table: Rect) -> float:
     """How far apart two instances' centroid rays pass (m); infinite when they meet behind a
-    camera or where no object can be (off the table, under it, high above it)."""
+    camera or where no object can be (off the `table`, under it, high above it)."""
     (pa, da), (pb, db) = line_of_sight(a), line_of_sight(b)
     w = pa - pb
     cross = da @ db
@@ -71,19 +71,17 @@ def ray_gap(a: Seen, b: Seen) -> float:
     tb = ((db @ w) - cross * (da @ w)) / denom
     qa, qb = pa + ta * da, pb + tb * db
     meet = (qa + qb) / 2
-    plausible = (
-        KITCHEN.table.contains(meet[0], meet[1]) and KITCHEN.table.z - 0.05 < meet[2] < TOP_Z
-    )
+    plausible = table.contains(meet[0], meet[1]) and table.z - 0.05 < meet[2] < TOP_Z
     if ta <= 0 or tb <= 0 or not plausible:
         return float("inf")
     return float(np.linalg.norm(qa - qb))
 
 
-def grouped(found: list[Seen]) -> list[list[Seen]]:
-    """The instances as objects: groups of instances of one type, at most one per view, every
-    two of them within `RAY_GAP`; groups seen by more views first, and among groups of one size
-    the one whose farthest pair is closest first. Each group lists its members strongest first;
-    the groups come in the order of their strongest members."""
+def grouped(found: list[Seen], table: Rect) -> list[list[Seen]]:
+    """The instances as objects (over the `table`, `ray_gap`): groups of instances of one type, at
+    most one per view, every two of them within `RAY_GAP`; groups seen by more views first, and
+    among groups of one size the one whose farthest pair is closest first. Each group lists its
+    members strongest first; the groups come in the order of their strongest members."""
     order = sorted(found, key=lambda s: -s.score)
     gaps = {
         (a, b): g
@@ -91,7 +89,7 @@ def grouped(found: list[Seen]) -> list[list[Seen]]:
         for b in range(a + 1, len(order))
         if order[a].view != order[b].view
         and order[a].type_index == order[b].type_index
-        and (g := ray_gap(order[a], order[b])) < RAY_GAP
+        and (g := ray_gap(order[a], order[b], table)) < RAY_GAP
     }
     near: dict[int, set[int]] = {k: set() for k in range(len(order))}
     for a, b in gaps:

@@ -30,7 +30,6 @@ from pathlib import Path
 import numpy as np
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.files import atomic, write_atomically
 from hsgplan.perception.keypoints import KEYPOINTS
 from hsgplan.perception.synthetic import (
@@ -40,11 +39,11 @@ from hsgplan.perception.synthetic import (
     ImageSample,
     render_sample,
 )
+from hsgplan.perception.vocabulary import TRAINING_WORLD, TYPES
 from hsgplan.runner.run_folder import logged_rows
 
 FORMAT = 1
 CHUNK = 16
-TYPES = tuple(KITCHEN.object_types)
 
 
 def chunk_path(run_dir: Path, chunk: int) -> Path:
@@ -92,7 +91,7 @@ def pack(samples: list[ImageSample], views: int = len(VIEWS)) -> dict[str, np.nd
         m = len(s.objects)
         out["images"][i] = s.images
         for j, name in enumerate(s.objects):
-            type_name, k = KITCHEN.split_instance(name)
+            type_name, k = TRAINING_WORLD.split_instance(name)
             out["types"][i, j], out["instance"][i, j] = TYPES.index(type_name), k
         out["poses"][i, :m] = s.poses
         out["keypoints"][i, :, :m] = s.keypoints

@@ -23,8 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.world import Kind
+from hsgplan.domain.world import Kind, ObjectType
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 
@@ -44,20 +43,20 @@ BOX_SYMMETRIES = (
 )
 
 
-def cuboid(obj: str) -> np.ndarray:
-    """The object's 9 keypoints in its own frame, metres: [9, 3]."""
-    half = np.asarray(KITCHEN.object_type(obj).size, dtype=np.float64) / 2
+def cuboid(t: ObjectType) -> np.ndarray:
+    """An object of type `t`: its 9 keypoints in its own frame, metres: [9, 3]."""
+    half = np.asarray(t.size, dtype=np.float64) / 2
     return np.vstack([CORNER_SIGNS * half, np.zeros((1, 3))])
 
 
-def in_world(obj: str, pose: Pose) -> np.ndarray:
-    """The object's 9 keypoints where `pose` puts it: [9, 3]."""
+def in_world(t: ObjectType, pose: Pose) -> np.ndarray:
+    """An object of type `t`: its 9 keypoints where `pose` puts it: [9, 3]."""
     m = pose.matrix()
-    return cuboid(obj) @ m[:3, :3].T + m[:3, 3]
+    return cuboid(t) @ m[:3, :3].T + m[:3, 3]
 
 
 def canonical_rotation(
-    obj: str, rotation: np.ndarray, position: np.ndarray, eye: np.ndarray
+    t: ObjectType, rotation: np.ndarray, position: np.ndarray, eye: np.ndarray
 ) -> np.ndarray:
     """The look-alike of the object's rotation that a camera at `eye` names keypoints by
     (see the module): [3, 3]."""
@@ -65,7 +64,7 @@ def canonical_rotation(
     if r[2, 2] < 0:  # upside down: the same look turned half way about x
         r = r @ BOX_SYMMETRIES[1]
     toward = np.asarray(eye, dtype=np.float64) - np.asarray(position, dtype=np.float64)
-    if KITCHEN.object_type(obj).kind is Kind.CAN:
+    if t.kind is Kind.CAN:
         local = r.T @ toward
         phi = math.atan2(local[1], local[0])
         c, s = math.cos(phi), math.sin(phi)
@@ -75,12 +74,12 @@ def canonical_rotation(
     return r
 
 
-def view_keypoints(obj: str, pose: Pose, camera: PinholeCamera) -> np.ndarray:
+def view_keypoints(t: ObjectType, pose: Pose, camera: PinholeCamera) -> np.ndarray:
     """The object's 9 keypoints as `camera` names them (its canonical look-alike), in pixels:
     [9, 2]."""
     m = pose.matrix()
-    r = canonical_rotation(obj, m[:3, :3], m[:3, 3], camera.eye)
-    return camera.project(cuboid(obj) @ r.T + m[:3, 3])
+    r = canonical_rotation(t, m[:3, :3], m[:3, 3], camera.eye)
+    return camera.project(cuboid(t) @ r.T + m[:3, 3])
 
 
 @dataclass(frozen=True)

@@ -27,8 +27,8 @@ from torch import nn
 
 from hsgplan.checkpoint import load_trained
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.keypoints import KEYPOINTS
+from hsgplan.perception.vocabulary import TYPES
 
 STRIDE = 4  # input pixels per output cell, unless a config says 2
 STRIDES = (2, 4)
@@ -39,7 +39,7 @@ CORNERS = KEYPOINTS - 1
 class PerceptionNetConfig:
     """What builds a keypoint network; saved as `config.json` beside its weights."""
 
-    types: int = len(KITCHEN.object_types)
+    types: int = len(TYPES)
     width: int = 32  # channels of the first block; doubled at each of the next two
     stages: int = 2
     stride: int = STRIDE  # input pixels per output cell: 4, or 2 through `_Refine`

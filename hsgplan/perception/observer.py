@@ -1,21 +1,22 @@
 """f_p in the loop: the robot's belief of where the objects are, from the fixed cameras' images.
 
 The observer is given what a real robot has (`sim.sensing.Look`): the images, the cameras'
-calibration, the arm's joints and what it knows of its own hand; and, when an episode starts,
-the goal's object names (their types follow from them). Nothing else: no staged pose, no
-simulated scene. Every look runs the pose estimator and names what it found. The goal names
-object instances, so the observer keeps a track of each: detections of a kind (cans, boxes)
-are given to that kind's tracked objects by an optimal assignment on the type f_p named and
-the distance to where each object was last seen (`assign`). An object has no pose until it is
-first seen: what is left of a look's detections after the tracks took theirs is given to the
-objects never seen, by type, the surest first (`first_sight`); look-alike duplicates of one
-type are named in the order f_p is surest of them. An object no view found this time keeps its
-last pose and is reported unseen; what was found is then made to rest again with the unseen
-objects where they are believed as supports too (a can put down on a butter hides it from
-every view, and would otherwise be seen sunk onto the shelf under it). The object in the hand
-is the robot's own knowledge: its pose is the arm's kinematics and the grasp as planned, not an
-estimate, and detections at the hand are not other objects; one let go since the last look was
-last seen where the hand let it go, not where it was carried.
+calibration, the arm's joints and what it knows of its own hand; and, when an episode starts, the
+goal's object names (their types follow from them) and the scene's `World` (the types' sizes, the
+table and the shelves: what a robot knows of its room and of what it handles). Nothing else: no
+staged pose, no simulated scene. Every look runs the pose estimator and names what it found. The
+goal names object instances, so the observer keeps a track of each: detections of a kind (cans,
+boxes) are given to that kind's tracked objects by an optimal assignment on the type f_p named and
+the distance to where each object was last seen (`assign`). An object has no pose until it is first
+seen: what is left of a look's detections after the tracks took theirs is given to the objects never
+seen, by type, the surest first (`first_sight`); look-alike duplicates of one type are named in the
+order f_p is surest of them. An object no view found this time keeps its last pose and is reported
+unseen; what was found is then made to rest again with the unseen objects where they are believed as
+supports too (a can put down on a butter hides it from every view, and would otherwise be seen sunk
+onto the shelf under it). The object in the hand is the robot's own knowledge: its pose is the arm's
+kinematics and the grasp as planned, not an estimate, and detections at the hand are not other
+objects; one let go since the last look was last seen where the hand let it go, not where it was
+carried.
 
 Each object's belief is as sure as its last sighting: one not seen this time, or seen by a
 single view (whose depth along its line of sight PnP gets worst), is reported `uncertain`.
@@ -26,15 +27,16 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.perception.cameras import VIEWS
+from hsgplan.domain.world import World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
+from hsgplan.perception.vocabulary import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -71,6 +73,7 @@ class RgbObserver:
     def __init__(self, estimator: PoseEstimator, cameras: tuple[Camera, ...] = VIEWS) -> None:
         self.estimator = estimator
         self.cameras = cameras
+        self.world: World | None = None  # the episode's scene (`start`)
         self._objects: tuple[str, ...] = ()
         self._last: dict[str, Pose] = {}
         # the last look's detections, the hand's left out: what a recording shows of f_p
@@ -80,14 +83,18 @@ class RgbObserver:
     def load(folder: Path) -> RgbObserver:
         return RgbObserver(PoseEstimator.load(folder))
 
-    def start(self, objects: tuple[str, ...]) -> None:
+    def start(self, objects: tuple[str, ...], world: World) -> None:
+        self.world = world
         self._objects = tuple(objects)
         self._last = {}
         self.detections = ()
 
     def look(self, look: Look) -> Seen:
         start = time.perf_counter()
-        detections = self.estimator.detect(look.images, look.cameras, look.arm)
+        world = self.world
+        if world is None:
+            raise RuntimeError("start() an episode before looking")
+        detections = self.estimator.detect(look.images, look.cameras, world, look.arm)
         held = look.holding
         if look.released is not None:
             # last seen in the hand: it is where the hand let it go, which the robot knows
@@ -97,10 +104,10 @@ class RgbObserver:
             detections = away_from_hand(detections, look.held_pose)
         self.detections = tuple(detections)
         known = {o: p for o, p in self._last.items() if o != held}
-        rest = self.estimator.rest if self.estimator.settled else None
-        tracks = tracked(detections, known, rest)
+        rest = partial(self.estimator.rest, world) if self.estimator.settled else None
+        tracks = tracked(detections, known, world, rest)
         never = [o for o in self._objects if o not in self._last and o != held]
-        first = first_sight(tracks.left, never, self._objects)
+        first = first_sight(tracks.left, never, self._objects, world)
         poses = tracks.poses | {o: d.pose for o, d in first.items()}
         views = {o: d.views for o, d in (tracks.found | first).items()}
         if held is not None and look.held_pose is not None:
@@ -110,7 +117,7 @@ class RgbObserver:
         unknown = tuple(o for o in self._objects if o not in self._last)
         uncertain = tuple(o for o in self._last if views.get(o, 0) <= 1) + unknown
         return Seen(
-            GeometricSceneGraph.from_poses(self._last, held=held, world=KITCHEN),
+            GeometricSceneGraph.from_poses(self._last, held=held, world=world),
             tracks.unseen,
             unknown,
             uncertain,
@@ -153,22 +160,23 @@ class Tracks:
 def tracked(
     detections: list[Detection],
     last: dict[str, Pose],
+    world: World,
     rest: Callable[[list[Detection], list[tuple[str, Pose]], dict[int, Pose]], list[Detection]]
     | None = None,
 ) -> Tracks:
-    """Every object's pose (by its last pose `last`) and those no detection was given
-    (`assigned`), which keep their last poses; with `rest` (`PoseEstimator.rest`), the
-    detections are made to rest again with the unseen objects as supports, a lone view's at
-    the place on its line of sight nearest where its object was (`along_ray_near`), and given
-    again."""
-    found = assigned(detections, last)
+    """Every object's pose (by its last pose `last`; their types are `world`'s) and those no
+    detection was given (`assigned`), which keep their last poses; with `rest`
+    (`PoseEstimator.rest`), the detections are made to rest again with the unseen objects as
+    supports, a lone view's at the place on its line of sight nearest where its object was
+    (`along_ray_near`), and given again."""
+    found = assigned(detections, last, world)
     unseen = tuple(o for o in last if o not in found)
     index = {id(d): k for k, d in enumerate(detections)}
     near = {index[id(d)]: last[o] for o, d in found.items() if len(d.rays) == 1}
     if (unseen or near) and rest is not None:
-        fixed = [(KITCHEN.type_of(o), last[o]) for o in unseen]
+        fixed = [(world.type_of(o), last[o]) for o in unseen]
         detections = rest(detections, fixed, near)
-        found = assigned(detections, last)
+        found = assigned(detections, last, world)
         unseen = tuple(o for o in last if o not in found)
     poses = {o: d.pose for o, d in found.items()}
     taken = {id(d) for d in found.values()}
@@ -177,7 +185,7 @@ def tracked(
 
 
 def first_sight(
-    detections: tuple[Detection, ...], never: list[str], objects: tuple[str, ...]
+    detections: tuple[Detection, ...], never: list[str], objects: tuple[str, ...], world: World
 ) -> dict[str, Detection]:
     """Objects never seen before (`never`, of the episode's `objects`), given the detections no
     tracked object took: each object (in its name's order) the detection f_p named its type,
@@ -189,18 +197,18 @@ def first_sight(
     out: dict[str, Detection] = {}
     pool = sorted(detections, key=lambda d: (-d.views, -d.type_confidence, -d.score))
     for o in never:
-        d = next((d for d in pool if d.type_name == KITCHEN.type_of(o)), None)
+        d = next((d for d in pool if d.type_name == world.type_of(o)), None)
         if d is not None:
             out[o] = d
             pool.remove(d)
-    present = {KITCHEN.type_of(o) for o in objects}
+    present = {world.type_of(o) for o in objects}
     for o in (o for o in never if o not in out):
-        kind = KITCHEN.object_type(o).kind
+        kind = world.object_type(o).kind
         d = next(
             (
                 d
                 for d in pool
-                if KITCHEN.object_types[d.type_name].kind is kind and d.type_name not in present
+                if world.object_type(d.type_name).kind is kind and d.type_name not in present
             ),
             None,
         )
@@ -210,12 +218,14 @@ def first_sight(
     return out
 
 
-def assign(detections: list[Detection], last: dict[str, Pose]) -> dict[str, Pose]:
+def assign(detections: list[Detection], last: dict[str, Pose], world: World) -> dict[str, Pose]:
     """Each object (by its last pose) and the pose of the detection it gets (`assigned`)."""
-    return {o: d.pose for o, d in assigned(detections, last).items()}
+    return {o: d.pose for o, d in assigned(detections, last, world).items()}
 
 
-def assigned(detections: list[Detection], last: dict[str, Pose]) -> dict[str, Detection]:
+def assigned(
+    detections: list[Detection], last: dict[str, Pose], world: World
+) -> dict[str, Detection]:
     """Each object (by its last pose) and the detection it gets, kind by kind (cans,
     boxes): the assignment of least total cost, a detection's cost for an object being its
     distance from the object's last pose counted up to `STILL`, plus `MISMATCH` when f_p named
@@ -226,9 +236,9 @@ def assigned(detections: list[Detection], last: dict[str, Pose]) -> dict[str, De
     further than `STILL`: two weak signs, where a look-alike phantom is likelier than a moved
     object."""
     out: dict[str, Detection] = {}
-    for kind in sorted({KITCHEN.object_type(o).kind for o in last}):
-        objects = [o for o in last if KITCHEN.object_type(o).kind is kind]
-        found = [d for d in detections if KITCHEN.object_types[d.type_name].kind is kind]
+    for kind in sorted({world.object_type(o).kind for o in last}):
+        objects = [o for o in last if world.object_type(o).kind is kind]
+        found = [d for d in detections if world.object_type(d.type_name).kind is kind]
         if not found:
             continue
         cost = np.empty((len(objects), len(found)))
@@ -236,7 +246,7 @@ def assigned(detections: list[Detection], last: dict[str, Pose]) -> dict[str, De
         for i, o in enumerate(objects):
             for j, d in enumerate(found):
                 far = float(np.linalg.norm(np.subtract(d.pose.position, last[o].position)))
-                same = d.type_name == KITCHEN.type_of(o)
+                same = d.type_name == world.type_of(o)
                 allowed[i, j] = same or far < (TRACK_DISTANCE if d.views > 1 else STILL)
                 cost[i, j] = min(far, STILL) + (0.0 if same else MISMATCH)
                 cost[i, j] += 1e-3 * far - 1e-2 * d.score

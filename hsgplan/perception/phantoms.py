@@ -31,12 +31,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import ObjectType, World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.settle import same_place
-from hsgplan.perception.visible import FURNITURE, SHRINK, Cuboid, paint, painted
+from hsgplan.perception.visible import SHRINK, Cuboid, furniture, paint, painted
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sensing import Box
 
@@ -51,58 +51,62 @@ def pruned(
     detections: list[Detection],
     instances: list[Seen],
     cameras: tuple[Camera, ...],
+    world: World,
     arm: tuple[Box, ...] = (),
 ) -> list[Detection]:
     """The detections (made to rest) less those the views contradict (rules 1 to 4 above);
     `instances` are every view's instances behind them, with `Seen.view` indexing `cameras`;
-    `arm` the arm's links, which hide what is behind them as the shelves do."""
-    kept = _once(detections)
+    `world` the scene's (its types' sizes, its shelves); `arm` the arm's links, which hide
+    what is behind them as the shelves do."""
+    kept = _once(detections, world)
     if all(d.views > 1 for d in kept):
         return kept
     pinholes = [PinholeCamera.of(c) for c in cameras]
-    occluders = FURNITURE + tuple(Cuboid.of_box(b) for b in arm)
-    labels = [painted(*_types_poses(kept), p, occluders) for p in pinholes]
+    occluders = furniture(world) + tuple(Cuboid.of_box(b) for b in arm)
+    types = [world.object_type(d.type_name) for d in kept]
+    labels = [painted(types, [d.pose for d in kept], p, occluders) for p in pinholes]
     kept = [
         d
         for k, d in enumerate(kept)
-        if d.views > 1 or not _missed(k, d, instances, pinholes, labels)
+        if d.views > 1 or not _missed(k, d, types[k], instances, pinholes, labels)
     ]
     kept = [d for d in kept if d.views > 1 or d.type_confidence >= SURE]
     sure = [d for d in kept if d.views > 1 and d.type_confidence >= SURE]
-    return [d for d in kept if d.views > 1 or not any(overlap(d, s) for s in sure)]
+    return [d for d in kept if d.views > 1 or not any(overlap(d, s, world) for s in sure)]
 
 
-def _once(detections: list[Detection]) -> list[Detection]:
+def _once(detections: list[Detection], world: World) -> list[Detection]:
     """The detections less those of a type found again in the same space as a surer one (more
     views, then the colour network's confidence, then the keypoint network's score)."""
     kept: list[Detection] = []
     for d in sorted(detections, key=lambda d: (-d.views, -d.type_confidence, -d.score)):
-        if not any(_again(d, k) for k in kept):
+        if not any(_again(d, k, world) for k in kept):
             kept.append(d)
     return [d for d in detections if any(d is k for k in kept)]
 
 
-def _again(d: Detection, k: Detection) -> bool:
-    return k.type_name == d.type_name and same_place(d.type_name, d.pose, k.type_name, k.pose)
-
-
-def _types_poses(detections: list[Detection]) -> tuple[list[str], list]:
-    return [d.type_name for d in detections], [d.pose for d in detections]
+def _again(d: Detection, k: Detection, world: World) -> bool:
+    if k.type_name != d.type_name:
+        return False
+    t = world.object_type(d.type_name)
+    return same_place(t, d.pose, t, k.pose)
 
 
 def _missed(
     index: int,
     d: Detection,
+    t: ObjectType,
     instances: list[Seen],
     pinholes: list[PinholeCamera],
     labels: list[np.ndarray],
 ) -> bool:
-    """Whether a view that did not find `d` would show it, yet found nothing there."""
+    """Whether a view that did not find `d` (of type `t`) would show it, yet found nothing
+    there."""
     centre = np.array([d.pose.position])
     for view, (pinhole, label) in enumerate(zip(pinholes, labels, strict=True)):
         if any(np.allclose(k.camera.eye, pinhole.eye) for k in d.keypoints):
             continue  # a view that found it
-        alone = paint([Cuboid.of_object(d.type_name, d.pose)], pinhole) == 0
+        alone = paint([Cuboid.of_object(t, d.pose)], pinhole) == 0
         area = int(alone.sum())
         shown = int((label == index).sum())
         if area == 0 or shown < MIN_PIXELS or shown < IN_SIGHT * area:
@@ -116,11 +120,12 @@ def _missed(
     return False
 
 
-def overlap(a: Detection, b: Detection) -> bool:
-    """Whether two detections' cuboids (footprints shrunk by `SHRINK`) share space: more than
-    `OVERLAP_Z` up and down, and footprints that no axis of either separates."""
-    fa, (la, ha) = _footprint(a)
-    fb, (lb, hb) = _footprint(b)
+def overlap(a: Detection, b: Detection, world: World) -> bool:
+    """Whether two detections' cuboids (footprints shrunk by `SHRINK`; sizes by their types in
+    `world`) share space: more than `OVERLAP_Z` up and down, and footprints that no axis of
+    either separates."""
+    fa, (la, ha) = _footprint(a, world.object_type(a.type_name))
+    fb, (lb, hb) = _footprint(b, world.object_type(b.type_name))
     if min(ha, hb) - max(la, lb) < OVERLAP_Z:
         return False
     for poly in (fa, fb):
@@ -133,9 +138,10 @@ def overlap(a: Detection, b: Detection) -> bool:
     return True
 
 
-def _footprint(d: Detection) -> tuple[np.ndarray, tuple[float, float]]:
-    """A detection's footprint's corners [4, 2] and its bottom's and top's heights."""
-    sx, sy, sz = KITCHEN.object_type(d.type_name).size
+def _footprint(d: Detection, t: ObjectType) -> tuple[np.ndarray, tuple[float, float]]:
+    """A detection's (of type `t`) footprint's corners [4, 2] and its bottom's and top's
+    heights."""
+    sx, sy, sz = t.size
     m = d.pose.matrix()
     corners = [(i * sx / 2, j * sy / 2, 0.0) for i, j in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
     world = SHRINK * np.array(corners) @ m[:3, :3].T + m[:3, 3]

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from hsgplan.domain.world import ObjectType
 from hsgplan.perception.keypoints import PinholeCamera, canonical_rotation, cuboid
 from hsgplan.scene_graph.geometry import Pose
 
@@ -46,10 +47,10 @@ class PoseEstimate:
     points: int  # keypoints used, all views
 
 
-def estimate_pose(obj: str, views: list[ViewKeypoints]) -> PoseEstimate | None:
-    """The object's pose in the world from its keypoints in the given views; None when no
-    view has `MIN_POINTS` keypoints."""
-    model = cuboid(obj)
+def estimate_pose(t: ObjectType, views: list[ViewKeypoints]) -> PoseEstimate | None:
+    """An object of type `t`: its pose in the world from its keypoints in the given views;
+    None when no view has `MIN_POINTS` keypoints."""
+    model = cuboid(t)
     fits = []
     for view in views:
         found = ~np.isnan(view.pixels).any(axis=1)
@@ -72,29 +73,29 @@ def estimate_pose(obj: str, views: list[ViewKeypoints]) -> PoseEstimate | None:
         )
         if ok:
             world = view.camera.camera_to_world() @ _matrix(rvec, tvec)
-            fits.append((_error(obj, views, world), world))
+            fits.append((_error(t, views, world), world))
     if not fits:
         return None
     best = min(fits, key=lambda f: f[0][0])[1]
-    fused = _refine(obj, views, best)
-    world = min((best, fused), key=lambda m: _error(obj, views, m)[0])
-    rms, used = _error(obj, views, world)
+    fused = _refine(t, views, best)
+    world = min((best, fused), key=lambda m: _error(t, views, m)[0])
+    rms, used = _error(t, views, world)
     return PoseEstimate(Pose.from_matrix(world), rms, used)
 
 
-def robust_cost(obj: str, views: list[ViewKeypoints], pose: Pose) -> float:
+def robust_cost(t: ObjectType, views: list[ViewKeypoints], pose: Pose) -> float:
     """Squared reprojection error over every view's keypoints, each capped at `OUTLIER_PX`."""
-    r = _residuals(obj, views, pose.matrix()).reshape(-1, 2)
+    r = _residuals(t, views, pose.matrix()).reshape(-1, 2)
     return float(np.minimum((r**2).sum(axis=1), OUTLIER_PX**2).sum())
 
 
-def upright_fit(obj: str, views: list[ViewKeypoints], position: tuple[float, ...]) -> Pose:
+def upright_fit(t: ObjectType, views: list[ViewKeypoints], position: tuple[float, ...]) -> Pose:
     """The upright pose at `position` whose yaw best explains every view's keypoints
     (`robust_cost`), over `YAWS` yaws (a can's cuboid is named by the view: any yaw will do)."""
     yaws = np.linspace(0.0, np.pi, YAWS, endpoint=False)
     return min(
         (Pose.from_xyz_yaw(*position, float(y)) for y in yaws),
-        key=lambda p: robust_cost(obj, views, p),
+        key=lambda p: robust_cost(t, views, p),
     )
 
 
@@ -105,33 +106,33 @@ def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
     return m
 
 
-def _residuals(obj: str, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
-    model, position = cuboid(obj), world[:3, 3]
+def _residuals(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
+    model, position = cuboid(t), world[:3, 3]
     out = []
     for view in views:
         found = ~np.isnan(view.pixels).any(axis=1)
-        rotation = canonical_rotation(obj, world[:3, :3], position, view.camera.eye)
+        rotation = canonical_rotation(t, world[:3, :3], position, view.camera.eye)
         points = model[found] @ rotation.T + position
         out.append((view.camera.project(points) - view.pixels[found]).ravel())
     return np.concatenate(out) if out else np.zeros(0)
 
 
-def _error(obj: str, views: list[ViewKeypoints], world: np.ndarray) -> tuple[float, int]:
-    r = _residuals(obj, views, world)
+def _error(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> tuple[float, int]:
+    r = _residuals(t, views, world)
     return (float(np.sqrt(np.mean(r**2))) if r.size else float("inf")), r.size // 2
 
 
-def _refine(obj: str, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
+def _refine(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
     """Gauss-Newton on the pose (rotation vector, translation) over every view's keypoints."""
     rvec, tvec = cv2.Rodrigues(world[:3, :3])[0].ravel(), world[:3, 3].copy()
     x = np.concatenate([rvec, tvec])
     for _ in range(10):
-        r = _residuals(obj, views, _matrix(x[:3], x[3:]))
+        r = _residuals(t, views, _matrix(x[:3], x[3:]))
         jac = np.empty((r.size, 6))
         for i in range(6):
             step = np.zeros(6)
             step[i] = 1e-6
-            jac[:, i] = (_residuals(obj, views, _matrix(*np.split(x + step, 2))) - r) / 1e-6
+            jac[:, i] = (_residuals(t, views, _matrix(*np.split(x + step, 2))) - r) / 1e-6
         dx = np.linalg.lstsq(jac, -r, rcond=None)[0]
         x = x + dx
         if np.linalg.norm(dx) < 1e-9:

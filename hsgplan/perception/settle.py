@@ -29,7 +29,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import ObjectType, World
 from hsgplan.scene_graph.geometry import Pose
 
 Ray = tuple[np.ndarray, np.ndarray]  # a line of sight: origin, unit direction (world)
@@ -73,19 +73,23 @@ def meeting_point(rays: tuple[Ray, ...] | list[Ray]) -> np.ndarray:
 
 
 def settle(
+    world: World,
     types: list[str],
     poses: list[Pose],
     rays: list[tuple[Ray, ...]] | None = None,
     costs: list[Callable[[np.ndarray], float] | None] | None = None,
     fixed: Sequence[tuple[str, Pose]] = (),
 ) -> list[Pose]:
-    """Each pose (of an object of `types[i]`, seen along `rays[i]` if given) made to rest,
-    lowest first (see the module); `costs[i]`, if given, says how badly the estimate's pose
-    with its centre moved to a point explains what the views saw. `fixed` objects (type and
-    pose) stay where they are and carry the others too: objects believed there, unseen."""
+    """Each pose (of an object of `types[i]`, seen along `rays[i]` if given) made to rest in
+    `world` (its table, shelves and types' sizes), lowest first (see the module); `costs[i]`,
+    if given, says how badly the estimate's pose with its centre moved to a point explains what
+    the views saw. `fixed` objects (type and pose) stay where they are and carry the others
+    too: objects believed there, unseen."""
     rays = rays or [()] * len(poses)
     out = [upright(p) for p in poses]
-    heights = [KITCHEN.object_type(t).size[2] for t in types]
+    kinds = [world.object_type(t) for t in types]
+    heights = [t.size[2] for t in kinds]
+    unseen = [(world.object_type(t), p) for t, p in fixed]
     order = sorted(range(len(out)), key=lambda i: out[i].position[2] - heights[i] / 2)
     settled: list[int] = []
     for i in order:
@@ -94,66 +98,65 @@ def settle(
             continue  # not upright: nothing to rest on
         carriers = [
             (t, p)
-            for t, p in [*fixed, *((types[k], out[k]) for k in settled)]
-            if not one_level(types[i], out[i], t, p)
+            for t, p in [*unseen, *((kinds[k], out[k]) for k in settled)]
+            if not one_level(kinds[i], out[i], t, p)
         ]
         if len(rays[i]) == 1 and abs(rays[i][0][1][2]) > GRAZING:
-            centre = _along_ray(np.array([x, y, z]), rays[i][0], heights[i], carriers)
+            centre = _along_ray(world, np.array([x, y, z]), rays[i][0], heights[i], carriers)
         else:
             cost = costs[i] if costs else None
-            several = [(types[k], out[k]) for k in settled if len(rays[k]) > 1]
-            solid = [(t, p) for t, p in [*fixed, *several] if (t, p) in carriers]
-            centre = _straight_down(np.array([x, y, z]), heights[i], carriers, cost, solid)
+            several = [(kinds[k], out[k]) for k in settled if len(rays[k]) > 1]
+            solid = [(t, p) for t, p in [*unseen, *several] if (t, p) in carriers]
+            centre = _straight_down(world, np.array([x, y, z]), heights[i], carriers, cost, solid)
         if centre is not None:
             out[i] = Pose(tuple(map(float, centre)), out[i].orientation)
         settled.append(i)
     return out
 
 
-def same_place(a: str, pa: Pose, b: str, pb: Pose) -> bool:
-    """Whether two estimates fill one space (an object found twice, once as a look-alike
-    type): centres within `OVERLAP_XY` across and under a quarter of their heights apart up and
-    down. Such a one is no support for the other."""
+def same_place(a: ObjectType, pa: Pose, b: ObjectType, pb: Pose) -> bool:
+    """Whether two estimates (of objects of types `a` and `b`) fill one space (an object found
+    twice, once as a look-alike type): centres within `OVERLAP_XY` across and under a quarter of
+    their heights apart up and down. Such a one is no support for the other."""
     across = math.dist(pa.position[:2], pb.position[:2])
     return across < OVERLAP_XY and one_level(a, pa, b, pb)
 
 
-def one_level(a: str, pa: Pose, b: str, pb: Pose) -> bool:
+def one_level(a: ObjectType, pa: Pose, b: ObjectType, pb: Pose) -> bool:
     """Whether two estimates' centres are under a quarter of their heights apart up and down:
     neither carries the other. A stacked object's centre is found a centimetre or two off, not
     a carrier's height; an object found twice a few centimetres apart was a carrier for itself
     (a butter at a shelf top's back edge, found 3 and 4 cm apart by two groups of views,
     rested on its own duplicate one box up, and the robot judged its place failed: tuning
     seed 900)."""
-    ha, hb = KITCHEN.object_type(a).size[2], KITCHEN.object_type(b).size[2]
+    ha, hb = a.size[2], b.size[2]
     return abs(pa.position[2] - pb.position[2]) < (ha + hb) / 4
 
 
-def _tops(x: float, y: float, carriers: list[tuple[str, Pose]]) -> list[float]:
+def _tops(world: World, x: float, y: float, carriers: list[tuple[ObjectType, Pose]]) -> list[float]:
     """The heights of the surfaces and carriers' top faces under (x, y)."""
-    return surfaces_under(x, y) + [
-        p.position[2] + KITCHEN.object_type(t).size[2] / 2
-        for t, p in carriers
-        if _on_top_face(x, y, t, p)
+    return surfaces_under(world, x, y) + [
+        p.position[2] + t.size[2] / 2 for t, p in carriers if _on_top_face(x, y, t, p)
     ]
 
 
-def fits_height(type_name: str, centre: np.ndarray) -> bool:
-    """Whether an object of `type_name` could have its centre at `centre` [3] (where several
-    views' rays meet), standing on the highest surface under it: no more than `SINK` lower
-    than half its height over that surface. True over no surface."""
-    tops = [t for t in surfaces_under(centre[0], centre[1]) if t <= centre[2]]
+def fits_height(world: World, t: ObjectType, centre: np.ndarray) -> bool:
+    """Whether an object of type `t` could have its centre at `centre` [3] (where several
+    views' rays meet), standing on the highest of `world`'s surfaces under it: no more than
+    `SINK` lower than half its height over that surface. True over no surface."""
+    tops = [top for top in surfaces_under(world, centre[0], centre[1]) if top <= centre[2]]
     if not tops:
         return True
-    return bool(centre[2] >= max(tops) + KITCHEN.object_type(type_name).size[2] / 2 - SINK)
+    return bool(centre[2] >= max(tops) + t.size[2] / 2 - SINK)
 
 
 def _straight_down(
+    world: World,
     centre: np.ndarray,
     height: float,
-    carriers: list[tuple[str, Pose]],
+    carriers: list[tuple[ObjectType, Pose]],
     cost: Callable[[np.ndarray], float] | None = None,
-    solid: Sequence[tuple[str, Pose]] = (),
+    solid: Sequence[tuple[ObjectType, Pose]] = (),
 ) -> np.ndarray | None:
     """The centre moved up or down onto the top under it nearest its bottom: nothing here
     floats, and two objects cannot overlap. A stacked object's centroid tends to be found a
@@ -169,7 +172,7 @@ def _straight_down(
     evaluation's seed 1, scene 54; nothing else changed on the 300 scenes of seeds 1 to 3).
     Through any carrier, a lone view's phantom beside a stack kept the object on it off its
     true carrier (5 scenes of seed 1)."""
-    tops = _tops(centre[0], centre[1], carriers)
+    tops = _tops(world, centre[0], centre[1], carriers)
     if not tops:
         return None
     bottom = centre[2] - height / 2
@@ -182,14 +185,14 @@ def _straight_down(
 
 
 def _through(
-    x: float, y: float, base: float, height: float, carriers: Sequence[tuple[str, Pose]]
+    x: float, y: float, base: float, height: float, carriers: Sequence[tuple[ObjectType, Pose]]
 ) -> bool:
     """Whether an object of `height` standing at `base` with its centre over (x, y) would pass
     through a carrier whose footprint, less `PASS` each side, holds that centre, by more than
     `PASS` up or down (a neighbour's edge is not under it)."""
     for t, p in carriers:
         if _on_top_face(x, y, t, p, -PASS):
-            half = KITCHEN.object_type(t).size[2] / 2
+            half = t.size[2] / 2
             low, high = p.position[2] - half, p.position[2] + half
             if min(high, base + height) - max(low, base) > PASS:
                 return True
@@ -197,7 +200,11 @@ def _through(
 
 
 def _along_ray(
-    centre: np.ndarray, ray: Ray, height: float, carriers: list[tuple[str, Pose]]
+    world: World,
+    centre: np.ndarray,
+    ray: Ray,
+    height: float,
+    carriers: list[tuple[ObjectType, Pose]],
 ) -> np.ndarray | None:
     """Where the ray meets a resting place: for each surface or carrier top, the point on the
     ray at the height the object's centre would have on it, if that point is over it; of
@@ -205,12 +212,12 @@ def _along_ray(
     origin, direction = ray
     candidates = []
     for level in {
-        round(t, 6) for t in [KITCHEN.table.z] + [s.top.z for s in KITCHEN.shelves.values()]
-    } | {round(p.position[2] + KITCHEN.object_type(t).size[2] / 2, 6) for t, p in carriers}:
+        round(t, 6) for t in [world.table.z] + [s.top.z for s in world.shelves.values()]
+    } | {round(p.position[2] + t.size[2] / 2, 6) for t, p in carriers}:
         z = level + height / 2
         point = origin + direction * (z - origin[2]) / direction[2]
         if (z - origin[2]) / direction[2] > 0 and any(
-            abs(t - level) < 1e-6 for t in _tops(point[0], point[1], carriers)
+            abs(t - level) < 1e-6 for t in _tops(world, point[0], point[1], carriers)
         ):
             candidates.append(point)
     if not candidates:
@@ -218,14 +225,16 @@ def _along_ray(
     return min(candidates, key=lambda p: float(np.linalg.norm(p - centre)))
 
 
-def surfaces_under(x: float, y: float) -> list[float]:
-    """The heights of the table's and the shelves' top faces under (x, y)."""
-    tops = [KITCHEN.table.z] if KITCHEN.table.contains(x, y, EDGE) else []
-    return tops + [s.top.z for s in KITCHEN.shelves.values() if s.top.contains(x, y, EDGE)]
+def surfaces_under(world: World, x: float, y: float) -> list[float]:
+    """The heights of the world's table's and shelves' top faces under (x, y)."""
+    tops = [world.table.z] if world.table.contains(x, y, EDGE) else []
+    return tops + [s.top.z for s in world.shelves.values() if s.top.contains(x, y, EDGE)]
 
 
-def _on_top_face(x: float, y: float, carrier: str, pose: Pose, edge: float = CARRIER_EDGE) -> bool:
-    sx, sy, _ = KITCHEN.object_type(carrier).size
+def _on_top_face(
+    x: float, y: float, carrier: ObjectType, pose: Pose, edge: float = CARRIER_EDGE
+) -> bool:
+    sx, sy, _ = carrier.size
     cx, cy, _ = pose.position
     r = pose.rotation
     dx, dy = x - cx, y - cy

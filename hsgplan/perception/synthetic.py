@@ -19,12 +19,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.world import Kind
-from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, in_world
+from hsgplan.perception.vocabulary import TRAINING_WORLD, VIEWS
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.render import Camera
 from hsgplan.sim.scene import Scene
@@ -73,25 +72,25 @@ class ImageSample:
 
 def draw_state(rng: random.Random, p_elsewhere: float = P_ELSEWHERE) -> SymbolicSceneGraph:
     """A random arrangement of 2 to `MAX_OBJECTS` objects, some cans inside the shelves."""
-    objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng, KITCHEN)
-    state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=KITCHEN)
-    inside_count = dict.fromkeys(KITCHEN.interior_capacity, 0)
+    objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng, TRAINING_WORLD)
+    state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=TRAINING_WORLD)
+    inside_count = dict.fromkeys(TRAINING_WORLD.interior_capacity, 0)
     literals = []
     for o in state.objects:
         where = state.location(o)
-        shelf = rng.choice(sorted(KITCHEN.interior_capacity))
+        shelf = rng.choice(sorted(TRAINING_WORLD.interior_capacity))
         if (
-            KITCHEN.object_type(o).kind is Kind.CAN
+            TRAINING_WORLD.object_type(o).kind is Kind.CAN
             and where == on(o, "open_space")
             and not state.resting_on(o)
-            and inside_count[shelf] < KITCHEN.interior_capacity[shelf]
+            and inside_count[shelf] < TRAINING_WORLD.interior_capacity[shelf]
             and rng.random() < P_INSIDE
         ):
             inside_count[shelf] += 1
             literals.append(inside(o, shelf))
         else:
             literals.append(where)
-    return SymbolicSceneGraph.from_literals(objects, literals, world=KITCHEN)
+    return SymbolicSceneGraph.from_literals(objects, literals, world=TRAINING_WORLD)
 
 
 def first_views(count: int) -> tuple[Camera, ...]:
@@ -108,7 +107,7 @@ def render_sample(
     could not be staged."""
     rng = random.Random(f"images-{seed}-{index}")
     state = draw_state(rng, p_elsewhere)
-    with Scene(state.objects, seed=rng.getrandbits(32), world=KITCHEN) as scene:
+    with Scene(state.objects, seed=rng.getrandbits(32), world=TRAINING_WORLD) as scene:
         if not stage(scene, state, rng):
             return None
         _randomise_fixtures(scene, rng)
@@ -131,7 +130,9 @@ def render_sample(
             images.append(np.clip(noisy, 0, 255).astype(np.uint8))
             pinhole = PinholeCamera.of(camera)
             points = zip(objects, poses, strict=True)
-            keypoints.append([pinhole.project(in_world(o, p)) for o, p in points])
+            keypoints.append(
+                [pinhole.project(in_world(TRAINING_WORLD.object_type(o), p)) for o, p in points]
+            )
             visible.append([int((seg == scene.bodies[o]).sum()) for o in objects])
     return ImageSample(
         seed,

@@ -40,10 +40,11 @@ from hsgplan.perception.colour import (
     load_colour,
 )
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
-from hsgplan.perception.images import TYPES, chunk_path, load_chunks
+from hsgplan.perception.images import chunk_path, load_chunks
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE, PerceptionNetConfig, build, load_perception_net
+from hsgplan.perception.vocabulary import TRAINING_WORLD, TYPES
 from hsgplan.runner.run_folder import logged_rows
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -133,7 +134,7 @@ def examples(data: dict[str, np.ndarray]) -> Examples:
             present = data["types"][i] >= 0
             every = np.asarray(
                 [
-                    view_keypoints(TYPES[t], _pose(p), camera)
+                    view_keypoints(TRAINING_WORLD.object_type(TYPES[t]), _pose(p), camera)
                     for t, p in zip(
                         data["types"][i][present], data["poses"][i][present], strict=True
                     )

@@ -24,8 +24,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.world import Board, shelf_boards
+from hsgplan.domain.world import Board, ObjectType, World, shelf_boards
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.sensing import Box
@@ -41,9 +40,9 @@ class Cuboid:
     half: tuple[float, float, float]
 
     @staticmethod
-    def of_object(type_name: str, pose: Pose, shrink: float = SHRINK) -> Cuboid:
-        """An object's cuboid, its footprint shrunk by `shrink` across."""
-        sx, sy, sz = KITCHEN.object_type(type_name).size
+    def of_object(t: ObjectType, pose: Pose, shrink: float = SHRINK) -> Cuboid:
+        """The cuboid of an object of type `t`, its footprint shrunk by `shrink` across."""
+        sx, sy, sz = t.size
         return Cuboid(pose, (shrink * sx / 2, shrink * sy / 2, sz / 2))
 
     @staticmethod
@@ -60,12 +59,16 @@ class Cuboid:
 
 
 OCCLUDED = -2  # a pixel an occluder shows (`painted`)
-# the shelves' walls and boards: the fixed furniture that hides what stands behind or in it
-FURNITURE = tuple(Cuboid.of_board(b) for s in KITCHEN.shelves.values() for b in shelf_boards(s))
+
+
+def furniture(world: World) -> tuple[Cuboid, ...]:
+    """The shelves' walls and boards: the fixed furniture that hides what stands behind or in
+    it."""
+    return tuple(Cuboid.of_board(b) for s in world.shelves.values() for b in shelf_boards(s))
 
 
 def painted(
-    types: list[str],
+    types: list[ObjectType],
     poses: list[Pose],
     camera: PinholeCamera,
     occluders: tuple[Cuboid, ...] = (),

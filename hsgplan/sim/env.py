@@ -151,7 +151,7 @@ class KitchenStorageEnv(gymnasium.Env):
         self._seen = self._judged = self._released = None
         if self.believing:
             self.world = BeliefWorld(options.objects(), scene_seed, options.goal.world)
-            self.observer.start(options.objects())
+            self.observer.start(options.objects(), options.goal.world)
         else:
             self.observer.reset(self.scene)
         typed = self._observe()

@@ -10,6 +10,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from hsgplan.domain.world import World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -77,7 +78,9 @@ class CameraObserver(Protocol):
     name: str
     cameras: tuple[Camera, ...]
 
-    def start(self, objects: tuple[str, ...]) -> None:
-        """A new episode: the goal's object names (their types follow from them), no poses."""
+    def start(self, objects: tuple[str, ...], world: World) -> None:
+        """A new episode: the goal's object names (their types follow from them), no poses,
+        and the scene's world: its object types' sizes, its table and shelves (what a robot
+        knows of its room and of the objects it handles)."""
 
     def look(self, look: Look) -> Seen: ...

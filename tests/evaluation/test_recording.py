@@ -14,10 +14,10 @@ import pytest
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.recording import EpisodeRecording
-from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.keypoints import PinholeCamera, in_world
 from hsgplan.perception.pnp import ViewKeypoints
+from hsgplan.perception.vocabulary import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.sensing import Look, Seen
@@ -96,7 +96,7 @@ def test_a_look_is_recorded_with_its_images_keypoints_and_detected_cuboids(tmp_p
     cameras = VIEWS[:2]
     pose = Pose((0.5, 0.0, 0.012))
     pinhole = PinholeCamera.of(cameras[0])
-    pixels = pinhole.project(in_world("butter", pose))
+    pixels = pinhole.project(in_world(KITCHEN.object_type("butter"), pose))
     pixels[3] = np.nan  # a keypoint the network did not find: not drawn
     seen_by = ViewKeypoints(pinhole, pixels)
     detection = Detection("butter", pose, 0.9, 1, 0.5, keypoints=(seen_by,))

@@ -7,6 +7,7 @@ import typing
 import grimp
 import numpy as np
 
+from hsgplan.domain.world import World
 from hsgplan.perception.observer import RgbObserver
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -42,10 +43,14 @@ def test_a_look_carries_images_calibration_joints_and_the_hands_own_record_only(
     assert set(hints.values()) <= allowed, hints
 
 
-def test_the_observer_is_given_looks_and_object_names_nothing_else():
+def test_the_observer_is_given_looks_object_names_and_its_world_nothing_else():
     assert isinstance(RgbObserver(estimator=None), CameraObserver)
     assert list(typing.get_type_hints(RgbObserver.look)) == ["look", "return"]
-    assert list(typing.get_type_hints(RgbObserver.start)) == ["objects", "return"]
+    assert typing.get_type_hints(RgbObserver.start) == {
+        "objects": tuple[str, ...],
+        "world": World,
+        "return": type(None),
+    }
     assert not hasattr(RgbObserver, "observe") and not hasattr(RgbObserver, "reset")
 
 

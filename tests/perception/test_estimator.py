@@ -39,7 +39,9 @@ class _TrueMaps(torch.nn.Module):
             pinhole = PinholeCamera.of(sample.cameras[v])
             named = np.stack(  # as this view names them
                 [
-                    view_keypoints(o, Pose(tuple(p[:3]), tuple(p[3:])), pinhole)
+                    view_keypoints(
+                        KITCHEN.object_type(o), Pose(tuple(p[:3]), tuple(p[3:])), pinhole
+                    )
                     for o, p in zip(sample.objects, sample.poses.astype(float), strict=True)
                 ]
             )
@@ -62,7 +64,7 @@ class _TrueMaps(torch.nn.Module):
 def test_perfect_maps_give_the_scene_back_duplicates_and_all():
     sample = render_sample(0, 1)  # twelve objects, five alphabet soups among them
     assert sample is not None and len(sample.objects) == 12
-    detections = PoseEstimator(_TrueMaps(sample)).detect(sample.images, sample.cameras)
+    detections = PoseEstimator(_TrueMaps(sample)).detect(sample.images, sample.cameras, KITCHEN)
     result = score_scene(sample, detections)
     seen = (sample.visible >= MIN_VISIBLE).any(axis=0)
     assert result.found >= seen.sum() - 1
@@ -86,11 +88,11 @@ def test_rotation_error_counts_a_cuboid_symmetry_as_no_error():
 
 def test_a_box_whose_rays_meet_a_centimetre_over_the_table_is_named_a_thin_one():
     probs = torch.tensor([0.0, 0.0, 0.0, 0.5, 0.3, 0.2])  # the colour says popcorn
-    assert TYPES[_of_kind(probs, "popcorn")[0]] == "popcorn"
+    assert TYPES[_of_kind(KITCHEN, probs, "popcorn")[0]] == "popcorn"
     low = np.array([0.5, 0.0, 0.012])
-    best, confidence = _of_kind(probs, "popcorn", low)
+    best, confidence = _of_kind(KITCHEN, probs, "popcorn", low)
     assert TYPES[best] == "cream_cheese" and confidence == pytest.approx(0.3)
-    assert TYPES[_of_kind(probs, "popcorn", np.array([0.5, 0.0, 0.063]))[0]] == "popcorn"
+    assert TYPES[_of_kind(KITCHEN, probs, "popcorn", np.array([0.5, 0.0, 0.063]))[0]] == "popcorn"
 
 
 def test_of_a_soup_and_a_box_found_in_one_place_the_colour_keeps_the_soup():
@@ -98,10 +100,10 @@ def test_of_a_soup_and_a_box_found_in_one_place_the_colour_keeps_the_soup():
     at = Pose.from_xyz_yaw(0.5, 0.0, 0.042, 0.0)
     found = []
     for kind in ("popcorn", "alphabet_soup"):
-        best, confidence = _of_kind(probs, kind)
+        best, confidence = _of_kind(KITCHEN, probs, kind)
         found.append(Detection(TYPES[best], at, 1.0, 2, 0.0, (), confidence))
     assert found[0].type_name == "popcorn"  # the likeliest box, though no box is likely
-    assert [d.type_name for d in _apart(found)] == ["alphabet_soup"]
+    assert [d.type_name for d in _apart(found, KITCHEN)] == ["alphabet_soup"]
 
 
 def test_a_lone_views_can_where_several_views_saw_one_of_its_type_is_that_can_again():
@@ -110,33 +112,37 @@ def test_a_lone_views_can_where_several_views_saw_one_of_its_type_is_that_can_ag
     several = Detection("alphabet_soup", lower, 0.8, 5, 0.0, (), 0.830)
     again = Detection("alphabet_soup", lone, 0.46, 1, 0.0, (), 0.835)  # surer, by a hair
     on_it = Detection("cherries", Pose.from_xyz_yaw(0.43, -0.37, 0.251, 0.0), 0.86, 5, 0.0, (), 0.9)
-    assert _apart([on_it, again, several]) == [on_it, several]
+    assert _apart([on_it, again, several], KITCHEN) == [on_it, several]
     # a lone view's box is kept as before: it may be the lower of a stack seen as one blob
     box = Pose.from_xyz_yaw(0.5, 0.0, 0.036, 0.0)
     blob = Detection("butter", box, 0.8, 3, 0.0, (), 0.6)
     lone_box = Detection("butter", Pose.from_xyz_yaw(0.5, 0.005, 0.03, 0.0), 0.5, 1, 0.0, (), 0.7)
-    assert _apart([blob, lone_box]) == [lone_box]
+    assert _apart([blob, lone_box], KITCHEN) == [lone_box]
 
 
 def _views_of(name: str, pose: Pose) -> list[ViewKeypoints]:
     cameras = [PinholeCamera.of(c) for c in VIEWS]
-    return [ViewKeypoints(c, view_keypoints(name, pose, c)) for c in cameras]
+    return [ViewKeypoints(c, view_keypoints(KITCHEN.object_type(name), pose, c)) for c in cameras]
 
 
 def test_an_object_on_its_side_stays_toppled_and_a_noisy_upright_one_stands():
     on_side = Pose(
         (0.5, 0.1, 0.0355), matrix_to_quat(Rotation.from_euler("x", 90, degrees=True).as_matrix())
     )
-    pose, error = _fitted("alphabet_soup", _views_of("alphabet_soup", on_side), [])
+    pose, error = _fitted(
+        KITCHEN.object_type("alphabet_soup"), _views_of("alphabet_soup", on_side), []
+    )
     assert pose is not None and abs(pose.rotation[2, 2]) < 0.1 and error < 1.0
     # one view alone never says toppled
-    lone, _ = _fitted("alphabet_soup", _views_of("alphabet_soup", on_side)[:1], [])
+    lone, _ = _fitted(
+        KITCHEN.object_type("alphabet_soup"), _views_of("alphabet_soup", on_side)[:1], []
+    )
     assert lone is not None and lone.rotation[2, 2] == pytest.approx(1.0)
     upright = Pose.from_xyz_yaw(0.45, -0.1, 0.012, 0.4)
     views = _views_of("butter", upright)
     noise = np.random.default_rng(0).normal(0, 1.5, size=(len(views), 9, 2))
     noisy = [ViewKeypoints(v.camera, v.pixels + n) for v, n in zip(views, noise, strict=True)]
-    pose, _ = _fitted("butter", noisy, [])
+    pose, _ = _fitted(KITCHEN.object_type("butter"), noisy, [])
     assert pose is not None and pose.rotation[2, 2] == pytest.approx(1.0)
 
 
@@ -147,7 +153,7 @@ def test_the_evaluation_sees_from_the_first_views_asked_for():
         def __init__(self):
             self.views = []
 
-        def detect(self, images, cameras):
+        def detect(self, images, cameras, world):
             assert len(images) == len(cameras)
             self.views.append(len(cameras))
             return []
@@ -178,7 +184,7 @@ def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand()
         def __init__(self, scenes):
             self.scenes = iter(scenes)
 
-        def detect(self, images, cams, arm=()):
+        def detect(self, images, cams, world, arm=()):
             s = next(self.scenes)
             found = [Detection(KITCHEN.type_of(o), p, 1.0, 2, 0.0) for o, p in s.truth.items()]
             if s.held is not None:
@@ -194,6 +200,8 @@ def test_a_lone_views_box_in_the_space_of_a_can_several_views_saw_is_not_kept():
     soup = Detection("alphabet_soup", Pose.from_xyz_yaw(0.54, -0.14, 0.042, 0.0), 0.8, 5, 0.0)
     soup = Detection(soup.type_name, soup.pose, 0.8, 5, 0.0, (), 0.51)  # a butter on it, above
     lone = Detection("butter", Pose.from_xyz_yaw(0.54, -0.13, 0.06, 0.0), 0.5, 1, 0.0, (), 0.95)
-    assert _apart([lone, soup]) == [soup]
+    assert _apart([lone, soup], KITCHEN) == [soup]
     several = Detection(lone.type_name, lone.pose, 0.5, 2, 0.0, (), 0.95)
-    assert _apart([several, soup]) == [several]  # two views against five: the colour decides
+    assert _apart([several, soup], KITCHEN) == [
+        several
+    ]  # two views against five: the colour decides

@@ -4,6 +4,7 @@ does not take that object's instance from it."""
 
 import numpy as np
 
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.fusion import RAY_GAP, Seen, grouped, line_of_sight, ray_gap
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.pnp import ViewKeypoints
@@ -23,7 +24,7 @@ def _seen(point, view: int, score: float, type_index: int = 0) -> Seen:
 def test_two_objects_seen_by_three_views_are_two_groups_of_three():
     a, b = (0.45, 0.10, 0.03), (0.60, -0.15, 0.03)
     found = [_seen(p, v, 0.5 + 0.1 * v) for p in (a, b) for v in range(3)]
-    groups = grouped(found)
+    groups = grouped(found, KITCHEN.table)
     assert len(groups) == 2
     for g in groups:
         assert sorted(s.view for s in g) == [0, 1, 2]
@@ -40,8 +41,10 @@ def test_a_strong_phantom_near_an_objects_line_of_sight_does_not_take_its_instan
     ghost = ghost + 0.01 * side / np.linalg.norm(side)
     phantom = _seen(ghost, 0, 0.9)  # stronger than anything else
     found = [phantom, _seen(real, 0, 0.6), _seen(real, 1, 0.5)]
-    assert ray_gap(phantom, found[2]) < RAY_GAP  # the greedy rule would have paired them
-    groups = grouped(found)
+    assert (
+        ray_gap(phantom, found[2], KITCHEN.table) < RAY_GAP
+    )  # the greedy rule would have paired them
+    groups = grouped(found, KITCHEN.table)
     assert [len(g) for g in groups] == [1, 2]
     assert groups[0][0] is phantom
     assert {s.view for s in groups[1]} == {0, 1}
@@ -49,8 +52,11 @@ def test_a_strong_phantom_near_an_objects_line_of_sight_does_not_take_its_instan
 
 def test_instances_of_different_types_or_of_one_view_are_never_one_object():
     p = (0.45, 0.0, 0.03)
-    assert [len(g) for g in grouped([_seen(p, 0, 0.9, 0), _seen(p, 1, 0.8, 1)])] == [1, 1]
-    assert [len(g) for g in grouped([_seen(p, 0, 0.9), _seen(p, 0, 0.8)])] == [1, 1]
+    assert [len(g) for g in grouped([_seen(p, 0, 0.9, 0), _seen(p, 1, 0.8, 1)], KITCHEN.table)] == [
+        1,
+        1,
+    ]
+    assert [len(g) for g in grouped([_seen(p, 0, 0.9), _seen(p, 0, 0.8)], KITCHEN.table)] == [1, 1]
 
 
 def test_a_pair_of_rays_to_two_objects_does_not_break_up_an_object_every_view_saw():
@@ -73,6 +79,8 @@ def test_a_pair_of_rays_to_two_objects_does_not_break_up_an_object_every_view_sa
         nudged(_seen(top, 2, 0.7), -1.0),
     )
     b1, b2 = _seen(below, 1, 0.6), _seen(below, 2, 0.5)
-    assert ray_gap(t0, b1) < ray_gap(t0, t1) < RAY_GAP  # the closest pair is a ghost
-    groups = grouped([t0, t1, t2, b1, b2])
+    assert (
+        ray_gap(t0, b1, KITCHEN.table) < ray_gap(t0, t1, KITCHEN.table) < RAY_GAP
+    )  # the closest pair is a ghost
+    groups = grouped([t0, t1, t2, b1, b2], KITCHEN.table)
     assert [{id(s) for s in g} for g in groups] == [{id(t0), id(t1), id(t2)}, {id(b1), id(b2)}]

@@ -6,6 +6,7 @@ import pytest
 
 from hsgplan.collect.images import ImagesConfig, collect_images
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.images import chunk_path, load_chunks
 from hsgplan.perception.keypoints import PinholeCamera, in_world
 from hsgplan.perception.synthetic import VIEWS, render_sample
@@ -22,7 +23,11 @@ def test_a_sample_is_its_seed_and_index_alone_and_its_keypoints_are_its_poses_pr
         pinhole = PinholeCamera.of(camera)
         for j, name in enumerate(a.objects):
             pose = Pose(tuple(map(float, a.poses[j, :3])), tuple(map(float, a.poses[j, 3:])))
-            assert np.allclose(a.keypoints[v, j], pinhole.project(in_world(name, pose)), atol=0.01)
+            assert np.allclose(
+                a.keypoints[v, j],
+                pinhole.project(in_world(KITCHEN.object_type(name), pose)),
+                atol=0.01,
+            )
     assert (a.visible.max(axis=0) > 0).mean() >= 0.5  # most objects are in sight somewhere
 
 

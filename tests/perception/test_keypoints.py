@@ -30,7 +30,7 @@ def _pose(rng: np.random.Generator, obj: str) -> Pose:
 
 
 def test_the_cuboid_has_eight_corners_and_its_centroid():
-    points = cuboid("cream_cheese")
+    points = cuboid(KITCHEN.object_type("cream_cheese"))
     assert points.shape == (KEYPOINTS, 3)
     assert np.allclose(points[8], 0) and np.allclose(points[:8].mean(axis=0), 0)
     assert np.allclose(points[:8].max(axis=0) * 2, KITCHEN.object_type("cream_cheese").size)
@@ -41,9 +41,9 @@ def test_pnp_gives_back_the_pose_that_was_projected(obj):
     rng = np.random.default_rng(0)
     for _ in range(5):
         pose = _pose(rng, obj)
-        views = [ViewKeypoints(c, view_keypoints(obj, pose, c)) for c in VIEWS]
+        views = [ViewKeypoints(c, view_keypoints(KITCHEN.object_type(obj), pose, c)) for c in VIEWS]
         for used in (views[:1], views[1:], views):
-            found = estimate_pose(obj, used)
+            found = estimate_pose(KITCHEN.object_type(obj), used)
             assert found is not None
             assert np.linalg.norm(np.subtract(found.pose.position, pose.position)) < 1e-4
             assert rotation_error(obj, pose, found.pose) < 0.05  # up to the look-alikes
@@ -54,11 +54,15 @@ def test_pnp_gives_back_the_pose_that_was_projected(obj):
 def test_look_alike_poses_have_the_same_keypoints_in_a_view(obj, turns):
     pose = Pose.from_xyz_yaw(0.5, 0.1, KITCHEN.object_type(obj).height / 2, 0.3)
     for c in VIEWS:
-        named = view_keypoints(obj, pose, c)
+        named = view_keypoints(KITCHEN.object_type(obj), pose, c)
         for turn in turns:
             turned = Pose.from_xyz_yaw(*pose.position, 0.3 + turn)
-            assert np.allclose(view_keypoints(obj, turned, c), named, atol=1e-6)
-        assert np.allclose(named[-1], c.project(in_world(obj, pose))[-1])  # the centroid
+            assert np.allclose(
+                view_keypoints(KITCHEN.object_type(obj), turned, c), named, atol=1e-6
+            )
+        assert np.allclose(
+            named[-1], c.project(in_world(KITCHEN.object_type(obj), pose))[-1]
+        )  # the centroid
 
 
 def test_two_views_with_noisy_or_missing_keypoints_still_place_the_object():
@@ -69,10 +73,12 @@ def test_two_views_with_noisy_or_missing_keypoints_still_place_the_object():
         pose = _pose(rng, obj)
         views = []
         for c in VIEWS:
-            pixels = view_keypoints(obj, pose, c) + rng.normal(0.0, 1.0, (KEYPOINTS, 2))
+            pixels = view_keypoints(KITCHEN.object_type(obj), pose, c) + rng.normal(
+                0.0, 1.0, (KEYPOINTS, 2)
+            )
             pixels[rng.choice(KEYPOINTS, 2, replace=False)] = np.nan  # two peaks not found
             views.append(ViewKeypoints(c, pixels))
-        found = estimate_pose(obj, views)
+        found = estimate_pose(KITCHEN.object_type(obj), views)
         assert found is not None and found.points == 2 * (KEYPOINTS - 2)
         errors.append(np.linalg.norm(np.subtract(found.pose.position, pose.position)))
     assert np.median(errors) < 0.01
@@ -80,9 +86,9 @@ def test_two_views_with_noisy_or_missing_keypoints_still_place_the_object():
 
 def test_a_view_with_too_few_keypoints_gives_no_pose():
     c = VIEWS[0]
-    pixels = c.project(in_world("butter", Pose.from_xyz_yaw(0.5, 0.0, 0.012)))
+    pixels = c.project(in_world(KITCHEN.object_type("butter"), Pose.from_xyz_yaw(0.5, 0.0, 0.012)))
     pixels[:5] = np.nan
-    assert estimate_pose("butter", [ViewKeypoints(c, pixels)]) is None
+    assert estimate_pose(KITCHEN.object_type("butter"), [ViewKeypoints(c, pixels)]) is None
 
 
 def test_the_pinhole_model_projects_where_pybullet_renders():
@@ -105,7 +111,7 @@ def test_the_pinhole_model_projects_where_pybullet_renders():
             )
             mask = np.asarray(seg).reshape(camera.height, camera.width) == scene.bodies[obj]
             rows, cols = np.nonzero(mask)
-            pixels = PinholeCamera.of(camera).project(in_world(obj, pose))
+            pixels = PinholeCamera.of(camera).project(in_world(KITCHEN.object_type(obj), pose))
             # the silhouette's extent is the projected cuboid's, to a pixel or two
             assert rows.size > 100
             assert abs(cols.min() - pixels[:, 0].min()) < 2.5

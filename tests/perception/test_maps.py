@@ -15,7 +15,7 @@ CAMERA = Camera(320, 240, (1.15, 0.0, 1.0), (0.42, 0.0, 0.05), 46.0)
 
 def _keypoints(obj: str, x: float, y: float, yaw: float) -> np.ndarray:
     pose = Pose.from_xyz_yaw(x, y, KITCHEN.object_type(obj).height / 2, yaw)
-    return PinholeCamera.of(CAMERA).project(in_world(obj, pose))
+    return PinholeCamera.of(CAMERA).project(in_world(KITCHEN.object_type(obj), pose))
 
 
 def test_maps_of_two_butters_and_a_can_decode_into_their_keypoints():

@@ -5,6 +5,7 @@ decoding, PnP and fusion are checked without a trained checkpoint."""
 
 import math
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 import pytest
@@ -16,7 +17,6 @@ from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.failures import Failure
-from hsgplan.perception.cameras import VIEWS
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.keypoints import PinholeCamera, in_world, view_keypoints
@@ -30,6 +30,7 @@ from hsgplan.perception.observer import (
     first_sight,
     tracked,
 )
+from hsgplan.perception.vocabulary import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.env import KitchenStorageEnv
@@ -45,7 +46,7 @@ def _at(type_name: str, x: float, y: float, score: float = 0.9) -> Detection:
 
 def test_a_lone_object_takes_its_types_strongest_detection_wherever_it_is():
     last = {"butter": Pose.from_xyz_yaw(0.5, 0.0, 0.05)}
-    found = assign([_at("butter", 0.2, 0.3, 0.5), _at("butter", 0.9, -0.3, 0.8)], last)
+    found = assign([_at("butter", 0.2, 0.3, 0.5), _at("butter", 0.9, -0.3, 0.8)], last, KITCHEN)
     assert found["butter"].position[:2] == (0.9, -0.3)
 
 
@@ -56,12 +57,14 @@ def test_duplicates_keep_their_names_and_one_put_down_elsewhere_is_found_by_elim
         "cherries_3": Pose.from_xyz_yaw(0.3, -0.2, 0.05),
     }
     detections = [_at("cherries", 0.51, 0.2), _at("cherries", 0.49, 0.0), _at("cherries", 0.9, 0.6)]
-    found = assign(detections, last)
+    found = assign(detections, last, KITCHEN)
     assert found["cherries"].position[:2] == (0.49, 0.0)
     assert found["cherries_2"].position[:2] == (0.51, 0.2)
     assert found["cherries_3"].position[:2] == (0.9, 0.6)  # moved far: the one left over
     # with one detection too many, the one put down elsewhere takes the nearer far one
-    found = assign([*detections[:2], _at("cherries", 0.3, 0.5), _at("cherries", 0.95, 0.6)], last)
+    found = assign(
+        [*detections[:2], _at("cherries", 0.3, 0.5), _at("cherries", 0.95, 0.6)], last, KITCHEN
+    )
     assert found["cherries_3"].position[:2] == (0.3, 0.5)
 
 
@@ -77,11 +80,11 @@ def test_an_object_that_stayed_is_known_by_where_it_is_whatever_type_f_p_named()
         _at("cream_cheese", 0.5, 0.01, 0.8),
         _at("tomato_soup", 0.4, -0.2),
     ]
-    found = assign(detections, last)
+    found = assign(detections, last, KITCHEN)
     assert found["butter"].position[:2] == (0.501, 0.0)
     assert found["cream_cheese"].position[:2] == (0.5, 0.01)
     assert found["cherries"].position[:2] == (0.4, -0.2)  # still where it was
-    far = assign([_at("popcorn", 0.9, 0.5)], {"butter": last["butter"]})
+    far = assign([_at("popcorn", 0.9, 0.5)], {"butter": last["butter"]}, KITCHEN)
     assert far == {}  # another type, far from where the butter was: not the butter
 
 
@@ -102,7 +105,9 @@ class _SceneMaps(torch.nn.Module):
         maps = []
         for camera in VIEWS:
             pinhole = PinholeCamera.of(camera)
-            points = np.stack([view_keypoints(o, p, pinhole) for o, p in poses.items()])
+            points = np.stack(
+                [view_keypoints(KITCHEN.object_type(o), p, pinhole) for o, p in poses.items()]
+            )
             maps.append(targets(points, kinds, len(TYPES), height, width))
         return [
             (
@@ -203,17 +208,17 @@ def test_an_object_no_view_has_found_has_no_pose_and_ends_the_episode_as_never_s
 
 def test_tracks_start_from_the_first_look_never_from_a_staged_pose():
     observer = RgbObserver(PoseEstimator(_SceneMaps()))
-    observer.start(("butter", "tomato_soup"))
+    observer.start(("butter", "tomato_soup"), KITCHEN)
     soup = Pose.from_xyz_yaw(0.5, 0.1, KITCHEN.object_types["tomato_soup"].size[2] / 2)
     lone = Detection("tomato_soup", soup, 0.9, 1, 1.0)
-    observer.estimator.detect = lambda images, cameras, arm: [lone]
+    observer.estimator.detect = lambda images, cameras, world, arm: [lone]
     look = Look(np.zeros((1, 2, 2, 3), np.uint8), VIEWS[:1], np.zeros(7))
     seen = observer.look(look)
     assert seen.scene_graph.objects == ("tomato_soup",)
     assert seen.unknown == ("butter",) and set(seen.uncertain) == {"butter", "tomato_soup"}
     butter = Pose.from_xyz_yaw(0.3, -0.2, KITCHEN.object_types["butter"].size[2] / 2)
     both = [replace(lone, views=3), Detection("butter", butter, 0.8, 2, 1.0)]
-    observer.estimator.detect = lambda images, cameras, arm: both
+    observer.estimator.detect = lambda images, cameras, world, arm: both
     seen = observer.look(look)
     assert seen.unknown == () and seen.uncertain == ()
     assert seen.scene_graph.pose("butter") == butter
@@ -221,12 +226,14 @@ def test_tracks_start_from_the_first_look_never_from_a_staged_pose():
 
 def test_first_sight_names_a_type_by_the_surest_detection_and_a_misnamed_one_by_its_kind():
     weak, sure = _at("butter", 0.2, 0.3, 0.5), replace(_at("butter", 0.6, 0.3, 0.4), views=4)
-    assert first_sight((weak, sure), ["butter"], ("butter",)) == {"butter": sure}
+    assert first_sight((weak, sure), ["butter"], ("butter",), KITCHEN) == {"butter": sure}
     # no cream cheese in the episode: a detection named so is the butter misnamed
     misnamed = _at("cream_cheese", 0.4, 0.1)
-    assert first_sight((misnamed,), ["butter"], ("butter",)) == {"butter": misnamed}
+    assert first_sight((misnamed,), ["butter"], ("butter",), KITCHEN) == {"butter": misnamed}
     # a popcorn in the episode, already seen: a second one is its phantom, not the butter
-    assert first_sight((_at("popcorn", 0.4, 0.1),), ["butter"], ("butter", "popcorn")) == {}
+    assert (
+        first_sight((_at("popcorn", 0.4, 0.1),), ["butter"], ("butter", "popcorn"), KITCHEN) == {}
+    )
 
 
 def test_a_goal_only_seen_reached_is_a_failure_of_perception():
@@ -260,8 +267,10 @@ def test_the_estimate_is_drawn_where_the_camera_sees_it():
     camera = VIEWS[0]
     image = np.zeros((camera.height, camera.width, 3), dtype=np.uint8)
     pose = Pose.from_xyz_yaw(0.5, 0.0, 0.05, 0.3)
-    drawn = draw_cuboids(image, camera, {"popcorn": pose})
-    u, v = np.round(PinholeCamera.of(camera).project(in_world("popcorn", pose))[-1]).astype(int)
+    drawn = draw_cuboids(image, camera, {"popcorn": pose}, KITCHEN)
+    u, v = np.round(
+        PinholeCamera.of(camera).project(in_world(KITCHEN.object_type("popcorn"), pose))[-1]
+    ).astype(int)
     assert tuple(drawn[v, u]) == COLOR  # the centroid's dot
     assert (drawn.any(axis=2)).sum() > 100 and not image.any()  # edges drawn, on a copy
 
@@ -290,11 +299,11 @@ def test_eval_sees_through_the_shipped_f_p_beside_the_ground_truth(tmp_path):
 def test_a_lone_views_detection_of_another_type_far_from_where_an_object_was_is_not_it():
     last = {"butter": Pose.from_xyz_yaw(0.5, 0.0, 0.012)}
     lone = Detection("cream_cheese", Pose.from_xyz_yaw(0.6, 0.0, 0.012), 0.9, 1, 1.0)
-    assert assign([lone], last) == {}  # 10 cm off, one view, another type: a phantom
+    assert assign([lone], last, KITCHEN) == {}  # 10 cm off, one view, another type: a phantom
     both = replace(lone, views=2)
-    assert assign([both], last)["butter"] == both.pose
+    assert assign([both], last, KITCHEN)["butter"] == both.pose
     near = replace(lone, pose=Pose.from_xyz_yaw(0.52, 0.0, 0.012))
-    assert assign([near], last)["butter"] == near.pose  # where it was: its colour misled
+    assert assign([near], last, KITCHEN)["butter"] == near.pose  # where it was: its colour misled
 
 
 def test_an_object_unseen_under_a_can_still_holds_the_can_up():
@@ -303,14 +312,16 @@ def test_an_object_unseen_under_a_can_still_holds_the_can_up():
     can_half = KITCHEN.object_types["tomato_soup"].size[2] / 2
     measured = Pose.from_xyz_yaw(0.5, 0.005, top + can_half - 0.003)  # seen on it, nearly
     can = Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)
-    (alone,) = PoseEstimator.rest([can])
+    (alone,) = PoseEstimator.rest(KITCHEN, [can])
     assert alone.pose.position[2] == pytest.approx(can_half)  # nothing found under it
-    (held_up,) = PoseEstimator.rest([can], [("butter", butter)])
+    (held_up,) = PoseEstimator.rest(KITCHEN, [can], [("butter", butter)])
     assert held_up.pose.position[2] == pytest.approx(top + can_half)
     # on its side, so nothing to rest on: left where it was seen, inside the table
     lying = Pose((0.5, 0.0, -0.15), (math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5)))
-    assert PoseEstimator.rest([replace(can, measured=lying)]) == []  # nothing can be there
-    (above,) = PoseEstimator.rest([replace(can, measured=replace(lying, position=(0.5, 0, 0.05)))])
+    assert PoseEstimator.rest(KITCHEN, [replace(can, measured=lying)]) == []  # nothing can be there
+    (above,) = PoseEstimator.rest(
+        KITCHEN, [replace(can, measured=replace(lying, position=(0.5, 0, 0.05)))]
+    )
     assert above.pose.position[2] == 0.05  # over the table, left as it was seen
 
 
@@ -322,14 +333,15 @@ def test_the_tracker_keeps_a_hidden_butter_where_it_was_and_the_can_on_it_up():
     )
     measured = Pose.from_xyz_yaw(0.5, 0.005, top + can_half - 0.003)
     (seen,) = PoseEstimator.rest(
-        [Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)]
+        KITCHEN,
+        [Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)],
     )
     last = {"butter": butter, "tomato_soup": Pose.from_xyz_yaw(0.5, 0.0, top + can_half)}
-    tracks = tracked([seen], last)
+    tracks = tracked([seen], last, KITCHEN)
     poses = tracks.poses
     assert tracks.unseen == ("butter",) and poses["butter"] == butter
     assert poses["tomato_soup"].position[2] == pytest.approx(can_half)  # sunk onto the table
-    tracks = tracked([seen], last, PoseEstimator.rest)
+    tracks = tracked([seen], last, KITCHEN, partial(PoseEstimator.rest, KITCHEN))
     poses = tracks.poses
     assert tracks.unseen == ("butter",) and poses["butter"] == butter
     assert tracks.left == () and set(tracks.found) == {"tomato_soup"}
@@ -354,10 +366,10 @@ def test_a_lone_views_butter_is_put_where_its_ray_passes_its_last_pose_and_holds
         0.45, 0.35, KITCHEN.shelves["shelf_a"].top.z + 2 * half + can_half - 0.004
     )
     can = Detection("tomato_soup", measured, 0.9, 3, 1.0, measured=measured)
-    found = PoseEstimator.rest([lone, can])
+    found = PoseEstimator.rest(KITCHEN, [lone, can])
     assert found[0].pose.position[2] == pytest.approx(half)  # on the table, far off
     last = {"butter": butter, "tomato_soup": replace(measured, position=(0.45, 0.35, 0.3))}
-    tracks = tracked(found, last, PoseEstimator.rest)
+    tracks = tracked(found, last, KITCHEN, partial(PoseEstimator.rest, KITCHEN))
     poses = tracks.poses
     assert tracks.unseen == () and np.allclose(poses["butter"].position, butter.position, atol=1e-6)
     assert poses["tomato_soup"].position[2] == pytest.approx(
@@ -365,7 +377,7 @@ def test_a_lone_views_butter_is_put_where_its_ray_passes_its_last_pose_and_holds
     )
     # a lone view's ray far from where the object was leaves its estimate as it was measured
     moved = {**last, "butter": Pose.from_xyz_yaw(0.45, 0.0, half, 0.0)}
-    poses = tracked(found, moved, PoseEstimator.rest).poses
+    poses = tracked(found, moved, KITCHEN, partial(PoseEstimator.rest, KITCHEN)).poses
     assert poses["butter"].position == pytest.approx(found[0].pose.position)
 
 

@@ -36,7 +36,7 @@ def test_a_tilted_estimate_is_turned_upright_keeping_its_yaw_and_upside_down_cou
 
 def test_an_estimate_over_nothing_is_left_as_it_is():
     beyond = _tilted(1.4, 0.0, 0.3, 0.0, 0.0)  # past the table's far edge
-    assert settle(["popcorn"], [beyond])[0].position == beyond.position
+    assert settle(KITCHEN, ["popcorn"], [beyond])[0].position == beyond.position
 
 
 def test_a_stack_lands_bottom_first_and_a_shelf_top_holds_what_is_near_it():
@@ -50,7 +50,7 @@ def test_a_stack_lands_bottom_first_and_a_shelf_top_holds_what_is_near_it():
         _tilted(0.3, -0.1, _half("popcorn") + 0.2, 0.0, 0.0),  # in the air: nothing floats
         _tilted(0.5, -0.4, _half("alphabet_soup") + 0.005, 0.0, 0.0),  # inside shelf b
     ]
-    out = settle(types, poses)
+    out = settle(KITCHEN, types, poses)
     assert out[1].position[2] == pytest.approx(_half("butter"))
     assert out[0].position[2] == pytest.approx(2 * _half("butter") + _half("cherries"))
     assert out[2].position[2] == pytest.approx(
@@ -64,7 +64,7 @@ def test_a_stacked_object_found_low_rests_on_its_carrier_not_inside_it():
     butter = Pose.from_xyz_yaw(0.5, 0.0, _half("butter"), 0.0)
     top = 2 * _half("butter")
     low = Pose.from_xyz_yaw(0.5, 0.01, top + _half("cherries") - 0.011, 0.0)  # 1.1 cm into it
-    _, cherries = settle(["butter", "cherries"], [butter, low])
+    _, cherries = settle(KITCHEN, ["butter", "cherries"], [butter, low])
     assert cherries.position[2] == pytest.approx(top + _half("cherries"))
     # a thin box found low enough that its centre is below its carrier's top (a can) still
     # rests on the can, not on the table inside it; one found down at the can's middle fills
@@ -73,7 +73,7 @@ def test_a_stacked_object_found_low_rests_on_its_carrier_not_inside_it():
     can_top = 2 * _half("alphabet_soup")
     for drop, expected in ((0.014, can_top), (0.06, 0.0)):
         box = Pose.from_xyz_yaw(0.5, 0.005, can_top + _half("cream_cheese") - drop, 0.0)
-        _, rests = settle(["alphabet_soup", "cream_cheese"], [can, box])
+        _, rests = settle(KITCHEN, ["alphabet_soup", "cream_cheese"], [can, box])
         assert rests.position[2] == pytest.approx(expected + _half("cream_cheese")), drop
 
 
@@ -82,10 +82,12 @@ def test_a_lone_views_estimate_slides_along_its_line_of_sight_onto_the_table():
     truth = np.array([0.5, 0.1, _half("butter")])
     direction = (truth - eye) / np.linalg.norm(truth - eye)
     too_near = eye + direction * (np.linalg.norm(truth - eye) - 0.02)  # 2 cm short in depth
-    (out,) = settle(["butter"], [Pose.from_xyz_yaw(*too_near, 0.2)], [((eye, direction),)])
+    (out,) = settle(KITCHEN, ["butter"], [Pose.from_xyz_yaw(*too_near, 0.2)], [((eye, direction),)])
     assert np.allclose(out.position, truth, atol=1e-9)
     # seen by two views, it sits where they put it and only drops onto the table
-    (both,) = settle(["butter"], [Pose.from_xyz_yaw(*too_near, 0.2)], [((eye, direction),) * 2])
+    (both,) = settle(
+        KITCHEN, ["butter"], [Pose.from_xyz_yaw(*too_near, 0.2)], [((eye, direction),) * 2]
+    )
     assert np.allclose(both.position[:2], too_near[:2]) and both.position[2] == truth[2]
 
 
@@ -106,28 +108,42 @@ def test_between_two_near_tops_the_keypoints_choose():
     # a soup found 1.3 cm low on the butter: its bottom is nearer the table than the butter's top
     low = Pose.from_xyz_yaw(0.5, 0.0, top + _half("alphabet_soup") - 0.013, 0.0)
     types = ["butter", "alphabet_soup"]
-    assert settle(types, [butter, low])[1].position[2] == pytest.approx(_half("alphabet_soup"))
+    assert settle(KITCHEN, types, [butter, low])[1].position[2] == pytest.approx(
+        _half("alphabet_soup")
+    )
     on_butter = top + _half("alphabet_soup")
 
     def cost(centre):  # the views saw it on the butter
         return abs(centre[2] - on_butter)
 
-    rests = settle(types, [butter, low], None, [lambda c: 0.0, cost])[1]
+    rests = settle(KITCHEN, types, [butter, low], None, [lambda c: 0.0, cost])[1]
     assert rests.position[2] == pytest.approx(on_butter)
     # a top farther than `NEAR_TOPS` from its bottom is not a candidate, whatever the cost
     far = Pose.from_xyz_yaw(0.5, 0.0, _half("alphabet_soup") - NEAR_TOPS / 2, 0.0)
-    rests = settle(types, [butter, far], None, [lambda c: 0.0, cost])[1]
+    rests = settle(KITCHEN, types, [butter, far], None, [lambda c: 0.0, cost])[1]
     assert rests.position[2] == pytest.approx(_half("alphabet_soup"))
 
 
 def test_a_centre_a_centimetre_over_the_table_is_no_popcorn():
     thin = np.array([0.5, 0.0, _half("butter")])
-    assert fits_height("butter", thin) and fits_height("cream_cheese", thin)
-    assert not fits_height("popcorn", thin) and not fits_height("alphabet_soup", thin)
-    assert fits_height("popcorn", np.array([0.5, 0.0, 2 * _half("butter") + _half("popcorn")]))
+    assert fits_height(KITCHEN, KITCHEN.object_type("butter"), thin) and fits_height(
+        KITCHEN, KITCHEN.object_type("cream_cheese"), thin
+    )
+    assert not fits_height(KITCHEN, KITCHEN.object_type("popcorn"), thin) and not fits_height(
+        KITCHEN, KITCHEN.object_type("alphabet_soup"), thin
+    )
+    assert fits_height(
+        KITCHEN,
+        KITCHEN.object_type("popcorn"),
+        np.array([0.5, 0.0, 2 * _half("butter") + _half("popcorn")]),
+    )
     on_shelf = np.array([0.49, 0.38, KITCHEN.shelves["shelf_a"].top.z + _half("butter")])
-    assert fits_height("butter", on_shelf) and not fits_height("popcorn", on_shelf)
-    assert fits_height("popcorn", np.array([1.4, 0.0, 0.01]))  # over no surface: no say
+    assert fits_height(KITCHEN, KITCHEN.object_type("butter"), on_shelf) and not fits_height(
+        KITCHEN, KITCHEN.object_type("popcorn"), on_shelf
+    )
+    assert fits_height(
+        KITCHEN, KITCHEN.object_type("popcorn"), np.array([1.4, 0.0, 0.01])
+    )  # over no surface: no say
 
 
 def test_nothing_rests_through_an_object_several_views_saw_but_a_lone_views_may_be_a_phantom():
@@ -138,13 +154,13 @@ def test_nothing_rests_through_an_object_several_views_saw_but_a_lone_views_may_
     types = ["cream_cheese", "popcorn"]
     costs = [None, lambda centre: centre[2]]
     ray = (np.array([0.5, 0.0, 1.0]), np.array([0.0, 0.0, -1.0]))  # straight down on both
-    seen_twice = settle(types, [cheese, low], [(ray, ray), (ray, ray)], costs)[1]
+    seen_twice = settle(KITCHEN, types, [cheese, low], [(ray, ray), (ray, ray)], costs)[1]
     assert seen_twice.position[2] == pytest.approx(top + _half("popcorn"))
-    seen_once = settle(types, [cheese, low], [(ray,), (ray, ray)], costs)[1]
+    seen_once = settle(KITCHEN, types, [cheese, low], [(ray,), (ray, ray)], costs)[1]
     assert seen_once.position[2] == pytest.approx(_half("popcorn"))
     # a neighbour's edge under the centre is no carrier to pass through
     beside = Pose.from_xyz_yaw(0.5 + 0.053 / 2 + 0.005, 0.0, _half("cream_cheese"), 0.0)
-    next_to = settle(types, [beside, low], [(ray, ray), (ray, ray)], costs)[1]
+    next_to = settle(KITCHEN, types, [beside, low], [(ray, ray), (ray, ray)], costs)[1]
     assert next_to.position[2] == pytest.approx(_half("popcorn"))
 
 
@@ -154,17 +170,22 @@ def test_an_object_found_twice_a_few_centimetres_apart_is_no_carrier_of_itself()
     top = KITCHEN.shelves["shelf_b"].top.z + _half("butter")
     near = Pose.from_xyz_yaw(0.555, -0.33, top, 0.0)
     far = Pose.from_xyz_yaw(0.594, -0.33, top - 0.007, 0.0)  # 3.9 cm on along its narrow side
-    assert one_level("butter", near, "butter", far) and not same_place(
-        "butter", near, "butter", far
+    assert one_level(
+        KITCHEN.object_type("butter"), near, KITCHEN.object_type("butter"), far
+    ) and not same_place(
+        KITCHEN.object_type("butter"),
+        near,
+        KITCHEN.object_type("butter"),
+        far,
     )
     # rested together, neither is carried by the other, even where the keypoints would
     # rather have the nearer one a box up
     one_up = top + 2 * _half("butter")
     costs = [None, lambda centre: abs(centre[2] - one_up)]
-    out = settle(["butter", "butter"], [far, near], [((), ())] * 2, costs)
+    out = settle(KITCHEN, ["butter", "butter"], [far, near], [((), ())] * 2, costs)
     assert [p.position[2] for p in out] == pytest.approx([top, top])
     # one found on the other, a box's height up, is carried
     above = Pose.from_xyz_yaw(0.57, -0.33, one_up - 0.004, 0.0)
-    _, rests = settle(["butter", "butter"], [near, above], [((), ())] * 2)
-    assert not one_level("butter", near, "butter", above)
+    _, rests = settle(KITCHEN, ["butter", "butter"], [near, above], [((), ())] * 2)
+    assert not one_level(KITCHEN.object_type("butter"), near, KITCHEN.object_type("butter"), above)
     assert rests.position[2] == pytest.approx(one_up)

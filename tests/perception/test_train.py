@@ -153,11 +153,15 @@ def test_examples_keep_the_keypoints_of_objects_in_sight_and_the_cuboids_of_all(
     names = list(KITCHEN.object_types)
     camera = PinholeCamera.of(c)
     assert [list(t) for t in found.types] == [[5]]  # the popcorn is barely in sight
-    expected = view_keypoints(names[5], poses[2], camera)
+    expected = view_keypoints(KITCHEN.object_type(names[5]), poses[2], camera)
     assert np.allclose(found.keypoints[0][0], expected, atol=1e-3)
     assert found.cuboids[0].shape == (2, 9, 2)
     assert np.allclose(found.cuboids[0][1], expected, atol=1e-3)
-    assert np.allclose(found.cuboids[0][0], view_keypoints(names[3], poses[0], camera), atol=1e-3)
+    assert np.allclose(
+        found.cuboids[0][0],
+        view_keypoints(KITCHEN.object_type(names[3]), poses[0], camera),
+        atol=1e-3,
+    )
 
 
 def test_collections_of_different_view_counts_train_together(tmp_path):

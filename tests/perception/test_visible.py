@@ -31,13 +31,15 @@ def _pixel(camera: PinholeCamera, pose: Pose) -> tuple[int, int]:
 
 def test_the_upper_box_hides_the_lower_ones_centroid_but_not_its_side():
     camera = PinholeCamera.of(VIEWS[0])
-    label = painted(["cream_cheese", "butter"], [LOWER, UPPER], camera)
+    label = painted(
+        [KITCHEN.object_type("cream_cheese"), KITCHEN.object_type("butter")], [LOWER, UPPER], camera
+    )
     u, v = _pixel(camera, LOWER)
     assert label[v, u] == 1  # the butter is what that pixel shows
     lower, upper = visible_masks(label, 2)
     assert lower.sum() >= MIN_REGION and upper.sum() > lower.sum()
     assert not (lower & upper).any()
-    alone = painted(["cream_cheese"], [LOWER], camera)
+    alone = painted([KITCHEN.object_type("cream_cheese")], [LOWER], camera)
     assert alone[v, u] == 0
 
 
@@ -52,7 +54,10 @@ class _NearestColour(torch.nn.Module):
 
 def _detection(name: str, pose: Pose) -> Detection:
     seen = tuple(
-        ViewKeypoints(PinholeCamera.of(c), view_keypoints(name, pose, PinholeCamera.of(c)))
+        ViewKeypoints(
+            PinholeCamera.of(c),
+            view_keypoints(KITCHEN.object_type(name), pose, PinholeCamera.of(c)),
+        )
         for c in VIEWS
     )
     return Detection(name, pose, 1.0, len(VIEWS), 0.0, (), 0.5, seen)
@@ -62,7 +67,7 @@ def _painted_images(types: list[str], poses: list[Pose]) -> np.ndarray:
     """The views with each painted pixel in its object's colour, the rest grey: [V, H, W, 3]."""
     images = []
     for camera in VIEWS:
-        label = painted(types, poses, PinholeCamera.of(camera))
+        label = painted([KITCHEN.object_type(x) for x in types], poses, PinholeCamera.of(camera))
         image = np.full((camera.height, camera.width, 3), 128, dtype=np.uint8)
         for i, t in enumerate(types):
             image[label == i] = np.array(KITCHEN.object_types[t].color[:3]) * 255
@@ -76,7 +81,7 @@ def test_a_box_under_another_is_named_by_the_colour_of_its_side_in_sight():
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
     # both named butter, as the colour at the lower one's centroid says
     found = [_detection("butter", LOWER), _detection("butter", UPPER)]
-    named = estimator._retyped(images, VIEWS, found)
+    named = estimator._retyped(KITCHEN, images, VIEWS, found)
     assert [d.type_name for d in named] == types
     assert np.allclose(named[0].pose.position, LOWER.position, atol=0.005)
 
@@ -117,16 +122,16 @@ def test_two_thin_boxes_seen_as_one_are_split_and_each_named_by_its_colour():
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
     height = KITCHEN.object_types["butter"].size[2]
     blob = _blob("butter", height)  # half-way up the stack: a box's height over the table
-    split = estimator._unstacked(images, VIEWS, [blob])
+    split = estimator._unstacked(KITCHEN, images, VIEWS, [blob])
     assert [d.type_name for d in split] == types and all(d.stacked for d in split)
     assert [d.pose.position[2] for d in split] == pytest.approx([height / 2, 3 * height / 2])
     # a lone box's height, a popcorn, or a box with something found under it: no stack
     alone = _blob("butter", height / 2)
-    assert estimator._unstacked(images, VIEWS, [alone]) == [alone]
+    assert estimator._unstacked(KITCHEN, images, VIEWS, [alone]) == [alone]
     tall = _blob("popcorn", height)
-    assert estimator._unstacked(images, VIEWS, [tall]) == [tall]
+    assert estimator._unstacked(KITCHEN, images, VIEWS, [tall]) == [tall]
     under = _blob("cream_cheese", height / 2)
-    assert estimator._unstacked(images, VIEWS, [under, blob]) == [under, blob]
+    assert estimator._unstacked(KITCHEN, images, VIEWS, [under, blob]) == [under, blob]
 
 
 def test_a_thin_box_carrying_what_rests_on_one_box_is_not_split():
@@ -136,9 +141,9 @@ def test_a_thin_box_carrying_what_rests_on_one_box_is_not_split():
     can = KITCHEN.object_types["tomato_soup"].size[2]
     blob = _blob("butter", height)  # found a box's height up, as two stacked would be
     on_one = _blob("tomato_soup", height + can / 2)
-    assert estimator._unstacked(images, VIEWS, [blob, on_one]) == [blob, on_one]
+    assert estimator._unstacked(KITCHEN, images, VIEWS, [blob, on_one]) == [blob, on_one]
     on_two = _blob("tomato_soup", 2 * height + can / 2)
-    split = estimator._unstacked(images, VIEWS, [blob, on_two])
+    split = estimator._unstacked(KITCHEN, images, VIEWS, [blob, on_two])
     assert sum(d.stacked for d in split) == 2 and on_two in split
 
 
@@ -168,7 +173,11 @@ def test_pixels_named_background_are_no_votes():
 def test_pixels_near_another_objects_are_left_out_of_a_vote():
     kept = 0
     for view in VIEWS:
-        label = painted(["cream_cheese", "butter"], [LOWER, UPPER], PinholeCamera.of(view))
+        label = painted(
+            [KITCHEN.object_type("cream_cheese"), KITCHEN.object_type("butter")],
+            [LOWER, UPPER],
+            PinholeCamera.of(view),
+        )
         lower, upper = visible_masks(label, 2)
         apart_lower, apart_upper = visible_masks(label, 2, apart=2)
         assert (apart_lower <= lower).all() and (apart_upper <= upper).all()
@@ -187,7 +196,7 @@ def test_a_stack_askew_is_split_and_each_box_named_by_its_own_pixels():
     images = _painted_images(types, [LOWER, askew])
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
     blob = _blob("butter", KITCHEN.object_types["butter"].size[2])  # at the lower one's yaw
-    split = estimator._unstacked(images, VIEWS, [blob])
+    split = estimator._unstacked(KITCHEN, images, VIEWS, [blob])
     assert [d.type_name for d in split] == types
 
 
@@ -201,19 +210,21 @@ def test_a_detection_under_the_surface_a_stack_stands_on_does_not_keep_it_one_bo
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
     blob = _blob("butter", top + height, lower)
     inside = _detection("tomato_soup", Pose.from_xyz_yaw(x, y, 0.042, 0.0))
-    split = estimator._unstacked(images, VIEWS, [inside, blob])
+    split = estimator._unstacked(KITCHEN, images, VIEWS, [inside, blob])
     assert inside in split and sum(d.stacked for d in split) == 2
     on_top = _detection("butter", lower)  # the lower box, found over the shelf's top
-    assert estimator._unstacked(images, VIEWS, [on_top, blob]) == [on_top, blob]
+    assert estimator._unstacked(KITCHEN, images, VIEWS, [on_top, blob]) == [on_top, blob]
 
 
 def test_a_box_whose_pixels_all_lie_near_another_ones_edge_is_named_by_them(monkeypatch):
     types, poses = ["cream_cheese", "butter"], [LOWER, UPPER]
     monkeypatch.setattr(estimator_module, "APART_PX", 20)
     for view in VIEWS:  # none of the lower box's pixels lies that far from the butter's
-        assert not visible_masks(painted(types, poses, PinholeCamera.of(view)), 2, 20)[0].any()
+        assert not visible_masks(
+            painted([KITCHEN.object_type(x) for x in types], poses, PinholeCamera.of(view)), 2, 20
+        )[0].any()
     images = _painted_images(types, poses)
     estimator = PoseEstimator(torch.nn.Identity(), colour=_NearestColour())
     found = [_detection("butter", LOWER), _detection("butter", UPPER)]  # as the centroids say
-    named = estimator._retyped(images, VIEWS, found)
+    named = estimator._retyped(KITCHEN, images, VIEWS, found)
     assert [d.type_name for d in named] == types
