@@ -27,12 +27,15 @@ def check_observer(name: str) -> None:
 
 
 def check_seen(perception: str, worlds: Iterable[World], scene: str | Path | None) -> None:
-    """Refuse f_p in a scene other than the kitchen, in one line: its network knows the
-    kitchen's six looks, and it places what it sees by the kitchen's cameras and fixtures."""
-    if perception == "rgb" and any(w != KITCHEN for w in worlds):
+    """Refuse f_p a scene it cannot see, in one line: one with objects whose look it has not
+    learned, or seen through other cameras (`perception.vocabulary.unseen_looks`)."""
+    if perception != "rgb":
+        return
+    from hsgplan.perception.vocabulary import unseen_looks
+
+    for why in filter(None, map(unseen_looks, worlds)):
         raise InvalidInputError(
-            f"--perception rgb: f_p knows the kitchen's objects, cameras and fixtures alone, "
-            f"not those of scene '{scene}'; see it with --perception gt"
+            f"--perception rgb: f_p cannot see scene '{scene}': {why}; see it with --perception gt"
         )
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import asdict
 
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import World
 from hsgplan.sim.render import Camera
 
 TRAINING_WORLD = KITCHEN
@@ -26,3 +27,18 @@ TYPES: tuple[str, ...] = tuple(TRAINING_WORLD.object_types)
 # seen by one view alone). The keypoint network was first trained on the first three (see
 # `perception.synthetic.ORIGINAL_VIEWS`), then fine-tuned on all five.
 VIEWS: tuple[Camera, ...] = tuple(Camera(**asdict(view)) for view in TRAINING_WORLD.cameras)
+
+
+def unseen_looks(world: World) -> str | None:
+    """Why f_p cannot see a scene of `world`, or None when it can: it has learned the looks
+    (name, kind and colour) of the training world's object types, seen through `VIEWS`. Their
+    sizes, the table and the shelves it takes from `world`, so a scene of moved shelves and
+    resized groceries is one it can look at."""
+    trained = TRAINING_WORLD.object_types
+    for t in world.type_list:
+        known = trained.get(t.name)
+        if known is None or known.kind != t.kind or known.color != t.color:
+            return f"it has not learned the look of '{t.name}'"
+    if tuple(world.cameras) != tuple(TRAINING_WORLD.cameras):
+        return "its cameras are not the ones f_p was trained with"
+    return None

@@ -3,6 +3,7 @@ says, its objects have the scene's sizes, f_m reads the scene's surfaces, and an
 its goal's world."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -97,22 +98,29 @@ def test_the_stream_baselines_are_refused_a_layout_before_anything_is_written(tm
     assert not (tmp_path / "e").exists()
 
 
-def test_f_p_is_refused_a_scene_other_than_the_kitchen_and_the_kitchens_file_is_the_kitchen(
-    tmp_path,
-):
+def test_f_p_is_refused_objects_it_never_saw_and_other_cameras_but_not_a_new_layout(tmp_path):
     from hsgplan.evaluation.config import EvalConfig
 
-    scene = tmp_path / "layout.toml"
-    scene.write_text(to_toml(scene_data(LAYOUT)))
+    new = tmp_path / "new.toml"
+    new.write_text(to_toml(scene_data(NEW)))
+    elsewhere = tmp_path / "cameras.toml"
+    moved = replace(LAYOUT.cameras[0], eye=(1.5, 0.0, 1.0))
+    elsewhere.write_text(to_toml(scene_data(replace(LAYOUT, cameras=(moved, *LAYOUT.cameras[1:])))))
     evaluation = ["eval", "world", "--agent", "oracle", "--sizes", "2", "--goals", "1"]
-    for args in (
-        ["demo", "--agent", "oracle", "--perception", "rgb", "--out", str(tmp_path / "d")],
-        [*evaluation, "--perception", "gt,rgb", "--out", str(tmp_path / "e")],
-    ):
-        r = runner.invoke(app, [*args, "--scene", str(scene)])
-        assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
-        assert "f_p knows the kitchen's" in r.output
+    for scene, why in ((new, "has not learned the look of"), (elsewhere, "its cameras")):
+        for args in (
+            ["demo", "--agent", "oracle", "--perception", "rgb", "--out", str(tmp_path / "d")],
+            [*evaluation, "--perception", "gt,rgb", "--out", str(tmp_path / "e")],
+        ):
+            r = runner.invoke(app, [*args, "--scene", str(scene)])
+            assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
+            assert "f_p cannot see scene" in r.output and why in r.output, r.output
     assert not (tmp_path / "d").exists() and not (tmp_path / "e").exists()
+    # moved shelves and resized groceries of the looks it learned: it sees them by their sizes
+    layout = tmp_path / "layout.toml"
+    layout.write_text(to_toml(scene_data(LAYOUT)))
+    seen = EvalConfig("oracle", (2,), 1, 0, perception="rgb", scene=str(layout))
+    assert list(seen.worlds().values()) == [LAYOUT]
     kitchen = EvalConfig("oracle", (2,), 1, 0, perception="rgb", scene=str(KITCHEN_SCENE))
     assert list(kitchen.worlds().values()) == [KITCHEN]
 
