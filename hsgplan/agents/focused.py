@@ -199,7 +199,7 @@ def _optimistic(
             if inst in off:
                 continue
             p = opt.new("pose", inst, 1)
-            value = _sketch(surface_pose(o, s, (0, 0)))
+            value = _sketch(surface_pose(o, s, (0, 0), prob.world))
             opt.poses[p] = value
             opt.facts += [("pose", o, p), ("supported", o, p, s)]
             queue.append((p, value, 1))
@@ -227,7 +227,9 @@ def _optimistic(
             u = opt.new("push", inst, level + 1)
             end = opt.new("pose", inst, level + 1)
             q = opt.new("conf", inst, level + 1)
-            opt.poses[end] = PoseValue(v.obj, math.nan, math.nan, v.z, v.yaw, "inside", shelf)
+            opt.poses[end] = PoseValue(
+                v.obj, math.nan, math.nan, v.z, v.yaw, "inside", shelf, world=v.world
+            )
             opt.facts += [("pose", v.obj, end), ("inside", v.obj, end, shelf)]
             opt.facts.append(("pushable", v.obj, p, shelf, u, end, q))
     return opt
@@ -236,7 +238,14 @@ def _optimistic(
 def _sketch(value: PoseValue) -> PoseValue:
     """An optimistic pose: where on the surface is not known until it is sampled."""
     return PoseValue(
-        value.obj, math.nan, math.nan, value.z, value.yaw, value.relation, value.support
+        value.obj,
+        math.nan,
+        math.nan,
+        value.z,
+        value.yaw,
+        value.relation,
+        value.support,
+        world=value.world,
     )
 
 
@@ -294,11 +303,11 @@ def _run(
     kind = inst[0]
     if kind == "place":
         _, o, s = inst
-        order = prob.bins.setdefault((o, s), bin_order(o, s, prob.rng))
+        order = prob.bins.setdefault((o, s), bin_order(o, s, prob.rng, prob.world))
         if not order:
             exhausted.add(inst)
             return []
-        p = prob.new_pose(surface_pose(o, s, order.pop(0)), 1)
+        p = prob.new_pose(surface_pose(o, s, order.pop(0), prob.world), 1)
         if not order:
             exhausted.add(inst)
         return [p]

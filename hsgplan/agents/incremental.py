@@ -175,9 +175,9 @@ class IncrementalPlanner:
                 add_grasp(prob, o, level)
         for o in objects:
             for s, samples in place_surfaces(prob, o, cfg):
-                order = prob.bins.setdefault((o, s), bin_order(o, s, prob.rng))
+                order = prob.bins.setdefault((o, s), bin_order(o, s, prob.rng, prob.world))
                 for _ in range(min(samples, len(order))):
-                    prob.new_pose(surface_pose(o, s, order.pop(0)), level)
+                    prob.new_pose(surface_pose(o, s, order.pop(0), prob.world), level)
         for pb in poses:
             for o in stackable(prob, prob.poses[pb], objects):
                 if ("stack", o, pb) in prob.done:

@@ -171,13 +171,13 @@ def initial_problem(sg: GeometricSceneGraph, state: SymbolicSceneGraph, rng) -> 
                 continue  # its support first
             pending.remove(o)
             if loc.predicate is Predicate.IN:
-                value = observed_pose(o, sg.pose(o), "inside", x)
+                value = observed_pose(o, sg.pose(o), "inside", x, prob.world)
             elif x in state.world.surfaces:
-                value = observed_pose(o, sg.pose(o), "supported", x)
+                value = observed_pose(o, sg.pose(o), "supported", x, prob.world)
             elif x in prob.observed:
-                value = observed_pose(o, sg.pose(o), "stacked", x)
+                value = observed_pose(o, sg.pose(o), "stacked", x, prob.world)
             else:
-                value = observed_pose(o, sg.pose(o), "loose", "")
+                value = observed_pose(o, sg.pose(o), "loose", "", prob.world)
             prob.observed[o] = prob.new_pose(value, 0, below=prob.observed.get(x, ""))
             prob.add("atpose", o, prob.observed[o])
     return prob

@@ -15,13 +15,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PushParams, extent_along, place_centre, place_xy
-from hsgplan.domain.world import PLACE_BINS, PLACE_LONG_AXIS_YAW, REACH_MAX_Z, Kind, spot_cells
+from hsgplan.domain.world import (
+    PLACE_BINS,
+    PLACE_LONG_AXIS_YAW,
+    REACH_MAX_Z,
+    Kind,
+    World,
+    spot_cells,
+)
 from hsgplan.motion.sampler import (
     HAND_DROP,
     HAND_HALF_LENGTH,
@@ -47,7 +53,8 @@ class PoseValue:
 
     `relation`: "supported" (on surface `support`, at place bins `bins`), "stacked" (on the
     object `support`), "inside" (shelf `support`'s interior) or "loose" (an observed pose that
-    is none of these, e.g. a toppled object).
+    is none of these, e.g. a toppled object). `world`: the scene's, whose type sizes `obj`
+    (not compared: a value is its pose).
     """
 
     obj: str
@@ -58,6 +65,7 @@ class PoseValue:
     relation: str
     support: str
     bins: tuple[int, int] | None = None
+    world: World = field(kw_only=True, compare=False, hash=False, repr=False)
 
     @property
     def pose(self) -> Pose:
@@ -65,11 +73,11 @@ class PoseValue:
 
     @property
     def bottom(self) -> float:
-        return self.z - KITCHEN.object_type(self.obj).height / 2
+        return self.z - self.world.object_type(self.obj).height / 2
 
     @property
     def top(self) -> float:
-        return self.z + KITCHEN.object_type(self.obj).height / 2
+        return self.z + self.world.object_type(self.obj).height / 2
 
 
 @dataclass(frozen=True)
@@ -80,38 +88,40 @@ class PushValue:
     end: PoseValue
 
 
-def observed_pose(obj: str, pose: Pose, relation: str, support: str) -> PoseValue:
-    """An observed pose; on a surface, with the place bins nearest it (a plan may put the
-    object back where it stands)."""
+def observed_pose(obj: str, pose: Pose, relation: str, support: str, world: World) -> PoseValue:
+    """An observed pose in a scene of `world`; on a surface, with the place bins nearest it (a
+    plan may put the object back where it stands)."""
     x, y, z = pose.position
     bins = None
     if relation == "supported":
         grid = [(xb, yb) for xb in range(PLACE_BINS) for yb in range(PLACE_BINS)]
-        bins = min(grid, key=lambda b: math.dist(place_xy(obj, support, *b, KITCHEN), (x, y)))
-    return PoseValue(obj, x, y, z, pose.yaw, relation, support, bins)
+        bins = min(grid, key=lambda b: math.dist(place_xy(obj, support, *b, world), (x, y)))
+    return PoseValue(obj, x, y, z, pose.yaw, relation, support, bins, world=world)
 
 
-def bin_order(obj: str, surface: str, rng: np.random.Generator) -> list[tuple[int, int]]:
+def bin_order(
+    obj: str, surface: str, rng: np.random.Generator, world: World
+) -> list[tuple[int, int]]:
     """The place bins in the order a pose sampler draws them: first, for each of the surface's
     spot cells (in a random order), the bin nearest its centre, so that the first poses on a
     surface stand apart as its capacity counts them; then every other bin, in a random order.
     (Measured on one 6-object goal: with every bin drawn uniformly, no plan was found within
     three levels, and the fourth held 3.8 million facts; cells first, the third had a plan.)"""
     grid = [(xb, yb) for xb in range(PLACE_BINS) for yb in range(PLACE_BINS)]
-    cells = spot_cells(KITCHEN.surface_rect(surface))
+    cells = spot_cells(world.surface_rect(surface))
     first: list[tuple[int, int]] = []
     for i in rng.permutation(len(cells)):
         centre = cells[i]
-        nearest = min(grid, key=lambda b: math.dist(place_xy(obj, surface, *b, KITCHEN), centre))
+        nearest = min(grid, key=lambda b: math.dist(place_xy(obj, surface, *b, world), centre))
         if nearest not in first:
             first.append(nearest)
     return first + [grid[i] for i in rng.permutation(len(grid)) if grid[i] not in first]
 
 
-def surface_pose(obj: str, surface: str, bins: tuple[int, int]) -> PoseValue:
+def surface_pose(obj: str, surface: str, bins: tuple[int, int], world: World) -> PoseValue:
     """The pose a place at these bins puts the object in (standing, long side along y)."""
-    x, y, z = place_centre(obj, surface, *bins, KITCHEN)
-    return PoseValue(obj, x, y, z, PLACE_LONG_AXIS_YAW, "supported", surface, bins)
+    x, y, z = place_centre(obj, surface, *bins, world)
+    return PoseValue(obj, x, y, z, PLACE_LONG_AXIS_YAW, "supported", surface, bins, world=world)
 
 
 def stack_pose(obj: str, below: PoseValue) -> PoseValue | None:
@@ -119,16 +129,18 @@ def stack_pose(obj: str, below: PoseValue) -> PoseValue | None:
     tower stays within the arm's reach."""
     if below.obj == obj or below.relation not in ("supported", "stacked"):
         return None
-    if not KITCHEN.can_support(KITCHEN.object_type(below.obj).name):
+    world = below.world
+    if not world.can_support(world.object_type(below.obj).name):
         return None
-    height = KITCHEN.object_type(obj).height
+    height = world.object_type(obj).height
     if below.top + height > REACH_MAX_Z:
         return None
-    return PoseValue(obj, below.x, below.y, below.top + height / 2, below.yaw, "stacked", below.obj)
+    z = below.top + height / 2
+    return PoseValue(obj, below.x, below.y, z, below.yaw, "stacked", below.obj, world=world)
 
 
 def _half_extents(p: PoseValue) -> tuple[float, float]:
-    fx, fy = KITCHEN.object_type(p.obj).footprint
+    fx, fy = p.world.object_type(p.obj).footprint
     c, s = abs(math.cos(p.yaw)), abs(math.sin(p.yaw))
     return (c * fx + s * fy) / 2, (s * fx + c * fy) / 2
 
@@ -157,7 +169,7 @@ class PoseTable:
 
     def _row(self, p: PoseValue) -> np.ndarray:
         hx, hy = _half_extents(p)
-        box = KITCHEN.object_type(p.obj).kind is Kind.BOX
+        box = p.world.object_type(p.obj).kind is Kind.BOX
         oid = self._ids.setdefault(p.obj, len(self._ids))
         c, s = math.cos(p.yaw), math.sin(p.yaw)
         return np.array([oid, p.x, p.y, p.bottom, p.top, hx, hy, box, c, s, max(hx, hy)])
@@ -202,9 +214,10 @@ def collides(a: PoseValue, b: PoseValue) -> bool:
 
 def push_shelf(p: PoseValue) -> str | None:
     """The shelf whose prepush region a pose rests on, if the object fits into it."""
-    for name, shelf in KITCHEN.shelves.items():
+    world = p.world
+    for name, shelf in world.shelves.items():
         if p.relation == "supported" and p.support == shelf.prepush:
-            return name if KITCHEN.fits_inside(KITCHEN.object_type(p.obj).name, name) else None
+            return name if world.fits_inside(world.object_type(p.obj).name, name) else None
     return None
 
 
@@ -244,9 +257,10 @@ class StreamWorld:
     def pushes(self, start: PoseValue, shelf: str) -> Iterator[tuple[PushValue, tuple[float, ...]]]:
         """The push stream: pushes from the pose into each of the shelf's slots, nearest
         first, those the arm can carry out (with the joints it starts from)."""
-        interior = KITCHEN.shelves[shelf].interior
-        sg = GeometricSceneGraph.from_poses({start.obj: start.pose}, world=self.scene.world)
-        slots = sorted(KITCHEN.interior_slots(shelf), key=lambda s: abs(s - start.y))
+        world = self.scene.world
+        interior = world.shelves[shelf].interior
+        sg = GeometricSceneGraph.from_poses({start.obj: start.pose}, world=world)
+        slots = sorted(world.interior_slots(shelf), key=lambda s: abs(s - start.y))
         for slot, params in zip(slots, push_candidates(sg, start.obj, shelf), strict=True):
             self._show(start)
             plan = plan_primitive(self.scene, params)
@@ -254,14 +268,13 @@ class StreamWorld:
                 continue
             end = PoseValue(
                 start.obj,
-                interior.x_min
-                + PUSH_DEPTH
-                + extent_along(start.obj, start.yaw, 0.0, self.scene.world),
+                interior.x_min + PUSH_DEPTH + extent_along(start.obj, start.yaw, 0.0, world),
                 slot,
                 start.z,
                 start.yaw,
                 "inside",
                 shelf,
+                world=world,
             )
             yield PushValue(params, end), tuple(float(v) for v in plan.q_at)
 

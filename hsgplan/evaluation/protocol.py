@@ -69,18 +69,9 @@ def check_agent_world(
     checkpoint: Path | None = None,
     motion_checkpoints: Path | None = None,
 ) -> None:
-    """`registry.check_reads` on the checkpoint folders of an agent (default: the shipped); the
-    stream baselines, whose streams still size and place by the kitchen's shelves, are refused
-    any other world in one line."""
-    from hsgplan.agents.registry import STREAM_AGENTS, agent_checkpoints, check_reads
-    from hsgplan.domain.kitchen import KITCHEN
+    """`registry.check_reads` on the checkpoint folders of an agent (default: the shipped)."""
+    from hsgplan.agents.registry import agent_checkpoints, check_reads
     from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
-
-    if agent in STREAM_AGENTS and world != KITCHEN:
-        raise InvalidInputError(
-            f"agent '{agent}': its streams know the kitchen's shelves alone, not those of "
-            f"scene '{scene}'"
-        )
 
     folders = agent_checkpoints(
         agent, checkpoint or TASK_CHECKPOINT, motion_checkpoints or MOTION_CHECKPOINTS

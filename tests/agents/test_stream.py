@@ -29,19 +29,23 @@ from hsgplan.sim.outcome import Outcome, Status
 
 
 def test_collision_test_keeps_towers_and_flags_crowding():
-    can = surface_pose("cherries", "shelf_a", (2, 5))
-    beside = surface_pose("tomato_soup", "shelf_a", (2, 6))  # the next bin: 2.4 cm apart
-    far = surface_pose("tomato_soup", "shelf_a", (8, 0))
+    can = surface_pose("cherries", "shelf_a", (2, 5), KITCHEN)
+    beside = surface_pose("tomato_soup", "shelf_a", (2, 6), KITCHEN)  # the next bin: 2.4 cm apart
+    far = surface_pose("tomato_soup", "shelf_a", (8, 0), KITCHEN)
     assert collides(can, beside) and collides(beside, can)
     assert not collides(can, far)
     on_can = stack_pose("butter", can)
     on_butter = stack_pose("tomato_soup", on_can)
     assert not collides(on_can, can) and not collides(on_butter, can)  # a tower stands
     # the hand taking a flat box would sweep into a tall can standing past its narrow side
-    box = surface_pose("butter", "open_space", (5, 5))
-    tall = surface_pose("alphabet_soup", "open_space", (8, 5))  # 11 cm away along x
-    assert collides(box, tall) and not collides(box, surface_pose("cherries", "shelf_b", (0, 0)))
-    assert stack_pose("butter", surface_pose("popcorn", "shelf_a", (5, 5))) is None  # too narrow
+    box = surface_pose("butter", "open_space", (5, 5), KITCHEN)
+    tall = surface_pose("alphabet_soup", "open_space", (8, 5), KITCHEN)  # 11 cm away along x
+    assert collides(box, tall) and not collides(
+        box, surface_pose("cherries", "shelf_b", (0, 0), KITCHEN)
+    )
+    assert (
+        stack_pose("butter", surface_pose("popcorn", "shelf_a", (5, 5), KITCHEN)) is None
+    )  # too narrow
 
 
 def test_expected_state_moves_only_the_acting_object():

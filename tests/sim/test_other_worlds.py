@@ -88,14 +88,22 @@ def test_an_agent_with_learned_parts_is_refused_a_world_of_other_names(tmp_path)
     assert not (tmp_path / "d").exists() and not (tmp_path / "e").exists()
 
 
-def test_the_stream_baselines_are_refused_a_layout_before_anything_is_written(tmp_path):
-    scene = tmp_path / "layout.toml"
-    scene.write_text(to_toml(scene_data(LAYOUT)))
-    args = ["eval", "world", "--agent", "stream-goal", "--sizes", "2", "--goals", "1"]
-    r = runner.invoke(app, [*args, "--scene", str(scene), "--out", str(tmp_path / "e")])
-    assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
-    assert "its streams know the kitchen's shelves" in r.output
-    assert not (tmp_path / "e").exists()
+def test_the_stream_baselines_place_size_and_push_by_their_scenes_world():
+    from hsgplan.agents.streams import push_shelf, stack_pose, surface_pose
+
+    shelf = next(s for s in LAYOUT.shelf_list if s.interior is not None)
+    can = LAYOUT.object_type("tomato_soup")
+    assert can.size != KITCHEN.object_type("tomato_soup").size  # resized in this layout
+    on_top = surface_pose("tomato_soup", shelf.name, (4, 4), LAYOUT)
+    assert on_top.bottom == pytest.approx(shelf.top.z)
+    assert on_top.top - on_top.bottom == pytest.approx(can.height)
+    assert shelf.top.contains(on_top.x, on_top.y)
+    butter = stack_pose("butter", on_top)
+    assert butter is not None and butter.bottom == pytest.approx(on_top.top)
+    assert butter.top - butter.bottom == pytest.approx(LAYOUT.object_type("butter").height)
+    before = surface_pose("tomato_soup", shelf.prepush, (4, 4), LAYOUT)
+    assert LAYOUT.regions[shelf.prepush].contains(before.x, before.y)
+    assert push_shelf(before) == shelf.name
 
 
 def test_f_p_is_refused_objects_it_never_saw_and_other_cameras_but_not_a_new_layout(tmp_path):
