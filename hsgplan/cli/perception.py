@@ -107,6 +107,16 @@ def eval_perception(
             min=1,
         ),
     ] = None,
+    scene: Annotated[
+        Path | None,
+        typer.Option(
+            "--scene",
+            help="Stage the scenes in this scene file's world, or round a folder of them (scene "
+            "k in its k-th file); default: the kitchen. f_p sees only the groceries and cameras "
+            "it learned (docs/scenes.md).",
+            parser=input_path,
+        ),
+    ] = None,
     loop: Annotated[
         bool,
         typer.Option(
@@ -118,16 +128,24 @@ def eval_perception(
     ] = False,
 ) -> None:
     """f_p on fresh synthetic scenes: pose errors per object type, symbolic scene graph match."""
+    from hsgplan.domain.errors import InvalidInputError
+    from hsgplan.domain.kitchen import KITCHEN
+    from hsgplan.domain.scene_file import read_worlds
+    from hsgplan.evaluation.config import unseeable
     from hsgplan.evaluation.perception_eval import evaluate, evaluate_loop, summary
     from hsgplan.perception.estimator import PoseEstimator
     from hsgplan.perception.synthetic import VIEWS, first_views
 
     shown = len(first_views(views)) if views is not None else len(VIEWS)  # before loading
+    worlds = (KITCHEN,) if scene is None else tuple(read_worlds(scene).values())
+    if why := unseeable(worlds, scene):
+        raise InvalidInputError(why)
     estimator = PoseEstimator.load(perception_checkpoint, settled=not raw, pruned=not unpruned)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         run = evaluate_loop if loop else evaluate
-        report = summary(run(estimator, scenes, seed, lambda: progress.advance(task), shown))
+        found = run(estimator, scenes, seed, lambda: progress.advance(task), shown, worlds)
+        report = summary(found)
     if as_json:
         print(json.dumps(report, indent=2))
         return
@@ -152,6 +170,7 @@ def eval_perception(
     title = (
         f"f_p on {report['scenes']} {'scenes from inside the loop' if loop else 'fresh scenes'}, "
         f"seed {seed}"
+        f"{f', in {scene}' if scene is not None else ''}"
         f"{f' (the first {views} views)' if views else ''}: objects found (recall) "
         f"{report['found_rate']:.3f}, detections matching an object (precision) "
         f"{report['precision']:.3f} ({report['unmatched_detections']} matched none), "

@@ -27,16 +27,18 @@ def check_observer(name: str) -> None:
 
 
 def check_seen(perception: str, worlds: Iterable[World], scene: str | Path | None) -> None:
-    """Refuse f_p a scene it cannot see, in one line: one with objects whose look it has not
-    learned, or seen through other cameras (`perception.vocabulary.unseen_looks`)."""
-    if perception != "rgb":
-        return
+    """Refuse f_p a scene it cannot see, in one line (`unseeable`)."""
+    if perception == "rgb" and (why := unseeable(worlds, scene)):
+        raise InvalidInputError(f"--perception rgb: {why}; see it with --perception gt")
+
+
+def unseeable(worlds: Iterable[World], scene: str | Path | None) -> str | None:
+    """Why f_p cannot see the scenes of `worlds` (read from `scene`), or None: one has objects
+    whose look it has not learned, or other cameras (`perception.vocabulary.unseen_looks`)."""
     from hsgplan.perception.vocabulary import unseen_looks
 
-    for why in filter(None, map(unseen_looks, worlds)):
-        raise InvalidInputError(
-            f"--perception rgb: f_p cannot see scene '{scene}': {why}; see it with --perception gt"
-        )
+    why = next(filter(None, map(unseen_looks, worlds)), None)
+    return None if why is None else f"f_p cannot see scene '{scene}': {why}"
 
 
 # the tables of an `eval world` run (`table1.tables`), in their order

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import random
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +22,7 @@ import numpy as np
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.checks import MAX_SEED
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import World
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.env import KitchenStorageEnv
@@ -40,20 +41,25 @@ class LoopScene:
     images: np.ndarray  # [V, H, W, 3]
     step: int  # steps run before it was taken
     arm: tuple[Box, ...] = ()  # the arm's links (what the robot knows of where its arm is)
+    world: World = KITCHEN  # the scene's
 
 
 class _Taken(Exception):
     pass
 
 
-def loop_scenes(scenes: int, seed: int, cameras: tuple[Camera, ...]) -> Iterator[LoopScene]:
-    """`scenes` scenes, each from an episode of its own."""
-    env = KitchenStorageEnv(world=KITCHEN)
+def loop_scenes(
+    scenes: int, seed: int, cameras: tuple[Camera, ...], worlds: Sequence[World] = (KITCHEN,)
+) -> Iterator[LoopScene]:
+    """`scenes` scenes, each from an episode of its own, scene k in `worlds[k % len(worlds)]`."""
+    envs = {id(w): KitchenStorageEnv(world=w) for w in worlds}
     agent = make_agent("oracle")
     try:
         for index in range(scenes):
+            world = worlds[index % len(worlds)]
+            env = envs[id(world)]
             rng = random.Random(f"{seed}/{index}")
-            goal = random_goals(rng.randint(*SIZES), 1, rng.randrange(MAX_SEED), world=KITCHEN)[0]
+            goal = random_goals(rng.randint(*SIZES), 1, rng.randrange(MAX_SEED), world=world)[0]
             wanted = rng.randint(1, MAX_STEPS_INTO)
             steps = _run_into(env, agent, goal, rng.randrange(MAX_SEED), wanted)
             scene = env.scene
@@ -64,9 +70,10 @@ def loop_scenes(scenes: int, seed: int, cameras: tuple[Camera, ...]) -> Iterator
             images = np.stack([c.capture(scene.bc) for c in cameras])
             truth = {o: p for o, p in poses.items() if o != held}
             arm = scene.robot.boxes()
-            yield LoopScene(truth, poses[held] if held else None, images, steps, arm)
+            yield LoopScene(truth, poses[held] if held else None, images, steps, arm, world)
     finally:
-        env.close()
+        for env in envs.values():
+            env.close()
 
 
 def _run_into(env: KitchenStorageEnv, agent, goal, seed: int, wanted: int) -> int:

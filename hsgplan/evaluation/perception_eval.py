@@ -22,14 +22,14 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import EntityKind
-from hsgplan.domain.world import Kind
+from hsgplan.domain.world import Kind, World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.keypoints import BOX_SYMMETRIES
@@ -63,24 +63,26 @@ class SceneResult:
     misread: str | None = None  # one of MISREADS where the scene is no symbolic match
 
 
-def rotation_error(obj: str, truth: Pose, estimate: Pose) -> float:
+def rotation_error(obj: str, truth: Pose, estimate: Pose, world: World) -> float:
     """Degrees between two orientations of an object, up to its cuboid's symmetries."""
     a, b = truth.rotation, estimate.rotation
-    if KITCHEN.object_type(obj).kind is Kind.CAN:
+    if world.object_type(obj).kind is Kind.CAN:
         cos = abs(float(a[:, 2] @ b[:, 2]))  # the axis, either way up
         return math.degrees(math.acos(min(1.0, cos)))
     best = max(np.trace(a.T @ b @ s) for s in BOX_SYMMETRIES)
     return math.degrees(math.acos(float(np.clip((best - 1) / 2, -1.0, 1.0))))
 
 
-def match(truth: dict[str, Pose], detections: list[Detection]) -> dict[str, Detection]:
+def match(
+    truth: dict[str, Pose], detections: list[Detection], world: World
+) -> dict[str, Detection]:
     """Each object of the scene (its true pose) and the detection matched to it (type by
     type, nearest pair first)."""
     pairs = sorted(
         (np.linalg.norm(np.subtract(d.pose.position, truth[o].position)), o, k)
         for o in truth
         for k, d in enumerate(detections)
-        if d.type_name == KITCHEN.type_of(o)
+        if d.type_name == world.type_of(o)
     )
     matched: dict[str, Detection] = {}
     taken: set[int] = set()
@@ -91,22 +93,22 @@ def match(truth: dict[str, Pose], detections: list[Detection]) -> dict[str, Dete
     return matched
 
 
-def score_scene(sample: ImageSample, detections: list[Detection]) -> SceneResult:
-    return score({o: _pose(sample, i) for i, o in enumerate(sample.objects)}, detections)
+def score_scene(sample: ImageSample, detections: list[Detection], world: World) -> SceneResult:
+    return score({o: _pose(sample, i) for i, o in enumerate(sample.objects)}, detections, world)
 
 
-def score(truth: dict[str, Pose], detections: list[Detection]) -> SceneResult:
-    """A scene's detections against its objects' true poses."""
-    matched = match(truth, detections)
+def score(truth: dict[str, Pose], detections: list[Detection], world: World) -> SceneResult:
+    """A scene's detections against its objects' true poses (in a scene of `world`)."""
+    matched = match(truth, detections, world)
     names = [o for o in truth if o in matched]
     translation = [
         100 * float(np.linalg.norm(np.subtract(matched[o].pose.position, truth[o].position)))
         for o in names
     ]
-    rotation = [rotation_error(o, truth[o], matched[o].pose) for o in names]
-    true_state = map_symbols(GeometricSceneGraph.from_poses(truth, world=KITCHEN)).state
+    rotation = [rotation_error(o, truth[o], matched[o].pose, world) for o in names]
+    true_state = map_symbols(GeometricSceneGraph.from_poses(truth, world=world)).state
     seen_state = map_symbols(
-        GeometricSceneGraph.from_poses({o: matched[o].pose for o in names}, world=KITCHEN)
+        GeometricSceneGraph.from_poses({o: matched[o].pose for o in names}, world=world)
     ).state
     same = len(names) == len(truth) and true_state == seen_state
     return SceneResult(
@@ -114,7 +116,7 @@ def score(truth: dict[str, Pose], detections: list[Detection]) -> SceneResult:
         len(names),
         tuple(translation),
         tuple(rotation),
-        tuple(KITCHEN.type_of(o) for o in names),
+        tuple(world.type_of(o) for o in names),
         same,
         len(detections),
         None if same else misread(truth, detections, matched, true_state, seen_state),
@@ -135,7 +137,8 @@ def misread(truth, detections, matched, true_state, seen_state) -> str:
     if missing:
         return "unseen"
     wrong = set(true_state.literals) ^ set(seen_state.literals)
-    targets = {KITCHEN.kind_of(lit.args[-1]) for lit in wrong if lit.predicate.arity == 2}
+    kind_of = true_state.world.kind_of
+    targets = {kind_of(lit.args[-1]) for lit in wrong if lit.predicate.arity == 2}
     if EntityKind.OBJECT in targets:
         return "stack_relation"
     if EntityKind.SHELF in targets:
@@ -145,7 +148,7 @@ def misread(truth, detections, matched, true_state, seen_state) -> str:
 
 def _on_object(state, obj: str) -> bool:
     below = state.location(obj).args[-1]
-    return KITCHEN.kind_of(below) is EntityKind.OBJECT
+    return state.world.kind_of(below) is EntityKind.OBJECT
 
 
 def evaluate(
@@ -154,16 +157,17 @@ def evaluate(
     seed: int,
     on_scene: Callable[[], None] | None = None,
     views: int = len(VIEWS),
+    worlds: Sequence[World] = (KITCHEN,),
 ) -> list[SceneResult]:
     """The scenes `(seed, 0 .. scenes - 1)` that could be staged, each scored, seen from the
-    first `views` fixed views."""
+    first `views` fixed views; scene k staged in a scene of `worlds[k % len(worlds)]`."""
     out = []
     for index in range(scenes):
-        sample = render_sample(seed, index, views=views)
+        world = worlds[index % len(worlds)]
+        sample = render_sample(seed, index, views=views, world=world)
         if sample is not None:
-            out.append(
-                score_scene(sample, estimator.detect(sample.images, sample.cameras, KITCHEN))
-            )
+            found = estimator.detect(sample.images, sample.cameras, world)
+            out.append(score_scene(sample, found, world))
         if on_scene:
             on_scene()
     return out
@@ -175,19 +179,20 @@ def evaluate_loop(
     seed: int,
     on_scene: Callable[[], None] | None = None,
     views: int = len(VIEWS),
+    worlds: Sequence[World] = (KITCHEN,),
 ) -> list[SceneResult]:
-    """f_p on scenes from inside the loop (`loop_scenes`), seen from the first `views` fixed
-    views as the rgb observer sees them."""
+    """f_p on scenes from inside the loop (`loop_scenes`; scene k in `worlds[k % len(worlds)]`),
+    seen from the first `views` fixed views as the rgb observer sees them."""
     from hsgplan.evaluation.loop_scenes import loop_scenes
     from hsgplan.perception.synthetic import first_views
 
     cameras = first_views(views)
     out = []
-    for scene in loop_scenes(scenes, seed, cameras):
-        detections = estimator.detect(scene.images, cameras, KITCHEN, scene.arm)
+    for scene in loop_scenes(scenes, seed, cameras, worlds):
+        detections = estimator.detect(scene.images, cameras, scene.world, scene.arm)
         # the robot knows where its hand is: what is there is not f_p's to find
         detections = away_from_hand(detections, scene.held)
-        out.append(score(scene.truth, detections))
+        out.append(score(scene.truth, detections, scene.world))
         if on_scene:
             on_scene()
     return out

@@ -21,7 +21,7 @@ import numpy as np
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import inside, on
-from hsgplan.domain.world import Kind
+from hsgplan.domain.world import Kind, World
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, in_world
 from hsgplan.perception.vocabulary import TRAINING_WORLD, VIEWS
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -70,27 +70,30 @@ class ImageSample:
     visible: np.ndarray
 
 
-def draw_state(rng: random.Random, p_elsewhere: float = P_ELSEWHERE) -> SymbolicSceneGraph:
-    """A random arrangement of 2 to `MAX_OBJECTS` objects, some cans inside the shelves."""
-    objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng, TRAINING_WORLD)
-    state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=TRAINING_WORLD)
-    inside_count = dict.fromkeys(TRAINING_WORLD.interior_capacity, 0)
+def draw_state(
+    rng: random.Random, p_elsewhere: float = P_ELSEWHERE, world: World = TRAINING_WORLD
+) -> SymbolicSceneGraph:
+    """A random arrangement of 2 to `MAX_OBJECTS` objects of `world`, some cans inside the
+    shelves."""
+    objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng, world)
+    state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=world)
+    inside_count = dict.fromkeys(world.interior_capacity, 0)
     literals = []
     for o in state.objects:
         where = state.location(o)
-        shelf = rng.choice(sorted(TRAINING_WORLD.interior_capacity))
+        shelf = rng.choice(sorted(world.interior_capacity))
         if (
-            TRAINING_WORLD.object_type(o).kind is Kind.CAN
+            world.object_type(o).kind is Kind.CAN
             and where == on(o, "open_space")
             and not state.resting_on(o)
-            and inside_count[shelf] < TRAINING_WORLD.interior_capacity[shelf]
+            and inside_count[shelf] < world.interior_capacity[shelf]
             and rng.random() < P_INSIDE
         ):
             inside_count[shelf] += 1
             literals.append(inside(o, shelf))
         else:
             literals.append(where)
-    return SymbolicSceneGraph.from_literals(objects, literals, world=TRAINING_WORLD)
+    return SymbolicSceneGraph.from_literals(objects, literals, world=world)
 
 
 def first_views(count: int) -> tuple[Camera, ...]:
@@ -101,13 +104,17 @@ def first_views(count: int) -> tuple[Camera, ...]:
 
 
 def render_sample(
-    seed: int, index: int, p_elsewhere: float = P_ELSEWHERE, views: int = len(VIEWS)
+    seed: int,
+    index: int,
+    p_elsewhere: float = P_ELSEWHERE,
+    views: int = len(VIEWS),
+    world: World = TRAINING_WORLD,
 ) -> ImageSample | None:
-    """The sample `(seed, index)` from the first `views` fixed views; None when its arrangement
-    could not be staged."""
+    """The sample `(seed, index)` staged in a scene of `world` (f_p's training world unless
+    told), from the first `views` fixed views; None when its arrangement could not be staged."""
     rng = random.Random(f"images-{seed}-{index}")
-    state = draw_state(rng, p_elsewhere)
-    with Scene(state.objects, seed=rng.getrandbits(32), world=TRAINING_WORLD) as scene:
+    state = draw_state(rng, p_elsewhere, world)
+    with Scene(state.objects, seed=rng.getrandbits(32), world=world) as scene:
         if not stage(scene, state, rng):
             return None
         _randomise_fixtures(scene, rng)
@@ -131,7 +138,7 @@ def render_sample(
             pinhole = PinholeCamera.of(camera)
             points = zip(objects, poses, strict=True)
             keypoints.append(
-                [pinhole.project(in_world(TRAINING_WORLD.object_type(o), p)) for o, p in points]
+                [pinhole.project(in_world(world.object_type(o), p)) for o, p in points]
             )
             visible.append([int((seg == scene.bodies[o]).sum()) for o in objects])
     return ImageSample(

@@ -65,7 +65,7 @@ def test_perfect_maps_give_the_scene_back_duplicates_and_all():
     sample = render_sample(0, 1)  # twelve objects, five alphabet soups among them
     assert sample is not None and len(sample.objects) == 12
     detections = PoseEstimator(_TrueMaps(sample)).detect(sample.images, sample.cameras, KITCHEN)
-    result = score_scene(sample, detections)
+    result = score_scene(sample, detections, KITCHEN)
     seen = (sample.visible >= MIN_VISIBLE).any(axis=0)
     assert result.found >= seen.sum() - 1
     assert np.median(result.translation_cm) < 0.5 and np.median(result.rotation_deg) < 3
@@ -79,11 +79,14 @@ def test_perfect_maps_give_the_scene_back_duplicates_and_all():
 def test_rotation_error_counts_a_cuboid_symmetry_as_no_error():
     upright = Pose.from_xyz_yaw(0.5, 0.0, 0.02, 0.3)
     turned = Pose.from_xyz_yaw(0.5, 0.0, 0.02, 0.3 + math.pi)
-    assert rotation_error("butter", upright, turned) < 1e-4  # half a turn: the same cuboid
+    assert rotation_error("butter", upright, turned, KITCHEN) < 1e-4  # half a turn: the same cuboid
     assert (
-        abs(rotation_error("butter", upright, Pose.from_xyz_yaw(0.5, 0, 0.02, 0.5)) - 11.46) < 0.1
+        abs(
+            rotation_error("butter", upright, Pose.from_xyz_yaw(0.5, 0, 0.02, 0.5), KITCHEN) - 11.46
+        )
+        < 0.1
     )
-    assert rotation_error("cherries", upright, Pose.from_xyz_yaw(0.5, 0, 0.02, 2.0)) < 1e-4
+    assert rotation_error("cherries", upright, Pose.from_xyz_yaw(0.5, 0, 0.02, 2.0), KITCHEN) < 1e-4
 
 
 def test_a_box_whose_rays_meet_a_centimetre_over_the_table_is_named_a_thin_one():
@@ -163,6 +166,39 @@ def test_the_evaluation_sees_from_the_first_views_asked_for():
         results = evaluate(estimator, 2, 1, views=views)
         assert estimator.views == [views] * len(results) and results
         assert all(r.found == 0 and not r.symbolic_match for r in results)
+
+
+def test_the_evaluation_stages_scene_k_in_the_kth_world_and_f_p_is_given_that_world():
+    from hsgplan.domain.layouts import random_layout
+    from hsgplan.evaluation.perception_eval import evaluate
+
+    layouts = (random_layout(KITCHEN, 3, 0), random_layout(KITCHEN, 3, 1))
+
+    class Told:
+        def __init__(self):
+            self.worlds = []
+
+        def detect(self, images, cameras, world):
+            self.worlds.append(world)
+            return []
+
+    told = Told()
+    results = evaluate(told, 4, 1, views=1, worlds=layouts)
+    assert len(results) == 4 and told.worlds == [layouts[0], layouts[1]] * 2
+
+
+def test_a_scene_of_objects_f_p_never_saw_is_refused_in_one_line(tmp_path):
+    from typer.testing import CliRunner
+
+    from hsgplan.cli import app
+    from hsgplan.domain.layouts import random_layout
+    from hsgplan.domain.scene_file import scene_data, to_toml
+
+    scene = tmp_path / "new.toml"
+    scene.write_text(to_toml(scene_data(random_layout(KITCHEN, 3, 0, new_objects=True))))
+    r = CliRunner().invoke(app, ["eval", "perception", "--scenes", "1", "--scene", str(scene)])
+    assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
+    assert "f_p cannot see scene" in r.output and "has not learned the look of" in r.output
 
 
 @pytest.mark.slow

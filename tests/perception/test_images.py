@@ -31,6 +31,19 @@ def test_a_sample_is_its_seed_and_index_alone_and_its_keypoints_are_its_poses_pr
     assert (a.visible.max(axis=0) > 0).mean() >= 0.5  # most objects are in sight somewhere
 
 
+def test_a_sample_staged_in_another_layout_is_labelled_with_that_layouts_sizes():
+    from hsgplan.domain.layouts import random_layout
+
+    layout = random_layout(KITCHEN, 3, 0)
+    sample = next(s for i in range(5) if (s := render_sample(2, i, views=1, world=layout)))
+    assert any(layout.object_type(n).size != KITCHEN.object_type(n).size for n in sample.objects)
+    pinhole = PinholeCamera.of(sample.cameras[0])
+    for j, name in enumerate(sample.objects):
+        pose = Pose(tuple(map(float, sample.poses[j, :3])), tuple(map(float, sample.poses[j, 3:])))
+        seen = pinhole.project(in_world(layout.object_type(name), pose))
+        assert np.allclose(sample.keypoints[0, j], seen, atol=0.01)
+
+
 def test_a_collection_resumes_without_rendering_again_and_refuses_a_damaged_chunk(tmp_path):
     config = ImagesConfig(samples=3, seed=0, chunk=2)
     rows = collect_images(config, tmp_path, workers=1)

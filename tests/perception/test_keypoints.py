@@ -46,7 +46,7 @@ def test_pnp_gives_back_the_pose_that_was_projected(obj):
             found = estimate_pose(KITCHEN.object_type(obj), used)
             assert found is not None
             assert np.linalg.norm(np.subtract(found.pose.position, pose.position)) < 1e-4
-            assert rotation_error(obj, pose, found.pose) < 0.05  # up to the look-alikes
+            assert rotation_error(obj, pose, found.pose, KITCHEN) < 0.05  # up to the look-alikes
             assert found.reprojection_px < 1e-3
 
 
