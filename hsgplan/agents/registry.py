@@ -235,9 +235,9 @@ def _reads_names(folder: Path) -> bool:
 def check_reads(folders: list[Path], world: World, scene: str | Path | None) -> None:
     """Refuse, in one line, checkpoints whose networks know the kitchen's names in a scene
     that names others (networks of the "geometry" features read any scene)."""
-    from hsgplan.domain.kitchen import KITCHEN
+    from hsgplan.scene_graph.names import NAMES_WORLD
 
-    others = world.names_beyond(KITCHEN)
+    others = world.names_beyond(NAMES_WORLD)
     bound = [f for f in folders if _reads_names(f)] if others else []
     if bound:
         raise InvalidInputError(

@@ -32,11 +32,11 @@ import numpy as np
 
 from hsgplan.data.motion_trials import ChunkResult, Trial
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import BINS, MotionPrimitive
 from hsgplan.files import atomic, write_atomically
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
+from hsgplan.scene_graph.names import ENTITY_NAMES, NAMES_WORLD, TYPE_NAMES
 from hsgplan.sim.outcome import Status
 
 # 2: a place that leaves an object unpickable is labelled `blocks_pick`; 3: a push task may
@@ -44,7 +44,7 @@ from hsgplan.sim.outcome import Status
 SCHEMA_VERSION = 3
 CHUNK_FORMAT = 2  # 2: a chunk carries its index and seed, checked on load
 STATUSES: tuple[Status, ...] = tuple(Status)
-TYPES: tuple[str, ...] = tuple(KITCHEN.object_types)
+TYPES: tuple[str, ...] = TYPE_NAMES
 SCHEMA = "schema.json"
 FIELDS = ("task", "attempt", "status", "crowding", "obj", "target", "bins", "poses")
 
@@ -77,7 +77,7 @@ class MotionData:
         return TYPES[int(self.obj[i])]
 
     def target_name(self, i: int) -> str:
-        return KITCHEN.entity_types[int(self.target[i])]
+        return ENTITY_NAMES[int(self.target[i])]
 
     def scene_graph(self, i: int) -> GeometricSceneGraph:
         """s_g of row i, as the primitive found it."""
@@ -87,7 +87,7 @@ class MotionData:
             if not np.isnan(p[0])
         }
         held = self.object_name(i) if self.primitive is MotionPrimitive.PLACE else None
-        return GeometricSceneGraph.from_poses(poses, held=held, world=KITCHEN)
+        return GeometricSceneGraph.from_poses(poses, held=held, world=NAMES_WORLD)
 
 
 def from_trials(primitive: MotionPrimitive, trials: list[Trial]) -> MotionData:
@@ -103,7 +103,7 @@ def from_trials(primitive: MotionPrimitive, trials: list[Trial]) -> MotionData:
         np.array([STATUSES.index(t.status) for t in trials], dtype=np.int8),
         np.array([t.crowding for t in trials], dtype=np.int8),
         np.array([TYPES.index(t.obj) for t in trials], dtype=np.int8),
-        np.array([KITCHEN.entity_types.index(t.target) for t in trials], dtype=np.int8),
+        np.array([ENTITY_NAMES.index(t.target) for t in trials], dtype=np.int8),
         np.array([t.bins for t in trials], dtype=np.int8).reshape(s, 2),
         poses,
     )
@@ -157,7 +157,7 @@ def row_problem(data: MotionData) -> str | None:
         "crowding": (data.crowding, None),
         "status": (data.status, len(STATUSES)),
         "obj": (data.obj, len(TYPES)),
-        "target": (data.target, len(KITCHEN.entity_types)),
+        "target": (data.target, len(ENTITY_NAMES)),
         "x or angle bin": (data.bins[:, 0], nx),
         "y or distance bin": (data.bins[:, 1], ny),
     }
@@ -235,7 +235,7 @@ def write_schema(folder: Path) -> None:
         "version": SCHEMA_VERSION,
         "statuses": [s.value for s in STATUSES],
         "object_types": list(TYPES),
-        "entity_types": list(KITCHEN.entity_types),
+        "entity_types": list(ENTITY_NAMES),
         "fields": FIELDS,
         "description": "Schema" + doc,
     }

@@ -22,10 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgplan.data.motion_tasks import MotionTask, draw_task
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import BINS, MotionPrimitive, params_for
 from hsgplan.domain.predicates import Predicate
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.names import NAMES_WORLD
 from hsgplan.sim.motion_plans import can_pick
 from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
@@ -83,9 +83,10 @@ def run_chunk(
     kind = MotionPrimitive(primitive)
     trials: list[Trial] = []
     unstaged = 0
-    with Scene((), seed=seed, visuals=False, world=KITCHEN) as scene:
+    # staged in the world whose names the data's columns index (`data.motion_store`)
+    with Scene((), seed=seed, visuals=False, world=NAMES_WORLD) as scene:
         for index in range(chunk * tasks_per_chunk, (chunk + 1) * tasks_per_chunk):
-            got = run_task(scene, draw_task(kind, seed, index, KITCHEN))
+            got = run_task(scene, draw_task(kind, seed, index, NAMES_WORLD))
             unstaged += got is None
             trials += got or []
     return ChunkResult(kind, seed, chunk, tuple(trials), unstaged)

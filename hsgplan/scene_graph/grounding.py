@@ -40,25 +40,25 @@ import torch
 from torch_geometric.data import Data
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PUSH_LEAD, place_xy, push_values
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.scene import Kind, World, check_features
 from hsgplan.domain.world import PLACE_BINS, PUSH_ANGLE_BINS, PUSH_DIST_BINS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.scene_graph.names import ENTITY_NAMES, NAMES_WORLD, TYPE_NAMES
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
-TYPES = tuple(KITCHEN.object_types)
+TYPES = TYPE_NAMES
 REGION_CLASSES: tuple[str, ...] = (
-    *KITCHEN.regions,
-    *(f"top:{s}" for s in KITCHEN.shelves),
-    *(f"in:{s}" for s in KITCHEN.shelves),
+    *NAMES_WORLD.regions,
+    *(f"top:{s}" for s in NAMES_WORLD.shelves),
+    *(f"in:{s}" for s in NAMES_WORLD.shelves),
     "held",
 )
 NODE_DIM = len(TYPES) + len(REGION_CLASSES) + 1 + 3 + 2 + 3 + 3
 EDGE_DIM = 4
-SUBGOAL_DIM = len(KITCHEN.entity_types) + len(TYPES)
+SUBGOAL_DIM = len(ENTITY_NAMES) + len(TYPES)
 KINDS = tuple(Kind)
 ROLES = ("region", "prepush", "top", "in", "held")
 TARGET_ROLES = ROLES[:4]
@@ -192,8 +192,8 @@ def _subgoal(world: World, obj: str, target: str, place: bool, features: str) ->
     moved = world.object_type(obj)
     if features == "names":
         u = [0.0] * SUBGOAL_DIM
-        u[KITCHEN.entity_types.index(target)] = 1.0
-        u[len(KITCHEN.entity_types) + TYPES.index(moved.name)] = 1.0
+        u[ENTITY_NAMES.index(target)] = 1.0
+        u[len(ENTITY_NAMES) + TYPES.index(moved.name)] = 1.0
         return u
     role = _role(world, target) if place else "in"
     rect = world.surface_rect(target) if place else world.shelves[target].interior

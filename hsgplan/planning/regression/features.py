@@ -17,9 +17,9 @@ from functools import cache
 
 import torch
 
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import PREDICATES, Predicate
 from hsgplan.domain.scene import EntityKind, Kind, World, check_features
+from hsgplan.scene_graph.names import ENTITY_NAMES, NAMES_WORLD
 
 KINDS = tuple(EntityKind)
 OBJECT_KINDS = tuple(Kind)
@@ -34,7 +34,7 @@ def node_dim(features: str) -> int:
     """Width of a node's features."""
     check_features(features)
     if features == "names":
-        return len(KITCHEN.entity_types) + len(KINDS)
+        return len(ENTITY_NAMES) + len(KINDS)
     return GEOMETRY_NODE_DIM
 
 
@@ -46,7 +46,7 @@ def edge_dim(features: str) -> int:
 
 def reads(features: str, world: World) -> bool:
     """Whether a network of these features can read a scene of this world."""
-    return features == "geometry" or not world.names_beyond(KITCHEN)
+    return features == "geometry" or not world.names_beyond(NAMES_WORLD)
 
 
 def _valid(world: World, pred: Predicate, src: str, dst: str) -> bool:
@@ -105,7 +105,7 @@ def node_features(nodes: tuple[str, ...], world: World, features: str) -> torch.
     check_features(features)
     if features == "geometry":
         return torch.tensor([_geometry(name, world) for name in nodes])
-    names = KITCHEN.entity_types
+    names = ENTITY_NAMES
     x = torch.zeros(len(nodes), node_dim(features))
     for i, name in enumerate(nodes):
         x[i, names.index(world.type_of(name))] = 1.0
