@@ -249,6 +249,8 @@ class PoseEstimator:
         for v, camera in enumerate(cameras):
             pinhole = PinholeCamera.of(camera)
             for inst in decode(beliefs[v].numpy(), fields[v].numpy(), self.net.stride):
+                if TYPES[inst.type_index] not in world.object_types:
+                    continue  # a type the scene holds none of
                 seen = ViewKeypoints(pinhole, inst.pixels)
                 single = estimate_pose(world.object_type(TYPES[inst.type_index]), [seen])
                 if single is not None:
@@ -331,9 +333,11 @@ def _cost_at(d: Detection, world: World, centre: np.ndarray) -> float:
 
 
 def _same_kind(world: World, type_name: str) -> torch.Tensor:
-    """Which types [types] (bool) are of `type_name`'s kind (can or box)."""
+    """Which types [types] (bool) are of `type_name`'s kind (can or box) and in `world` (a
+    scene of fewer types holds none of the others)."""
     kind = world.object_type(type_name).kind
-    return torch.tensor([world.object_type(t).kind is kind for t in TYPES])
+    present = world.object_types
+    return torch.tensor([t in present and present[t].kind is kind for t in TYPES])
 
 
 def _of_kind(
@@ -345,7 +349,10 @@ def _of_kind(
     same = _same_kind(world, type_name)
     if centre is not None:
         fits = same & torch.tensor(
-            [fits_height(world, world.object_type(t), centre) for t in TYPES]
+            [
+                bool(same[k]) and fits_height(world, world.object_type(t), centre)
+                for k, t in enumerate(TYPES)
+            ]
         )
         same = fits if bool(fits.any()) else same
     best = int(torch.where(same, probs, torch.full_like(probs, -1.0)).argmax())  # of the kind

@@ -3,6 +3,7 @@ the scene's true maps: what the estimator makes of perfect maps, and how the eva
 scores it. (The trained network's quality is measured by `hsgplan eval perception`.)"""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -96,6 +97,14 @@ def test_a_box_whose_rays_meet_a_centimetre_over_the_table_is_named_a_thin_one()
     best, confidence = _of_kind(KITCHEN, probs, "popcorn", low)
     assert TYPES[best] == "cream_cheese" and confidence == pytest.approx(0.3)
     assert TYPES[_of_kind(KITCHEN, probs, "popcorn", np.array([0.5, 0.0, 0.063]))[0]] == "popcorn"
+
+
+def test_a_scene_without_a_type_is_never_read_to_hold_one():
+    without = replace(KITCHEN, type_list=tuple(t for t in KITCHEN.type_list if t.name != "popcorn"))
+    probs = torch.tensor([0.0, 0.0, 0.0, 0.5, 0.3, 0.2])  # the colour says popcorn
+    assert TYPES[_of_kind(without, probs, "cream_cheese")[0]] == "cream_cheese"
+    over = np.array([0.5, 0.0, 0.063])  # where a popcorn's centre would be, over the table
+    assert TYPES[_of_kind(without, probs, "butter", over)[0]] == "cream_cheese"
 
 
 def test_of_a_soup_and_a_box_found_in_one_place_the_colour_keeps_the_soup():
