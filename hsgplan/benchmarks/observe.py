@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from hsgplan.domain.world import World
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.observer import tracked
 from hsgplan.perception.synthetic import VIEWS, render_sample
@@ -54,17 +55,17 @@ def bench_observe(
     seed: int,
     views: int = len(VIEWS),
     on_scene: Callable[[], None] | None = None,
+    world: World = TRAINING_WORLD,
 ) -> list[ObserveTiming]:
-    """Time f_p on the scenes `(seed, 0 .. scenes - 1)` that could be staged; a row per group
-    of sizes that holds any, then one over all of them."""
+    """Time f_p on the scenes `(seed, 0 .. scenes - 1)` that could be staged (in `world`); a
+    row per group of sizes that holds any, then one over all of them."""
     torch.set_num_threads(1)
     estimator = PoseEstimator.load(checkpoint)
-    world = TRAINING_WORLD  # the staged scenes' (`render_sample`)
     rest = partial(estimator.rest, world) if estimator.settled else None
     times: list[tuple[int, float, float, float]] = []
     for index in range(scenes):
         start = time.perf_counter()
-        sample = render_sample(seed, index, views=views)
+        sample = render_sample(seed, index, views=views, world=world)
         rendered = time.perf_counter() - start
         if sample is not None:
             known = {

@@ -13,6 +13,7 @@ from dataclasses import asdict, dataclass
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import World
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
 from hsgplan.symbolic.generator import random_goals, random_state
 
@@ -39,8 +40,9 @@ def bench_symbolic(
     optimal_max_size: int = 8,
     timeout_s: float = 30.0,
     on_problem: Callable[[], None] | None = None,
+    world: World = KITCHEN,
 ) -> list[SizeTiming]:
-    """Time both Fast Downward configurations on `goals` problems per size.
+    """Time both Fast Downward configurations on `goals` problems per size, in `world`.
 
     The optimal configuration runs only up to `optimal_max_size` objects: past that, A* with
     LM-cut runs into its time-out on most problems and the median says nothing.
@@ -55,8 +57,8 @@ def bench_symbolic(
     for n in sizes:
         rng = random.Random(f"bench-symbolic-{n}-{seed}")
         problems = [
-            (random_state(g.objects, rng, world=KITCHEN), g)
-            for g in random_goals(n, goals, seed, world=KITCHEN)
+            (random_state(g.objects, rng, world=world), g)
+            for g in random_goals(n, goals, seed, world=world)
         ]
         for planner in planners:
             if planner.optimal and n > optimal_max_size:

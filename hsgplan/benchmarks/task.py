@@ -19,6 +19,7 @@ from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.world import World
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.symbolic.generator import random_goals, random_state
 
@@ -56,8 +57,9 @@ def bench_task(
     goals: int,
     seed: int,
     on_episode: Callable[[], None] | None = None,
+    world: World = KITCHEN,
 ) -> list[TaskTiming]:
-    """Time the three planners on `goals` problems per size."""
+    """Time the three planners on `goals` problems per size, in `world`."""
     import torch
 
     from hsgplan.planning.fast_downward import FastDownwardTaskPlanner, NoPlanError
@@ -70,7 +72,7 @@ def bench_task(
     closed_loop = FastDownwardTaskPlanner(follow_plan=False)
     rows = []
     for n in sizes:
-        problems = random_goals(n, goals, seed, stacking=n > 2, world=KITCHEN)
+        problems = random_goals(n, goals, seed, stacking=n > 2, world=world)
         times: dict[str, list[list[float]]] = {"regression": [], "fd (closed loop)": []}
         solved = {"regression": 0, "fd (closed loop)": 0, "fd (one plan)": 0}
         plans = []
@@ -80,7 +82,7 @@ def bench_task(
                 episode = run_task_episode(planner, goal, episode_seed, 0)
                 times[name].append(list(episode.decision_ms))
                 solved[name] += episode.success
-            state = random_state(goal.objects, random.Random(f"task-{episode_seed}"), world=KITCHEN)
+            state = random_state(goal.objects, random.Random(f"task-{episode_seed}"), world=world)
             try:
                 plans.append([1000 * closed_loop.planner.plan(state, goal).seconds])
                 solved["fd (one plan)"] += 1

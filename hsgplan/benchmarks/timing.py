@@ -102,15 +102,22 @@ TIMING_KIND = "bench-timing"
 
 
 def check_timing_folder(
-    sizes: Sequence[int], goals: int, seed: int, out: Path, search: str = DEFAULT_SEARCH
+    sizes: Sequence[int],
+    goals: int,
+    seed: int,
+    out: Path,
+    search: str = DEFAULT_SEARCH,
+    scene: str | None = None,
 ) -> tuple[dict, str]:
     """Every refusal of the run folders before anything is written; what the top folder is
     claimed with and its refusal."""
     agents = timing_agents(search)
-    config = EvalConfig("", tuple(sizes), goals, seed)
+    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene)
     table = {"sizes": list(config.sizes), "goals": goals, "seed": seed}
     if search != "search":  # folders made before there was a choice timed `search`, unnamed
         table["search"] = search
+    if scene is not None:  # folders of the kitchen keep the claim they had before scenes
+        table["scene"] = scene
     refusal = (
         f"'{out}' holds a timing run with other sizes, goals, seed or search baseline; "
         "use another --out"
@@ -129,6 +136,7 @@ def run_timing(
     on_episode: Callable[[EpisodeRecord], None] | None = None,
     search: str = DEFAULT_SEARCH,
     ray: str | None = None,
+    scene: str | None = None,
 ) -> dict:
     """Both agents' episodes into `out/AGENT/` (on Ray at `ray`, one core an episode as on
     the local pool); the summary, also written as `summary.json`, `table2.md` and
@@ -138,8 +146,8 @@ def run_timing(
     "search": "search", ...}`: the baseline's entries are under its name (`search` or
     `stream`), which `"search"` names.
     """
-    config = EvalConfig("", tuple(sizes), goals, seed)
-    table, refusal = check_timing_folder(sizes, goals, seed, out, search)
+    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene)
+    table, refusal = check_timing_folder(sizes, goals, seed, out, search, scene)
     claim(out, TIMING_KIND, table, refusal)
     records = {
         key: run_evaluation(replace(config, agent=agent), out / key, workers, on_episode, ray)
@@ -155,15 +163,16 @@ def run_timing(
         "seed": seed,
         "workers": workers,
         "run": str(out),
-    }
+    } | ({} if scene is None else {"scene": scene})
     write_atomically(out / "summary.json", json.dumps(report, indent=2) + "\n")
     write_atomically(out / "table2.md", "\n\n".join(t.markdown() for t in tables(report)) + "\n")
     plot_times_by_size(_series(report), out / "table2.png")
     return report
 
 
-def total_episodes(sizes: Sequence[int], goals: int, seed: int) -> int:
-    return len(timing_agents()) * len(episode_specs(EvalConfig("", tuple(sizes), goals, seed)))
+def total_episodes(sizes: Sequence[int], goals: int, seed: int, scene: str | None = None) -> int:
+    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene)
+    return len(timing_agents()) * len(episode_specs(config))
 
 
 def _series(report: dict) -> dict[str, dict[str, dict[int, float]]]:
@@ -216,7 +225,8 @@ def tables(report: dict) -> list[TextTable]:
     )
     title = (
         f"Seconds per episode, {report['goals']} goals per size, seed {report['seed']}, "
-        f"{report['workers']} worker(s): the search baseline ({LABELS[name]}) against ours, "
+        + (f"in {report['scene']}, " if "scene" in report else "")
+        + f"{report['workers']} worker(s): the search baseline ({LABELS[name]}) against ours, "
         "beside the paper's Table 2; task medians (quartiles), their ratio, motion medians"
     )
     return [TextTable(title, header, tuple(rows))]

@@ -15,6 +15,8 @@ from hsgplan.cli.common import (
     PerceptionCheckpoint,
     RayAddress,
     RunFolder,
+    SceneFiles,
+    SceneOption,
     Summaries,
     bounded_option,
     check_ray,
@@ -25,6 +27,7 @@ from hsgplan.cli.common import (
     parse_sizes,
     print_table,
     refuses_bad_input,
+    scene_world,
     shown,
 )
 from hsgplan.domain.errors import InvalidInputError
@@ -38,6 +41,10 @@ app = typer.Typer(
 )
 SearchName = choice("SearchName", SEARCH_BASELINES)
 DEFAULT_SEARCH_NAME = SearchName(DEFAULT_SEARCH)
+
+
+def _in(scene: Path | None) -> str:
+    return "" if scene is None else f", in {scene}"
 
 
 @app.command("sim")
@@ -81,21 +88,28 @@ def bench_symbolic(
     ] = 8,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
     markdown: MarkdownFlag = False,
+    scene: SceneOption = None,
 ) -> None:
     """Fast Downward plan time per size: median over the goals, both search configurations."""
     from hsgplan.benchmarks.symbolic import bench_symbolic as run
 
     size_list = parse_sizes(sizes)
+    world = scene_world(scene)
     total = sum(goals * (2 if n <= optimal_max_size else 1) for n in size_list)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("planning", total=total)
         rows = run(
-            size_list, goals, seed, optimal_max_size, on_problem=lambda: progress.advance(task)
+            size_list,
+            goals,
+            seed,
+            optimal_max_size,
+            on_problem=lambda: progress.advance(task),
+            world=world,
         )
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
-    title = f"Fast Downward plan time, median over {goals} goals per size (seed {seed})"
+    title = f"Fast Downward plan time, median over {goals} goals per size (seed {seed}{_in(scene)})"
     header = ("objects", "planner", "solved", "median s", "median plan length")
     cells = [
         (
@@ -121,16 +135,20 @@ def bench_task(
     ] = TASK_CHECKPOINT,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
     markdown: MarkdownFlag = False,
+    scene: SceneOption = None,
 ) -> None:
     """Task-planning time: the learned regression planner against Fast Downward, one core."""
+    from hsgplan.agents.registry import check_reads
     from hsgplan.benchmarks.task import bench_task as run
     from hsgplan.planning.regression.gnn import load_network
 
     size_list = parse_sizes(sizes)
+    world = scene_world(scene)
     load_network(checkpoint / "preimage")  # a missing checkpoint fails before any work
+    check_reads([checkpoint], world, scene)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("episodes", total=goals * len(size_list))
-        rows = run(checkpoint, size_list, goals, seed, lambda: progress.advance(task))
+        rows = run(checkpoint, size_list, goals, seed, lambda: progress.advance(task), world)
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
@@ -149,7 +167,8 @@ def bench_task(
         for r in rows
     ]
     print_table(
-        f"Task-planning time, median over {goals} goals per size, one core (seed {seed})",
+        f"Task-planning time, median over {goals} goals per size, one core (seed {seed}"
+        f"{_in(scene)})",
         ("objects", "planner", "solved", "ms per decision", "ms per episode"),
         cells,
         markdown,
@@ -182,6 +201,7 @@ def bench_timing(
         bool, typer.Option("--json", help="Print one JSON object.", metavar="")
     ] = False,
     markdown: MarkdownFlag = False,
+    scene: SceneFiles = None,
 ) -> None:
     """The paper's Table 2: task-planning and motion seconds per episode, ours (regression +
     GNN) against a search-based baseline, on the same goals; writes table2.md, table2.png
@@ -202,12 +222,13 @@ def bench_timing(
     which = "" if baseline == "search" else f"-{baseline}"
     folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}{which}"
     # cheap refusals before the agents load
-    check_timing_folder(size_list, goals, seed, folder, baseline)
+    where = None if scene is None else str(scene)
+    check_timing_folder(size_list, goals, seed, folder, baseline, where)
     check_ray(ray)
     for agent in agents.values():  # a missing checkpoint is refused before any work
         make_agent(agent)
     with Progress(console=err, transient=True) as progress:
-        total = total_episodes(size_list, goals, seed)
+        total = total_episodes(size_list, goals, seed, where)
         task = progress.add_task(f"ours, {baseline}", total=total)
         report = run_timing(
             size_list,
@@ -218,6 +239,7 @@ def bench_timing(
             lambda r: progress.advance(task),
             baseline,
             ray,
+            where,
         )
     if as_json:
         print(json.dumps(report, indent=2))
@@ -277,12 +299,17 @@ def bench_observe(
     perception_checkpoint: PerceptionCheckpoint = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.", metavar="")] = False,
     markdown: MarkdownFlag = False,
+    scene: SceneOption = None,
 ) -> None:
     """Seconds per observation through f_p (rendering timed apart and excluded): the keypoint
     network, PnP, fusion, naming and resting, and the tracker; medians over the scenes."""
     from hsgplan.benchmarks.observe import bench_observe as run
+    from hsgplan.evaluation.config import unseeable
     from hsgplan.evaluation.observers import perception_folder
 
+    world = scene_world(scene)
+    if why := unseeable([world], scene):
+        raise InvalidInputError(why)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         rows = run(
@@ -290,12 +317,14 @@ def bench_observe(
             scenes,
             seed,
             on_scene=lambda: progress.advance(task),
+            world=world,
         )
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
     print_table(
-        f"One observation through f_p, one core: seconds per scene, {scenes} scenes, seed {seed}",
+        f"One observation through f_p, one core: seconds per scene, {scenes} scenes, seed {seed}"
+        f"{_in(scene)}",
         ("objects", "scenes", "stage + render (excluded)", "f_p", "tracker", "observation", "p90"),
         [
             (

@@ -250,6 +250,16 @@ SceneFiles = Annotated[
         parser=input_path,
     ),
 ]
+
+
+def scene_world(scene: Path | None):
+    """The world of a `--scene` file (the kitchen without one), refused in one line if bad."""
+    from hsgplan.domain.kitchen import KITCHEN
+    from hsgplan.domain.scene_file import read_world
+
+    return read_world(scene) if scene else KITCHEN
+
+
 SceneOption = Annotated[
     Path | None,
     typer.Option(

@@ -9,7 +9,15 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli.common import SceneOption, bounded_option, err, out, refuses_bad_input, shown
+from hsgplan.cli.common import (
+    SceneOption,
+    bounded_option,
+    err,
+    out,
+    refuses_bad_input,
+    scene_world,
+    shown,
+)
 from hsgplan.cli.common import out_file as file_to_write
 from hsgplan.domain.errors import InvalidInputError
 
@@ -24,18 +32,11 @@ class Search(StrEnum):
         return {"auto": None, "optimal": True, "fast": False}[self.value]
 
 
-def _world(scene: Path | None):
-    from hsgplan.domain.kitchen import KITCHEN
-    from hsgplan.domain.scene_file import read_world
-
-    return read_world(scene) if scene else KITCHEN
-
-
 def _scene(goal_text: str, names_text: str | None, init: str | None, scene: Path | None = None):
     from hsgplan.domain.goals import parse_goal
     from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
-    world = _world(scene)
+    world = scene_world(scene)
     goal = parse_goal(goal_text, world=world)
     names = list(goal.objects)
     if names_text is not None:
@@ -136,7 +137,7 @@ def goals(
     from hsgplan.symbolic.generator import check_size, random_goals
 
     check_size(objects)
-    drawn = random_goals(objects, goals, seed, stacking=stacking, world=_world(scene))
+    drawn = random_goals(objects, goals, seed, stacking=stacking, world=scene_world(scene))
     header = f"hsgplan goals --objects {objects} --goals {goals} --seed {seed}" + (
         "" if stacking else " --no-stacking"
     )

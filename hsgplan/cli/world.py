@@ -33,6 +33,7 @@ from hsgplan.cli.common import (
     parse_sizes,
     print_table,
     refuses_bad_input,
+    scene_world,
     shown,
 )
 from hsgplan.domain.errors import InvalidInputError
@@ -112,8 +113,6 @@ def demo(
     drawing per step, a record; with --rerun, a 3D recording for rerun's viewer."""
     from hsgplan.agents.registry import make_agent
     from hsgplan.domain.goals import parse_goal
-    from hsgplan.domain.kitchen import KITCHEN
-    from hsgplan.domain.scene_file import read_world
     from hsgplan.evaluation.config import check_seen
     from hsgplan.evaluation.demo import demo_goal, run_demo
     from hsgplan.evaluation.observers import make_observer
@@ -121,7 +120,7 @@ def demo(
     from hsgplan.symbolic.generator import check_size
 
     agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
-    world = read_world(scene) if scene else KITCHEN
+    world = scene_world(scene)
     folders = (
         shipped(checkpoint) if checkpoint else TASK_CHECKPOINT,
         shipped(motion_checkpoints) if motion_checkpoints else MOTION_CHECKPOINTS,

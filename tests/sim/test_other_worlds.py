@@ -167,3 +167,19 @@ def test_an_evaluation_over_a_folder_runs_each_scene_on_the_same_goal_seeds(tmp_
     assert run_config(config)["fingerprint"] != before  # another scene: another run
     kitchen = run_config(EvalConfig("regression+gnn", (2,), 1, 0))
     assert "scene" not in kitchen  # as runs in the kitchen were always claimed
+
+
+def test_the_benchmarks_run_in_a_scene_file_and_refuse_one_their_models_cannot_read(tmp_path):
+    layout, new = tmp_path / "layout.toml", tmp_path / "new.toml"
+    layout.write_text(to_toml(scene_data(LAYOUT)))
+    new.write_text(to_toml(scene_data(NEW)))
+    args = ["bench", "symbolic", "--sizes", "2", "--goals", "1", "--markdown"]
+    r = runner.invoke(app, [*args, "--scene", str(layout)])
+    assert r.exit_code == 0 and f"in {layout})" in r.output, r.output
+    for args, why in (
+        (["bench", "task", "--sizes", "2", "--goals", "1"], "know the kitchen's objects"),
+        (["bench", "observe", "--scenes", "1"], "f_p cannot see scene"),
+    ):
+        r = runner.invoke(app, [*args, "--scene", str(new)])
+        assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
+        assert why in r.output, r.output
