@@ -189,3 +189,21 @@ def test_an_object_found_twice_a_few_centimetres_apart_is_no_carrier_of_itself()
     _, rests = settle(KITCHEN, ["butter", "butter"], [near, above], [((), ())] * 2)
     assert not one_level(KITCHEN.object_type("butter"), near, KITCHEN.object_type("butter"), above)
     assert rests.position[2] == pytest.approx(one_up)
+
+
+def test_estimates_rest_on_the_shelves_and_by_the_sizes_of_the_world_they_are_seen_in():
+    from hsgplan.domain.layouts import random_layout
+
+    layout = random_layout(KITCHEN, 3, 0)
+    shelf = layout.shelves["shelf_a"]
+    assert shelf.top.z != KITCHEN.shelves["shelf_a"].top.z  # another height than the kitchen's
+    x, y = (shelf.top.x_min + shelf.top.x_max) / 2, (shelf.top.y_min + shelf.top.y_max) / 2
+    soup = layout.object_type("tomato_soup").size[2] / 2
+    butter = layout.object_type("butter").size[2]
+    found = [
+        Pose.from_xyz_yaw(x, y, shelf.top.z + soup + 0.012, 0.0),  # a centimetre afloat
+        Pose.from_xyz_yaw(x, y, shelf.top.z + 2 * soup + butter / 2 - 0.006, 0.0),  # sunk in it
+    ]
+    can, box = settle(layout, ["tomato_soup", "butter"], found)
+    assert can.position[2] == pytest.approx(shelf.top.z + soup)
+    assert box.position[2] == pytest.approx(shelf.top.z + 2 * soup + butter / 2)
