@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     CollectWorkers,
     RayAddress,
+    SceneOption,
     Summaries,
     bounded_option,
     check_ray,
@@ -163,13 +164,15 @@ def images(
             min=1,
         ),
     ] = None,
+    scene: SceneOption = None,
 ) -> None:
     """Synthetic training images for f_p: random scenes from the fixed cameras, domain
     randomised, with every object's pose and cuboid keypoints (format: perception/images.py)."""
     from hsgplan.collect.images import collect_images
 
     check_ray(ray)
-    config = ImagesConfig(samples, seed, p_elsewhere=p_elsewhere)
+    where = None if scene is None else str(scene)
+    config = ImagesConfig(samples, seed, p_elsewhere=p_elsewhere, scene=where)
     if views is not None:
         config = replace(config, views=views)
     with Progress(console=err, transient=True) as progress:

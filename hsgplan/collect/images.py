@@ -7,8 +7,12 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from hsgplan.domain.checks import BOUNDS, MAX_SAMPLES, bounded, check_fields, setting
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.world import World
 from hsgplan.perception.images import CHUNK, FORMAT, render_chunk, write_format
 from hsgplan.perception.synthetic import P_ELSEWHERE, VIEWS, first_views
+from hsgplan.perception.vocabulary import TRAINING_WORLD, unseen_looks
 from hsgplan.runner.items import run_items
 
 KIND = "collect-images"
@@ -22,10 +26,19 @@ class ImagesConfig:
     chunk: int = setting(CHUNK, lo=1, hi=MAX_SAMPLES)
     p_elsewhere: float = setting(P_ELSEWHERE, lo=0.0, hi=1.0)  # see `synthetic.P_ELSEWHERE`
     views: int = len(VIEWS)  # the first this many fixed views (3: shoulders and front)
+    # a scene file whose world the scenes are staged in (None: f_p's training world, the
+    # kitchen); its groceries must be ones f_p has types for (`vocabulary.unseen_looks`)
+    scene: str | None = None
 
     def __post_init__(self) -> None:
         check_fields(self)
         first_views(self.views)
+        if self.scene is not None and (why := unseen_looks(self.world())):
+            raise InvalidInputError(f"--scene {self.scene}: {why}")
+
+    def world(self) -> World:
+        """The world the scenes are staged in."""
+        return TRAINING_WORLD if self.scene is None else read_world(self.scene)
 
     @property
     def chunks(self) -> int:
@@ -43,7 +56,9 @@ def collect_images(
     # The views are recorded as cameras (a collection from before the count was a setting
     # holds the first three), not as the count; the samples wanted under the key collections
     # have always recorded them by ("count"), so that every collection resumes.
-    settings = {k: v for k, v in asdict(config).items() if k not in ("views", "samples")} | {
+    # a collection of the training world records no scene, as before scenes could be given
+    dropped = ("views", "samples") + (("scene",) if config.scene is None else ())
+    settings = {k: v for k, v in asdict(config).items() if k not in dropped} | {
         "count": config.samples,
         "format": FORMAT,
         "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in first_views(config.views)],
@@ -66,4 +81,5 @@ def collect_images(
 
 def _render(item: tuple[str, int, ImagesConfig]) -> dict:
     run_dir, chunk, c = item
-    return render_chunk(run_dir, c.seed, chunk, c.chunk, c.samples, c.p_elsewhere, c.views)
+    world = c.world()
+    return render_chunk(run_dir, c.seed, chunk, c.chunk, c.samples, c.p_elsewhere, c.views, world)

@@ -15,6 +15,11 @@ keypoints, M = `MAX_OBJECTS`):
 | keypoints | float32 | [n, V, M, K, 2]    | pixel (u right, v down; OpenCV's centres); NaN pad   |
 | visible   | int32   | [n, V, M]          | the object's pixels in sight in that view            |
 | cameras   | float32 | [n, V, 7]          | eye xyz, target xyz, vertical field of view (deg)    |
+| sizes     | float32 | [n, M, 3]          | the object's size in its scene (m); NaN padding      |
+
+`sizes` is written by collections staged in a scene file's world (`collect images --scene`); a
+chunk without it holds the training world's sizes (`load_chunks` gives it NaN sizes: its types'
+own).
 
 The run folder's `episodes.jsonl` logs every finished chunk with its file's SHA-256; a run
 started again runs only the chunks not logged, and `load_chunks` refuses a file that is not
@@ -30,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.world import World
 from hsgplan.files import atomic, write_atomically
 from hsgplan.perception.keypoints import KEYPOINTS
 from hsgplan.perception.synthetic import (
@@ -58,23 +64,29 @@ def render_chunk(
     count: int,
     p_elsewhere: float = P_ELSEWHERE,
     views: int = len(VIEWS),
+    world: World = TRAINING_WORLD,
 ) -> dict:
-    """Render a chunk's samples (of the first `count`) into its file, written whole or not at
-    all; the worker's entry point. Returns what the run log keeps of it."""
+    """Render a chunk's samples (of the first `count`, staged in scenes of `world`) into its
+    file, written whole or not at all; the worker's entry point. Returns what the run log keeps
+    of it."""
     indices = range(chunk * size, min((chunk + 1) * size, count))
-    samples = [render_sample(seed, i, p_elsewhere, views) for i in indices]
+    samples = [render_sample(seed, i, p_elsewhere, views, world) for i in indices]
     kept = [s for s in samples if s is not None]
     path = chunk_path(Path(run_dir), chunk)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic(path) as tmp:
-        np.savez_compressed(tmp, **pack(kept, views))
+        sized = world is not TRAINING_WORLD  # the training world's chunks stay as they were
+        np.savez_compressed(tmp, **pack(kept, views, world if sized else None))
         digest = hashlib.sha256(tmp.read_bytes()).hexdigest()
     unstaged = len(indices) - len(kept)
     return {"chunk": chunk, "samples": len(kept), "unstaged": unstaged, "sha256": digest}
 
 
-def pack(samples: list[ImageSample], views: int = len(VIEWS)) -> dict[str, np.ndarray]:
-    """The arrays of a chunk (`views` each; a chunk whose draws were all unstaged holds none)."""
+def pack(
+    samples: list[ImageSample], views: int = len(VIEWS), world: World | None = None
+) -> dict[str, np.ndarray]:
+    """The arrays of a chunk (`views` each; a chunk whose draws were all unstaged holds none);
+    with `world`, the objects' sizes in it too."""
     n, v = len(samples), views
     h, w = VIEWS[0].height, VIEWS[0].width
     out = {
@@ -97,6 +109,10 @@ def pack(samples: list[ImageSample], views: int = len(VIEWS)) -> dict[str, np.nd
         out["keypoints"][i, :, :m] = s.keypoints
         out["visible"][i, :, :m] = s.visible
         out["cameras"][i] = [[*c.eye, *c.target, c.fov] for c in s.cameras]
+    if world is not None:
+        out["sizes"] = np.full((n, MAX_OBJECTS, 3), np.nan, dtype=np.float32)
+        for i, s in enumerate(samples):
+            out["sizes"][i, : len(s.objects)] = [world.object_type(o).size for o in s.objects]
     return out
 
 
@@ -118,6 +134,8 @@ def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:
             part = {k: data[k] for k in data.files}
         if problem := chunk_problem(part, row["samples"]):
             raise InvalidInputError(f"'{path}' is damaged: {problem}; collect again")
+        if "sizes" not in part:  # the training world's: its types' own sizes
+            part["sizes"] = np.full((*part["types"].shape, 3), np.nan, dtype=np.float32)
         parts.append(part)
     views = {p["images"].shape[1] for p in parts if len(p["images"])}
     if len(views) > 1:  # collections of several view counts train together (`train.joined`)
@@ -147,6 +165,8 @@ def chunk_problem(arrays: dict[str, np.ndarray], samples: int) -> str | None:
     for name, shape in shapes.items():
         if arrays[name].shape[1:] != shape:
             return f"{name} of shape {arrays[name].shape[1:]}, not {shape}"
+    if "sizes" in arrays and arrays["sizes"].shape[1:] != (MAX_OBJECTS, 3):
+        return f"sizes of shape {arrays['sizes'].shape[1:]}, not {(MAX_OBJECTS, 3)}"
     types = arrays["types"]
     if types.dtype.kind not in "iu" or ((types < -1) | (types >= len(TYPES))).any():
         return f"an object type outside -1 to {len(TYPES) - 1}"

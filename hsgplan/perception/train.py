@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import random
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import cv2
@@ -31,6 +31,7 @@ from hsgplan.domain.checks import (
     setting,
 )
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.world import ObjectType
 from hsgplan.perception.colour import (
     BACKGROUND,
     PATCH,
@@ -117,9 +118,11 @@ class Examples:
 
 def examples(data: dict[str, np.ndarray]) -> Examples:
     """Every (sample, view) of a loaded collection, its keypoints named as that view names
-    them (`perception.keypoints.view_keypoints`, from the stored poses and cameras)."""
+    them (`perception.keypoints.view_keypoints`, from the stored poses, sizes and cameras)."""
     images, keypoints, types, cuboids = [], [], [], []
     n, views, height, width = data["images"].shape[:4]
+    # no sizes (the training world's collections): each type's own
+    sizes = data.get("sizes", np.full((*data["types"].shape, 3), np.nan, dtype=np.float32))
     for i in range(n):
         for v in range(views):
             seen = (data["types"][i] >= 0) & (data["visible"][i, v] >= MIN_VISIBLE)
@@ -134,9 +137,12 @@ def examples(data: dict[str, np.ndarray]) -> Examples:
             present = data["types"][i] >= 0
             every = np.asarray(
                 [
-                    view_keypoints(TRAINING_WORLD.object_type(TYPES[t]), _pose(p), camera)
-                    for t, p in zip(
-                        data["types"][i][present], data["poses"][i][present], strict=True
+                    view_keypoints(_sized(t, size), _pose(p), camera)
+                    for t, p, size in zip(
+                        data["types"][i][present],
+                        data["poses"][i][present],
+                        sizes[i][present],
+                        strict=True,
                     )
                 ],
                 dtype=np.float32,
@@ -156,6 +162,13 @@ def joined(parts: list[Examples]) -> Examples:
         [t for p in parts for t in p.types],
         [c for p in parts for c in p.cuboids],
     )
+
+
+def _sized(t: int, size: np.ndarray) -> ObjectType:
+    """The type `TYPES[t]` at the size it had in its scene (a layout resizes its groceries);
+    NaN: the training world's, the type's own."""
+    own = TRAINING_WORLD.object_type(TYPES[t])
+    return own if np.isnan(size).any() else replace(own, size=tuple(map(float, size)))
 
 
 def _pose(p: np.ndarray) -> Pose:

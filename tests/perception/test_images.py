@@ -126,3 +126,34 @@ def test_a_chunk_whose_arrays_break_the_format_is_named_damaged():
     swapped = dict(good, poses=good["keypoints"])
     assert "poses of shape" in chunk_problem(swapped, 1)
     assert "no cameras" in chunk_problem({k: v for k, v in good.items() if k != "cameras"}, 1)
+
+
+def test_a_collection_staged_in_a_layout_keeps_its_sizes_and_trains_on_them(tmp_path):
+    from hsgplan.domain.layouts import random_layout
+    from hsgplan.domain.scene_file import scene_data, to_toml
+    from hsgplan.perception.train import examples
+
+    layout = random_layout(KITCHEN, 3, 0)
+    scene = tmp_path / "layout.toml"
+    scene.write_text(to_toml(scene_data(layout)))
+    config = ImagesConfig(samples=2, seed=0, chunk=2, views=1, scene=str(scene))
+    collect_images(config, tmp_path / "run", workers=1)
+    data = load_chunks(tmp_path / "run")
+    names = list(KITCHEN.object_types)
+    for types, sizes in zip(data["types"], data["sizes"], strict=True):
+        for t, size in zip(types[types >= 0], sizes[types >= 0], strict=True):
+            assert np.allclose(size, layout.object_type(names[t]).size)
+    found = examples(data)
+    checked = 0
+    for k, every in enumerate(found.cuboids):  # labels: the stored keypoints, by the view's names
+        present = data["types"][k][data["types"][k] >= 0]
+        stored = data["keypoints"][k, 0][data["types"][k] >= 0]
+        assert np.allclose(every[:, -1], stored[:, -1], atol=1e-3)  # the centroids
+        boxes = [KITCHEN.object_type(names[t]).kind == "box" for t in present]
+        # a box's corners named by the view are its own, in the order of a look-alike
+        assert np.allclose(np.sort(every[boxes], axis=1), np.sort(stored[boxes], axis=1), atol=1e-3)
+        checked += sum(boxes)
+    assert checked > 0
+    kitchen = ImagesConfig(samples=2, seed=0, chunk=2, views=1)
+    collect_images(kitchen, tmp_path / "kitchen", workers=1)
+    assert np.isnan(load_chunks(tmp_path / "kitchen")["sizes"]).all()  # its types' own sizes
