@@ -348,7 +348,7 @@ def _of_kind(
     meet), among those whose height fits it (`settle.fits_height`) if any does."""
     same = _same_kind(world, type_name)
     if centre is not None:
-        fits = same & torch.tensor(
+        fits = torch.tensor(
             [
                 bool(same[k]) and fits_height(world, world.object_type(t), centre)
                 for k, t in enumerate(TYPES)

@@ -87,8 +87,8 @@ def settle(
     too: objects believed there, unseen."""
     rays = rays or [()] * len(poses)
     out = [upright(p) for p in poses]
-    kinds = [world.object_type(t) for t in types]
-    heights = [t.size[2] for t in kinds]
+    shapes = [world.object_type(t) for t in types]  # each estimate's type, for its size
+    heights = [t.size[2] for t in shapes]
     unseen = [(world.object_type(t), p) for t, p in fixed]
     order = sorted(range(len(out)), key=lambda i: out[i].position[2] - heights[i] / 2)
     settled: list[int] = []
@@ -98,14 +98,14 @@ def settle(
             continue  # not upright: nothing to rest on
         carriers = [
             (t, p)
-            for t, p in [*unseen, *((kinds[k], out[k]) for k in settled)]
-            if not one_level(kinds[i], out[i], t, p)
+            for t, p in [*unseen, *((shapes[k], out[k]) for k in settled)]
+            if not one_level(shapes[i], out[i], t, p)
         ]
         if len(rays[i]) == 1 and abs(rays[i][0][1][2]) > GRAZING:
             centre = _along_ray(world, np.array([x, y, z]), rays[i][0], heights[i], carriers)
         else:
             cost = costs[i] if costs else None
-            several = [(kinds[k], out[k]) for k in settled if len(rays[k]) > 1]
+            several = [(shapes[k], out[k]) for k in settled if len(rays[k]) > 1]
             solid = [(t, p) for t, p in [*unseen, *several] if (t, p) in carriers]
             centre = _straight_down(world, np.array([x, y, z]), heights[i], carriers, cost, solid)
         if centre is not None:
