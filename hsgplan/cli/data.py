@@ -193,6 +193,7 @@ def reach(
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     out_dir: CollectionFolder = RUNS / "collect-reach",
+    scene: SceneOption = None,
 ) -> None:
     """Self-supervised reachability: primitives executed in the simulated world from staged
     symbolic states, and what the world showed after each (f_reach's labels)."""
@@ -202,7 +203,7 @@ def reach(
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("staged states", total=states)
         summary = collect_reach(
-            out_dir, states, seed, workers, ray, lambda _: progress.advance(bar)
+            out_dir, states, seed, workers, ray, lambda _: progress.advance(bar), scene=scene
         )
     statuses = ", ".join(f"{k} {v}" for k, v in summary.by_status.items())
     out.print(

@@ -11,8 +11,8 @@ States (`draw_reach_state`), from `random.Random(f"reach-{seed}-{index}")`:
 - n objects, n uniform in 2..8, drawn as the goal generator draws them (distinct types up to
   six, the six and uniform duplicates beyond);
 - with probability `P_HOLD` (1/2) one of them, uniform, is in the hand (clear, not inside);
-- with probability `P_CROWDED_STATE` (5/6) one place is to be crowded, uniform among the two
-  shelf tops, the two prepush regions and the two shelf interiors;
+- with probability `P_CROWDED_STATE` (5/6) one place is to be crowded, uniform among the
+  world's shelf tops, prepush regions and shelf interiors;
 - the others, in uniformly shuffled order, go: to the crowded place with probability `P_CROWD`
   while it has room (and, for an interior, the object fits); otherwise onto a bare object that
   can carry it with probability `P_STACK` (towers of at most the world's `max_tower_levels`);
@@ -27,9 +27,12 @@ surface, on an object, a place of an object not held), then the action uniform w
 action's parameter choices (`motion.sampler.candidates`, best first) are planned in turn, at
 most `MAX_PARAMS`, and the first that plans is executed.
 
-A work item is one state, `(seed, index)`; each worker process stages its states in one scene
-(a new physics client costs more than staging and running a state). Staging resets everything
-a state's trials depend on, so a state's row does not depend on what its process ran before.
+The states are drawn and staged in the kitchen, or in the world of a scene file (`scene`): its
+object types, shelves and regions; given a folder of scene files, state k in the k-th. A work
+item is one state, `(seed, index)`; each worker process stages its states in one scene per
+world (a new physics client costs more than staging and running a state). Staging resets
+everything a state's trials depend on, so a state's row does not depend on what its process ran
+before.
 """
 
 from __future__ import annotations
@@ -51,6 +54,8 @@ from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.room import Room
+from hsgplan.domain.scene import OPEN_SPACE, World
+from hsgplan.domain.scene_file import read_world, read_worlds
 from hsgplan.motion.sampler import candidates
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.runner.items import run_items
@@ -67,27 +72,41 @@ MAX_PARAMS = 5  # parameter choices planned, best first, before the action count
 MIN_OBJECTS, MAX_OBJECTS = 2, 8
 P_HOLD, P_CROWDED_STATE, P_CROWD, P_STACK = 0.5, 5 / 6, 0.85, 0.35
 
-OPEN = "open_space"
-TOPS = tuple(KITCHEN.shelves)
-PREPUSH = tuple(r for r in KITCHEN.regions if r != OPEN)
-# a place to crowd: ("on", surface) or ("in", shelf)
-CROWDABLE = (*(("on", s) for s in TOPS + PREPUSH), *(("in", s) for s in KITCHEN.shelves))
+
+@dataclass(frozen=True)
+class _Places:
+    """A world's places, as the state distribution groups them."""
+
+    tops: tuple[str, ...]
+    prepush: tuple[str, ...]
+    # a place to crowd: ("on", surface) or ("in", shelf)
+    crowdable: tuple[tuple[str, str], ...]
+
+    @staticmethod
+    def of(world: World) -> _Places:
+        tops = tuple(world.shelves)
+        prepush = tuple(r for r in world.regions if r != OPEN_SPACE)
+        inside_ = tuple(("in", s) for s in world.interior_capacity)
+        return _Places(tops, prepush, (*(("on", s) for s in tops + prepush), *inside_))
 
 
-def draw_reach_state(seed: int, index: int) -> SymbolicSceneGraph:
-    """A state to stage (the distribution is in the module docstring)."""
+def draw_reach_state(seed: int, index: int, world: World = KITCHEN) -> SymbolicSceneGraph:
+    """A state to stage in `world` (the distribution is in the module docstring)."""
     rng = random.Random(f"reach-{seed}-{index}")
-    objects = draw_objects(rng.randint(MIN_OBJECTS, MAX_OBJECTS), rng, KITCHEN)
+    places = _Places.of(world)
+    objects = draw_objects(rng.randint(MIN_OBJECTS, MAX_OBJECTS), rng, world)
     order = list(objects)
     rng.shuffle(order)
     literals = [in_grasp(order.pop())] if rng.random() < P_HOLD else []
-    crowd = rng.choice(CROWDABLE) if rng.random() < P_CROWDED_STATE else None
-    room = Room.left(world=KITCHEN)
-    literals += [_put(o, room, crowd, rng) for o in order]
-    return SymbolicSceneGraph.from_literals(objects, literals, limits=False, world=KITCHEN)
+    crowd = rng.choice(places.crowdable) if rng.random() < P_CROWDED_STATE else None
+    room = Room.left(world=world)
+    literals += [_put(o, room, crowd, places, rng) for o in order]
+    return SymbolicSceneGraph.from_literals(objects, literals, limits=False, world=world)
 
 
-def _put(o: str, room: Room, crowd: tuple[str, str] | None, rng: random.Random) -> Literal:
+def _put(
+    o: str, room: Room, crowd: tuple[str, str] | None, places: _Places, rng: random.Random
+) -> Literal:
     if crowd is not None:
         how, where = crowd
         free = room.free_interiors(o) if how == "in" else room.free_tops()
@@ -95,7 +114,7 @@ def _put(o: str, room: Room, crowd: tuple[str, str] | None, rng: random.Random) 
             return _count(o, room, how, where)
     if room.bases() and rng.random() < P_STACK:
         return _count(o, room, "on", rng.choice(room.bases()))
-    kinds = [("on", room.free_tops(k)) for k in ((OPEN,), TOPS, PREPUSH)]
+    kinds = [("on", room.free_tops(k)) for k in ((OPEN_SPACE,), places.tops, places.prepush)]
     kinds.append(("in", room.free_interiors(o)))
     how, places = rng.choice([(h, p) for h, p in kinds if p])
     return _count(o, room, how, rng.choice(places))
@@ -135,7 +154,7 @@ def _stratum(action: Action, state: SymbolicSceneGraph) -> str:
         return type(action).__name__
     if state.held() != action.obj:
         return "place not held"
-    return "place on surface" if action.target in KITCHEN.surfaces else "place on object"
+    return "place on surface" if action.target in state.world.surfaces else "place on object"
 
 
 def execute_action(scene: Scene, action: Action, max_params: int = MAX_PARAMS) -> tuple[str, bool]:
@@ -195,8 +214,9 @@ def record_reach_state(
     actions_per_state: int = ACTIONS_PER_STATE,
     max_params: int = MAX_PARAMS,
 ) -> dict:
-    """Draw state `index` of `seed`, stage it and execute its chosen actions: the logged row."""
-    state = draw_reach_state(seed, index)
+    """Draw state `index` of `seed` in the scene's world, stage it and execute its chosen
+    actions: the logged row."""
+    state = draw_reach_state(seed, index, scene.world)
     actions = choose_actions(
         state, random.Random(f"reach-actions-{seed}-{index}"), actions_per_state
     )
@@ -213,21 +233,27 @@ class ReachItem:
     index: int
     actions_per_state: int = ACTIONS_PER_STATE
     max_params: int = MAX_PARAMS
+    scene: str | None = None  # a scene file's path (None: the kitchen)
 
     @property
     def key(self) -> str:
         return f"{self.seed}/{self.index}"
 
 
+def _path(file: Path | None) -> str | None:
+    return None if file is None else str(file)
+
+
 @functools.cache
-def _process_scene() -> Scene:
-    return Scene((), visuals=False, world=KITCHEN)
+def _process_scene(scene: str | None) -> Scene:
+    world = KITCHEN if scene is None else read_world(Path(scene))
+    return Scene((), visuals=False, world=world)
 
 
 def run_reach_item(item: ReachItem) -> dict:
-    """The worker entry point (pool or Ray): one state, in this process's scene."""
+    """The worker entry point (pool or Ray): one state, in this process's scene of its world."""
     return record_reach_state(
-        _process_scene(), item.seed, item.index, item.actions_per_state, item.max_params
+        _process_scene(item.scene), item.seed, item.index, item.actions_per_state, item.max_params
     )
 
 
@@ -251,10 +277,14 @@ def collect_reach(
     *,
     actions_per_state: int = ACTIONS_PER_STATE,
     max_params: int = MAX_PARAMS,
+    scene: Path | None = None,
 ) -> ReachSummary:
     """Stage states 0..`states`-1 of `seed` and execute primitives from each, logged to the run
     folder `out`. A rerun keeps what is logged and runs only the missing states, so `states`
-    may grow; a folder made with other settings is refused. `on_item` sees each state's row."""
+    may grow; a folder made with other settings (the scene file among them) is refused.
+    `on_item` sees each state's row. `scene`: stage them in this scene file's world, or round a
+    folder of them, state k in the k-th file (default: the kitchen); the path is kept in the
+    folder's configuration, where readers find it (`evaluation.reach_eval.collection_worlds`)."""
     for name, value in (
         ("--states", states),
         ("actions per state", actions_per_state),
@@ -270,16 +300,24 @@ def collect_reach(
         "actions_per_state": actions_per_state,
         "max_params": max_params,
     }
+    worlds: dict[Path | None, World] = {None: KITCHEN}
+    if scene is not None:  # a kitchen collection records no scene, as before scenes were given
+        worlds = dict(read_worlds(scene))
+        config["scene"] = str(scene)
+    files, in_turn = list(worlds), list(worlds.values())
     # claimed here first for a refusal that says what differs, and to count what is logged
     claim(
         out,
         "reach",
         config,
         f"'{out}' holds a reach collection made with other settings (seed, "
-        "actions per state, parameter choices, or an older layout); use another --out",
+        "actions per state, parameter choices, scene, or an older layout); use another --out",
     )
     logged = {str(row.get("key")) for row in logged_rows(out) if isinstance(row, dict)}
-    items = [ReachItem(seed, i, actions_per_state, max_params) for i in range(states)]
+    items = [
+        ReachItem(seed, i, actions_per_state, max_params, _path(files[i % len(files)]))
+        for i in range(states)
+    ]
     rows = run_items(
         run_reach_item,
         items,
@@ -292,7 +330,9 @@ def collect_reach(
         on_result=on_item,
     )
     ran = sum(item.key not in logged for item in items)
-    trials: list[WorldTrial] = [t for row in rows for t in trials_of(row, KITCHEN)]
+    trials: list[WorldTrial] = [
+        t for i, row in enumerate(rows) for t in trials_of(row, in_turn[i % len(in_turn)])
+    ]
     return ReachSummary(
         states,
         sum(row.get("staged", True) is not False for row in rows),

@@ -103,9 +103,11 @@ def trials_of(row: dict, world: World) -> list[WorldTrial]:
     ]
 
 
-def load_world_trials(folder: Path, world: World) -> list[WorldTrial]:
+def load_world_trials(folder: Path, world: World | Sequence[World]) -> list[WorldTrial]:
     """Every trial of a collection folder collected in `world`, states in key order, trials in
-    the order run."""
+    the order run. A collection staged round a folder of scenes gives their worlds in turn:
+    state k was staged in the k-th (`collect reach --scene DIR`)."""
+    worlds = [world] if isinstance(world, World) else list(world)
     path = Path(folder) / RESULTS
     if not path.is_file():
         raise InvalidInputError(f"'{folder}' holds no collection of executed primitives")
@@ -127,7 +129,7 @@ def load_world_trials(folder: Path, world: World) -> list[WorldTrial]:
     for key in sorted(results):
         result = results[key]
         try:
-            trials += trials_of(result, world)
+            trials += trials_of(result, worlds[key[-1] % len(worlds)])
         except (AttributeError, KeyError, TypeError, ValueError) as e:
             where = "/".join(map(str, key))
             raise InvalidInputError(f"'{path}' state {where} is damaged: {_why(e)}") from None

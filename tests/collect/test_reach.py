@@ -25,11 +25,14 @@ from hsgplan.data.world_trials import load_world_trials, trials_of
 from hsgplan.domain.actions import Pick, Place, Push
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import in_grasp, on
+from hsgplan.domain.scene_file import read_world
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.scene import Scene
 
 BOUNDED = [s for s in KITCHEN.surface_capacity if s != "open_space"]  # shelf tops, prepush regions
+NEW_OBJECTS = Path(__file__).parents[2] / "scenes/new-objects/new-objects-000.toml"
+LAYOUT = Path(__file__).parents[2] / "scenes/layouts/layout-000.toml"
 
 
 def _situations(s: SymbolicSceneGraph) -> set[str]:
@@ -160,3 +163,56 @@ def test_a_folder_collected_with_other_settings_is_refused(tmp_path):
     (tmp_path / "config.json").write_text('{"kind": "reach", "seed": 0}\n')
     r = CliRunner().invoke(app, ["collect", "reach", "--states", "1", "--out", str(tmp_path)])
     assert r.exit_code == 2 and "other settings" in r.stderr
+
+
+def test_states_are_drawn_staged_and_recorded_in_the_scenes_world():
+    world = read_world(NEW_OBJECTS)
+    states = [draw_reach_state(0, i, world) for i in range(40)]
+    names = set(world.object_types)
+    assert all({world.type_of(o) for o in s.objects} <= names for s in states)
+    assert {x for s in states for lit in s.literals for x in lit.args} - set(world.surfaces) - {
+        o for s in states for o in s.objects
+    } == set()  # every place a literal names is the scene's own
+    with Scene((), world=world) as scene:
+        row = record_reach_state(scene, 0, 3)
+    assert row["trials"] and trials_of(row, world=world)
+
+
+@pytest.mark.slow
+def test_a_collection_round_a_folder_of_scenes_records_it_and_is_read_in_each(tmp_path):
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    (scenes / "a.toml").write_text(LAYOUT.read_text())
+    (scenes / "b.toml").write_text(NEW_OBJECTS.read_text())
+    out = tmp_path / "reach"
+    args = ["collect", "reach", "--states", "2", "--workers", "1", "--out", str(out)]
+    r = CliRunner().invoke(app, [*args, "--scene", str(scenes)])
+    assert r.exit_code == 0, r.output
+    assert json.loads((out / "config.json").read_text())["scene"] == str(scenes)
+    lines = (out / "episodes.jsonl").read_text().splitlines()
+    rows = {json.loads(x)["key"]: json.loads(x)["result"] for x in lines}
+    # state k in the k-th file: the layout holds the kitchen's groceries, the other new ones
+    assert set(rows["0/0"]["objects"]) <= set(KITCHEN.object_types)
+    assert not set(rows["0/1"]["objects"]) & set(KITCHEN.object_types)
+    worlds = [read_world(LAYOUT), read_world(NEW_OBJECTS)]
+    assert len(load_world_trials(out, worlds)) == sum(len(r["trials"]) for r in rows.values())
+    # the same folder in another world is another collection
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2 and "other settings" in r.stderr
+    # networks that know the kitchen's names cannot read the new groceries; geometry can
+    r = CliRunner().invoke(app, ["eval", "reach", "--data", str(out)])
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "names others" in r.stderr
+    geometry = Path(__file__).parents[2] / "checkpoints/task-geometry"
+    r = CliRunner().invoke(
+        app, ["eval", "reach", "--data", str(out), "--checkpoint", str(geometry)]
+    )
+    assert r.exit_code == 0, r.output
+
+
+def test_a_collection_whose_scene_is_gone_is_refused_in_one_line(tmp_path):
+    (tmp_path / "config.json").write_text('{"kind": "reach", "scene": "nowhere/scenes"}\n')
+    (tmp_path / "episodes.jsonl").write_text("")
+    r = CliRunner().invoke(app, ["eval", "reach", "--data", str(tmp_path)])
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "nowhere/scenes" in r.stderr and "not found" in r.stderr
