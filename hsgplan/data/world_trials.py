@@ -33,6 +33,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_literal
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import read_worlds
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.outcome import Status
 
@@ -101,6 +102,19 @@ def trials_of(row: dict, world: World) -> list[WorldTrial]:
         )
         for t in row["trials"]
     ]
+
+
+def collection_worlds(folder: Path, default: World) -> list[World]:
+    """The worlds a collection was staged in, state k in the k-th: its configuration's scene
+    file or folder of them (`collect reach --scene`), else `default` (a collection made without
+    a scene records none)."""
+    made = Path(folder) / "config.json"
+    scene = read_json(made, "collection configuration").get("scene") if made.is_file() else None
+    if scene is None:
+        return [default]
+    if not isinstance(scene, str) or not Path(scene).exists():
+        raise InvalidInputError(f"'{folder}' was collected in scene {scene!r}, not found here")
+    return list(read_worlds(scene).values())
 
 
 def load_world_trials(folder: Path, world: World | Sequence[World]) -> list[WorldTrial]:

@@ -17,13 +17,9 @@ from pathlib import Path
 
 import torch
 
-from hsgplan.data.world_trials import WorldTrial, load_world_trials
+from hsgplan.data.world_trials import WorldTrial, collection_worlds, load_world_trials
 from hsgplan.domain.actions import Action, Place, Push
-from hsgplan.domain.checks import read_json
-from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_worlds
 from hsgplan.planning.regression.examples import world_labels
 from hsgplan.planning.regression.planner import RegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -97,18 +93,6 @@ def _add(s: Scores, truth: bool, said: bool) -> Scores:
     )
 
 
-def collection_worlds(folder: Path) -> list[World]:
-    """The worlds a collection of executed primitives was staged in, state k in the k-th: its
-    configuration's scene file or folder of them (`collect reach --scene`), else the kitchen."""
-    made = Path(folder) / "config.json"
-    scene = read_json(made, "collection configuration").get("scene") if made.is_file() else None
-    if scene is None:
-        return [KITCHEN]
-    if not isinstance(scene, str) or not Path(scene).exists():
-        raise InvalidInputError(f"'{folder}' was collected in scene {scene!r}, not found here")
-    return list(read_worlds(scene).values())
-
-
 @torch.inference_mode()
 def evaluate_reach(checkpoint: Path, trials: list[WorldTrial] | Path) -> dict:
     """Scores by kind and overall: `{"by_kind": {kind: {...}}, "overall": {...}}`; a folder's
@@ -117,7 +101,7 @@ def evaluate_reach(checkpoint: Path, trials: list[WorldTrial] | Path) -> dict:
     if isinstance(trials, Path):
         from hsgplan.agents.registry import check_reads
 
-        worlds = collection_worlds(trials)
+        worlds = collection_worlds(trials, KITCHEN)
         for world in worlds:
             check_reads([checkpoint], world, world.name)
         trials = load_world_trials(trials, worlds)

@@ -22,7 +22,7 @@ from torch_geometric.data import Batch
 
 from hsgplan import training
 from hsgplan.checkpoint import fingerprint
-from hsgplan.data.world_trials import load_world_trials
+from hsgplan.data.world_trials import collection_worlds, load_world_trials
 from hsgplan.domain.checks import BOUNDS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import World
@@ -119,7 +119,8 @@ def _examples(
                     demos, config.seed, config.reach_singles
                 )
             }
-        trials = load_world_trials(shipped(config.world_trials), world)
+        folder = shipped(config.world_trials)
+        trials = load_world_trials(folder, collection_worlds(folder, world))
         return {
             "primitives executed in the simulated world": world_reach_examples(trials, []),
             "demonstrated changes": world_reach_examples([], demos),
