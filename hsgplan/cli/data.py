@@ -59,6 +59,7 @@ def demos(
             "for a learning curve; the first round is the paper's set).",
         ),
     ] = 1,
+    scene: SceneOption = None,
 ) -> None:
     """Record the paper's 18 short demonstrations with the oracle in the simulated world."""
     from hsgplan.collect.demos import collect_demos
@@ -66,6 +67,7 @@ def demos(
 
     command = f"hsgplan collect demos --seed {seed} --out {out_dir}"
     command += " --full-scene" * full_scene + f" --rounds {rounds}" * (rounds > 1)
+    command += f" --scene {scene}" * (scene is not None)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("demonstrations", total=len(TASKS) * rounds)
         done = collect_demos(
@@ -76,6 +78,7 @@ def demos(
             full_scene=full_scene,
             rounds=rounds,
             on_start=lambda n: progress.update(task, completed=n),  # a resumed set starts there
+            scene=scene,
         )
         progress.update(task, completed=len(TASKS) * rounds)
     steps = sum(len(d.actions) for d in done)

@@ -78,7 +78,7 @@ def train_task(
                 bars[name] = progress.add_task(name, total=cfg.epochs)
             progress.update(bars[name], completed=epoch, description=f"{name} loss {loss:.4f}")
 
-        run(cfg, out_dir, on_epoch, world=KITCHEN)  # the demonstrations are the kitchen's
+        run(cfg, out_dir, on_epoch, world=KITCHEN)  # of data recorded without a scene file
     out.print(f"trained f_preimage, f_reach and the forward baseline into {shown(out_dir)}")
 
 

@@ -7,7 +7,10 @@ curve trains on (round 1 is the paper's set).
 A demonstration's scene holds the objects its goal names, or, with `full_scene`, one object of
 every type (the paper does not say its demonstrations' scenes hold only the named objects):
 the others rest wherever the sampler puts them, and the oracle moves them when they are in the
-way."""
+way.
+
+With a scene file (`scene`), the demonstrations are recorded in its world; the tasks name the
+kitchen's groceries and shelves, so the scene must hold them (a layout of the kitchen)."""
 
 from __future__ import annotations
 
@@ -21,6 +24,8 @@ from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import read_world
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.files import write_atomically
 from hsgplan.runner.lock import hold_folder
@@ -38,10 +43,13 @@ def round_task(task: str, r: int) -> str:
     return task if r == 0 else f"{task}@{r + 1}"
 
 
-def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) -> Demo | None:
-    """Run the oracle on one task; the demonstration, or None if the episode failed."""
-    goal = parse_goal(goal_text, world=KITCHEN)
-    others = tuple(t for t in KITCHEN.object_types if t not in goal.objects) if full_scene else ()
+def record_demo(
+    task: str, goal_text: str, seed: int, full_scene: bool = False, world: World = KITCHEN
+) -> Demo | None:
+    """Run the oracle on one task in `world`; the demonstration, or None if the episode
+    failed."""
+    goal = parse_goal(goal_text, world=world)
+    others = tuple(t for t in world.object_types if t not in goal.objects) if full_scene else ()
     states: list[SymbolicSceneGraph] = []
     actions: list[str] = []
 
@@ -53,7 +61,7 @@ def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) 
         states.append(obs.symbols.state)
 
     result = run_episode(
-        KitchenStorageEnv(visuals=False, world=KITCHEN),
+        KitchenStorageEnv(visuals=False, world=world),
         make_agent("oracle"),
         goal,
         seed,
@@ -69,13 +77,15 @@ def record_demo(task: str, goal_text: str, seed: int, full_scene: bool = False) 
         ResetOptions(goal, others=others).objects(),
         tuple(actions),
         tuple(tuple(str(lit) for lit in s.sorted_literals()) for s in states),
-        world=KITCHEN,
+        world=world,
     )
 
 
-def _recorded(out: Path, seed: int, full_scene: bool) -> dict[str, Demo]:
-    """The demonstrations already in `out`, by task; a set made with another seed or scene
-    refused."""
+def _recorded(
+    out: Path, seed: int, full_scene: bool, scene: str | None, world: World
+) -> dict[str, Demo]:
+    """The demonstrations already in `out`, by task; a set made with another seed, scene of
+    objects or scene file refused."""
     meta_path = out / META
     if meta_path.exists():
         saved = read_json(meta_path, "demonstration metadata")
@@ -84,7 +94,10 @@ def _recorded(out: Path, seed: int, full_scene: bool) -> dict[str, Demo]:
         if saved.get("full_scene", False) != full_scene:
             scene = "every object type" if saved.get("full_scene") else "their goal's objects alone"
             raise InvalidInputError(f"'{out}' holds demonstrations recorded in a scene of {scene}")
-    return {d.task: d for d in read_demos(out / DEMOS, KITCHEN, tolerate_cut=True)}
+        if saved.get("scene") != scene:
+            where = saved.get("scene") or "the kitchen"
+            raise InvalidInputError(f"'{out}' holds demonstrations recorded in {where}")
+    return {d.task: d for d in read_demos(out / DEMOS, world, tolerate_cut=True)}
 
 
 def collect_demos(
@@ -95,21 +108,36 @@ def collect_demos(
     full_scene: bool = False,
     rounds: int = 1,
     on_start: Callable[[int], None] | None = None,
+    scene: Path | None = None,
 ) -> list[Demo]:
     """Record every task of every round not yet in `out` (appending as each finishes); all
-    demos, round by round in task order. `on_start` hears how many are already recorded."""
+    demos, round by round in task order. `on_start` hears how many are already recorded.
+    `scene`: record them in this scene file's world (default: the kitchen), which `meta.json`
+    keeps (`data.demos.demos_world`)."""
     if rounds < 1:
         raise InvalidInputError(f"rounds {rounds}: need at least 1")
+    world, where = (KITCHEN, None) if scene is None else (read_world(scene), str(scene))
+    if scene is not None:
+        for _, goal in TASKS:
+            try:
+                parse_goal(goal, world=world)
+            except InvalidInputError as e:
+                raise InvalidInputError(
+                    f"--scene {scene}: the demonstration tasks name the kitchen's groceries "
+                    f"and shelves ({e})"
+                ) from None
     check_own(out, META, "demonstration set")  # never into another command's folder
     meta = {"format": FORMAT, "version": VERSION, "seed": seed, "command": command}
     if full_scene:
         meta["full_scene"] = True
     if rounds > 1:
         meta["rounds"] = rounds
+    if where is not None:  # a kitchen set records no scene, as before scenes were given
+        meta["scene"] = where
     meta_path = out / META
-    _recorded(out, seed, full_scene)
+    _recorded(out, seed, full_scene, where, world)
     hold_folder(out)  # one writer: a second collection into `out` is refused
-    done = _recorded(out, seed, full_scene)  # again, now that the folder is ours
+    done = _recorded(out, seed, full_scene, where, world)  # again, now that the folder is ours
     saved = read_json(meta_path, "demonstration metadata") if meta_path.exists() else {}
     if saved.get("rounds", 1) < rounds or not saved:  # a set grown by more rounds says so
         write_atomically(meta_path, json.dumps(meta, indent=2) + "\n")
@@ -125,7 +153,7 @@ def collect_demos(
             continue
         base = seed * 1000 + r * ROUND_STRIDE + i * RETRIES
         for attempt in range(RETRIES):
-            demo = record_demo(task, goal, base + attempt, full_scene)
+            demo = record_demo(task, goal, base + attempt, full_scene, world)
             if demo is not None:
                 break
         else:

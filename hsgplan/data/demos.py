@@ -12,7 +12,8 @@ symbolic scene graph is read by f_m from the simulator at every state. An episod
 had a primitive fail on the way, or whose goal held from the start is retried with the next
 seed; the seed that was kept is recorded.
 
-On disk (`FORMAT`): a folder with `meta.json` (version, command, seed) and `demos.jsonl`, one
+On disk (`FORMAT`): a folder with `meta.json` (version, command, seed, and the scene file a set
+was recorded in when it was not the kitchen's: `scene`) and `demos.jsonl`, one
 demonstration per line: {"task", "goal", "seed", "objects", "actions": [str],
 "states": [[literal, ...], ...]} with len(states) == len(actions) + 1; literals and actions are
 in the goal / action text syntax.
@@ -29,6 +30,7 @@ from hsgplan.domain.checks import read_json, read_text
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal
 from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import read_world
 from hsgplan.paths import shipped
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -97,6 +99,18 @@ class Demo:
 
     def symbolic_actions(self) -> list[Action]:
         return [parse_action(a, self.world) for a in self.actions]
+
+
+def demos_world(folder: Path, default: World) -> World:
+    """The world a demonstration set was recorded in: its `meta.json`'s scene file, else
+    `default` (a set recorded without a scene records none)."""
+    folder = shipped(folder)
+    scene = read_json(folder / META, "demonstration metadata").get("scene")
+    if scene is None:
+        return default
+    if not isinstance(scene, str) or not Path(scene).is_file():
+        raise InvalidInputError(f"'{folder}' was recorded in scene {scene!r}, not found here")
+    return read_world(Path(scene))
 
 
 def load_demos(folder: Path, world: World) -> list[Demo]:

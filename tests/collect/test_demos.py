@@ -9,12 +9,14 @@ from typer.testing import CliRunner
 from hsgplan.cli import app
 from hsgplan.collect import demos as record_demos
 from hsgplan.collect.demos import collect_demos
-from hsgplan.data.demos import TASKS, load_demos
+from hsgplan.data.demos import TASKS, demos_world, load_demos
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene_file import read_world
 from hsgplan.symbolic.transition import apply
 
 SHIPPED = Path(__file__).resolve().parents[2] / "data" / "demos" / "v1"
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
 
 
 def test_the_paper_task_mix():
@@ -123,7 +125,7 @@ def test_a_full_scene_collection_is_not_resumed_as_a_goal_objects_one(tmp_path, 
 def _stub_recorder(seeds: list[int]):
     """A recorder that runs no simulation: one made-up transition per task, its seed noted."""
 
-    def record(task, goal_text, seed, full_scene=False):
+    def record(task, goal_text, seed, full_scene=False, world=KITCHEN):
         seeds.append(seed)
         return record_demos.Demo(
             task, goal_text, seed, ("butter",), ("a",), (("x",), ("y",)), world=KITCHEN
@@ -159,3 +161,27 @@ def test_cli_refuses_zero_rounds_in_one_line(tmp_path):
     r = CliRunner().invoke(app, ["collect", "demos", "--rounds", "0", "--out", str(tmp_path / "d")])
     assert r.exit_code == 2 and "rounds" in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "d").exists()
+
+
+def test_demos_recorded_in_a_layout_keep_it_and_are_not_resumed_in_the_kitchen(
+    tmp_path, monkeypatch
+):
+    monkeypatch.setattr(record_demos, "TASKS", TASKS[:1])
+    layout = SCENES / "layouts" / "layout-003.toml"
+    (demo,) = collect_demos(tmp_path, seed=3, scene=layout)
+    world = read_world(layout)
+    assert demo.world == world != KITCHEN
+    assert json.loads((tmp_path / "meta.json").read_text())["scene"] == str(layout)
+    assert demos_world(tmp_path, KITCHEN) == world
+    assert demo.goal_literals().satisfied_by(load_demos(tmp_path, world)[0].symbolic_states()[-1])
+    with pytest.raises(InvalidInputError, match="recorded in"):
+        collect_demos(tmp_path, seed=3)
+
+
+def test_a_scene_without_the_tasks_groceries_is_refused_in_one_line(tmp_path):
+    scene = SCENES / "new-objects" / "new-objects-000.toml"
+    out = tmp_path / "demos"
+    r = CliRunner().invoke(app, ["collect", "demos", "--scene", str(scene), "--out", str(out)])
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "the demonstration tasks name the kitchen's groceries" in r.stderr
+    assert not out.exists()

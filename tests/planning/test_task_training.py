@@ -292,3 +292,18 @@ def test_a_demo_limit_trains_on_the_first_demonstrations_alone(tmp_path):
             TaskTrainConfig.from_json(tiny | {"demo_limit": 19}), tmp_path / "more", world=KITCHEN
         )
     assert not (tmp_path / "more").exists()
+
+
+def test_demonstrations_of_a_layout_are_learnt_in_it_and_not_mixed_with_another_world(tmp_path):
+    layout = Path(__file__).resolve().parents[2] / "scenes" / "layouts" / "layout-003.toml"
+    demos = tmp_path / "demos"
+    demos.mkdir()
+    meta = json.loads((DEMOS / "meta.json").read_text()) | {"scene": str(layout)}
+    (demos / "meta.json").write_text(json.dumps(meta))
+    (demos / "demos.jsonl").write_text((DEMOS / "demos.jsonl").read_text())
+    kitchen_trials = tmp_path / "reach"
+    kitchen_trials.mkdir()
+    (kitchen_trials / "config.json").write_text('{"kind": "reach", "seed": 0}')
+    config = TINY | {"demos": str(demos), "reach": "world", "world_trials": str(kitchen_trials)}
+    with pytest.raises(InvalidInputError, match="a planner learns in one world"):
+        train_task(TaskTrainConfig.from_json(config | {"epochs": 1}), tmp_path / "m", world=KITCHEN)

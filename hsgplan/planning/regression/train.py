@@ -102,9 +102,10 @@ class TaskTrainConfig:
 
 
 def _examples(
-    name: str, demos, trajs, config: TaskTrainConfig, world: World
+    name: str, demos, trajs, config: TaskTrainConfig, world: World, home: World
 ) -> dict[str, list[Example]]:
-    """A network's training examples by where their labels come from."""
+    """A network's training examples by where their labels come from, in `world`; `home` is
+    the world of data that records no scene."""
     n = len(demos)  # the demonstrations come first, then copy after copy
     if name == "reach":
         if config.reach == "predicates":
@@ -120,7 +121,13 @@ def _examples(
                 )
             }
         folder = shipped(config.world_trials)
-        trials = load_world_trials(folder, collection_worlds(folder, world))
+        worlds = collection_worlds(folder, home)
+        if any(w != world for w in worlds):
+            raise InvalidInputError(
+                f"'{config.world_trials}' was collected in another world than the "
+                f"demonstrations ('{world.name}'): a planner learns in one world"
+            )
+        trials = load_world_trials(folder, worlds)
         return {
             "primitives executed in the simulated world": world_reach_examples(trials, []),
             "demonstrated changes": world_reach_examples([], demos),
@@ -155,10 +162,12 @@ def train_task(
     world: World,
 ) -> None:
     """Train (or go on training) the three networks into the checkpoint folder `out` on the
-    demonstrations (and executed primitives) recorded in `world`; each network's folder gets
-    `labels.json`, its label counts by source."""
-    from hsgplan.data.demos import load_demos
+    demonstrations (and executed primitives) recorded in `world`, or in the scene file they
+    were recorded in (`collect demos --scene`, `collect reach --scene`): all in one world.
+    Each network's folder gets `labels.json`, its label counts by source."""
+    from hsgplan.data.demos import demos_world, load_demos
 
+    home, world = world, demos_world(Path(config.demos), world)
     demos = load_demos(Path(config.demos), world)
     if config.demo_limit is not None:
         if config.demo_limit > len(demos):
@@ -176,7 +185,7 @@ def train_task(
     for name, classes in NETWORKS.items():
         if training.finished(out / name):
             continue  # finished earlier
-        by_source = _examples(name, demos, trajs, config, world)
+        by_source = _examples(name, demos, trajs, config, world, home)
         (out / name).mkdir(exist_ok=True)
         counts = {source: label_counts(ex) for source, ex in by_source.items()}
         write_atomically(out / name / "labels.json", json.dumps(counts, indent=2) + "\n")
