@@ -54,20 +54,24 @@ def bench_sim(
     episodes: Annotated[int, bounded_option("episodes", "Oracle episodes per size.")] = 5,
     seed: Annotated[int, bounded_option("seed", "Random seed.")] = 0,
     markdown: MarkdownFlag = False,
+    scene: SceneFiles = None,
 ) -> None:
     """Median seconds per primitive (motion planning included) and per oracle episode."""
     from hsgplan.benchmarks.sim import bench_sim as run
+    from hsgplan.domain.scene_file import read_worlds
 
     size_list = parse_sizes(sizes)
+    where = None if scene is None else str(scene)
+    files = 1 if scene is None else len(read_worlds(scene))  # each read: a bad one refused
     with Progress(console=err, transient=True) as progress:
-        task = progress.add_task("oracle episodes", total=len(size_list) * episodes)
-        rows = run(size_list, episodes, seed, lambda r: progress.advance(task))
+        task = progress.add_task("oracle episodes", total=len(size_list) * episodes * files)
+        rows = run(size_list, episodes, seed, lambda r: progress.advance(task), where)
     cells = [
         (r.what, str(r.samples), "—" if r.median_seconds is None else f"{r.median_seconds:.3f}")
         for r in rows
     ]
     print_table(
-        f"Simulation speed, one core (seed {seed})",
+        f"Simulation speed, one core (seed {seed}{_in(scene)})",
         ("what", "samples", "median s"),
         cells,
         markdown,
