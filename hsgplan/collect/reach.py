@@ -116,8 +116,8 @@ def _put(
         return _count(o, room, "on", rng.choice(room.bases()))
     kinds = [("on", room.free_tops(k)) for k in ((OPEN_SPACE,), places.tops, places.prepush)]
     kinds.append(("in", room.free_interiors(o)))
-    how, places = rng.choice([(h, p) for h, p in kinds if p])
-    return _count(o, room, how, rng.choice(places))
+    how, free = rng.choice([(h, p) for h, p in kinds if p])
+    return _count(o, room, how, rng.choice(free))
 
 
 def _count(o: str, room: Room, how: str, where: str) -> Literal:
