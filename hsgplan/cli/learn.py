@@ -212,6 +212,11 @@ def eval_task(
     )
 
 
+def _worlds(report: dict) -> int:
+    """How many worlds other than the kitchen an `eval reach` report's trials were staged in."""
+    return len(report.get("worlds") or ())
+
+
 @refuses_bad_input
 def eval_reach(
     checkpoint: Annotated[
@@ -254,7 +259,8 @@ def eval_reach(
         for kind, v in [*report["by_kind"].items(), ("all", report["overall"])]
     ]
     print_table(
-        f"f_reach of {checkpoint} on {report['trials']} executed primitives from {data}",
+        f"f_reach of {checkpoint} on {report['trials']} executed primitives from {data}"
+        + (f" (staged in {n} worlds)" if (n := _worlds(report)) else ""),
         ("question", "n", "reachable", "precision", "recall", "yes when not", "accuracy"),
         rows,
         markdown,

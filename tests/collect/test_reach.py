@@ -208,6 +208,7 @@ def test_a_collection_round_a_folder_of_scenes_records_it_and_is_read_in_each(tm
         app, ["eval", "reach", "--data", str(out), "--checkpoint", str(geometry)]
     )
     assert r.exit_code == 0, r.output
+    assert "(staged in 2 worlds)" in " ".join(r.stdout.split())
 
 
 def test_a_collection_whose_scene_is_gone_is_refused_in_one_line(tmp_path):
