@@ -240,10 +240,6 @@ class ReachItem:
         return f"{self.seed}/{self.index}"
 
 
-def _path(file: Path | None) -> str | None:
-    return None if file is None else str(file)
-
-
 @functools.cache
 def _process_scene(scene: str | None) -> Scene:
     world = KITCHEN if scene is None else read_world(Path(scene))
@@ -300,9 +296,9 @@ def collect_reach(
         "actions_per_state": actions_per_state,
         "max_params": max_params,
     }
-    worlds: dict[Path | None, World] = {None: KITCHEN}
+    worlds: dict[str | None, World] = {None: KITCHEN}
     if scene is not None:  # a kitchen collection records no scene, as before scenes were given
-        worlds = dict(read_worlds(scene))
+        worlds = {str(p): w for p, w in read_worlds(scene).items()}
         config["scene"] = str(scene)
     files, in_turn = list(worlds), list(worlds.values())
     # claimed here first for a refusal that says what differs, and to count what is logged
@@ -315,7 +311,7 @@ def collect_reach(
     )
     logged = {str(row.get("key")) for row in logged_rows(out) if isinstance(row, dict)}
     items = [
-        ReachItem(seed, i, actions_per_state, max_params, _path(files[i % len(files)]))
+        ReachItem(seed, i, actions_per_state, max_params, files[i % len(files)])
         for i in range(states)
     ]
     rows = run_items(

@@ -30,7 +30,7 @@ from hsgplan.domain.checks import read_json, read_text
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.scene_file import recorded_worlds
 from hsgplan.paths import shipped
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
@@ -106,11 +106,7 @@ def demos_world(folder: Path, default: World) -> World:
     `default` (a set recorded without a scene records none)."""
     folder = shipped(folder)
     scene = read_json(folder / META, "demonstration metadata").get("scene")
-    if scene is None:
-        return default
-    if not isinstance(scene, str) or not Path(scene).is_file():
-        raise InvalidInputError(f"'{folder}' was recorded in scene {scene!r}, not found here")
-    return read_world(Path(scene))
+    return recorded_worlds(scene, default, folder)[0]
 
 
 def load_demos(folder: Path, world: World) -> list[Demo]:

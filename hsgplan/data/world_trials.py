@@ -33,7 +33,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_literal
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_worlds
+from hsgplan.domain.scene_file import recorded_worlds
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.outcome import Status
 
@@ -110,11 +110,7 @@ def collection_worlds(folder: Path, default: World) -> list[World]:
     a scene records none)."""
     made = Path(folder) / "config.json"
     scene = read_json(made, "collection configuration").get("scene") if made.is_file() else None
-    if scene is None:
-        return [default]
-    if not isinstance(scene, str) or not Path(scene).exists():
-        raise InvalidInputError(f"'{folder}' was collected in scene {scene!r}, not found here")
-    return list(read_worlds(scene).values())
+    return recorded_worlds(scene, default, folder)
 
 
 def load_world_trials(folder: Path, world: World | Sequence[World]) -> list[WorldTrial]:

@@ -256,6 +256,17 @@ def read_worlds(path: Path | str) -> dict[Path, World]:
     return {p: read_world(p) for p in paths}
 
 
+def recorded_worlds(scene: object, default: World, folder: Path | str) -> list[World]:
+    """The worlds a data folder's metadata says it was made in: its `scene` (a scene file or a
+    folder of them, in file order), else `default` (data made without a scene records none). A
+    scene that is not found here is refused in one line."""
+    if scene is None:
+        return [default]
+    if not isinstance(scene, str) or not Path(scene).exists():
+        raise InvalidInputError(f"'{folder}' was made in scene {scene!r}, not found here")
+    return list(read_worlds(scene).values())
+
+
 def _span_out(r: Rect) -> dict:
     return {"x": [r.x_min, r.x_max], "y": [r.y_min, r.y_max]}
 

@@ -98,12 +98,12 @@ def evaluate_reach(checkpoint: Path, trials: list[WorldTrial] | Path) -> dict:
     """Scores by kind and overall: `{"by_kind": {kind: {...}}, "overall": {...}}`; a folder's
     trials are read in the worlds they were collected in (their names under "worlds" unless
     the kitchen alone), which the checkpoint must read (`check_reads`)."""
-    scene = None
+    names = None
     if isinstance(trials, Path):
         from hsgplan.agents.registry import check_reads
 
         worlds = collection_worlds(trials, KITCHEN)
-        scene = None if worlds == [KITCHEN] else sorted({w.name for w in worlds})
+        names = None if worlds == [KITCHEN] else sorted({w.name for w in worlds})
         for world in worlds:
             check_reads([checkpoint], world, world.name)
         trials = load_world_trials(trials, worlds)
@@ -124,5 +124,5 @@ def evaluate_reach(checkpoint: Path, trials: list[WorldTrial] | Path) -> dict:
         "by_kind": {str(k): scores[k].as_json() for k in order if k in scores},
         "overall": overall.as_json(),
         "trials": len(trials),
-        "worlds": scene,
+        "worlds": names,
     }
