@@ -1,14 +1,23 @@
 """The one agent class: a task planner and a motion generator, composed as the paper composes
 them. The task planner reads the symbolic scene graph s_s and names the next action and the
 subgoal it serves; the motion generator reads the geometric scene graph s_g and chooses the
-action's parameters."""
+action's parameters.
+
+Beyond the paper, an agent made with `check_actions` tries the task planner's action in its
+model of the scene before it takes it (the dry runs a checked motion generator makes: the
+motion planner, no domain rule): the primitive must plan and, for a pick the planner means to
+follow with a place or a stack, that place must plan once the pick is done (tried in the model
+and taken back). An action that fails the check is refused: the task planner is asked again
+without it, up to `REFUSALS` times, after which its first choice is taken as without checks.
+"""
 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 from hsgplan.agents.base import Decision
-from hsgplan.domain.actions import Pick, Push
+from hsgplan.domain.actions import Action, Pick, Push, push_after
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.predicates import in_grasp
@@ -19,6 +28,10 @@ from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.outcome import Outcome
 
+# Actions refused per decision before the task planner's first choice is taken regardless: a
+# budget, as the dry runs per proposal are, not tuned.
+REFUSALS = 4
+
 
 class HierarchicalAgent:
     """Args:
@@ -27,6 +40,8 @@ class HierarchicalAgent:
     motion: the motion level (`hsgplan.motion.interface.MotionGenerator`).
     rules: the recovery rules in force (`hsgplan.domain.recovery`); this class applies the
         task half of `push_give_up` (a push with no parameters becomes a pick).
+    check_actions: try each action in the model of the scene before taking it, and refuse
+        those that fail (see the module's docstring).
     """
 
     def __init__(
@@ -35,11 +50,13 @@ class HierarchicalAgent:
         planner: TaskPlanner,
         motion: MotionGenerator,
         rules: RecoveryRules = ALL_RULES,
+        check_actions: bool = False,
     ) -> None:
         self.name = name
         self.planner = planner
         self.motion = motion
         self.rules = rules
+        self.check_actions = check_actions
 
     def reset(self, goal: Goal, seed: int) -> None:
         self.planner.reset(goal, seed)
@@ -52,9 +69,43 @@ class HierarchicalAgent:
         goal: Goal,
         feasible: Feasibility | None = None,
     ) -> Decision:
-        task = self.planner.next_action(state, goal)
+        if not self.check_actions or feasible is None:
+            return self._decide(sg, state, goal, feasible, frozenset())[0]
+        start = time.perf_counter()
+        refused: list[Action] = []
+        first: tuple[Decision, Action | None] | None = None
+        task_seconds = 0.0
+        for _ in range(REFUSALS + 1):
+            d, following = self._decide(sg, state, goal, feasible, frozenset(refused))
+            task_seconds += d.task_seconds
+            if d.action is None:
+                break
+            if self._carried_out(sg, d, following, feasible):
+                first = None
+                break
+            first = first or (d, following)
+            refused.append(d.action)
+        if first is not None:
+            d, following = first
+            if d.params is not None:  # the generator's memory back on this action
+                self.motion.propose(sg, d.action, following, feasible)
+        motion_seconds = time.perf_counter() - start - task_seconds
+        return replace(d, task_seconds=task_seconds, motion_seconds=motion_seconds)
+
+    def _decide(
+        self,
+        sg: GeometricSceneGraph,
+        state: SymbolicSceneGraph,
+        goal: Goal,
+        feasible: Feasibility | None,
+        refused: frozenset[Action],
+    ) -> tuple[Decision, Action | None]:
+        """The planner's next action (never one of `refused`) with its parameters, and the
+        action the planner means to take after it."""
+        task = self.planner.next_action(state, goal, refused) if refused else None
+        task = task or self.planner.next_action(state, goal)
         if task.action is None:
-            return Decision(None, None, task.seconds, 0.0, task.note)
+            return Decision(None, None, task.seconds, 0.0, task.note), None
         start = time.perf_counter()
         action, subgoal = task.action, task.subgoal
         params = self.motion.propose(sg, action, task.following, feasible)
@@ -67,7 +118,32 @@ class HierarchicalAgent:
             params = self.motion.propose(sg, action, None, feasible)
         note = "" if params else f"every parameter choice for {action} failed"
         seconds = time.perf_counter() - start
-        return Decision(action, params, task.seconds, seconds, note, subgoal)
+        decision = Decision(action, params, task.seconds, seconds, note, subgoal)
+        return decision, task.following if action == task.action else None
+
+    def _carried_out(
+        self,
+        sg: GeometricSceneGraph,
+        d: Decision,
+        following: Action | None,
+        feasible: Feasibility,
+    ) -> bool:
+        """Whether the decision's primitive plans in the model of the scene and, for a pick
+        followed by a place or a stack, whether that plans once the pick is done."""
+        if d.params is None or not feasible(d.params):
+            return False
+        trial_of = getattr(feasible, "trial", None)  # a model to try primitives in
+        if not isinstance(d.action, Pick) or following is None or trial_of is None:
+            return True
+        with trial_of() as trial:
+            ok = trial.run(d.params).ok
+            if ok:
+                after = trial.scene_graph()
+                then = push_after(following, sg.world)
+                params = self.motion.propose(after, following, then, feasible)
+                ok = params is not None and feasible(params)
+        self.motion.propose(sg, d.action, following, feasible)  # its memory back in this scene
+        return ok
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
         self.motion.observe(params, outcome)

@@ -70,6 +70,9 @@ TASK_PLANNERS: dict[str, Callable[[Path, RecoveryRules], TaskPlanner]] = {
     # and the picks other goal literals still need stay likely
     "regression-ahead": _regression_ahead,
     "regression-ahead-chain": _regression_ahead_chain,  # the look up the chain alone
+    # the same planner; the agent tries each action in its model first and refuses those
+    # that do not plan (`agents/hierarchical.py`)
+    "regression-ahead-checked": _regression_ahead,
     "regression-paper": _regression_paper,  # the paper's loop (`paper_loop.py`), no rules
     "forward": _forward,
     "fd": _fast_downward,
@@ -133,6 +136,8 @@ WHOLE_AGENTS: dict[str, str] = {
     "then evaluate only the streams the plan uses",
     "stream-focused-goal": "the same with the goal-directed streams of stream-goal",
 }
+# task planners whose agent checks each action in its model before taking it
+CHECKED_PLANNERS = ("regression-ahead-checked",)
 STREAM_AGENTS = ("stream", "stream-goal", "stream-focused", "stream-focused-goal")
 AGENT_NAMES = [*AGENTS, *WHOLE_AGENTS]
 # The search-based baselines Table 2 may time against ours (`hsgplan bench timing --search`),
@@ -192,6 +197,7 @@ def agent_parts(name: str) -> tuple[str, str]:
 LEARNED_PLANNERS = (
     "regression",
     "regression-ahead",
+    "regression-ahead-checked",
     "regression-ahead-chain",
     "regression-paper",
     "forward",
@@ -272,4 +278,5 @@ def make_agent(
         make_planner(planner, checkpoint, rules),
         make_motion(motion, motion_checkpoints, rules),
         rules,
+        check_actions=planner in CHECKED_PLANNERS,
     )

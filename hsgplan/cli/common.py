@@ -16,7 +16,7 @@ from rich.table import Table
 from rich.text import Text
 from typer.core import TyperGroup
 
-from hsgplan.agents.registry import AGENT_NAMES, MOTION_GENERATORS, TASK_PLANNERS
+from hsgplan.agents.registry import AGENT_NAMES, CHECKED_PLANNERS, MOTION_GENERATORS, TASK_PLANNERS
 from hsgplan.domain.checks import BOUNDS, check_output, read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import PROTOCOLS
@@ -286,6 +286,10 @@ def choice(what: str, names) -> type[StrEnum]:
 
 AgentName = choice("AgentName", AGENT_NAMES)
 PlannerName = choice("PlannerName", TASK_PLANNERS)
+# the symbolic loop has no model of the scene for an agent to check actions in
+SymbolicPlannerName = choice(
+    "SymbolicPlannerName", [p for p in TASK_PLANNERS if p not in CHECKED_PLANNERS]
+)
 MotionName = choice("MotionName", MOTION_GENERATORS)
 ProtocolName = choice("ProtocolName", PROTOCOLS)
 

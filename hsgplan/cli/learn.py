@@ -12,12 +12,12 @@ from rich.progress import Progress
 from hsgplan.cli.common import (
     CollectWorkers,
     MarkdownFlag,
-    PlannerName,
     ProtocolName,
     RayAddress,
     RunFolder,
     SceneFiles,
     Summaries,
+    SymbolicPlannerName,
     bounded_option,
     check_ray,
     dash,
@@ -38,7 +38,7 @@ from hsgplan.paths import REACH_HELD_OUT, RUNS, TASK_CHECKPOINT
 train_app = typer.Typer(
     cls=Summaries, no_args_is_help=True, help="Train the learned models (resumable)."
 )
-REGRESSION = PlannerName("regression")
+REGRESSION = SymbolicPlannerName("regression")
 
 
 @train_app.command("task")
@@ -111,7 +111,7 @@ RECOVERING_PROTOCOL = ProtocolName("recovering")
 
 @refuses_bad_input
 def eval_task(
-    planner: Annotated[PlannerName, typer.Option(help="Task planner.")] = REGRESSION,
+    planner: Annotated[SymbolicPlannerName, typer.Option(help="Task planner.")] = REGRESSION,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
     goals: Annotated[int, bounded_option("goals", "Random goals per size.")] = 100,
     seed: Annotated[int, bounded_option("seed", "Seed of the goals and start states.")] = 0,

@@ -51,4 +51,8 @@ class TaskPlanner(Protocol):
     def reset(self, goal: Goal, seed: int) -> None:
         """A new episode towards `goal`, seeded."""
 
-    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision: ...
+    def next_action(
+        self, state: SymbolicSceneGraph, goal: Goal, refused: frozenset[Action] = frozenset()
+    ) -> TaskDecision:
+        """The next action from `state` towards `goal`, never one of `refused` (actions an
+        agent found it cannot carry out from here: it asks again without them)."""

@@ -219,7 +219,9 @@ class FastDownwardTaskPlanner:
     def reset(self, goal: Goal | None, seed: int) -> None:
         self.plan = None
 
-    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
+    def next_action(
+        self, state: SymbolicSceneGraph, goal: Goal, refused: frozenset[Action] = frozenset()
+    ) -> TaskDecision:
         start = time.perf_counter()
         plan = self._remaining(state) if self.follow_plan else None
         if plan is None:
@@ -230,6 +232,8 @@ class FastDownwardTaskPlanner:
         if not plan.actions:
             return TaskDecision.none("the goal holds", start)
         action = plan.actions[0]
+        if action in refused:  # an optimal plan has no second choice to offer
+            return TaskDecision.none(f"the plan's next action {action} was refused", start)
         following = plan.actions[1] if len(plan.actions) > 1 else None
         seconds = time.perf_counter() - start
         return TaskDecision(action, intended_literal(action), seconds, following=following)

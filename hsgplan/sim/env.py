@@ -122,6 +122,9 @@ class KitchenStorageEnv(gymnasium.Env):
         self.last_plan: MotionPlan | None = None
         # dry runs' plans, each with the state of the scene it was made in (`_state`)
         self._checked: dict[PrimitiveParams, tuple[MotionPlan, float, tuple]] = {}
+        # dry runs that found no plan, with the state they were made in: asked again there,
+        # the answer is the same
+        self._unplannable: set[tuple[PrimitiveParams, tuple]] = set()
         # dry runs (as a feasibility check) and trials of whole plans, for agents that look ahead
         self.lookahead = Lookahead(self._planning_scene, self.check)
 
@@ -148,6 +151,7 @@ class KitchenStorageEnv(gymnasium.Env):
         )
         self.steps = 0
         self._checked.clear()
+        self._unplannable.clear()
         self._seen = self._judged = self._released = None
         if self.believing:
             self.world = BeliefWorld(options.objects(), scene_seed, options.goal.world)
@@ -190,6 +194,7 @@ class KitchenStorageEnv(gymnasium.Env):
             # The plan is part of this primitive's cost: its time is added back.
             outcome = Outcome(outcome.status, outcome.detail, outcome.seconds + plan_seconds)
         self._checked.clear()
+        self._unplannable.clear()
         self.steps += 1
         before = self._judged_from  # the look the step is judged from (after any relook)
         typed = self._observe()
@@ -215,12 +220,22 @@ class KitchenStorageEnv(gymnasium.Env):
 
     def check(self, action: PrimitiveParams) -> bool:
         """A dry run: whether the primitive can be planned in the scene as it is. Nothing
-        moves, no step is spent, and a following `step` with the same action reuses the plan."""
+        moves, no step is spent, and a following `step` with the same action reuses the plan.
+        Asked again in the same state, it answers from the first dry run."""
+        state = self._state()
+        if (action, state) in self._unplannable:
+            return False
+        if action in self._checked and self._checked[action][2] == state:
+            return True
         start = time.perf_counter()
         plan = plan_primitive(self._planning_scene(), action)
+        # Planning puts the arm back, and the held object with it, to within rounding: a plan
+        # is kept with the state it leaves, which the step it is reused by compares with.
+        after = self._state()
         if isinstance(plan, PlanFailure):
+            self._unplannable.update(((action, state), (action, after)))
             return False
-        self._checked[action] = (plan, time.perf_counter() - start, self._state())
+        self._checked[action] = (plan, time.perf_counter() - start, after)
         return True
 
     def _state(self) -> tuple:

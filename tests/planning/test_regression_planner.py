@@ -124,3 +124,22 @@ def test_an_action_that_keeps_failing_is_tried_again_as_often_as_the_detour():
     assert actions[0] == refused
     at_start = sum(1 for a in actions if a == refused)
     assert at_start >= 5, [str(a) for a in actions]
+
+
+def test_a_refused_action_is_never_named_and_a_pick_names_what_it_is_for():
+    goal = parse_goal(GOALS[1], world=KITCHEN)
+    for seed in range(3):
+        start = random_state(goal.objects, random.Random(seed), world=KITCHEN)
+        refused: set = set()
+        for _ in range(4):
+            planner = RegressionPlanner(TASK_CHECKPOINT, seed=seed, look_ahead=True)
+            d = planner.next_action(start, goal, frozenset(refused))
+            if d.action is None:
+                break
+            assert d.action not in refused, (seed, d.action)
+            if isinstance(d.action, Pick) and d.subgoal == in_grasp(d.action.obj):
+                # the place up the chain, of the same object (a goal literal or on the way)
+                assert isinstance(d.following, Place), (seed, d)
+                assert d.following.obj == d.action.obj
+            refused.add(d.action)
+        assert refused, seed

@@ -50,7 +50,9 @@ class ForwardPlanner:
         self._failed: dict[SymbolicSceneGraph, Counter[Action]] = {}
 
     @torch.inference_mode()
-    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
+    def next_action(
+        self, state: SymbolicSceneGraph, goal: Goal, refused: frozenset[Action] = frozenset()
+    ) -> TaskDecision:
         start = time.perf_counter()
         if goal.satisfied_by(state):
             return TaskDecision.none("the goal holds", start)
@@ -60,7 +62,8 @@ class ForwardPlanner:
         ranked = []
         for flat in probs.flatten().argsort(descending=True).tolist()[: self.TOP]:
             lit = slots.literal(*divmod(flat, probs.shape[1]))
-            if not state.holds(lit) and (action := action_for(lit, state)) is not None:
+            action = None if state.holds(lit) else action_for(lit, state)
+            if action is not None and action not in refused:
                 ranked.append((lit, action))
         if self._last is not None and self._last[0] == state:
             self._failed.setdefault(state, Counter())[self._last[1]] += 1

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import torch
 
+from hsgplan.domain.actions import Action
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.recovery import RecoveryRules
 from hsgplan.planning.base import TaskDecision
@@ -48,16 +49,18 @@ class PaperRegressionPlanner(RegressionPlanner):
         super().__init__(checkpoint, seed, max_depth, RecoveryRules.none())
 
     @torch.inference_mode()
-    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
+    def next_action(
+        self, state: SymbolicSceneGraph, goal: Goal, refused: frozenset[Action] = frozenset()
+    ) -> TaskDecision:
         start = time.perf_counter()
         if not (unsatisfied := unsatisfied_literals(state, goal)):
             return TaskDecision.none("the goal holds", start)
         for _ in range(TRIES):
-            if found := self._descend(state, goal, unsatisfied):
+            if found := self._descend(state, goal, unsatisfied, refused):
                 return TaskDecision.taken(found[1], found[0], start, state.world)
         return TaskDecision.none("regression stuck", start)
 
-    def _descend(self, state, goal: Goal, candidates: list):
+    def _descend(self, state, goal: Goal, candidates: list, refused=frozenset()):
         """One path down from the goal: (literal, action) where f_reach says "reachable", or
         None where the path ends first."""
         context = frozenset(goal.literals)
@@ -65,7 +68,8 @@ class PaperRegressionPlanner(RegressionPlanner):
         for _ in range(self.max_depth):
             lit = self.rng.choice(candidates)
             node = Node(lit, context, (*path, lit))
-            if self.reachable(state, [lit])[0] and (action := action_for(lit, state)):
+            action = action_for(lit, state)
+            if action is not None and action not in refused and self.reachable(state, [lit])[0]:
                 return lit, action
             (pre,) = self._preimages(state, [node])
             context = frozenset((context - {lit}) | {m for m in pre if m.positive})

@@ -16,14 +16,14 @@ from __future__ import annotations
 import random
 import time
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from hsgplan.domain.actions import Action
+from hsgplan.domain.actions import Action, Pick
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.predicates import Literal
@@ -37,7 +37,7 @@ from hsgplan.planning.regression.encoding import (
     touching,
 )
 from hsgplan.planning.regression.gnn import load_network
-from hsgplan.planning.regression.lookahead import chain_reachable, keeps_picks
+from hsgplan.planning.regression.lookahead import chain_reachable, imagined, keeps_picks
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 MAX_DEPTH = 8
@@ -184,7 +184,9 @@ class RegressionPlanner:
         return logits.softmax(-1)[:, 1].tolist()
 
     @torch.inference_mode()
-    def next_action(self, state: SymbolicSceneGraph, goal: Goal) -> TaskDecision:
+    def next_action(
+        self, state: SymbolicSceneGraph, goal: Goal, refused: frozenset[Action] = frozenset()
+    ) -> TaskDecision:
         start = time.perf_counter()
         if not (unsatisfied := unsatisfied_literals(state, goal)):
             return TaskDecision.none("the goal holds", start)
@@ -192,7 +194,8 @@ class RegressionPlanner:
         if rules.failed_goal_waits and self._last is not None and self._last[0] == state:
             self._failed_roots.add(self._last[2])
         taken = self._taken.setdefault((goal, state), Counter())
-        if (step := self._follow(state, goal, taken if rules.avoid_taken else ())) is not None:
+        kept = refused | set(taken) if rules.avoid_taken else refused
+        if (step := self._follow(state, goal, kept)) is not None:
             taken[step[1]] += 1
             self._last = (state, step[1], step[2])
             return TaskDecision.taken(step[1], step[0], start, state.world)
@@ -216,10 +219,10 @@ class RegressionPlanner:
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
         seen: dict[Literal, tuple[float, Node]] = {}
-        passes = [(set(taken), None)] if rules.avoid_taken else []
+        passes = [(set(taken) | refused, None)] if rules.avoid_taken else []
         if rules.least_taken:
-            passes.append((set(), taken))
-        for avoid, counts in passes or [(set(), None)]:
+            passes.append((set(refused), taken))
+        for avoid, counts in passes or [(set(refused), None)]:
             vetoed: list[Node] = []
             for frontier in (free, [x for x in pairs if x not in free]):
                 found = self._search(state, frontier, avoid, seen, counts, vetoed)
@@ -247,7 +250,14 @@ class RegressionPlanner:
         taken[action] += 1
         self._plan = (goal, list(reversed(node.chain)), node.path[0])
         self._last = (state, action, node.path[0])
-        return TaskDecision.taken(action, node.lit, start, state.world)
+        decision = TaskDecision.taken(action, node.lit, start, state.world)
+        if isinstance(action, Pick) and node.chain:
+            # what the pick is for: the action of the literal next up the chain, in the state
+            # with the object in hand (an agent that checks its actions tries both)
+            after = imagined(state, node.lit)
+            up = action_for(node.chain[-1][0], after) if after is not None else None
+            decision = replace(decision, following=up)
+        return decision
 
     def _follow(self, state, goal, avoid) -> tuple[Literal, Action, Literal] | None:
         """The next step up the kept chain, if its preimage holds now, and the chain's root."""
