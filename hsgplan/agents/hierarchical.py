@@ -14,7 +14,7 @@ without it, up to `REFUSALS` times, after which its first choice is taken as wit
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 from hsgplan.agents.base import Decision
 from hsgplan.domain.actions import Action, Pick, Push, push_after
@@ -31,6 +31,16 @@ from hsgplan.sim.outcome import Outcome
 # Actions refused per decision before the task planner's first choice is taken regardless: a
 # budget, as the dry runs per proposal are, not tuned.
 REFUSALS = 4
+
+
+@dataclass(frozen=True)
+class _Choice:
+    """A decision, the action the task planner named for it (a push given up becomes a pick)
+    and the action the planner means to take after it."""
+
+    decision: Decision
+    named: Action | None
+    following: Action | None
 
 
 class HierarchicalAgent:
@@ -70,25 +80,26 @@ class HierarchicalAgent:
         feasible: Feasibility | None = None,
     ) -> Decision:
         if not self.check_actions or feasible is None:
-            return self._decide(sg, state, goal, feasible, frozenset())[0]
+            return self._decide(sg, state, goal, feasible, frozenset()).decision
         start = time.perf_counter()
         refused: list[Action] = []
-        first: tuple[Decision, Action | None] | None = None
+        first: _Choice | None = None
         task_seconds = 0.0
         for _ in range(REFUSALS + 1):
-            d, following = self._decide(sg, state, goal, feasible, frozenset(refused))
+            choice = self._decide(sg, state, goal, feasible, frozenset(refused))
+            d = choice.decision
             task_seconds += d.task_seconds
-            if d.action is None:
+            if choice.named is None:
                 break
-            if self._carried_out(sg, d, following, feasible):
+            if self._carried_out(sg, d, choice.following, feasible):
                 first = None
                 break
-            first = first or (d, following)
-            refused.append(d.action)
+            first = first or choice
+            refused.append(choice.named)
         if first is not None:
-            d, following = first
+            d = first.decision
             if d.params is not None:  # the generator's memory back on this action
-                self.motion.propose(sg, d.action, following, feasible)
+                self.motion.propose(sg, d.action, first.following, feasible)
         motion_seconds = time.perf_counter() - start - task_seconds
         return replace(d, task_seconds=task_seconds, motion_seconds=motion_seconds)
 
@@ -99,13 +110,12 @@ class HierarchicalAgent:
         goal: Goal,
         feasible: Feasibility | None,
         refused: frozenset[Action],
-    ) -> tuple[Decision, Action | None]:
-        """The planner's next action (never one of `refused`) with its parameters, and the
-        action the planner means to take after it."""
+    ) -> _Choice:
+        """The planner's next action (never one of `refused`) with its parameters."""
         task = self.planner.next_action(state, goal, refused) if refused else None
         task = task or self.planner.next_action(state, goal)
         if task.action is None:
-            return Decision(None, None, task.seconds, 0.0, task.note), None
+            return _Choice(Decision(None, None, task.seconds, 0.0, task.note), None, None)
         start = time.perf_counter()
         action, subgoal = task.action, task.subgoal
         params = self.motion.propose(sg, action, task.following, feasible)
@@ -119,7 +129,8 @@ class HierarchicalAgent:
         note = "" if params else f"every parameter choice for {action} failed"
         seconds = time.perf_counter() - start
         decision = Decision(action, params, task.seconds, seconds, note, subgoal)
-        return decision, task.following if action == task.action else None
+        following = task.following if action == task.action else None
+        return _Choice(decision, task.action, following)
 
     def _carried_out(
         self,
