@@ -16,14 +16,16 @@ SEED = 3
 
 
 @pytest.mark.slow
-def test_moving_the_true_objects_after_a_look_changes_neither_belief_nor_decision():
+# the second agent tries each action in its model (a pick run there and taken back)
+@pytest.mark.parametrize("agent_name", ["learned", "regression-ahead-checked+gnn-checked"])
+def test_moving_the_true_objects_after_a_look_changes_neither_belief_nor_decision(agent_name):
     env = KitchenStorageEnv(observer=make_observer("rgb"), world=KITCHEN)
     try:
         _, info = env.reset(seed=SEED, options=ResetOptions(GOAL))
         obs = info["observation"]
 
         def decide():
-            agent = make_agent("learned")
+            agent = make_agent(agent_name)
             agent.reset(GOAL, SEED)
             return agent.decide(obs.scene_graph, obs.symbols.state, GOAL, feasible=env.lookahead)
 
