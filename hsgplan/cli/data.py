@@ -110,9 +110,11 @@ def _collect_command(primitive: str, default_samples: int):
         tasks_per_chunk: Annotated[
             int, config_option(CollectConfig, "tasks_per_chunk", "Tasks per unit of work.")
         ] = config_default(CollectConfig, "tasks_per_chunk"),
+        scene: SceneOption = None,
     ) -> None:
         check_ray(ray)
-        _collect(primitive, samples, workers, seed, ray, out_dir, tasks_per_chunk)
+        where = None if scene is None else str(scene)
+        _collect(primitive, samples, workers, seed, ray, out_dir, tasks_per_chunk, where)
 
     command.__doc__ = (
         f"Self-supervised {primitive} data: uniformly sampled bins tried in generated scenes."
@@ -125,11 +127,20 @@ app.command("place")(_collect_command("place", 14573))
 app.command("push")(_collect_command("push", 8000))
 
 
-def _collect(primitive: str, samples: int, workers: int, seed: int, ray, out_dir: Path, chunk: int):
+def _collect(
+    primitive: str,
+    samples: int,
+    workers: int,
+    seed: int,
+    ray,
+    out_dir: Path,
+    chunk: int,
+    scene: str | None,
+):
     from hsgplan.collect.motion import collect
     from hsgplan.domain.parameters import MotionPrimitive
 
-    config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray, chunk)
+    config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray, chunk, scene)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task(f"{primitive} samples", total=samples)
         summary = collect(config, out_dir, lambda n: progress.update(bar, completed=n))

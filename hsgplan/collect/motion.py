@@ -30,8 +30,11 @@ from hsgplan.domain.checks import (
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
+from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import read_world
 from hsgplan.runner.engines import engine
 from hsgplan.runner.run_folder import check_own, claim
+from hsgplan.scene_graph.names import NAMES_WORLD
 
 WORK = "work"
 REJECTED = "rejected"
@@ -46,19 +49,31 @@ class CollectConfig:
     ray_address: str | None = None
     # the unit of work, and of what an interruption loses
     tasks_per_chunk: int = setting(TASKS_PER_CHUNK, lo=1, hi=MAX_TASKS_PER_CHUNK)
+    # a scene file whose world the tasks are drawn and staged in (None: the kitchen)
+    scene: str | None = None
 
     def __post_init__(self) -> None:
         check_fields(self)
+        if self.scene is not None and Path(self.scene).is_dir():
+            raise InvalidInputError(
+                f"--scene {self.scene}: a motion dataset is collected in one world; "
+                "give one scene file"
+            )
+
+    def world(self) -> World:
+        """The world the tasks are drawn and staged in (a bad scene file refused in one line)."""
+        return NAMES_WORLD if self.scene is None else read_world(self.scene)
 
     def dataset_settings(self) -> dict:
-        """What decides a dataset's rows (the chunking does not), kept in its manifest."""
+        """What decides a dataset's rows (the chunking does not), kept in its manifest; a
+        kitchen collection records no scene, as before scenes could be given."""
         return {
             "primitive": self.primitive.value,
             "seed": self.seed,
             "samples": self.samples,
             "attempts_per_task": ATTEMPTS_PER_TASK[self.primitive],
             "schema_version": store.SCHEMA_VERSION,
-        }
+        } | ({} if self.scene is None else {"scene": self.scene})
 
 
 @dataclass(frozen=True)
@@ -87,13 +102,15 @@ def check_out(config: CollectConfig, out: Path) -> None:
         if made is None or {k: v for k, v in made.items() if k != "sha256"} != (
             config.dataset_settings()
         ):
-            was = f" (samples {made.get('samples')}, seed {made.get('seed')})" if made else ""
+            where = f", scene {made['scene']}" if made and made.get("scene") else ""
+            settings = f"samples {made.get('samples')}, seed {made.get('seed')}" if made else ""
+            was = f" ({settings}{where})" if made else ""
             raise InvalidInputError(
                 f"'{dataset}' holds a dataset collected with other settings{was}; use another --out"
             )
 
 
-def _done_chunks(config: CollectConfig, folder: Path) -> tuple[dict[int, int], int]:
+def _done_chunks(config: CollectConfig, folder: Path, world: World) -> tuple[dict[int, int], int]:
     """Successful trials in each chunk on disk, and how many files were set aside: a damaged
     chunk, or one that is not the chunk its name says, is moved to `rejected/` (never kept,
     never silently deleted) and runs again."""
@@ -103,7 +120,7 @@ def _done_chunks(config: CollectConfig, folder: Path) -> tuple[dict[int, int], i
     for k, path in store.chunk_files(folder).items():
         try:
             data, _ = store.load_chunk(
-                path, config.primitive, config.seed, k, config.tasks_per_chunk
+                path, config.primitive, config.seed, k, config.tasks_per_chunk, world
             )
             done[k] = int(data.ok.sum())
         except InvalidInputError:
@@ -131,6 +148,7 @@ def collect(
 
     `progress` is told the number of successes on disk after every finished chunk.
     """
+    world = config.world()
     check_out(config, out)
     folder = work_folder(out, config.primitive, config.seed)
     claim(
@@ -143,21 +161,24 @@ def collect(
             "attempts_per_task": ATTEMPTS_PER_TASK[config.primitive],
             "schema_version": store.SCHEMA_VERSION,
             "chunk_format": store.CHUNK_FORMAT,
-        },
+        }
+        | ({} if config.scene is None else {"scene": config.scene}),
         f"'{folder}' holds chunks made with other collection settings; use another --out",
     )
-    store.write_schema(out)
-    done, rejected = _done_chunks(config, folder)
+    store.write_schema(out, world)
+    done, rejected = _done_chunks(config, folder, world)
     ran = 0
     if progress:
         progress(sum(done.values()))
     if _prefix_done(done, config.samples) is None:
         with engine(config.workers, config.ray_address) as runner:
-            ran = _run(runner, config, folder, done, progress)
-    return _pack(config, out, folder, done, ran, rejected)
+            ran = _run(runner, config, folder, done, progress, world)
+    return _pack(config, out, folder, done, ran, rejected, world)
 
 
-def _run(runner, config: CollectConfig, folder: Path, done: dict[int, int], progress) -> int:
+def _run(
+    runner, config: CollectConfig, folder: Path, done: dict[int, int], progress, world: World
+) -> int:
     in_flight: dict[object, int] = {}
     window = 2 * config.workers
     ran = 0
@@ -168,12 +189,12 @@ def _run(runner, config: CollectConfig, folder: Path, done: dict[int, int], prog
         while len(in_flight) < window and (expected < config.samples or not in_flight):
             while nxt in done or nxt in in_flight.values():
                 nxt += 1
-            job = (config.primitive.value, config.seed, nxt, config.tasks_per_chunk)
+            job = (config.primitive.value, config.seed, nxt, config.tasks_per_chunk, config.scene)
             in_flight[runner.submit(run_chunk, *job)] = nxt
             expected += per_chunk
         handle, result = runner.next_done(set(in_flight))
         del in_flight[handle]
-        store.save_chunk(folder, result)
+        store.save_chunk(folder, result, world)
         done[result.chunk] = sum(t.ok for t in result.trials)
         ran += 1
         if progress:
@@ -182,17 +203,16 @@ def _run(runner, config: CollectConfig, folder: Path, done: dict[int, int], prog
 
 
 def _pack(
-    config: CollectConfig, out: Path, folder: Path, done, ran: int, rejected: int
+    config: CollectConfig, out: Path, folder: Path, done, ran: int, rejected: int, world: World
 ) -> CollectSummary:
     n_chunks = _prefix_done(done, config.samples) or 0
+    kind, seed, per_chunk = config.primitive, config.seed, config.tasks_per_chunk
     chunks = [
-        store.load_chunk(
-            store.chunk_path(folder, k), config.primitive, config.seed, k, config.tasks_per_chunk
-        )
+        store.load_chunk(store.chunk_path(folder, k), kind, seed, k, per_chunk, world)
         for k in range(n_chunks)
     ]
     unstaged = sum(u for _, u in chunks)
-    trials = store.concat(config.primitive, [data for data, _ in chunks])
+    trials = store.concat(config.primitive, [data for data, _ in chunks], world)
     order = np.lexsort((trials.attempt, trials.task))
     ok = order[trials.ok[order]][: config.samples]
     dataset = out / f"{config.primitive.value}.npz"

@@ -8,12 +8,14 @@ Schema (version `SCHEMA_VERSION`), written beside the data as `schema.json`:
 | attempt  | int8    | [S]       | try within the task                                           |
 | status   | int8    | [S]       | index into `STATUSES` (0 = success)                           |
 | crowding | int8    | [S]       | objects already on the target surface / inside the shelf      |
-| obj      | int8    | [S]       | index into the kitchen's object types, of the object moved    |
-| target   | int8    | [S]       | index into the kitchen's entity types, of the target          |
+| obj      | int8    | [S]       | index into the world's object types, of the object moved      |
+| target   | int8    | [S]       | index into the world's entity types, of the target            |
 | bins     | int8    | [S, 2]    | (x_bin, y_bin) for place, (angle_bin, dist_bin) for push      |
-| poses    | float32 | [S, 6, 7] | per object type: position, quaternion xyzw; NaN if absent     |
+| poses    | float32 | [S, T, 7] | per object type: position, quaternion xyzw; NaN if absent     |
 
-Simulated scenes hold at most one instance of each type, so a type index names an object. For
+The world is the kitchen (T = 6), or the scene file a collection was made in, which the
+dataset's manifest names (`scene`) and `schema.json` lists the types of. Simulated scenes hold
+at most one instance of each type, so a type index names an object. For
 place the object placed is the one held. A dataset file (`place.npz`, `push.npz`) holds the
 successful trials only; `place_trials.npz` / `push_trials.npz` every trial up to the last of
 them, failures included; the collector's chunk files hold every trial plus `unstaged`.
@@ -33,10 +35,12 @@ import numpy as np
 from hsgplan.data.motion_trials import ChunkResult, Trial
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import BINS, MotionPrimitive
+from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import recorded_worlds
 from hsgplan.files import atomic, write_atomically
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
-from hsgplan.scene_graph.names import ENTITY_NAMES, NAMES_WORLD, TYPE_NAMES
+from hsgplan.scene_graph.names import NAMES_WORLD, TYPE_NAMES
 from hsgplan.sim.outcome import Status
 
 # 2: a place that leaves an object unpickable is labelled `blocks_pick`; 3: a push task may
@@ -62,6 +66,15 @@ class MotionData:
     target: np.ndarray
     bins: np.ndarray
     poses: np.ndarray
+    world: World = NAMES_WORLD  # whose object and entity types the indices name
+
+    @property
+    def types(self) -> tuple[str, ...]:
+        return tuple(self.world.object_types)
+
+    @property
+    def entities(self) -> tuple[str, ...]:
+        return tuple(self.world.entity_types)
 
     def __len__(self) -> int:
         return len(self.task)
@@ -71,41 +84,47 @@ class MotionData:
         return self.status == STATUSES.index(Status.SUCCESS)
 
     def take(self, rows) -> MotionData:
-        return MotionData(self.primitive, *(getattr(self, f)[rows] for f in FIELDS))
+        rows_of = (getattr(self, f)[rows] for f in FIELDS)
+        return MotionData(self.primitive, *rows_of, world=self.world)
 
     def object_name(self, i: int) -> str:
-        return TYPES[int(self.obj[i])]
+        return self.types[int(self.obj[i])]
 
     def target_name(self, i: int) -> str:
-        return ENTITY_NAMES[int(self.target[i])]
+        return self.entities[int(self.target[i])]
 
     def scene_graph(self, i: int) -> GeometricSceneGraph:
         """s_g of row i, as the primitive found it."""
+        types = self.types
         poses = {
-            TYPES[k]: Pose(tuple(map(float, p[:3])), tuple(map(float, p[3:])))
+            types[k]: Pose(tuple(map(float, p[:3])), tuple(map(float, p[3:])))
             for k, p in enumerate(self.poses[i])
             if not np.isnan(p[0])
         }
         held = self.object_name(i) if self.primitive is MotionPrimitive.PLACE else None
-        return GeometricSceneGraph.from_poses(poses, held=held, world=NAMES_WORLD)
+        return GeometricSceneGraph.from_poses(poses, held=held, world=self.world)
 
 
-def from_trials(primitive: MotionPrimitive, trials: list[Trial]) -> MotionData:
+def from_trials(
+    primitive: MotionPrimitive, trials: list[Trial], world: World = NAMES_WORLD
+) -> MotionData:
     s = len(trials)
-    poses = np.full((s, len(TYPES), 7), np.nan, dtype=np.float32)
+    types, entities = tuple(world.object_types), tuple(world.entity_types)
+    poses = np.full((s, len(types), 7), np.nan, dtype=np.float32)
     for i, t in enumerate(trials):
         for node in t.before.nodes:
-            poses[i, TYPES.index(node.type_name)] = node.pose.position + node.pose.orientation
+            poses[i, types.index(node.type_name)] = node.pose.position + node.pose.orientation
     return MotionData(
         primitive,
         np.array([t.task for t in trials], dtype=np.int32),
         np.array([t.attempt for t in trials], dtype=np.int8),
         np.array([STATUSES.index(t.status) for t in trials], dtype=np.int8),
         np.array([t.crowding for t in trials], dtype=np.int8),
-        np.array([TYPES.index(t.obj) for t in trials], dtype=np.int8),
-        np.array([ENTITY_NAMES.index(t.target) for t in trials], dtype=np.int8),
+        np.array([types.index(t.obj) for t in trials], dtype=np.int8),
+        np.array([entities.index(t.target) for t in trials], dtype=np.int8),
         np.array([t.bins for t in trials], dtype=np.int8).reshape(s, 2),
         poses,
+        world,
     )
 
 
@@ -117,24 +136,27 @@ def save(path: Path, data: MotionData, **extra: np.ndarray) -> None:
         np.savez_compressed(f, primitive=np.array(data.primitive.value), **arrays, **extra)
 
 
-def load(path: Path) -> MotionData:
-    """Read a dataset or chunk file; a missing or damaged file is refused in one line."""
-    return _read(path)[0]
+def load(path: Path, world: World = NAMES_WORLD) -> MotionData:
+    """Read a dataset or chunk file of `world`; a missing or damaged file is refused in one
+    line."""
+    return _read(path, world)[0]
 
 
-def _read(path: Path) -> tuple[MotionData, dict[str, int]]:
+def _read(path: Path, world: World = NAMES_WORLD) -> tuple[MotionData, dict[str, int]]:
     """The rows and the integer extras (a chunk's index, seed, unstaged count) of a file."""
     if not path.is_file():
         raise InvalidInputError(f"'{path}': no such motion data file")
     try:
         with np.load(path, allow_pickle=False) as z:
-            data = MotionData(MotionPrimitive(str(z["primitive"])), *(z[f] for f in FIELDS))
+            kind = MotionPrimitive(str(z["primitive"]))
+            data = MotionData(kind, *(z[f] for f in FIELDS), world=world)
             extras = {k: int(z[k]) for k in z.files if k not in FIELDS and k != "primitive"}
     except Exception as e:  # zip, numpy and value errors alike: a damaged file, one line
         raise InvalidInputError(f"'{path}' is not a readable motion data file ({e})") from None
     n = len(data.task)
     shapes = [getattr(data, f).shape[:1] == (n,) for f in FIELDS]
-    if not all(shapes) or data.bins.shape[1:] != (2,) or data.poses.shape[1:] != (len(TYPES), 7):
+    poses_shape = (len(data.types), 7)
+    if not all(shapes) or data.bins.shape[1:] != (2,) or data.poses.shape[1:] != poses_shape:
         raise InvalidInputError(f"'{path}' does not follow the motion data schema")
     if problem := row_problem(data):
         raise InvalidInputError(f"'{path}' is damaged: {problem}")
@@ -156,8 +178,8 @@ def row_problem(data: MotionData) -> str | None:
         "attempt": (data.attempt, None),
         "crowding": (data.crowding, None),
         "status": (data.status, len(STATUSES)),
-        "obj": (data.obj, len(TYPES)),
-        "target": (data.target, len(ENTITY_NAMES)),
+        "obj": (data.obj, len(data.types)),
+        "target": (data.target, len(data.entities)),
         "x or angle bin": (data.bins[:, 0], nx),
         "y or distance bin": (data.bins[:, 1], ny),
     }
@@ -174,7 +196,7 @@ def row_problem(data: MotionData) -> str | None:
     if len(data) and absent[rows, data.obj.astype(np.int64)].any():
         i = int(np.argmax(absent[rows, data.obj.astype(np.int64)]))
         return f"row {i}: the object acted on, {data.object_name(i)}, has no pose"
-    target_is_object = data.target < len(TYPES)
+    target_is_object = data.target < len(data.types)
     target = np.where(target_is_object, data.target, 0).astype(np.int64)
     bad = target_is_object & (absent[rows, target] | (data.target == data.obj))
     if bad.any():
@@ -199,18 +221,23 @@ def chunk_files(folder: Path) -> dict[int, Path]:
     return dict(sorted(found.items()))
 
 
-def save_chunk(folder: Path, result: ChunkResult) -> None:
-    data = from_trials(result.primitive, list(result.trials))
+def save_chunk(folder: Path, result: ChunkResult, world: World = NAMES_WORLD) -> None:
+    data = from_trials(result.primitive, list(result.trials), world)
     extras = {"unstaged": result.unstaged, "chunk": result.chunk, "seed": result.seed}
     save(chunk_path(folder, result.chunk), data, **{k: np.array(v) for k, v in extras.items()})
 
 
 def load_chunk(
-    path: Path, primitive: MotionPrimitive, seed: int, chunk: int, tasks_per_chunk: int
+    path: Path,
+    primitive: MotionPrimitive,
+    seed: int,
+    chunk: int,
+    tasks_per_chunk: int,
+    world: World = NAMES_WORLD,
 ) -> tuple[MotionData, int]:
     """A chunk's rows and unstaged count, checked to be the chunk its name says of this
     collection: a damaged chunk, or one copied from another place, is refused in one line."""
-    data, extras = _read(path)
+    data, extras = _read(path, world)
     tasks = range(chunk * tasks_per_chunk, (chunk + 1) * tasks_per_chunk)
     own = (
         data.primitive is primitive
@@ -223,19 +250,22 @@ def load_chunk(
     return data, extras["unstaged"]
 
 
-def concat(primitive: MotionPrimitive, parts: list[MotionData]) -> MotionData:
+def concat(
+    primitive: MotionPrimitive, parts: list[MotionData], world: World = NAMES_WORLD
+) -> MotionData:
     if not parts:
-        return from_trials(primitive, [])
-    return MotionData(primitive, *(np.concatenate([getattr(p, f) for p in parts]) for f in FIELDS))
+        return from_trials(primitive, [], world)
+    joined = (np.concatenate([getattr(p, f) for p in parts]) for f in FIELDS)
+    return MotionData(primitive, *joined, world=world)
 
 
-def write_schema(folder: Path) -> None:
+def write_schema(folder: Path, world: World = NAMES_WORLD) -> None:
     doc = (__doc__ or "").split("Schema", 1)[1]
     schema = {
         "version": SCHEMA_VERSION,
         "statuses": [s.value for s in STATUSES],
-        "object_types": list(TYPES),
-        "entity_types": list(ENTITY_NAMES),
+        "object_types": list(world.object_types),
+        "entity_types": list(world.entity_types),
         "fields": FIELDS,
         "description": "Schema" + doc,
     }
@@ -275,7 +305,7 @@ def load_dataset(path: Path, primitive: MotionPrimitive | None = None) -> Motion
             f"'{path}' does not match its manifest {manifest_path(path).name} "
             "(damaged or replaced); collect it again"
         )
-    data = load(path)
+    data = load(path, dataset_world(path, manifest))
     if primitive is not None and data.primitive is not primitive:
         raise InvalidInputError(
             f"'{path}' holds {data.primitive.value} trials, not {primitive.value} ones"
@@ -291,3 +321,12 @@ def load_dataset(path: Path, primitive: MotionPrimitive | None = None) -> Motion
             f"{manifest.get('samples')!r}"
         )
     return data
+
+
+def dataset_world(path: Path, manifest: dict | None = None) -> World:
+    """The world a dataset file was collected in: the scene its manifest names, else the
+    kitchen (data collected before scenes could be given names none). A scene not found here
+    is refused in one line."""
+    manifest = read_manifest(path) if manifest is None else manifest
+    scene = (manifest or {}).get("scene")
+    return recorded_worlds(scene, NAMES_WORLD, path)[0]

@@ -24,6 +24,7 @@ import numpy as np
 from hsgplan.data.motion_tasks import MotionTask, draw_task
 from hsgplan.domain.parameters import BINS, MotionPrimitive, params_for
 from hsgplan.domain.predicates import Predicate
+from hsgplan.domain.scene_file import read_world
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.names import NAMES_WORLD
 from hsgplan.sim.motion_plans import can_pick
@@ -77,16 +78,22 @@ class ChunkResult:
 
 
 def run_chunk(
-    primitive: str, seed: int, chunk: int, tasks_per_chunk: int = TASKS_PER_CHUNK
+    primitive: str,
+    seed: int,
+    chunk: int,
+    tasks_per_chunk: int = TASKS_PER_CHUNK,
+    scene_file: str | None = None,
 ) -> ChunkResult:
-    """Stage every task of a chunk and try it; the worker entry point (pool or Ray)."""
+    """Stage every task of a chunk and try it; the worker entry point (pool or Ray). The
+    tasks are drawn and staged in the world of `scene_file`, else in the kitchen, whose names
+    the shipped data's columns index (`data.motion_store`)."""
     kind = MotionPrimitive(primitive)
+    world = NAMES_WORLD if scene_file is None else read_world(scene_file)
     trials: list[Trial] = []
     unstaged = 0
-    # staged in the world whose names the data's columns index (`data.motion_store`)
-    with Scene((), seed=seed, visuals=False, world=NAMES_WORLD) as scene:
+    with Scene((), seed=seed, visuals=False, world=world) as scene:
         for index in range(chunk * tasks_per_chunk, (chunk + 1) * tasks_per_chunk):
-            got = run_task(scene, draw_task(kind, seed, index, NAMES_WORLD))
+            got = run_task(scene, draw_task(kind, seed, index, world))
             unstaged += got is None
             trials += got or []
     return ChunkResult(kind, seed, chunk, tuple(trials), unstaged)

@@ -40,6 +40,7 @@ from hsgplan.files import write_atomically
 from hsgplan.motion.models import MotionNetConfig, build
 from hsgplan.paths import MOTION_DATA, shipped
 from hsgplan.scene_graph.grounding import dims, ground
+from hsgplan.scene_graph.names import NAMES_WORLD
 from hsgplan.training import TRAIN_CONFIG
 
 
@@ -112,6 +113,13 @@ def _training_rows(config: MotionTrainConfig) -> MotionData:
         data = data.take(slice(0, config.samples))
     if len(data) == 0:
         raise InvalidInputError(f"no successful {config.primitive} samples in '{folder}'")
+    others = data.world.names_beyond(NAMES_WORLD)
+    if config.features == "names" and others:
+        raise InvalidInputError(
+            f"'{folder}' was collected in a scene that names others than the kitchen "
+            f"({', '.join(others)}); networks of features names know the kitchen's names "
+            "alone: train with features geometry"
+        )
     if config.loss == "ce":
         return data
     trials = load_dataset(folder / f"{config.primitive}_trials.npz", primitive)

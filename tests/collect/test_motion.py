@@ -1,10 +1,12 @@
 """Self-supervised motion data: task draws, resume after a kill, and the Ray path."""
 
+import json
 import os
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +20,7 @@ from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.predicates import Predicate
 
 PLACE, PUSH = MotionPrimitive.PLACE, MotionPrimitive.PUSH
+NEW_OBJECTS = Path(__file__).resolve().parents[2] / "scenes" / "new-objects"
 
 
 def test_tasks_are_drawn_from_their_index_alone():
@@ -233,3 +236,39 @@ def test_some_push_tasks_start_where_a_short_push_leaves_the_can():
             farthest_place = place_xy(task.obj, "prepush_a", PLACE_BINS - 1, 0, world=KITCHEN)[0]
             assert x > farthest_place
             release(scene, staged)
+
+
+def test_a_collection_in_a_scene_file_is_made_and_read_in_its_world(tmp_path):
+    from hsgplan.domain.scene_file import read_world
+    from hsgplan.motion.train import MotionTrainConfig, train_motion
+
+    scene = tmp_path / "groceries.toml"  # a copy, so that it can go
+    scene.write_text((NEW_OBJECTS / "new-objects-000.toml").read_text())
+    world = read_world(scene)
+    out = tmp_path / "data"
+    config = CollectConfig(PLACE, 3, workers=1, tasks_per_chunk=2, scene=str(scene))
+    summary = collect(config, out)
+    data = store.load_dataset(summary.dataset, PLACE)
+    assert data.world == world and len(data) == 3
+    assert data.poses.shape[1] == len(world.object_types)
+    assert {data.object_name(i) for i in range(3)} <= set(world.object_types)
+    assert data.scene_graph(0).held == data.object_name(0)
+    assert store.read_manifest(summary.dataset)["scene"] == str(scene)
+    schema = json.loads((out / store.SCHEMA).read_text())
+    assert schema["object_types"] == list(world.object_types)
+    # the same folder in the kitchen is another collection
+    with pytest.raises(InvalidInputError, match="scene"):
+        collect(CollectConfig(PLACE, 3, workers=1, tasks_per_chunk=2), out)
+    # networks that know the kitchen's names cannot learn from it
+    names = MotionTrainConfig(data=str(out), epochs=1)
+    with pytest.raises(InvalidInputError, match="features geometry"):
+        train_motion(names, tmp_path / "net")
+    assert not (tmp_path / "net").exists()
+    scene.unlink()
+    with pytest.raises(InvalidInputError, match="not found here"):
+        store.load_dataset(summary.dataset, PLACE)
+
+
+def test_a_folder_of_scenes_is_refused_for_motion_data():
+    with pytest.raises(InvalidInputError, match="one world"):
+        CollectConfig(PUSH, 3, scene=str(NEW_OBJECTS))
