@@ -34,10 +34,13 @@ class CollectTiming:
         return asdict(self) | {"samples_per_second": self.samples_per_second}
 
 
-def bench_collect(primitives: list[str], samples: int, workers: int) -> list[CollectTiming]:
+def bench_collect(
+    primitives: list[str], samples: int, workers: int, scene: str | None = None
+) -> list[CollectTiming]:
+    """Each primitive's collection timed, in the kitchen or in a scene file's world."""
     rows = []
     for p in primitives:
-        config = CollectConfig(MotionPrimitive(p), samples, BENCH_SEED, workers)
+        config = CollectConfig(MotionPrimitive(p), samples, BENCH_SEED, workers, scene=scene)
         with tempfile.TemporaryDirectory() as tmp:
             start = time.perf_counter()
             summary = collect(config, Path(tmp))

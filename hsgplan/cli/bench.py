@@ -262,6 +262,7 @@ def bench_collect(
     workers: Annotated[int, bounded_option("workers", "Processes.")] = 2,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
     markdown: MarkdownFlag = False,
+    scene: SceneOption = None,
 ) -> None:
     """Successful motion samples per second of the collector (wall time, start-up included)."""
     from hsgplan.benchmarks.collect import bench_collect as run
@@ -272,7 +273,7 @@ def bench_collect(
     for p in kinds:
         if p not in ("place", "push"):
             raise InvalidInputError(f"primitive '{p}': place or push")
-    rows = run(kinds, samples, workers)
+    rows = run(kinds, samples, workers, None if scene is None else str(scene))
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
@@ -288,7 +289,7 @@ def bench_collect(
         for r in rows
     ]
     print_table(
-        "Motion data collection speed",
+        f"Motion data collection speed{_in(scene)}",
         ("primitive", "workers", "samples", "trials successful", "seconds", "samples per s"),
         cells,
         markdown,
