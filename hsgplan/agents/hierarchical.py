@@ -112,8 +112,9 @@ class HierarchicalAgent:
         refused: frozenset[Action],
     ) -> _Choice:
         """The planner's next action (never one of `refused`) with its parameters."""
-        task = self.planner.next_action(state, goal, refused) if refused else None
-        task = task or self.planner.next_action(state, goal)
+        # a planner is asked with refusals only when there are some (not every one takes them)
+        ask = self.planner.next_action
+        task = ask(state, goal, refused) if refused else ask(state, goal)
         if task.action is None:
             return _Choice(Decision(None, None, task.seconds, 0.0, task.note), None, None)
         start = time.perf_counter()
