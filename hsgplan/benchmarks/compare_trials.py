@@ -12,9 +12,14 @@ from collections import Counter
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from hsgplan.data.motion_store import STATUSES, MotionData, chunk_files, load
+from hsgplan.data.motion_store import STATUSES, MotionData, chunk_files, dataset_world, load
+from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
+from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import recorded_worlds
+from hsgplan.runner.run_folder import CONFIG
+from hsgplan.scene_graph.names import NAMES_WORLD
 
 # (task, attempt) -> (bins, status index)
 Trials = dict[tuple[int, int], tuple[tuple[int, int], int]]
@@ -39,10 +44,21 @@ def read_trials(path: Path) -> tuple[MotionPrimitive, Trials]:
             raise InvalidInputError(f"'{path}': a folder without chunk files")
     else:
         files = [path]  # a missing or damaged file is refused by `load`, in one line
-    parts = [load(f) for f in files]
+    world = _world(path)
+    parts = [load(f, world) for f in files]
     if len({p.primitive for p in parts}) > 1:
         raise InvalidInputError(f"'{path}': chunks of both primitives")
     return parts[0].primitive, {k: v for p in parts for k, v in _rows(p)}
+
+
+def _world(path: Path) -> World:
+    """The world a collection was made in: a work folder's configuration, a file's manifest
+    (the kitchen where they name no scene)."""
+    if not path.is_dir():
+        return dataset_world(path)
+    config = path / CONFIG
+    scene = read_json(config, "collection settings").get("scene") if config.exists() else None
+    return recorded_worlds(scene, NAMES_WORLD, path)[0]
 
 
 def _rows(data: MotionData):

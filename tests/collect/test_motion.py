@@ -264,6 +264,12 @@ def test_a_collection_in_a_scene_file_is_made_and_read_in_its_world(tmp_path):
     with pytest.raises(InvalidInputError, match="features geometry"):
         train_motion(names, tmp_path / "net")
     assert not (tmp_path / "net").exists()
+    # the trial-by-trial comparison reads the chunks and the trials file in the same world
+    from hsgplan.benchmarks.compare_trials import compare, read_trials
+
+    _, chunks = read_trials(work_folder(out, PLACE, 0))
+    _, kept = read_trials(out / "place_trials.npz")
+    assert compare(chunks, kept).same_outcome == len(kept) > 0
     scene.unlink()
     with pytest.raises(InvalidInputError, match="not found here"):
         store.load_dataset(summary.dataset, PLACE)
