@@ -73,7 +73,12 @@ class CollectConfig:
             "samples": self.samples,
             "attempts_per_task": ATTEMPTS_PER_TASK[self.primitive],
             "schema_version": store.SCHEMA_VERSION,
-        } | ({} if self.scene is None else {"scene": self.scene})
+        } | self.scene_setting()
+
+    def scene_setting(self) -> dict:
+        """The scene as the settings record it: none for the kitchen, as before scenes could
+        be given (so the shipped data's settings stay as they were)."""
+        return {} if self.scene is None else {"scene": self.scene}
 
 
 @dataclass(frozen=True)
@@ -162,7 +167,7 @@ def collect(
             "schema_version": store.SCHEMA_VERSION,
             "chunk_format": store.CHUNK_FORMAT,
         }
-        | ({} if config.scene is None else {"scene": config.scene}),
+        | config.scene_setting(),
         f"'{folder}' holds chunks made with other collection settings; use another --out",
     )
     store.write_schema(out, world)

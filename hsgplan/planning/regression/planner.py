@@ -194,7 +194,7 @@ class RegressionPlanner:
         if rules.failed_goal_waits and self._last is not None and self._last[0] == state:
             self._failed_roots.add(self._last[2])
         taken = self._taken.setdefault((goal, state), Counter())
-        kept = refused | set(taken) if rules.avoid_taken else refused
+        kept = (refused | set(taken)) if rules.avoid_taken else refused
         if (step := self._follow(state, goal, kept)) is not None:
             taken[step[1]] += 1
             self._last = (state, step[1], step[2])
