@@ -4,11 +4,13 @@ import json
 from pathlib import Path
 
 import pytest
+import torch
 from typer.testing import CliRunner
 
 from hsgplan.checkpoint import write_manifest
 from hsgplan.cli import app
 from hsgplan.data.demos import load_demos
+from hsgplan.data.world_trials import WorldTrial
 from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
@@ -294,16 +296,27 @@ def test_a_demo_limit_trains_on_the_first_demonstrations_alone(tmp_path):
     assert not (tmp_path / "more").exists()
 
 
-def test_demonstrations_of_a_layout_are_learnt_in_it_and_not_mixed_with_another_world(tmp_path):
-    layout = Path(__file__).resolve().parents[2] / "scenes" / "layouts" / "layout-003.toml"
-    demos = tmp_path / "demos"
-    demos.mkdir()
-    meta = json.loads((DEMOS / "meta.json").read_text()) | {"scene": str(layout)}
-    (demos / "meta.json").write_text(json.dumps(meta))
-    (demos / "demos.jsonl").write_text((DEMOS / "demos.jsonl").read_text())
-    kitchen_trials = tmp_path / "reach"
-    kitchen_trials.mkdir()
-    (kitchen_trials / "config.json").write_text('{"kind": "reach", "seed": 0}')
-    config = TINY | {"demos": str(demos), "reach": "world", "world_trials": str(kitchen_trials)}
-    with pytest.raises(InvalidInputError, match="a planner learns in one world"):
-        train_task(TaskTrainConfig.from_json(config | {"epochs": 1}), tmp_path / "m", world=KITCHEN)
+def test_executed_primitives_are_learnt_in_the_worlds_they_were_staged_in(tmp_path):
+    from hsgplan.domain.actions import Pick
+    from hsgplan.evaluation.config import world_of_file
+    from hsgplan.planning.regression.encoding import with_features
+    from hsgplan.planning.regression.examples import world_reach_examples
+
+    scenes = Path(__file__).resolve().parents[2] / "scenes"
+    layout = world_of_file(str(scenes / "layouts" / "layout-003.toml"))
+    before = SymbolicSceneGraph.from_literals(["butter"], [on("butter", "shelf_a")], world=layout)
+    after = SymbolicSceneGraph.from_literals(["butter"], [in_grasp("butter")], world=layout)
+    trial = WorldTrial(before, Pick("butter"), "success", after)
+    (example,) = world_reach_examples([trial], [])[:1]
+    assert example.world is layout  # described in its own world, not the demonstrations'
+    in_layout = with_features(example.as_data(), layout, "geometry")
+    in_kitchen = with_features(example.as_data(), KITCHEN, "geometry")
+    assert not torch.equal(in_layout.x, in_kitchen.x)  # the shelves' sizes differ
+    # names describe the kitchen's groceries alone: trials among other groceries are refused
+    trials = tmp_path / "reach"
+    trials.mkdir()
+    new = scenes / "new-objects" / "new-objects-000.toml"
+    (trials / "config.json").write_text(json.dumps({"kind": "reach", "seed": 0, "scene": str(new)}))
+    config = TINY | {"reach": "world", "world_trials": str(trials), "epochs": 1}
+    with pytest.raises(InvalidInputError, match="know the kitchen's names alone"):
+        train_task(TaskTrainConfig.from_json(config), tmp_path / "m", world=KITCHEN)

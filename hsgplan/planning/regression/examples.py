@@ -34,7 +34,7 @@ from torch_geometric.data import Data
 from hsgplan.data.demos import Demo
 from hsgplan.data.world_trials import WorldTrial
 from hsgplan.domain.predicates import Literal, Predicate
-from hsgplan.domain.scene import EntityKind
+from hsgplan.domain.scene import EntityKind, World
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.planning.regression.augment import Trajectory, varied
 from hsgplan.planning.regression.encoding import DONT_CARE, FALSE, TRUE, Slots, encode
@@ -48,6 +48,9 @@ class Example:
     data: Data
     target: torch.Tensor  # [E, P] long
     mask: torch.Tensor  # [E, P] bool
+    # the world its state was in, where that is not the demonstrations' (a collection of
+    # executed primitives staged in other scenes): what features other than names describe
+    world: World | None = None
 
     def as_data(self) -> Data:
         d = self.data.clone()
@@ -160,7 +163,7 @@ def _labelled(state: SymbolicSceneGraph, labels: dict[Literal, bool]) -> Example
         e, p = slots.slot(lit)
         target[e, p] = int(yes)
         mask[e, p] = True
-    return Example(data, target, mask)
+    return Example(data, target, mask, state.world)
 
 
 def _examples_of(state: SymbolicSceneGraph, labels: dict[Literal, bool], singles) -> list[Example]:

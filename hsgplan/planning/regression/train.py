@@ -37,7 +37,7 @@ from hsgplan.planning.regression.examples import (
     preimage_examples,
     world_reach_examples,
 )
-from hsgplan.planning.regression.features import check_features, edge_dim, node_dim
+from hsgplan.planning.regression.features import check_features, edge_dim, node_dim, reads
 from hsgplan.planning.regression.gnn import (
     EdgeClassifier,
     EdgeClassifierConfig,
@@ -122,10 +122,14 @@ def _examples(
             }
         folder = shipped(config.world_trials)
         worlds = collection_worlds(folder, home)
-        if any(w != world for w in worlds):
+        # each state is described in the world it was staged in (`Example.world`), which
+        # need not be the demonstrations': f_reach may learn from other layouts
+        unread = sorted({w.name for w in worlds if not reads(config.features, w)})
+        if unread:
             raise InvalidInputError(
-                f"'{config.world_trials}' was collected in another world than the "
-                f"demonstrations ('{world.name}'): a planner learns in one world"
+                f"'{config.world_trials}' was collected in scenes of other groceries than the "
+                f"kitchen's ({', '.join(unread)}); networks of features names know the "
+                "kitchen's names alone: train with features geometry"
             )
         trials = load_world_trials(folder, worlds)
         return {
@@ -163,8 +167,10 @@ def train_task(
 ) -> None:
     """Train (or go on training) the three networks into the checkpoint folder `out` on the
     demonstrations (and executed primitives) recorded in `world`, or in the scene file they
-    were recorded in (`collect demos --scene`, `collect reach --scene`): all in one world.
-    Each network's folder gets `labels.json`, its label counts by source."""
+    were recorded in (`collect demos --scene`, `collect reach --scene`). The executed
+    primitives may come from other worlds than the demonstrations (a folder of layouts): each
+    state is described in its own. Each network's folder gets `labels.json`, its label counts
+    by source."""
     from hsgplan.data.demos import demos_world, load_demos
 
     home, world = world, demos_world(Path(config.demos), world)
@@ -220,7 +226,7 @@ def _train_one(
     model = EdgeClassifier(net_config)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start = training.resume(folder, model, optim, data)
-    graphs = [with_features(e.as_data(), world, config.features) for e in examples]
+    graphs = [with_features(e.as_data(), e.world or world, config.features) for e in examples]
     epochs = config.reach_epochs if name == "reach" and config.reach_epochs else config.epochs
     for epoch in range(start, epochs):
         rng = random.Random(f"{config.seed}-{name}-{epoch}")
