@@ -321,3 +321,4 @@ def test_executed_primitives_are_learnt_in_the_worlds_they_were_staged_in(tmp_pa
     config = TINY | {"reach": "world", "world_trials": str(trials), "epochs": 1}
     with pytest.raises(InvalidInputError, match="know the kitchen's names alone"):
         train_task(TaskTrainConfig.from_json(config), tmp_path / "m", world=KITCHEN)
+    assert not (tmp_path / "m").exists()  # refused before anything was trained

@@ -121,17 +121,7 @@ def _examples(
                 )
             }
         folder = shipped(config.world_trials)
-        worlds = collection_worlds(folder, home)
-        # each state is described in the world it was staged in (`Example.world`), which
-        # need not be the demonstrations': f_reach may learn from other layouts
-        unread = sorted({w.name for w in worlds if not reads(config.features, w)})
-        if unread:
-            raise InvalidInputError(
-                f"'{config.world_trials}' was collected in scenes of other groceries than the "
-                f"kitchen's ({', '.join(unread)}); networks of features names know the "
-                "kitchen's names alone: train with features geometry"
-            )
-        trials = load_world_trials(folder, worlds)
+        trials = load_world_trials(folder, _trial_worlds(config, home))
         return {
             "primitives executed in the simulated world": world_reach_examples(trials, []),
             "demonstrated changes": world_reach_examples([], demos),
@@ -145,6 +135,21 @@ def _examples(
     if len(trajs) > n:
         out["copies with added objects"] = make(trajs[n:])
     return out
+
+
+def _trial_worlds(config: TaskTrainConfig, home: World) -> list[World]:
+    """The worlds f_reach's executed primitives were staged in. Each state is described in its
+    own (`Example.world`), which need not be the demonstrations': f_reach may learn round other
+    layouts. InvalidInputError for worlds the networks' features cannot read."""
+    worlds = collection_worlds(shipped(config.world_trials), home)
+    unread = sorted({w.name for w in worlds if not reads(config.features, w)})
+    if unread:
+        raise InvalidInputError(
+            f"'{config.world_trials}' was collected in scenes of other groceries than the "
+            f"kitchen's ({', '.join(unread)}); networks of features names know the "
+            "kitchen's names alone: train with features geometry"
+        )
+    return worlds
 
 
 def label_counts(examples: list[Example]) -> dict:
@@ -182,6 +187,8 @@ def train_task(
                 "demonstrations"
             )
         demos = demos[: config.demo_limit]
+    if config.reach == "world":
+        _trial_worlds(config, home)  # refused before anything is trained or written
     sources = [config.demos] + ([config.world_trials] if config.reach == "world" else [])
     data = fingerprint(Path(s) for s in sources)
     # a checkpoint trained before a setting existed was trained with its default
