@@ -133,11 +133,8 @@ BAD = [
     (["eval", "perception", "--scenes", "1", "--views", "6"], "views 6: there are 1 to 5"),
     ([*WORLD, "--tables", "success,plots"], "no table 'plots'"),
     (["eval", "world", "--goals", "100001"], "less than or equal to 100000"),
-    (
-        ["collect", "push", "--scene", "scenes/layouts"],
-        "a motion dataset is collected in one world",
-    ),
-    (["bench", "collect", "--scene", "scenes/new-objects"], "collected in one world"),
+    (["collect", "push", "--scene", "scenes/new-objects"], "round scenes of the same types"),
+    (["bench", "collect", "--scene", "scenes/new-objects"], "round scenes of the same types"),
     (["eval", "task", "--planner", "regression-ahead-checked"], "is not one of 'regression'"),
 ]
 

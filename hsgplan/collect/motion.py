@@ -6,6 +6,10 @@ with the same folder reads which chunks are done and runs only the others, so an
 loses at most the chunks that were in flight and repeats nothing that was saved. The dataset is
 the successful trials in (task, attempt) order, cut at N: it is the same whichever engine ran
 the chunks, in whatever order they finished, and however often the run was interrupted.
+
+Given a folder of scene files (of the same object and fixture types), chunk k is staged in the
+folder's k-th file, counted round, as `collect reach` stages state k: one dataset whose rows
+each know their world, so that a network learns round many scenes.
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ from hsgplan.domain.checks import (
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.scene_file import read_worlds
 from hsgplan.runner.engines import engine
 from hsgplan.runner.run_folder import check_own, claim
 from hsgplan.scene_graph.names import NAMES_WORLD
@@ -49,31 +53,44 @@ class CollectConfig:
     ray_address: str | None = None
     # the unit of work, and of what an interruption loses
     tasks_per_chunk: int = setting(TASKS_PER_CHUNK, lo=1, hi=MAX_TASKS_PER_CHUNK)
-    # a scene file whose world the tasks are drawn and staged in (None: the kitchen)
+    # a scene file, or a folder of them, whose worlds the tasks are drawn and staged in (None:
+    # the kitchen)
     scene: str | None = None
 
     def __post_init__(self) -> None:
         check_fields(self)
-        if self.scene is not None and Path(self.scene).is_dir():
-            raise InvalidInputError(
-                f"--scene {self.scene}: a motion dataset is collected in one world; "
-                "give one scene file"
-            )
 
-    def world(self) -> World:
-        """The world the tasks are drawn and staged in (a bad scene file refused in one line)."""
-        return NAMES_WORLD if self.scene is None else read_world(self.scene)
+    def places(self) -> list[tuple[str | None, World]]:
+        """The scene files chunks are staged in, in turn, with their worlds (the kitchen's
+        none); a bad scene file, or a folder of scenes of other types, refused in one line."""
+        if self.scene is None:
+            return [(None, NAMES_WORLD)]
+        found = read_worlds(self.scene)
+        store.one_set_of_types(list(found.values()), self.scene)
+        return [(str(path), world) for path, world in found.items()]
+
+    def round_scenes(self) -> bool:
+        return self.scene is not None and Path(self.scene).is_dir()
 
     def dataset_settings(self) -> dict:
-        """What decides a dataset's rows (the chunking does not), kept in its manifest; a
-        kitchen collection records no scene, as before scenes could be given."""
-        return {
-            "primitive": self.primitive.value,
-            "seed": self.seed,
-            "samples": self.samples,
-            "attempts_per_task": ATTEMPTS_PER_TASK[self.primitive],
-            "schema_version": store.SCHEMA_VERSION,
-        } | self.scene_setting()
+        """What decides a dataset's rows, kept in its manifest: the chunking too where chunks
+        take turns round a folder of scenes; a kitchen collection records no scene, as before
+        scenes could be given."""
+        per_chunk = {}
+        if self.round_scenes():
+            files = store.scene_file_names(str(self.scene))
+            per_chunk = {"tasks_per_chunk": self.tasks_per_chunk, "scene_files": files}
+        return (
+            {
+                "primitive": self.primitive.value,
+                "seed": self.seed,
+                "samples": self.samples,
+                "attempts_per_task": ATTEMPTS_PER_TASK[self.primitive],
+                "schema_version": store.SCHEMA_VERSION,
+            }
+            | self.scene_setting()
+            | per_chunk
+        )
 
     def scene_setting(self) -> dict:
         """The scene as the settings record it: none for the kitchen, as before scenes could
@@ -115,7 +132,7 @@ def check_out(config: CollectConfig, out: Path) -> None:
             )
 
 
-def _done_chunks(config: CollectConfig, folder: Path, world: World) -> tuple[dict[int, int], int]:
+def _done_chunks(config: CollectConfig, folder: Path, places) -> tuple[dict[int, int], int]:
     """Successful trials in each chunk on disk, and how many files were set aside: a damaged
     chunk, or one that is not the chunk its name says, is moved to `rejected/` (never kept,
     never silently deleted) and runs again."""
@@ -125,7 +142,7 @@ def _done_chunks(config: CollectConfig, folder: Path, world: World) -> tuple[dic
     for k, path in store.chunk_files(folder).items():
         try:
             data, _ = store.load_chunk(
-                path, config.primitive, config.seed, k, config.tasks_per_chunk, world
+                path, config.primitive, config.seed, k, config.tasks_per_chunk, _of(places, k)[1]
             )
             done[k] = int(data.ok.sum())
         except InvalidInputError:
@@ -153,7 +170,7 @@ def collect(
 
     `progress` is told the number of successes on disk after every finished chunk.
     """
-    world = config.world()
+    places = config.places()
     check_out(config, out)
     folder = work_folder(out, config.primitive, config.seed)
     claim(
@@ -167,22 +184,28 @@ def collect(
             "schema_version": store.SCHEMA_VERSION,
             "chunk_format": store.CHUNK_FORMAT,
         }
-        | config.scene_setting(),
+        | config.scene_setting()
+        | {k: v for k, v in config.dataset_settings().items() if k == "scene_files"},
         f"'{folder}' holds chunks made with other collection settings; use another --out",
     )
-    store.write_schema(out, world)
-    done, rejected = _done_chunks(config, folder, world)
+    store.write_schema(out, places[0][1])
+    done, rejected = _done_chunks(config, folder, places)
     ran = 0
     if progress:
         progress(sum(done.values()))
     if _prefix_done(done, config.samples) is None:
         with engine(config.workers, config.ray_address) as runner:
-            ran = _run(runner, config, folder, done, progress, world)
-    return _pack(config, out, folder, done, ran, rejected, world)
+            ran = _run(runner, config, folder, done, progress, places)
+    return _pack(config, out, folder, done, ran, rejected, places)
+
+
+def _of(places: list[tuple[str | None, World]], chunk: int) -> tuple[str | None, World]:
+    """The scene file and world chunk `chunk` is staged in."""
+    return places[chunk % len(places)]
 
 
 def _run(
-    runner, config: CollectConfig, folder: Path, done: dict[int, int], progress, world: World
+    runner, config: CollectConfig, folder: Path, done: dict[int, int], progress, places
 ) -> int:
     in_flight: dict[object, int] = {}
     window = 2 * config.workers
@@ -194,12 +217,13 @@ def _run(
         while len(in_flight) < window and (expected < config.samples or not in_flight):
             while nxt in done or nxt in in_flight.values():
                 nxt += 1
-            job = (config.primitive.value, config.seed, nxt, config.tasks_per_chunk, config.scene)
+            scene_file = _of(places, nxt)[0]
+            job = (config.primitive.value, config.seed, nxt, config.tasks_per_chunk, scene_file)
             in_flight[runner.submit(run_chunk, *job)] = nxt
             expected += per_chunk
         handle, result = runner.next_done(set(in_flight))
         del in_flight[handle]
-        store.save_chunk(folder, result, world)
+        store.save_chunk(folder, result, _of(places, result.chunk)[1])
         done[result.chunk] = sum(t.ok for t in result.trials)
         ran += 1
         if progress:
@@ -208,16 +232,16 @@ def _run(
 
 
 def _pack(
-    config: CollectConfig, out: Path, folder: Path, done, ran: int, rejected: int, world: World
+    config: CollectConfig, out: Path, folder: Path, done, ran: int, rejected: int, places
 ) -> CollectSummary:
     n_chunks = _prefix_done(done, config.samples) or 0
     kind, seed, per_chunk = config.primitive, config.seed, config.tasks_per_chunk
     chunks = [
-        store.load_chunk(store.chunk_path(folder, k), kind, seed, k, per_chunk, world)
+        store.load_chunk(store.chunk_path(folder, k), kind, seed, k, per_chunk, _of(places, k)[1])
         for k in range(n_chunks)
     ]
     unstaged = sum(u for _, u in chunks)
-    trials = store.concat(config.primitive, [data for data, _ in chunks], world)
+    trials = store.concat(config.primitive, [data for data, _ in chunks], places[0][1])
     order = np.lexsort((trials.attempt, trials.task))
     ok = order[trials.ok[order]][: config.samples]
     dataset = out / f"{config.primitive.value}.npz"

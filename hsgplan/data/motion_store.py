@@ -14,9 +14,11 @@ Schema (version `SCHEMA_VERSION`), written beside the data as `schema.json`:
 | poses    | float32 | [S, T, 7] | per object type: position, quaternion xyzw; NaN if absent     |
 
 The world is the kitchen (T = 6), or the scene file a collection was made in, which the
-dataset's manifest names (`scene`) and `schema.json` lists the types of. Simulated scenes hold
-at most one instance of each type, so a type index names an object. For
-place the object placed is the one held. A dataset file (`place.npz`, `push.npz`) holds the
+dataset's manifest names (`scene`) and `schema.json` lists the types of. Collected round a
+folder of scene files (all of the same types), chunk k of the tasks (`task // tasks_per_chunk`,
+which the manifest records) was staged in the folder's k-th file, counted round. Simulated
+scenes hold at most one instance of each type, so a type index names an object. For place the
+object placed is the one held. A dataset file (`place.npz`, `push.npz`) holds the
 successful trials only; `place_trials.npz` / `push_trials.npz` every trial up to the last of
 them, failures included; the collector's chunk files hold every trial plus `unstaged`.
 About 190 bytes a row before compression.
@@ -27,7 +29,7 @@ from __future__ import annotations
 import hashlib
 import json
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -67,6 +69,10 @@ class MotionData:
     bins: np.ndarray
     poses: np.ndarray
     world: World = NAMES_WORLD  # whose object and entity types the indices name
+    # Collected round a folder of scene files: the world of each chunk of tasks, in turn (none:
+    # every row is of `world`); see the module's schema.
+    worlds: tuple[World, ...] = ()
+    tasks_per_chunk: int = 0
 
     @property
     def types(self) -> tuple[str, ...]:
@@ -84,8 +90,13 @@ class MotionData:
         return self.status == STATUSES.index(Status.SUCCESS)
 
     def take(self, rows) -> MotionData:
-        rows_of = (getattr(self, f)[rows] for f in FIELDS)
-        return MotionData(self.primitive, *rows_of, world=self.world)
+        return replace(self, **{f: getattr(self, f)[rows] for f in FIELDS})
+
+    def world_of(self, i: int) -> World:
+        """The world row i was staged in."""
+        if not self.worlds:
+            return self.world
+        return self.worlds[(int(self.task[i]) // self.tasks_per_chunk) % len(self.worlds)]
 
     def object_name(self, i: int) -> str:
         return self.types[int(self.obj[i])]
@@ -102,7 +113,7 @@ class MotionData:
             if not np.isnan(p[0])
         }
         held = self.object_name(i) if self.primitive is MotionPrimitive.PLACE else None
-        return GeometricSceneGraph.from_poses(poses, held=held, world=self.world)
+        return GeometricSceneGraph.from_poses(poses, held=held, world=self.world_of(i))
 
 
 def from_trials(
@@ -305,7 +316,10 @@ def load_dataset(path: Path, primitive: MotionPrimitive | None = None) -> Motion
             f"'{path}' does not match its manifest {manifest_path(path).name} "
             "(damaged or replaced); collect it again"
         )
-    data = load(path, dataset_world(path, manifest))
+    worlds = dataset_worlds(path, manifest)
+    data = load(path, worlds[0])
+    if manifest and "tasks_per_chunk" in manifest:  # collected round a folder of scene files
+        data = replace(data, worlds=tuple(worlds), tasks_per_chunk=_round(path, manifest))
     if primitive is not None and data.primitive is not primitive:
         raise InvalidInputError(
             f"'{path}' holds {data.primitive.value} trials, not {primitive.value} ones"
@@ -324,9 +338,45 @@ def load_dataset(path: Path, primitive: MotionPrimitive | None = None) -> Motion
 
 
 def dataset_world(path: Path, manifest: dict | None = None) -> World:
-    """The world a dataset file was collected in: the scene its manifest names, else the
-    kitchen (data collected before scenes could be given names none). A scene not found here
-    is refused in one line."""
+    """The world whose types a dataset file's indices name (the first of its worlds)."""
+    return dataset_worlds(path, manifest)[0]
+
+
+def dataset_worlds(path: Path, manifest: dict | None = None) -> list[World]:
+    """The worlds a dataset file was collected in: the scene file or folder its manifest
+    names, else the kitchen (data collected before scenes could be given names none). A scene
+    not found here, or a folder of scenes of other types, is refused in one line."""
     manifest = read_manifest(path) if manifest is None else manifest
     scene = (manifest or {}).get("scene")
-    return recorded_worlds(scene, NAMES_WORLD, path)[0]
+    return one_set_of_types(recorded_worlds(scene, NAMES_WORLD, path), scene)
+
+
+def _round(path: Path, manifest: dict) -> int:
+    """The chunking of a collection round a folder of scene files, refused in one line where
+    the folder no longer holds the files it was collected round (rows would change world)."""
+    per_chunk, names = manifest["tasks_per_chunk"], manifest.get("scene_files")
+    if not isinstance(per_chunk, int) or per_chunk < 1:
+        raise InvalidInputError(f"'{path}': its manifest's tasks_per_chunk is {per_chunk!r}")
+    if names != scene_file_names(manifest["scene"]):
+        raise InvalidInputError(
+            f"'{path}' was collected round other scene files than '{manifest['scene']}' "
+            "holds now; collect it again"
+        )
+    return per_chunk
+
+
+def scene_file_names(scene: str) -> list[str]:
+    """The names of a folder's scene files, in the order chunks take turns round them."""
+    return [p.name for p in sorted(Path(scene).glob("*.toml"))]
+
+
+def one_set_of_types(worlds: list[World], scene: object) -> list[World]:
+    """`worlds`, refused in one line unless they name the same object and entity types (the
+    columns of one motion dataset index one set of them)."""
+    kinds = {(tuple(w.object_types), tuple(w.entity_types)) for w in worlds}
+    if len(kinds) > 1:
+        raise InvalidInputError(
+            f"the scene files in '{scene}' name different objects or fixtures; a motion "
+            "dataset is collected round scenes of the same types"
+        )
+    return worlds

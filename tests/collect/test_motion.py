@@ -21,6 +21,7 @@ from hsgplan.domain.predicates import Predicate
 
 PLACE, PUSH = MotionPrimitive.PLACE, MotionPrimitive.PUSH
 NEW_OBJECTS = Path(__file__).resolve().parents[2] / "scenes" / "new-objects"
+LAYOUTS = NEW_OBJECTS.parent / "layouts"
 
 
 def test_tasks_are_drawn_from_their_index_alone():
@@ -275,6 +276,51 @@ def test_a_collection_in_a_scene_file_is_made_and_read_in_its_world(tmp_path):
         store.load_dataset(summary.dataset, PLACE)
 
 
-def test_a_folder_of_scenes_is_refused_for_motion_data():
-    with pytest.raises(InvalidInputError, match="one world"):
-        CollectConfig(PUSH, 3, scene=str(NEW_OBJECTS))
+def test_a_collection_round_a_folder_of_scenes_stages_chunk_k_in_the_kth_file(tmp_path):
+    from dataclasses import replace
+
+    from hsgplan.domain.scene_file import read_world
+    from hsgplan.motion.train import MotionTrainConfig, train_motion
+
+    folder = tmp_path / "scenes"
+    folder.mkdir()
+    for name in ("layout-000.toml", "layout-001.toml"):  # copies, so that one can go
+        (folder / name).write_text((LAYOUTS / name).read_text())
+    worlds = [read_world(folder / n) for n in ("layout-000.toml", "layout-001.toml")]
+    assert worlds[0] != worlds[1]
+    out = tmp_path / "data"
+    config = CollectConfig(PLACE, 6, workers=1, tasks_per_chunk=2, scene=str(folder))
+    summary = collect(config, out)
+    data = store.load_dataset(summary.dataset, PLACE)
+    assert store.read_manifest(summary.dataset)["tasks_per_chunk"] == 2
+    chunks = {int(t) // 2 % 2 for t in data.task}
+    assert chunks == {0, 1}, "both scenes give samples"
+    for i in range(len(data)):
+        world = worlds[int(data.task[i]) // 2 % 2]
+        assert data.world_of(i) == world
+        sg = data.scene_graph(i)
+        node = sg.node(data.object_name(i))
+        assert node.type == world.object_type(data.object_name(i))
+    # the rows are those the chunks were staged with: chunk 1 comes from the second file
+    chunk = store.load_chunk(store.chunk_path(work_folder(out, PLACE, 0), 1), PLACE, 0, 1, 2,
+                             worlds[1])[0]  # fmt: skip
+    assert set(map(int, chunk.task)) <= {2, 3}
+    # a network of the geometry features learns round both
+    net = MotionTrainConfig(data=str(out), epochs=1, features="geometry", loss="bce")
+    train_motion(net, tmp_path / "net")
+    assert (tmp_path / "net" / "model.safetensors").exists()
+    # another chunking is another collection, refused before anything is written
+    with pytest.raises(InvalidInputError, match="other settings"):
+        collect(replace(config, tasks_per_chunk=3), out)
+    # a folder that no longer holds the files it was collected round: rows would change world
+    (folder / "layout-001.toml").unlink()
+    with pytest.raises(InvalidInputError, match="other scene files"):
+        store.load_dataset(summary.dataset, PLACE)
+    with pytest.raises(InvalidInputError, match="other"):
+        collect(config, out)
+
+
+def test_a_folder_of_scenes_of_other_groceries_is_refused_in_one_line(tmp_path):
+    with pytest.raises(InvalidInputError, match="same types"):
+        collect(CollectConfig(PUSH, 3, scene=str(NEW_OBJECTS)), tmp_path / "data")
+    assert not (tmp_path / "data").exists()
