@@ -1,7 +1,8 @@
 """How far the hand strays from a push line with the line's IK solved every k poses: `hsgplan
 bench line-error`, the basis of LINE_IK_EVERY (`sim/motion_plans.py`, docs/decisions.md).
 
-Runs push tasks of a seed stream no data uses, once per k, and measures the hand's distance from
+Runs push tasks of a seed stream no data uses (in the kitchen, or task i in the i-th of the
+worlds given, counted round), once per k, and measures the hand's distance from
 every pose of each line found. Between solved poses the joints are interpolated, so the
 distance is the interpolation's error plus the solver's.
 """
@@ -17,6 +18,7 @@ from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
+from hsgplan.domain.scene import World
 from hsgplan.sim import motion_plans
 from hsgplan.sim.scene import Scene
 
@@ -49,7 +51,12 @@ def summarize(every: int, lines: int, errors_m: Sequence[float]) -> LineError:
     )
 
 
-def line_error(tasks: int, every: int, on_task: Callable[[], None] | None = None) -> LineError:
+def line_error(
+    tasks: int,
+    every: int,
+    on_task: Callable[[], None] | None = None,
+    worlds: Sequence[World] = (KITCHEN,),
+) -> LineError:
     errors: list[float] = []
     lines = 0
     solve, saved = motion_plans._line, motion_plans.LINE_IK_EVERY
@@ -68,11 +75,12 @@ def line_error(tasks: int, every: int, on_task: Callable[[], None] | None = None
 
     motion_plans._line, motion_plans.LINE_IK_EVERY = watched, every
     try:
-        with Scene((), seed=SEED, world=KITCHEN) as scene:
-            for i in range(tasks):
-                run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, i, KITCHEN))
-                if on_task:
-                    on_task()
+        for k, world in enumerate(worlds):  # one physics client a world
+            with Scene((), seed=SEED, world=world) as scene:
+                for i in range(k, tasks, len(worlds)):
+                    run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, i, world))
+                    if on_task:
+                        on_task()
     finally:
         motion_plans._line, motion_plans.LINE_IK_EVERY = solve, saved
     return summarize(every, lines, errors)

@@ -2,7 +2,8 @@
 push-reach`, the basis of PUSH_SLACK (`sim/motion_plans.py`, docs/decisions.md).
 
 Runs push tasks of the collection's seed-0 stream from a task index far past any shipped data,
-with the too-short refusal switched off, and takes each trial's margin
+(in the kitchen, or task i in the i-th of the worlds given, counted round) with the too-short
+refusal switched off, and takes each trial's margin
 `x + (dist - PUSH_LEAD) cos(angle) - x_min`: PUSH_SLACK must stay below every success's margin,
 and the trials under it are those the refusal spares.
 """
@@ -11,13 +12,14 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PUSH_LEAD, MotionPrimitive, push_values
+from hsgplan.domain.scene import World
 from hsgplan.sim import motion_plans
 from hsgplan.sim.scene import Scene
 
@@ -58,25 +60,30 @@ def summarize(
     )
 
 
-def push_reach(tasks: int, first: int, on_task: Callable[[], None] | None = None) -> PushReach:
+def push_reach(
+    tasks: int,
+    first: int,
+    on_task: Callable[[], None] | None = None,
+    worlds: Sequence[World] = (KITCHEN,),
+) -> PushReach:
     slack = motion_plans.PUSH_SLACK
     margins: list[tuple[float, bool]] = []
     statuses: Counter[str] = Counter()
     # with the refusal off, the pushes it would refuse are run and their margins seen
     motion_plans.PUSH_SLACK = -math.inf
     try:
-        with Scene((), seed=SEED, world=KITCHEN) as scene:
-            for index in range(first, first + tasks):
-                for trial in (
-                    run_task(scene, draw_task(MotionPrimitive.PUSH, SEED, index, KITCHEN)) or []
-                ):
-                    angle, dist = push_values(*trial.bins)
-                    x = trial.before.pose(trial.obj).position[0]
-                    x_min = KITCHEN.shelves[trial.target].interior.x_min
-                    margins.append((reach_margin(x, angle, dist, x_min), trial.ok))
-                    statuses[trial.status.value] += 1
-                if on_task:
-                    on_task()
+        for k, world in enumerate(worlds):  # one physics client a world
+            with Scene((), seed=SEED, world=world) as scene:
+                for index in range(first + k, first + tasks, len(worlds)):
+                    task = draw_task(MotionPrimitive.PUSH, SEED, index, world)
+                    for trial in run_task(scene, task) or []:
+                        angle, dist = push_values(*trial.bins)
+                        x = trial.before.pose(trial.obj).position[0]
+                        x_min = world.shelves[trial.target].interior.x_min
+                        margins.append((reach_margin(x, angle, dist, x_min), trial.ok))
+                        statuses[trial.status.value] += 1
+                    if on_task:
+                        on_task()
     finally:
         motion_plans.PUSH_SLACK = slack
     return summarize(margins, statuses, slack)

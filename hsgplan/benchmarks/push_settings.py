@@ -3,14 +3,15 @@
 (`sim/primitives.py`, `data/motion_trials.py`, docs/decisions.md).
 
 For each setting, runs push tasks of seed streams no data uses, one physics client per seed,
-until each client has tried `trials` parameter pairs. Time is process time: less sensitive to a
+until each client has tried `trials` parameter pairs; client k in the kitchen, or in the k-th of
+the worlds given, counted round. Time is process time: less sensitive to a
 shared machine than wall time, still noisy by about 10%.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 
 from hsgplan.data import motion_trials
@@ -18,6 +19,7 @@ from hsgplan.data.motion_tasks import draw_task
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
+from hsgplan.domain.scene import World
 from hsgplan.sim import primitives
 from hsgplan.sim.motion_plans import PUSH_STEP
 from hsgplan.sim.scene import TIME_STEP, Scene
@@ -79,7 +81,11 @@ class PushSettingRow:
 
 
 def push_settings(
-    scenes: int, trials: int, setting: PushSetting, on_task: Callable[[], None] | None = None
+    scenes: int,
+    trials: int,
+    setting: PushSetting,
+    on_task: Callable[[], None] | None = None,
+    worlds: Sequence[World] = (KITCHEN,),
 ) -> PushSettingRow:
     tasks = tasks_per_scene(trials, setting)
     saved = primitives.PUSH_SUBSTEPS, motion_trials.ATTEMPTS_PER_TASK[PUSH]
@@ -91,9 +97,10 @@ def push_settings(
     start = time.process_time()
     try:
         for seed in range(FIRST_SEED, FIRST_SEED + scenes):
-            with Scene((), seed=seed, world=KITCHEN) as scene:
+            world = worlds[(seed - FIRST_SEED) % len(worlds)]
+            with Scene((), seed=seed, world=world) as scene:
                 for index in range(tasks):
-                    got = motion_trials.run_task(scene, draw_task(PUSH, seed, index, KITCHEN)) or []
+                    got = motion_trials.run_task(scene, draw_task(PUSH, seed, index, world)) or []
                     ran += len(got)
                     successes += sum(t.ok for t in got)
                     if on_task:

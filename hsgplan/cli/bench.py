@@ -22,6 +22,7 @@ from hsgplan.cli.common import (
     check_ray,
     choice,
     err,
+    in_scene,
     input_path,
     out,
     parse_sizes,
@@ -41,10 +42,6 @@ app = typer.Typer(
 )
 SearchName = choice("SearchName", SEARCH_BASELINES)
 DEFAULT_SEARCH_NAME = SearchName(DEFAULT_SEARCH)
-
-
-def _in(scene: Path | None) -> str:
-    return "" if scene is None else f", in {scene}"
 
 
 @app.command("sim")
@@ -71,7 +68,7 @@ def bench_sim(
         for r in rows
     ]
     print_table(
-        f"Simulation speed, one core (seed {seed}{_in(scene)})",
+        f"Simulation speed, one core (seed {seed}{in_scene(scene)})",
         ("what", "samples", "median s"),
         cells,
         markdown,
@@ -113,7 +110,8 @@ def bench_symbolic(
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
-    title = f"Fast Downward plan time, median over {goals} goals per size (seed {seed}{_in(scene)})"
+    where = in_scene(scene)
+    title = f"Fast Downward plan time, median over {goals} goals per size (seed {seed}{where})"
     header = ("objects", "planner", "solved", "median s", "median plan length")
     cells = [
         (
@@ -172,7 +170,7 @@ def bench_task(
     ]
     print_table(
         f"Task-planning time, median over {goals} goals per size, one core (seed {seed}"
-        f"{_in(scene)})",
+        f"{in_scene(scene)})",
         ("objects", "planner", "solved", "ms per decision", "ms per episode"),
         cells,
         markdown,
@@ -289,7 +287,7 @@ def bench_collect(
         for r in rows
     ]
     print_table(
-        f"Motion data collection speed{_in(scene)}",
+        f"Motion data collection speed{in_scene(scene)}",
         ("primitive", "workers", "samples", "trials successful", "seconds", "samples per s"),
         cells,
         markdown,
@@ -329,7 +327,7 @@ def bench_observe(
         return
     print_table(
         f"One observation through f_p, one core: seconds per scene, {scenes} scenes, seed {seed}"
-        f"{_in(scene)}",
+        f"{in_scene(scene)}",
         ("objects", "scenes", "stage + render (excluded)", "f_p", "tracker", "observation", "p90"),
         [
             (

@@ -13,11 +13,14 @@ from rich.progress import Progress
 
 from hsgplan.cli.common import (
     MarkdownFlag,
+    SceneFiles,
     bounded_option,
     err,
+    in_scene,
     input_path,
     print_table,
     refuses_bad_input,
+    scene_worlds,
 )
 
 JsonFlag = Annotated[bool, typer.Option("--json", help="Print JSON.", metavar="")]
@@ -46,20 +49,23 @@ def push_reach(
     ] = 900_000,
     as_json: JsonFlag = False,
     markdown: MarkdownFlag = False,
+    scene: SceneFiles = None,
 ) -> None:
     """PUSH_SLACK's basis: how far past the shelf's front a push's bound lies for the pushes
     that succeed, with the too-short refusal off; PUSH_SLACK must stay below the smallest."""
     from hsgplan.benchmarks.push_reach import push_reach as run
 
+    worlds = scene_worlds(scene)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("push tasks", total=tasks)
-        report = run(tasks, first, on_task=lambda: progress.advance(bar))
+        report = run(tasks, first, on_task=lambda: progress.advance(bar), worlds=worlds)
     if as_json:
         print(json.dumps(report.to_json(), indent=2))
         return
     statuses = ", ".join(f"{k} {v}" for k, v in sorted(report.statuses.items()))
     print_table(
-        f"Push reach past the shelf's front, tasks {first} to {first + tasks - 1} of seed 0",
+        f"Push reach past the shelf's front, tasks {first} to {first + tasks - 1} of seed 0"
+        + in_scene(scene),
         (
             "trials",
             "successes",
@@ -96,22 +102,24 @@ def line_error(
     ] = None,
     as_json: JsonFlag = False,
     markdown: MarkdownFlag = False,
+    scene: SceneFiles = None,
 ) -> None:
     """LINE_IK_EVERY's basis: how far the hand strays from a push line with the line's IK
     solved every K poses and the joints interpolated between."""
     from hsgplan.benchmarks.line_error import line_error as run
 
     settings = every or [4, 8]
+    worlds = scene_worlds(scene)
     rows = []
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("push tasks", total=tasks * len(settings))
         for k in settings:
-            rows.append(run(tasks, k, on_task=lambda: progress.advance(bar)))
+            rows.append(run(tasks, k, on_task=lambda: progress.advance(bar), worlds=worlds))
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
     print_table(
-        f"The hand's distance from its push line, {tasks} tasks (seed 41)",
+        f"The hand's distance from its push line, {tasks} tasks (seed 41{in_scene(scene)})",
         ("IK every", "lines", "mean mm", "p99 mm", "max mm"),
         [
             (
@@ -141,6 +149,7 @@ def push_settings(
     ] = None,
     as_json: JsonFlag = False,
     markdown: MarkdownFlag = False,
+    scene: SceneFiles = None,
 ) -> None:
     """PUSH_SUBSTEPS' and ATTEMPTS_PER_TASK's basis: push successes and CPU seconds per success
     under other push speeds and tries per staged scene."""
@@ -149,16 +158,18 @@ def push_settings(
 
     chosen = [parse_setting(s) for s in setting or ["4:4", "3:4", "3:8"]]
     total = sum(scenes * tasks_per_scene(trials, s) for s in chosen)  # refuses before any work
+    worlds = scene_worlds(scene)
     rows = []
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("push tasks", total=total)
         for s in chosen:
-            rows.append(run(scenes, trials, s, on_task=lambda: progress.advance(bar)))
+            rows.append(run(scenes, trials, s, lambda: progress.advance(bar), worlds))
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return
     print_table(
-        f"Push settings: {trials} trials in each of {scenes} scenes (CPU time, ~10% noise)",
+        f"Push settings: {trials} trials in each of {scenes} scenes{in_scene(scene)} (CPU time, "
+        "~10% noise)",
         ("substeps", "m/s", "attempts", "trials", "successes", "CPU s per success"),
         [
             (

@@ -252,6 +252,20 @@ SceneFiles = Annotated[
 ]
 
 
+def in_scene(scene: Path | None) -> str:
+    """ ", in SCENE" for a table's title, where a scene was given."""
+    return "" if scene is None else f", in {scene}"
+
+
+def scene_worlds(scene: Path | None) -> list:
+    """The worlds of a `--scene` file or folder (the kitchen without one), in file order, each
+    read (and a bad one refused in one line) before anything runs."""
+    from hsgplan.domain.kitchen import KITCHEN
+    from hsgplan.domain.scene_file import read_worlds
+
+    return list(read_worlds(scene).values()) if scene else [KITCHEN]
+
+
 def scene_world(scene: Path | None):
     """The world of a `--scene` file (the kitchen without one), refused in one line if bad."""
     from hsgplan.domain.kitchen import KITCHEN

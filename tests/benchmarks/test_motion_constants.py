@@ -2,6 +2,7 @@
 two, leaves the constants it varies as they were, and refuses bad input in one line."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ from hsgplan.sim import motion_plans, primitives
 
 runner = CliRunner()
 PUSH = MotionPrimitive.PUSH
+LAYOUTS = Path(__file__).resolve().parents[2] / "scenes" / "layouts"
 
 
 def bench(*args):
@@ -123,7 +125,41 @@ def test_each_measurement_runs_on_one_task_and_restores_the_constants():
     )
 
 
+def test_given_worlds_each_task_or_client_is_staged_in_its_own_in_turn(monkeypatch):
+    from hsgplan.benchmarks import line_error, push_reach, push_settings
+    from hsgplan.domain.scene_file import read_worlds
+
+    worlds = list(read_worlds(LAYOUTS).values())[:2]
+    drawn = []
+
+    def draw(primitive, seed, index, world):
+        drawn.append((index, worlds.index(world)))
+        return None
+
+    for module in (push_reach, line_error):
+        monkeypatch.setattr(module, "draw_task", draw)
+        monkeypatch.setattr(module, "run_task", lambda scene, task: [])
+    push_reach.push_reach(3, 10, worlds=worlds)
+    assert sorted(drawn) == [(10, 0), (11, 1), (12, 0)]
+    drawn.clear()
+    line_error.line_error(3, 4, worlds=worlds)
+    assert sorted(drawn) == [(0, 0), (1, 1), (2, 0)]
+    drawn.clear()
+    monkeypatch.setattr(push_settings, "draw_task", lambda p, seed, i, w: draw(p, seed, seed, w))
+    monkeypatch.setattr(push_settings.motion_trials, "run_task", lambda scene, task: [])
+    push_settings.push_settings(3, 2, PushSetting(3, 2), worlds=worlds)
+    first = push_settings.FIRST_SEED
+    assert sorted(drawn) == [(first, 0), (first + 1, 1), (first + 2, 0)]
+
+
+def test_a_measurement_runs_round_a_folder_of_scenes():
+    r = bench("push-reach", "--tasks", "2", "--scene", str(LAYOUTS), "--json")
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["trials"] > 0
+
+
 BAD = [
+    (["line-error", "--scene", "nope.toml"], "scene file 'nope.toml' does not exist"),
     (["push-reach", "--tasks", "-1"], "greater than or equal to 1"),
     (["push-reach", "--first", "-5"], "greater than or equal to 0"),
     (["line-error", "--tasks", "0"], "greater than or equal to 1"),
