@@ -354,12 +354,14 @@ def dataset_worlds(path: Path, manifest: dict | None = None) -> list[World]:
 def _round(path: Path, manifest: dict) -> int:
     """The chunking of a collection round a folder of scene files, refused in one line where
     the folder no longer holds the files it was collected round (rows would change world)."""
-    per_chunk, names = manifest["tasks_per_chunk"], manifest.get("scene_files")
-    if not isinstance(per_chunk, int) or per_chunk < 1:
-        raise InvalidInputError(f"'{path}': its manifest's tasks_per_chunk is {per_chunk!r}")
-    if names != scene_file_names(manifest["scene"]):
+    per_chunk, names, scene = (manifest.get(k) for k in ("tasks_per_chunk", "scene_files", "scene"))
+    if not isinstance(per_chunk, int) or per_chunk < 1 or not isinstance(scene, str):
         raise InvalidInputError(
-            f"'{path}' was collected round other scene files than '{manifest['scene']}' "
+            f"'{path}': its manifest's tasks_per_chunk {per_chunk!r} or scene {scene!r} is wrong"
+        )
+    if names != scene_file_names(scene):
+        raise InvalidInputError(
+            f"'{path}' was collected round other scene files than '{scene}' "
             "holds now; collect it again"
         )
     return per_chunk
