@@ -38,7 +38,7 @@ from hsgplan.data.motion_trials import ChunkResult, Trial
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import BINS, MotionPrimitive
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import recorded_worlds
+from hsgplan.domain.scene_file import recorded_worlds, scene_paths
 from hsgplan.files import atomic, write_atomically
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -359,17 +359,12 @@ def _round(path: Path, manifest: dict) -> int:
         raise InvalidInputError(
             f"'{path}': its manifest's tasks_per_chunk {per_chunk!r} or scene {scene!r} is wrong"
         )
-    if names != scene_file_names(scene):
+    if names != [p.name for p in scene_paths(scene)]:
         raise InvalidInputError(
             f"'{path}' was collected round other scene files than '{scene}' "
             "holds now; collect it again"
         )
     return per_chunk
-
-
-def scene_file_names(scene: str) -> list[str]:
-    """The names of a folder's scene files, in the order chunks take turns round them."""
-    return [p.name for p in sorted(Path(scene).glob("*.toml"))]
 
 
 def one_set_of_types(worlds: list[World], scene: object) -> list[World]:

@@ -246,11 +246,17 @@ def read_world_text(text: str, path: Path | str) -> World:
     return world_of(data, f"scene file '{path}'")
 
 
+def scene_paths(path: Path | str) -> list[Path]:
+    """A scene file, or a folder's scene files in the order work takes turns round them."""
+    path = Path(path)
+    return sorted(path.glob("*.toml")) if path.is_dir() else [path]
+
+
 def read_worlds(path: Path | str) -> dict[Path, World]:
     """The world of a scene file, or of every `.toml` file in a folder (by name), each read
     (and so checked) before anything runs."""
     path = Path(path)
-    paths = sorted(path.glob("*.toml")) if path.is_dir() else [path]
+    paths = scene_paths(path)
     if not paths:
         raise InvalidInputError(f"the folder '{path}' holds no scene file (*.toml)")
     return {p: read_world(p) for p in paths}
