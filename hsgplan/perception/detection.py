@@ -27,7 +27,7 @@ class Detection:
     reprojection_px: float
     rays: tuple[Ray, ...] = ()
     # the colour network's probability of the type, among every type (1: no colour network, or
-    # no member view's centroid patch in its image: then it wins `_apart` over measured ones)
+    # no member view's centroid patch in its image: then it wins `apart.apart` over measured ones)
     type_confidence: float = 1.0
     keypoints: tuple[ViewKeypoints, ...] = ()  # each view's keypoints behind it
     stacked: bool = False  # one of two thin boxes that the views saw as one (`STACK_BAND`)

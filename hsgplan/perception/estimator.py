@@ -16,7 +16,7 @@ contradict is dropped (`perception.phantoms`).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Collection, Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
@@ -24,23 +24,23 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from hsgplan.domain.world import Kind, ObjectType, World
+from hsgplan.domain.world import World
 from hsgplan.paths import shipped
 from hsgplan.perception import phantoms
+from hsgplan.perception.apart import apart
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
 from hsgplan.perception.colour import ColourNet, features, load_colour, pixel_vote, type_probs
 from hsgplan.perception.detection import Detection
-from hsgplan.perception.fusion import Seen, along_ray_near, grouped, line_of_sight
+from hsgplan.perception.fitting import fitted, fuse
+from hsgplan.perception.fusion import Seen, along_ray_near, line_of_sight
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
-from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost, upright_fit
+from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost
 from hsgplan.perception.settle import (
     OVERLAP_XY,
-    Ray,
     fits_height,
     meeting_point,
-    same_place,
     settle,
     surfaces_under,
 )
@@ -50,14 +50,6 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sensing import Box
 
-# A free (tilted) fit stands for a toppled object only where its reprojection cost is at most
-# this fraction of the best upright fit's. At 1 (no preference for upright), a thin box half
-# hidden under a can was often fitted a little better tilted, was no carrier to settle on,
-# and the can fell onto the table: symbolic match on 100 tuning scenes (seed 2) 0.66 at 1,
-# 0.69 at 0.5 and at 0.25, and 0.69 always upright. One view alone never says toppled: a can
-# under a box seen by one view was fitted tilted and carried nothing (seed 4's scene 43; on
-# 500 scenes of seeds 1 to 5, 1 scene better on seed 3, none worse).
-TOPPLED_COST = 0.5
 # Two thin boxes stacked (2.4 cm each) are one blob in the keypoint network's maps (their
 # centroids are one cell apart), found as one box where the views' rays meet: half-way up the
 # stack, a box's height over the surface, where a lone box's centre is half of it over. So a
@@ -148,7 +140,7 @@ class PoseEstimator:
                 out.append(replace(d, type_confidence=confidence))
                 continue
             t = world.object_type(TYPES[best])
-            pose, error = _fitted(t, list(d.keypoints), list(d.rays))
+            pose, error = fitted(t, list(d.keypoints), list(d.rays))
             if pose is not None:
                 d = replace(d, type_name=TYPES[best], pose=pose, reprojection_px=error)
             out.append(replace(d, type_confidence=confidence))
@@ -256,9 +248,9 @@ class PoseEstimator:
                 if single is not None:
                     found.append(Seen(inst.type_index, inst.score, v, seen, single.pose))
         typed = partial(self._typed, world, images)
-        fused = _apart(_fuse(found, typed, world), world)
+        fused = apart(fuse(found, typed, world), world)
         if self.colour is not None:
-            fused = _apart(self._retyped(world, images, cameras, fused), world)
+            fused = apart(self._retyped(world, images, cameras, fused), world)
         if not self.settled:
             return fused
         fused = self._unstacked(world, images, cameras, fused)
@@ -357,90 +349,3 @@ def _of_kind(
         same = fits if bool(fits.any()) else same
     best = int(torch.where(same, probs, torch.full_like(probs, -1.0)).argmax())  # of the kind
     return best, float(probs[best])
-
-
-def _fuse(
-    found: list[Seen], typed: Callable[[list[Seen]], tuple[int, float]], world: World
-) -> list[Detection]:
-    """One detection per object that the views' lines of sight group (`fusion.grouped`),
-    named by `typed` and fitted to every member's keypoints (its type's cuboid in `world`)."""
-    out = []
-    for members in grouped(found, world.table):
-        kind, confidence = typed(members)
-        name = TYPES[kind]
-        rays = [line_of_sight(s) for s in members]
-        views = [s.keypoints for s in members]
-        pose, error = _fitted(world.object_type(name), views, rays)
-        if pose is None:
-            continue
-        score = members[0].score
-        out.append(
-            Detection(name, pose, score, len(members), error, tuple(rays), confidence, tuple(views))
-        )
-    return out
-
-
-def _fitted(
-    t: ObjectType, views: list[ViewKeypoints], rays: list[Ray]
-) -> tuple[Pose | None, float]:
-    """The pose of an object of type `t` from the keypoints of the views that saw it, and
-    its RMS reprojection error (pixels); None if PnP finds none."""
-    fused = estimate_pose(t, views)
-    if fused is None:
-        return None, math.inf
-    pose = fused.pose
-    if len(rays) > 1:  # the centroid where the views' lines of sight meet
-        pose = Pose(tuple(map(float, meeting_point(rays))), pose.orientation)
-    # Objects here rest upright: the best upright yaw, unless a free pose explains several
-    # views' keypoints much better (a toppled object; see `TOPPLED_COST`).
-    level = upright_fit(t, views, pose.position)
-    cost = robust_cost(t, views, level)
-    if len(views) > 1 and (free := robust_cost(t, views, pose)) < TOPPLED_COST * cost:
-        cost = free
-    else:
-        pose = level
-    points = sum(int((~np.isnan(v.pixels).any(axis=1)).sum()) for v in views)
-    return pose, math.sqrt(cost / max(points, 1))
-
-
-def _apart(detections: list[Detection], world: World) -> list[Detection]:
-    """Two objects cannot fill one space. Detections that fill one (`settle.same_place`) are
-    one object found twice, mostly once in each look-alike type's maps; the one whose type the
-    colour network is surest of, among every type, is kept (then the stronger). Choosing among
-    the types of its kind alone fails: a box the keypoint network saw where a soup stands, the
-    likeliest box by a soup's colour, could win over the soup (symbolic match on 500 scenes of
-    seeds 1 to 5, 3 scenes better). But a can a single view saw where a can of its type that
-    several views saw stands is that can found again, whatever the colour: the lower of two
-    cans stacked, which all five views saw, lost to one view's duplicate surer of its colour
-    by a hair, the upper can fell to the shelf, and the agent placed it again until the step
-    limit (Table 1 rgb, seed 40033; on seeds 1 to 5, one scene better, none worse). A lone
-    view's thin box stays: it may be the lower of a stack the others saw as one blob. Nor is
-    a lone view's detection of the other kind than one several views saw in its space: a soup
-    under a butter shows the butter's yellow at its centroid's pixel in the views from above,
-    so its type's mean probability is low, while one view's duplicate of the butter, found too
-    low (a single view's depth is its weak axis), filled the soup's space surer of its colour,
-    and the soup was lost (2 of 6 look-alikes on 300 tuning scenes, seeds 900 to 902)."""
-    several = [d for d in detections if d.views > 1]
-    kept: list[Detection] = []
-    for d in sorted(detections, key=lambda d: (-d.type_confidence, -d.score)):
-        if d.views == 1 and any(_found_again(d, k, world) for k in several):
-            continue
-        if not any(_same_place(d, k, world) for k in kept):
-            kept.append(d)
-    return kept
-
-
-def _same_place(d: Detection, k: Detection, world: World) -> bool:
-    a, b = world.object_type(d.type_name), world.object_type(k.type_name)
-    return same_place(a, d.pose, b, k.pose)
-
-
-def _found_again(d: Detection, k: Detection, world: World) -> bool:
-    """Whether a lone view's `d` is `k`, which several views saw, found again: in its space, a
-    can of its type or anything of the other kind."""
-    if not _same_place(d, k, world):
-        return False
-    kind = world.object_type(d.type_name).kind
-    if kind is not world.object_type(k.type_name).kind:
-        return True
-    return kind is Kind.CAN and k.type_name == d.type_name

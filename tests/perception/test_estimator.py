@@ -12,8 +12,10 @@ from scipy.spatial.transform import Rotation
 
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.evaluation.perception_eval import rotation_error, score_scene, summary
+from hsgplan.perception.apart import apart
 from hsgplan.perception.detection import Detection
-from hsgplan.perception.estimator import PoseEstimator, _apart, _fitted, _of_kind
+from hsgplan.perception.estimator import PoseEstimator, _of_kind
+from hsgplan.perception.fitting import fitted
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE
@@ -115,7 +117,7 @@ def test_of_a_soup_and_a_box_found_in_one_place_the_colour_keeps_the_soup():
         best, confidence = _of_kind(KITCHEN, probs, kind)
         found.append(Detection(TYPES[best], at, 1.0, 2, 0.0, (), confidence))
     assert found[0].type_name == "popcorn"  # the likeliest box, though no box is likely
-    assert [d.type_name for d in _apart(found, KITCHEN)] == ["alphabet_soup"]
+    assert [d.type_name for d in apart(found, KITCHEN)] == ["alphabet_soup"]
 
 
 def test_a_lone_views_can_where_several_views_saw_one_of_its_type_is_that_can_again():
@@ -124,12 +126,12 @@ def test_a_lone_views_can_where_several_views_saw_one_of_its_type_is_that_can_ag
     several = Detection("alphabet_soup", lower, 0.8, 5, 0.0, (), 0.830)
     again = Detection("alphabet_soup", lone, 0.46, 1, 0.0, (), 0.835)  # surer, by a hair
     on_it = Detection("cherries", Pose.from_xyz_yaw(0.43, -0.37, 0.251, 0.0), 0.86, 5, 0.0, (), 0.9)
-    assert _apart([on_it, again, several], KITCHEN) == [on_it, several]
+    assert apart([on_it, again, several], KITCHEN) == [on_it, several]
     # a lone view's box is kept as before: it may be the lower of a stack seen as one blob
     box = Pose.from_xyz_yaw(0.5, 0.0, 0.036, 0.0)
     blob = Detection("butter", box, 0.8, 3, 0.0, (), 0.6)
     lone_box = Detection("butter", Pose.from_xyz_yaw(0.5, 0.005, 0.03, 0.0), 0.5, 1, 0.0, (), 0.7)
-    assert _apart([blob, lone_box], KITCHEN) == [lone_box]
+    assert apart([blob, lone_box], KITCHEN) == [lone_box]
 
 
 def _views_of(name: str, pose: Pose) -> list[ViewKeypoints]:
@@ -141,12 +143,12 @@ def test_an_object_on_its_side_stays_toppled_and_a_noisy_upright_one_stands():
     on_side = Pose(
         (0.5, 0.1, 0.0355), matrix_to_quat(Rotation.from_euler("x", 90, degrees=True).as_matrix())
     )
-    pose, error = _fitted(
+    pose, error = fitted(
         KITCHEN.object_type("alphabet_soup"), _views_of("alphabet_soup", on_side), []
     )
     assert pose is not None and abs(pose.rotation[2, 2]) < 0.1 and error < 1.0
     # one view alone never says toppled
-    lone, _ = _fitted(
+    lone, _ = fitted(
         KITCHEN.object_type("alphabet_soup"), _views_of("alphabet_soup", on_side)[:1], []
     )
     assert lone is not None and lone.rotation[2, 2] == pytest.approx(1.0)
@@ -154,7 +156,7 @@ def test_an_object_on_its_side_stays_toppled_and_a_noisy_upright_one_stands():
     views = _views_of("butter", upright)
     noise = np.random.default_rng(0).normal(0, 1.5, size=(len(views), 9, 2))
     noisy = [ViewKeypoints(v.camera, v.pixels + n) for v, n in zip(views, noise, strict=True)]
-    pose, _ = _fitted(KITCHEN.object_type("butter"), noisy, [])
+    pose, _ = fitted(KITCHEN.object_type("butter"), noisy, [])
     assert pose is not None and pose.rotation[2, 2] == pytest.approx(1.0)
 
 
@@ -245,8 +247,8 @@ def test_a_lone_views_box_in_the_space_of_a_can_several_views_saw_is_not_kept():
     soup = Detection("alphabet_soup", Pose.from_xyz_yaw(0.54, -0.14, 0.042, 0.0), 0.8, 5, 0.0)
     soup = Detection(soup.type_name, soup.pose, 0.8, 5, 0.0, (), 0.51)  # a butter on it, above
     lone = Detection("butter", Pose.from_xyz_yaw(0.54, -0.13, 0.06, 0.0), 0.5, 1, 0.0, (), 0.95)
-    assert _apart([lone, soup], KITCHEN) == [soup]
+    assert apart([lone, soup], KITCHEN) == [soup]
     several = Detection(lone.type_name, lone.pose, 0.5, 2, 0.0, (), 0.95)
-    assert _apart([several, soup], KITCHEN) == [
+    assert apart([several, soup], KITCHEN) == [
         several
     ]  # two views against five: the colour decides
