@@ -23,3 +23,13 @@ def test_a_row_differs_from_the_shipped_gnn_in_its_head_and_loss_only(row, kind)
     assert {k for k in shipped if config[k] != shipped[k]} <= {"head", "loss"}
     assert {k: config[k] for k in ROWS[row]} == ROWS[row]
     assert set(config) == set(shipped)
+
+
+@pytest.mark.parametrize("kind", ["place", "push"])
+def test_networks_trained_round_layouts_differ_from_the_kitchens_in_their_data_only(kind):
+    config = json.loads((home() / "configs" / "layouts-motion" / f"{kind}-gnn.json").read_text())
+    baseline = home() / "checkpoints" / "motion-geometry" / f"{kind}-gnn" / "train_config.json"
+    kitchen = json.loads(baseline.read_text())
+    MotionTrainConfig.from_json(config)
+    assert {k for k in kitchen if config[k] != kitchen[k]} == {"data"}
+    assert set(config) == set(kitchen)
