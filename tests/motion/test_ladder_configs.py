@@ -33,3 +33,5 @@ def test_networks_trained_round_layouts_differ_from_the_kitchens_in_their_data_o
     MotionTrainConfig.from_json(config)
     assert {k for k in kitchen if config[k] != kitchen[k]} == {"data"}
     assert set(config) == set(kitchen)
+    shipped = home() / "checkpoints" / "motion-geometry-layouts" / f"{kind}-gnn"
+    assert json.loads((shipped / "train_config.json").read_text()) == config
