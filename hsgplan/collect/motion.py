@@ -35,7 +35,7 @@ from hsgplan.domain.checks import (
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_worlds, scene_paths
+from hsgplan.domain.scene_file import read_worlds, scene_file_names
 from hsgplan.runner.engines import engine
 from hsgplan.runner.run_folder import check_own, claim
 from hsgplan.scene_graph.names import NAMES_WORLD
@@ -78,7 +78,7 @@ class CollectConfig:
         scenes could be given."""
         per_chunk = {}
         if self.round_scenes():
-            files = [p.name for p in scene_paths(self.scene)]
+            files = scene_file_names(self.scene)
             per_chunk = {"tasks_per_chunk": self.tasks_per_chunk, "scene_files": files}
         return (
             {

@@ -38,7 +38,7 @@ from hsgplan.data.motion_trials import ChunkResult, Trial
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import BINS, MotionPrimitive
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import recorded_worlds, scene_paths
+from hsgplan.domain.scene_file import recorded_worlds, scene_file_names
 from hsgplan.files import atomic, write_atomically
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -359,7 +359,7 @@ def _round(path: Path, manifest: dict) -> int:
         raise InvalidInputError(
             f"'{path}': its manifest's tasks_per_chunk {per_chunk!r} or scene {scene!r} is wrong"
         )
-    if names != [p.name for p in scene_paths(scene)]:
+    if names != scene_file_names(scene):
         raise InvalidInputError(
             f"'{path}' was collected round other scene files than '{scene}' "
             "holds now; collect it again"

@@ -252,6 +252,11 @@ def scene_paths(path: Path | str) -> list[Path]:
     return sorted(path.glob("*.toml")) if path.is_dir() else [path]
 
 
+def scene_file_names(path: Path | str) -> list[str]:
+    """The names of `scene_paths(path)`, as a collection round a folder records them."""
+    return [p.name for p in scene_paths(path)]
+
+
 def read_worlds(path: Path | str) -> dict[Path, World]:
     """The world of a scene file, or of every `.toml` file in a folder (by name), each read
     (and so checked) before anything runs."""
