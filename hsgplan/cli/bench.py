@@ -311,7 +311,7 @@ def bench_observe(
     from hsgplan.evaluation.observers import perception_folder
 
     world = scene_world(scene)
-    if why := unseeable([world], scene):
+    if why := unseeable([world], scene, perception_checkpoint):
         raise InvalidInputError(why)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)

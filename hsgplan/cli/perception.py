@@ -133,12 +133,15 @@ def eval_perception(
     from hsgplan.domain.scene_file import read_worlds
     from hsgplan.evaluation.config import unseeable
     from hsgplan.evaluation.perception_eval import evaluate, evaluate_loop, summary
+    from hsgplan.paths import shipped
     from hsgplan.perception.estimator import PoseEstimator
-    from hsgplan.perception.synthetic import VIEWS, first_views
+    from hsgplan.perception.synthetic import first_views
+    from hsgplan.perception.vocabulary import read_vocabulary
 
-    shown = len(first_views(views)) if views is not None else len(VIEWS)  # before loading
+    cameras = read_vocabulary(shipped(perception_checkpoint)).views
+    shown = len(first_views(views, cameras)) if views is not None else len(cameras)
     worlds = (KITCHEN,) if scene is None else tuple(read_worlds(scene).values())
-    if why := unseeable(worlds, scene):
+    if why := unseeable(worlds, scene, perception_checkpoint):
         raise InvalidInputError(why)
     estimator = PoseEstimator.load(perception_checkpoint, settled=not raw, pruned=not unpruned)
     with Progress(console=err, transient=True) as progress:

@@ -126,7 +126,7 @@ def demo(
         shipped(motion_checkpoints) if motion_checkpoints else MOTION_CHECKPOINTS,
     )
     check_agent_world(agent, world, scene, *folders)
-    check_seen(perception.value, [world], scene)
+    check_seen(perception.value, [world], scene, perception_checkpoint)
     made = make_agent(agent, *folders)  # an unknown name or a missing checkpoint: before work
     observer = make_observer(
         perception.value, perception_checkpoint and shipped(perception_checkpoint)

@@ -7,13 +7,13 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from hsgplan.domain.checks import BOUNDS, MAX_SAMPLES, bounded, check_fields, setting
-from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene_file import read_world
 from hsgplan.domain.world import World
 from hsgplan.perception.images import CHUNK, FORMAT, render_chunk, write_format
 from hsgplan.perception.synthetic import P_ELSEWHERE, VIEWS, first_views
-from hsgplan.perception.vocabulary import TRAINING_WORLD, unseen_looks
+from hsgplan.perception.vocabulary import TRAINING_WORLD, Vocabulary
 from hsgplan.runner.items import run_items
+from hsgplan.sim.render import Camera
 
 KIND = "collect-images"
 
@@ -26,19 +26,21 @@ class ImagesConfig:
     chunk: int = setting(CHUNK, lo=1, hi=MAX_SAMPLES)
     p_elsewhere: float = setting(P_ELSEWHERE, lo=0.0, hi=1.0)  # see `synthetic.P_ELSEWHERE`
     views: int = len(VIEWS)  # the first this many fixed views (3: shoulders and front)
-    # a scene file whose world the scenes are staged in (None: f_p's training world, the
-    # kitchen); its groceries must be ones f_p has types for (`vocabulary.unseen_looks`)
+    # a scene file whose world the scenes are staged in (None: the kitchen, the shipped f_p's);
+    # an f_p trained on the images learns its groceries' looks through its cameras
     scene: str | None = None
 
     def __post_init__(self) -> None:
         check_fields(self)
-        first_views(self.views)
-        if self.scene is not None and (why := unseen_looks(self.world())):
-            raise InvalidInputError(f"--scene {self.scene}: {why}")
+        self.cameras()
 
     def world(self) -> World:
         """The world the scenes are staged in."""
         return TRAINING_WORLD if self.scene is None else read_world(self.scene)
+
+    def cameras(self) -> tuple[Camera, ...]:
+        """The fixed views rendered: the first `views` of the world's."""
+        return first_views(self.views, Vocabulary(self.world()).views)
 
     @property
     def chunks(self) -> int:
@@ -61,7 +63,7 @@ def collect_images(
     settings = {k: v for k, v in asdict(config).items() if k not in dropped} | {
         "count": config.samples,
         "format": FORMAT,
-        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in first_views(config.views)],
+        "views": [[*c.eye, *c.target, c.fov, c.width, c.height] for c in config.cameras()],
     }
     items = [(str(run_dir), c, config) for c in range(config.chunks)]
     rows = run_items(
@@ -75,7 +77,7 @@ def collect_images(
         ray=ray,
         on_result=on_chunk,
     )
-    write_format(run_dir)
+    write_format(run_dir, Vocabulary(config.world()))
     return rows
 
 

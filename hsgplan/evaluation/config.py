@@ -26,18 +26,30 @@ def check_observer(name: str) -> None:
         raise InvalidInputError(f"--perception '{name}': one of {', '.join(OBSERVERS)}")
 
 
-def check_seen(perception: str, worlds: Iterable[World], scene: str | Path | None) -> None:
-    """Refuse f_p a scene it cannot see, in one line (`unseeable`)."""
-    if perception == "rgb" and (why := unseeable(worlds, scene)):
+def check_seen(
+    perception: str,
+    worlds: Iterable[World],
+    scene: str | Path | None,
+    checkpoint: str | Path | None = None,
+) -> None:
+    """Refuse f_p (`checkpoint`'s, else the shipped one) a scene it cannot see, in one line
+    (`unseeable`)."""
+    if perception == "rgb" and (why := unseeable(worlds, scene, checkpoint)):
         raise InvalidInputError(f"--perception rgb: {why}; see it with --perception gt")
 
 
-def unseeable(worlds: Iterable[World], scene: str | Path | None) -> str | None:
-    """Why f_p cannot see the scenes of `worlds` (read from `scene`), or None: one has objects
-    whose look it has not learned, or other cameras (`perception.vocabulary.unseen_looks`)."""
-    from hsgplan.perception.vocabulary import unseen_looks
+def unseeable(
+    worlds: Iterable[World], scene: str | Path | None, checkpoint: str | Path | None = None
+) -> str | None:
+    """Why f_p (`checkpoint`'s, else the shipped one) cannot see the scenes of `worlds` (read
+    from `scene`), or None: one has objects whose look it has not learned, or other cameras
+    (`perception.vocabulary`)."""
+    from hsgplan.evaluation.observers import perception_folder
+    from hsgplan.paths import shipped
+    from hsgplan.perception.vocabulary import read_vocabulary
 
-    why = next(filter(None, map(unseen_looks, worlds)), None)
+    vocabulary = read_vocabulary(shipped(perception_folder(checkpoint)))
+    why = next(filter(None, map(vocabulary.unseen_looks, worlds)), None)
     return None if why is None else f"f_p cannot see scene '{scene}': {why}"
 
 
@@ -70,7 +82,8 @@ class EvalConfig:
         if self.protocol == PAPER and self.rules_off:
             raise InvalidInputError("the paper protocol has no recovery rule to switch off")
         self.rules()  # an unknown rule's name is refused here
-        check_seen(self.perception, self.worlds().values(), self.scene)  # a bad scene, too
+        # a bad scene, too
+        check_seen(self.perception, self.worlds().values(), self.scene, self.perception_checkpoint)
 
     def worlds(self) -> dict[str | None, World]:
         """The worlds its episodes run in, by scene file ({None: the kitchen} without one)."""

@@ -186,7 +186,7 @@ def evaluate_loop(
     from hsgplan.evaluation.loop_scenes import loop_scenes
     from hsgplan.perception.synthetic import first_views
 
-    cameras = first_views(views)
+    cameras = first_views(views, estimator.vocabulary.views)
     out = []
     for scene in loop_scenes(scenes, seed, cameras, worlds):
         detections = estimator.detect(scene.images, cameras, scene.world, scene.arm)

@@ -32,6 +32,7 @@ from torch import nn
 
 from hsgplan.checkpoint import load_trained
 from hsgplan.domain.checks import BOUNDS, check_fields, from_settings, setting
+from hsgplan.domain.scene_file import MAX_TYPES
 from hsgplan.perception.vocabulary import TYPES
 
 PATCH = 3  # pixels each side of the centroid's pixel
@@ -39,14 +40,15 @@ FEATURES = 4  # chromaticity r, g, b and brightness
 MIN_REGION = 12  # pixels of an object in sight for their colour to name it
 MIN_VOTES = 6  # of them named a type of the object's kind, for `pixel_vote` to say
 FOLDER = "colour"
-TYPE_COUNT = len(TYPES)
-BACKGROUND = TYPE_COUNT  # the background's class index (a network of `TYPE_COUNT + 1` classes)
+TYPE_COUNT = len(TYPES)  # the shipped f_p's object types (the kitchen's)
+# the background's class index in a network of the kitchen's types: the last, after its types
+BACKGROUND = TYPE_COUNT
 
 
 @dataclass(frozen=True)
 class ColourConfig:
-    # the object types, then the background
-    types: int = setting(TYPE_COUNT + 1, lo=TYPE_COUNT, hi=TYPE_COUNT + 1)
+    # the object types (f_p's vocabulary: `perception.vocabulary`), then the background
+    types: int = setting(TYPE_COUNT + 1, lo=2, hi=MAX_TYPES + 1)
     hidden: int = setting(32, lo=1, hi=4096)
     steps: int = setting(400, lo=1, hi=1_000_000)
     lr: float = setting(0.01, above=0, hi=10)
@@ -75,6 +77,7 @@ class ColourNet(nn.Module):
 
     def __init__(self, config: ColourConfig) -> None:
         super().__init__()
+        self.objects = config.types - 1  # classes before the background's
         self.mlp = nn.Sequential(
             nn.Linear(FEATURES, config.hidden), nn.ReLU(), nn.Linear(config.hidden, config.types)
         )
@@ -85,9 +88,9 @@ class ColourNet(nn.Module):
 
 def type_probs(colour: ColourNet, rows: np.ndarray) -> torch.Tensor:
     """The colour network's probabilities of the object types, against one another (the
-    background left out): [N, FEATURES] features -> [N, TYPE_COUNT]."""
+    background left out): [N, FEATURES] features -> [N, types]."""
     with torch.no_grad():
-        return torch.softmax(colour(torch.from_numpy(rows))[:, :TYPE_COUNT], dim=1)
+        return torch.softmax(colour(torch.from_numpy(rows))[:, : colour.objects], dim=1)
 
 
 def features(image: np.ndarray, pixel: np.ndarray) -> np.ndarray | None:
@@ -121,10 +124,10 @@ def pixel_vote(
     with torch.no_grad():
         logits = colour(torch.from_numpy(rows))
     named = logits.argmax(dim=1)
-    votes = (named < TYPE_COUNT) & allowed[named.clamp(max=TYPE_COUNT - 1)]
+    votes = (named < colour.objects) & allowed[named.clamp(max=colour.objects - 1)]
     if int(votes.sum()) < MIN_VOTES:
         return None
-    return torch.softmax(logits[votes, :TYPE_COUNT], dim=1).mean(dim=0)
+    return torch.softmax(logits[votes, : colour.objects], dim=1).mean(dim=0)
 
 
 def _described(pixels: np.ndarray) -> np.ndarray:

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import World
 from hsgplan.paths import shipped
 from hsgplan.perception import phantoms
@@ -45,7 +46,7 @@ from hsgplan.perception.settle import (
     surfaces_under,
 )
 from hsgplan.perception.visible import painted, visible_masks
-from hsgplan.perception.vocabulary import TYPES
+from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY, Vocabulary, read_vocabulary
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sensing import Box
@@ -74,6 +75,7 @@ class PoseEstimator:
     colour: the colour network that names each object's type (`perception.colour`); without
         it, the keypoint network's type is kept.
     pruned: drop what a lone view found that the other views contradict.
+    vocabulary: the types the networks' channels name (`perception.vocabulary`).
 
     What it knows of the scene it looks at (its object types' sizes and kinds, its table and
     shelves) is that scene's `World`, given with each look.
@@ -85,21 +87,31 @@ class PoseEstimator:
         settled: bool = True,
         colour: ColourNet | None = None,
         pruned: bool = True,
+        vocabulary: Vocabulary = KITCHEN_VOCABULARY,
     ) -> None:
         self.net = net
         self.settled = settled
         self.colour = colour
         self.pruned = pruned
+        self.vocabulary = vocabulary
+        self.types = vocabulary.types
 
     @staticmethod
     def load(folder: Path, settled: bool = True, pruned: bool = True) -> PoseEstimator:
         """The estimator of a checkpoint folder (the keypoint network, and the colour network
-        in its `colour/`)."""
-        net = load_perception_net(folder)[0]
+        in its `colour/`), naming its vocabulary's types; one whose networks have another
+        count of types than its vocabulary is refused in one line."""
+        net, config = load_perception_net(folder)
         colour = load_colour(shipped(folder) / COLOUR_FOLDER)
-        return PoseEstimator(net, settled, colour, pruned)
+        vocabulary = read_vocabulary(shipped(folder))
+        if not config.types == colour.objects == len(vocabulary.types):
+            raise InvalidInputError(
+                f"f_p '{folder}': its networks name {config.types} and {colour.objects} "
+                f"types, its vocabulary {len(vocabulary.types)}"
+            )
+        return PoseEstimator(net, settled, colour, pruned, vocabulary)
 
-    def _typed(self, world: World, images: np.ndarray, members: list[Seen]) -> tuple[int, float]:
+    def _typed(self, world: World, images: np.ndarray, members: list[Seen]) -> tuple[str, float]:
         """The type of an object its members saw, and its probability: by the colour network
         over the members' views, among the types of the kind (can or box) the keypoint network
         saw, which it tells apart well, that fit the height where their rays meet; else the
@@ -108,11 +120,11 @@ class PoseEstimator:
         rows = [features(images[s.view], s.keypoints.pixels[-1]) for s in members]
         rows = [r for r in rows if r is not None]
         if self.colour is None or not rows:
-            return members[0].type_index, 1.0
+            return self.types[members[0].type_index], 1.0
         probs = type_probs(self.colour, np.stack(rows)).mean(dim=0)
         rays = [line_of_sight(s) for s in members]
         centre = meeting_point(rays) if len(rays) > 1 else None
-        return _of_kind(world, probs, TYPES[members[0].type_index], centre)
+        return _of_kind(world, self.types, probs, self.types[members[0].type_index], centre)
 
     def _retyped(
         self,
@@ -135,14 +147,14 @@ class PoseEstimator:
                 continue
             centre = np.array(d.pose.position) if len(d.rays) > 1 else None
             probs = torch.stack(seen).mean(dim=0)
-            best, confidence = _of_kind(world, probs, d.type_name, centre)
-            if TYPES[best] == d.type_name:
+            best, confidence = _of_kind(world, self.types, probs, d.type_name, centre)
+            if best == d.type_name:
                 out.append(replace(d, type_confidence=confidence))
                 continue
-            t = world.object_type(TYPES[best])
+            t = world.object_type(best)
             pose, error = fitted(t, list(d.keypoints), list(d.rays))
             if pose is not None:
-                d = replace(d, type_name=TYPES[best], pose=pose, reprojection_px=error)
+                d = replace(d, type_name=best, pose=pose, reprojection_px=error)
             out.append(replace(d, type_confidence=confidence))
         return out
 
@@ -161,7 +173,7 @@ class PoseEstimator:
         assert self.colour is not None
         types = [world.object_type(d.type_name) for d in found]
         poses = [d.pose for d in found]
-        kinds = [_same_kind(world, d.type_name) for d in found]
+        kinds = [_same_kind(world, self.types, d.type_name) for d in found]
         rows: list[list[torch.Tensor]] = [[] for _ in found]
         for image, camera in zip(images, cameras, strict=True):
             pinhole = PinholeCamera.of(camera)
@@ -219,9 +231,9 @@ class PoseEstimator:
                 d = out[k]
                 probs = torch.stack(votes[k]).mean(dim=0)
                 centre = np.array(d.pose.position)
-                best, confidence = _of_kind(world, probs, d.type_name, centre)
-                if world.object_type(TYPES[best]).size[2] <= THIN:  # the same cuboid but for a mm
-                    out[k] = replace(d, type_name=TYPES[best], type_confidence=confidence)
+                best, confidence = _of_kind(world, self.types, probs, d.type_name, centre)
+                if world.object_type(best).size[2] <= THIN:  # the same cuboid but for a mm
+                    out[k] = replace(d, type_name=best, type_confidence=confidence)
         return out
 
     @torch.inference_mode()
@@ -241,10 +253,11 @@ class PoseEstimator:
         for v, camera in enumerate(cameras):
             pinhole = PinholeCamera.of(camera)
             for inst in decode(beliefs[v].numpy(), fields[v].numpy(), self.net.stride):
-                if TYPES[inst.type_index] not in world.object_types:
+                name = self.types[inst.type_index]
+                if name not in world.object_types:
                     continue  # a type the scene holds none of
                 seen = ViewKeypoints(pinhole, inst.pixels)
-                single = estimate_pose(world.object_type(TYPES[inst.type_index]), [seen])
+                single = estimate_pose(world.object_type(name), [seen])
                 if single is not None:
                     found.append(Seen(inst.type_index, inst.score, v, seen, single.pose))
         typed = partial(self._typed, world, images)
@@ -324,28 +337,32 @@ def _cost_at(d: Detection, world: World, centre: np.ndarray) -> float:
     return robust_cost(t, list(d.keypoints), at)
 
 
-def _same_kind(world: World, type_name: str) -> torch.Tensor:
-    """Which types [types] (bool) are of `type_name`'s kind (can or box) and in `world` (a
-    scene of fewer types holds none of the others)."""
+def _same_kind(world: World, types: tuple[str, ...], type_name: str) -> torch.Tensor:
+    """Which of f_p's `types` [types] (bool) are of `type_name`'s kind (can or box) and in
+    `world` (a scene of fewer types holds none of the others)."""
     kind = world.object_type(type_name).kind
     present = world.object_types
-    return torch.tensor([t in present and present[t].kind is kind for t in TYPES])
+    return torch.tensor([t in present and present[t].kind is kind for t in types])
 
 
 def _of_kind(
-    world: World, probs: torch.Tensor, type_name: str, centre: np.ndarray | None = None
-) -> tuple[int, float]:
-    """The likeliest type of `type_name`'s kind (can or box) by the colour network's
-    probabilities [types], and its probability; with `centre` (where several views' rays
-    meet), among those whose height fits it (`settle.fits_height`) if any does."""
-    same = _same_kind(world, type_name)
+    world: World,
+    types: tuple[str, ...],
+    probs: torch.Tensor,
+    type_name: str,
+    centre: np.ndarray | None = None,
+) -> tuple[str, float]:
+    """The likeliest of f_p's `types` of `type_name`'s kind (can or box) by the colour
+    network's probabilities [types], and its probability; with `centre` (where several views'
+    rays meet), among those whose height fits it (`settle.fits_height`) if any does."""
+    same = _same_kind(world, types, type_name)
     if centre is not None:
         fits = torch.tensor(
             [
                 bool(same[k]) and fits_height(world, world.object_type(t), centre)
-                for k, t in enumerate(TYPES)
+                for k, t in enumerate(types)
             ]
         )
         same = fits if bool(fits.any()) else same
     best = int(torch.where(same, probs, torch.full_like(probs, -1.0)).argmax())  # of the kind
-    return best, float(probs[best])
+    return types[best], float(probs[best])

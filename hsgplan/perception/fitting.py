@@ -12,7 +12,6 @@ from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen, grouped, line_of_sight
 from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost, upright_fit
 from hsgplan.perception.settle import Ray, meeting_point
-from hsgplan.perception.vocabulary import TYPES
 from hsgplan.scene_graph.geometry import Pose
 
 # A free (tilted) fit stands for a toppled object only where its reprojection cost is at most
@@ -26,14 +25,13 @@ TOPPLED_COST = 0.5
 
 
 def fuse(
-    found: list[Seen], typed: Callable[[list[Seen]], tuple[int, float]], world: World
+    found: list[Seen], typed: Callable[[list[Seen]], tuple[str, float]], world: World
 ) -> list[Detection]:
     """One detection per object that the views' lines of sight group (`fusion.grouped`),
     named by `typed` and fitted to every member's keypoints (its type's cuboid in `world`)."""
     out = []
     for members in grouped(found, world.table):
-        kind, confidence = typed(members)
-        name = TYPES[kind]
+        name, confidence = typed(members)
         rays = [line_of_sight(s) for s in members]
         views = [s.keypoints for s in members]
         pose, error = fitted(world.object_type(name), views, rays)

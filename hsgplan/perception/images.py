@@ -9,7 +9,7 @@ keypoints, M = `MAX_OBJECTS`):
 |-----------|---------|--------------------|------------------------------------------------------|
 | index     | int32   | [n]                | the sample's index in the `(seed)` stream            |
 | images    | uint8   | [n, V, H, W, 3]    | RGB                                                  |
-| types     | int8    | [n, M]             | index into the kitchen's types, -1 past the last one |
+| types     | int8    | [n, M]             | index into the collection's types, -1 past the last |
 | instance  | int8    | [n, M]             | 1 for `cherries`, 2 for `cherries_2`, ...; 0 padding |
 | poses     | float32 | [n, M, 7]          | position (m), quaternion xyzw; NaN padding           |
 | keypoints | float32 | [n, V, M, K, 2]    | pixel (u right, v down; OpenCV's centres); NaN pad   |
@@ -17,9 +17,10 @@ keypoints, M = `MAX_OBJECTS`):
 | cameras   | float32 | [n, V, 7]          | eye xyz, target xyz, vertical field of view (deg)    |
 | sizes     | float32 | [n, M, 3]          | the object's size in its scene (m); NaN padding      |
 
-`sizes` is written by collections staged in a scene file's world (`collect images --scene`); a
-chunk without it holds the training world's sizes (`load_chunks` gives it NaN sizes: its types'
-own).
+`types` index the object types of the world the collection was staged in, in its scene file's
+order (`collection_vocabulary`: the kitchen's, unless `collect images --scene` named another).
+`sizes` is written by collections staged in a scene file's world; a chunk without it holds its
+types' own sizes (`load_chunks` fills them in).
 
 The run folder's `episodes.jsonl` logs every finished chunk with its file's SHA-256; a run
 started again runs only the chunks not logged, and `load_chunks` refuses a file that is not
@@ -34,7 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
+from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.scene_file import recorded_worlds
 from hsgplan.domain.world import World
 from hsgplan.files import atomic, write_atomically
 from hsgplan.perception.keypoints import KEYPOINTS
@@ -45,8 +48,8 @@ from hsgplan.perception.synthetic import (
     ImageSample,
     render_sample,
 )
-from hsgplan.perception.vocabulary import TRAINING_WORLD, TYPES
-from hsgplan.runner.run_folder import logged_rows
+from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY, TRAINING_WORLD, Vocabulary
+from hsgplan.runner.run_folder import CONFIG, logged_rows
 
 FORMAT = 1
 CHUNK = 16
@@ -76,19 +79,23 @@ def render_chunk(
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic(path) as tmp:
         sized = world is not TRAINING_WORLD  # the training world's chunks stay as they were
-        np.savez_compressed(tmp, **pack(kept, views, world if sized else None))
+        np.savez_compressed(tmp, **pack(kept, views, world, sized))
         digest = hashlib.sha256(tmp.read_bytes()).hexdigest()
     unstaged = len(indices) - len(kept)
     return {"chunk": chunk, "samples": len(kept), "unstaged": unstaged, "sha256": digest}
 
 
 def pack(
-    samples: list[ImageSample], views: int = len(VIEWS), world: World | None = None
+    samples: list[ImageSample],
+    views: int = len(VIEWS),
+    world: World = TRAINING_WORLD,
+    sized: bool = False,
 ) -> dict[str, np.ndarray]:
-    """The arrays of a chunk (`views` each; a chunk whose draws were all unstaged holds none);
-    with `world`, the objects' sizes in it too."""
+    """The arrays of a chunk of samples staged in `world` (`views` each; a chunk whose draws
+    were all unstaged holds none); `sized`: the objects' sizes in it too."""
     n, v = len(samples), views
-    h, w = VIEWS[0].height, VIEWS[0].width
+    h, w = world.cameras[0].height, world.cameras[0].width
+    types = Vocabulary(world).types
     out = {
         "index": np.array([s.index for s in samples], dtype=np.int32),
         "images": np.zeros((n, v, h, w, 3), dtype=np.uint8),
@@ -103,22 +110,32 @@ def pack(
         m = len(s.objects)
         out["images"][i] = s.images
         for j, name in enumerate(s.objects):
-            type_name, k = TRAINING_WORLD.split_instance(name)
-            out["types"][i, j], out["instance"][i, j] = TYPES.index(type_name), k
+            type_name, k = world.split_instance(name)
+            out["types"][i, j], out["instance"][i, j] = types.index(type_name), k
         out["poses"][i, :m] = s.poses
         out["keypoints"][i, :, :m] = s.keypoints
         out["visible"][i, :, :m] = s.visible
         out["cameras"][i] = [[*c.eye, *c.target, c.fov] for c in s.cameras]
-    if world is not None:
+    if sized:
         out["sizes"] = np.full((n, MAX_OBJECTS, 3), np.nan, dtype=np.float32)
         for i, s in enumerate(samples):
             out["sizes"][i, : len(s.objects)] = [world.object_type(o).size for o in s.objects]
     return out
 
 
+def collection_vocabulary(run_dir: Path) -> Vocabulary:
+    """The types and cameras of the world a collection was staged in (its configuration's
+    scene file, else the kitchen): what its `types` index."""
+    made = Path(run_dir) / CONFIG
+    scene = read_json(made, "collection configuration").get("scene") if made.is_file() else None
+    return Vocabulary(recorded_worlds(scene, TRAINING_WORLD, run_dir)[0])
+
+
 def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:
-    """Every logged chunk of a collection, concatenated in chunk order; a chunk file missing,
-    damaged or not the one logged is refused in one line."""
+    """Every logged chunk of a collection, concatenated in chunk order, every object's size
+    in its scene given; a chunk file missing, damaged or not the one logged is refused in one
+    line."""
+    vocabulary = collection_vocabulary(run_dir)
     rows = sorted(
         (r["result"] for r in logged_rows(run_dir) if isinstance(r, dict) and "result" in r),
         key=lambda r: r["chunk"],
@@ -132,10 +149,10 @@ def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:
             raise InvalidInputError(f"'{path}' is missing or not the chunk logged; collect again")
         with np.load(path, allow_pickle=False) as data:
             part = {k: data[k] for k in data.files}
-        if problem := chunk_problem(part, row["samples"]):
+        if problem := chunk_problem(part, row["samples"], vocabulary):
             raise InvalidInputError(f"'{path}' is damaged: {problem}; collect again")
-        if "sizes" not in part:  # the training world's: its types' own sizes
-            part["sizes"] = np.full((*part["types"].shape, 3), np.nan, dtype=np.float32)
+        if "sizes" not in part:  # its types' own sizes
+            part["sizes"] = own_sizes(part["types"], vocabulary)
         parts.append(part)
     views = {p["images"].shape[1] for p in parts if len(p["images"])}
     if len(views) > 1:  # collections of several view counts train together (`train.joined`)
@@ -143,10 +160,21 @@ def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
-def chunk_problem(arrays: dict[str, np.ndarray], samples: int) -> str | None:
+def own_sizes(types: np.ndarray, vocabulary: Vocabulary) -> np.ndarray:
+    """Each object's size as its type has it (NaN where there is none): [..., 3] for
+    `types` [...] indices into the vocabulary's types (-1: none)."""
+    table = np.array([vocabulary.object_type(k).size for k in range(len(vocabulary.types))])
+    sizes = np.full((*types.shape, 3), np.nan, dtype=np.float32)
+    sizes[types >= 0] = table[types[types >= 0]]
+    return sizes
+
+
+def chunk_problem(
+    arrays: dict[str, np.ndarray], samples: int, vocabulary: Vocabulary = KITCHEN_VOCABULARY
+) -> str | None:
     """What breaks the format in a chunk's arrays (`pack`'s), or None: every array present,
     one row per sample as logged, the views and objects alike in every array, every type an
-    index into `TYPES` (or -1, no object)."""
+    index into the vocabulary's types (or -1, no object)."""
     names = ("index", "images", "types", "instance", "poses", "keypoints", "visible", "cameras")
     if missing := [n for n in names if n not in arrays]:
         return f"no {', '.join(missing)}"
@@ -154,7 +182,7 @@ def chunk_problem(arrays: dict[str, np.ndarray], samples: int) -> str | None:
         return f"not {samples} samples in every array"
     v = arrays["images"].shape[1] if arrays["images"].ndim == 5 else -1
     shapes = {
-        "images": (v, VIEWS[0].height, VIEWS[0].width, 3),
+        "images": (v, vocabulary.views[0].height, vocabulary.views[0].width, 3),
         "types": (MAX_OBJECTS,),
         "instance": (MAX_OBJECTS,),
         "poses": (MAX_OBJECTS, 7),
@@ -168,13 +196,15 @@ def chunk_problem(arrays: dict[str, np.ndarray], samples: int) -> str | None:
     if "sizes" in arrays and arrays["sizes"].shape[1:] != (MAX_OBJECTS, 3):
         return f"sizes of shape {arrays['sizes'].shape[1:]}, not {(MAX_OBJECTS, 3)}"
     types = arrays["types"]
-    if types.dtype.kind not in "iu" or ((types < -1) | (types >= len(TYPES))).any():
-        return f"an object type outside -1 to {len(TYPES) - 1}"
+    count = len(vocabulary.types)
+    if types.dtype.kind not in "iu" or ((types < -1) | (types >= count)).any():
+        return f"an object type outside -1 to {count - 1}"
     return None
 
 
-def write_format(run_dir: Path) -> None:
+def write_format(run_dir: Path, vocabulary: Vocabulary = KITCHEN_VOCABULARY) -> None:
     """The format above, beside the chunks, for whoever reads them without this package."""
     doc = (__doc__ or "").split("Format", 1)[1].split("The run folder", 1)[0]
-    text = json.dumps({"format": FORMAT, "types": TYPES, "description": "Format" + doc}, indent=1)
+    types = list(vocabulary.types)
+    text = json.dumps({"format": FORMAT, "types": types, "description": "Format" + doc}, indent=1)
     write_atomically(run_dir / "format.json", text + "\n")

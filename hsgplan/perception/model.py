@@ -39,7 +39,7 @@ CORNERS = KEYPOINTS - 1
 class PerceptionNetConfig:
     """What builds a keypoint network; saved as `config.json` beside its weights."""
 
-    types: int = len(TYPES)
+    types: int = len(TYPES)  # type channels: f_p's vocabulary's (`perception.vocabulary`)
     width: int = 32  # channels of the first block; doubled at each of the next two
     stages: int = 2
     stride: int = STRIDE  # input pixels per output cell: 4, or 2 through `_Refine`

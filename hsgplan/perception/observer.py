@@ -81,7 +81,9 @@ class RgbObserver:
 
     @staticmethod
     def load(folder: Path) -> RgbObserver:
-        return RgbObserver(PoseEstimator.load(folder))
+        """The observer of an f_p checkpoint folder, through the cameras it was trained with."""
+        estimator = PoseEstimator.load(folder)
+        return RgbObserver(estimator, estimator.vocabulary.views)
 
     def start(self, objects: tuple[str, ...], world: World) -> None:
         self.world = world

@@ -23,7 +23,7 @@ from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.world import Kind, World
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, in_world
-from hsgplan.perception.vocabulary import TRAINING_WORLD, VIEWS
+from hsgplan.perception.vocabulary import TRAINING_WORLD, VIEWS, Vocabulary
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.render import Camera
 from hsgplan.sim.scene import Scene
@@ -96,11 +96,12 @@ def draw_state(
     return SymbolicSceneGraph.from_literals(objects, literals, world=world)
 
 
-def first_views(count: int) -> tuple[Camera, ...]:
-    """The first `count` fixed views; a count past them (or under one) is refused in a line."""
-    if not 1 <= count <= len(VIEWS):
-        raise InvalidInputError(f"views {count}: there are 1 to {len(VIEWS)} fixed views")
-    return VIEWS[:count]
+def first_views(count: int, views: tuple[Camera, ...] = VIEWS) -> tuple[Camera, ...]:
+    """The first `count` fixed `views` (the kitchen's unless told); a count past them (or
+    under one) is refused in a line."""
+    if not 1 <= count <= len(views):
+        raise InvalidInputError(f"views {count}: there are 1 to {len(views)} fixed views")
+    return views[:count]
 
 
 def render_sample(
@@ -110,8 +111,10 @@ def render_sample(
     views: int = len(VIEWS),
     world: World = TRAINING_WORLD,
 ) -> ImageSample | None:
-    """The sample `(seed, index)` staged in a scene of `world` (f_p's training world unless
-    told), from the first `views` fixed views; None when its arrangement could not be staged."""
+    """The sample `(seed, index)` staged in a scene of `world` (the kitchen unless told),
+    from the first `views` of its fixed views; None when its arrangement could not be staged."""
+    every = Vocabulary(world).views
+    first_views(views, every)
     rng = random.Random(f"images-{seed}-{index}")
     state = draw_state(rng, p_elsewhere, world)
     with Scene(state.objects, seed=rng.getrandbits(32), world=world) as scene:
@@ -121,10 +124,10 @@ def render_sample(
         for _ in range(rng.randint(0, DISTRACTORS)):
             _add_distractor(scene, rng)
         # the first three's jitter is always drawn, so fewer views change nothing else
-        cameras = tuple(_jittered(c, rng) for c in VIEWS[:ORIGINAL_VIEWS])[:views]
+        cameras = tuple(_jittered(c, rng) for c in every[:ORIGINAL_VIEWS])[:views]
         light = _light(rng)
         cameras += tuple(
-            _jittered(VIEWS[k], random.Random(f"images-{seed}-{index}-view-{k}"))
+            _jittered(every[k], random.Random(f"images-{seed}-{index}-view-{k}"))
             for k in range(ORIGINAL_VIEWS, views)
         )
         objects = scene.objects

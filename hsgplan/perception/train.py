@@ -41,11 +41,16 @@ from hsgplan.perception.colour import (
     load_colour,
 )
 from hsgplan.perception.colour import FOLDER as COLOUR_FOLDER
-from hsgplan.perception.images import chunk_path, load_chunks
+from hsgplan.perception.images import chunk_path, collection_vocabulary, load_chunks
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE, PerceptionNetConfig, build, load_perception_net
-from hsgplan.perception.vocabulary import TRAINING_WORLD, TYPES
+from hsgplan.perception.vocabulary import (
+    KITCHEN_VOCABULARY,
+    Vocabulary,
+    read_vocabulary,
+    write_vocabulary,
+)
 from hsgplan.runner.run_folder import logged_rows
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -78,8 +83,11 @@ class PerceptionTrainConfig:
     def __post_init__(self) -> None:
         check_fields(self)
 
-    def net_config(self) -> PerceptionNetConfig:
-        return PerceptionNetConfig(width=self.width, stages=self.stages, stride=self.stride)
+    def net_config(self, types: int = len(KITCHEN_VOCABULARY.types)) -> PerceptionNetConfig:
+        """The network's sizes, for `types` type channels (its vocabulary's)."""
+        return PerceptionNetConfig(
+            types=types, width=self.width, stages=self.stages, stride=self.stride
+        )
 
     @property
     def folders(self) -> list[Path]:
@@ -116,12 +124,13 @@ class Examples:
         )
 
 
-def examples(data: dict[str, np.ndarray]) -> Examples:
-    """Every (sample, view) of a loaded collection, its keypoints named as that view names
-    them (`perception.keypoints.view_keypoints`, from the stored poses, sizes and cameras)."""
+def examples(data: dict[str, np.ndarray], vocabulary: Vocabulary = KITCHEN_VOCABULARY) -> Examples:
+    """Every (sample, view) of a loaded collection whose types index `vocabulary`'s, its
+    keypoints named as that view names them (`perception.keypoints.view_keypoints`, from the
+    stored poses, sizes and cameras)."""
     images, keypoints, types, cuboids = [], [], [], []
     n, views, height, width = data["images"].shape[:4]
-    # no sizes (the training world's collections): each type's own
+    # no sizes: each type's own
     sizes = data.get("sizes", np.full((*data["types"].shape, 3), np.nan, dtype=np.float32))
     for i in range(n):
         for v in range(views):
@@ -137,7 +146,7 @@ def examples(data: dict[str, np.ndarray]) -> Examples:
             present = data["types"][i] >= 0
             every = np.asarray(
                 [
-                    view_keypoints(_sized(t, size), _pose(p), camera)
+                    view_keypoints(_sized(vocabulary, t, size), _pose(p), camera)
                     for t, p, size in zip(
                         data["types"][i][present],
                         data["poses"][i][present],
@@ -164,10 +173,10 @@ def joined(parts: list[Examples]) -> Examples:
     )
 
 
-def _sized(t: int, size: np.ndarray) -> ObjectType:
-    """The type `TYPES[t]` at the size it had in its scene (a layout resizes its groceries);
-    NaN: the training world's, the type's own."""
-    own = TRAINING_WORLD.object_type(TYPES[t])
+def _sized(vocabulary: Vocabulary, t: int, size: np.ndarray) -> ObjectType:
+    """The vocabulary's type `t` at the size it had in its scene (a layout resizes its
+    groceries); NaN: the type's own."""
+    own = vocabulary.object_type(t)
     return own if np.isnan(size).any() else replace(own, size=tuple(map(float, size)))
 
 
@@ -226,27 +235,54 @@ def train_perception(
     the colour network that names types (`perception.colour`) into `out/colour/` (seconds);
     `on_batch` sees (images done this epoch, images in an epoch) after every batch."""
     config.net_config()  # a stride the network does not have: refused before any write
+    if not config.folders:
+        raise InvalidInputError("no image collection named")
+    vocabulary = _vocabulary(config)  # collections of other looks: refused before any write
     torch.manual_seed(config.seed)
-    model = build(config.net_config())
+    net_config = config.net_config(len(vocabulary.types))
+    model = build(net_config)
     if config.init:  # one that does not fit: refused before any write
         _start_from(model, load_perception_net(Path(config.init))[0])
     parts = [load_chunks(f) for f in config.folders]  # missing or damaged: refused, too
-    if not parts:
-        raise InvalidInputError("no image collection named")
     chunks = [chunk_path(f, r["result"]["chunk"]) for f in config.folders for r in logged_rows(f)]
     data_print = fingerprint(chunks + ([Path(config.init)] if config.init else []))
     training.claim(out, asdict(config), asdict(PerceptionTrainConfig()), data_print)
-    found = joined([examples(p) for p in parts])  # collections of different view counts too
+    write_vocabulary(out, vocabulary)
+    # collections of different view counts join too
+    found = joined([examples(p, vocabulary) for p in parts])
     if len(found.images) == 0:
         raise InvalidInputError(f"no images in '{config.images}'")
     if not training.finished(out):
-        _train_keypoints(config, model, found, out, data_print, on_epoch, on_batch)
-    train_colour(colour_samples(found), out / COLOUR_FOLDER, ColourConfig(seed=config.seed))
+        _train_keypoints(config, net_config, model, found, out, data_print, on_epoch, on_batch)
+    count = len(vocabulary.types)
+    colour = ColourConfig(types=count + 1, seed=config.seed)
+    train_colour(colour_samples(found, background=count), out / COLOUR_FOLDER, colour)
 
 
-def colour_samples(found: Examples) -> list[tuple[np.ndarray, int]]:
+def _vocabulary(config: PerceptionTrainConfig) -> Vocabulary:
+    """The types and cameras the collections were staged with, which the networks learn
+    (`perception.vocabulary`); collections (or an init checkpoint) of other looks, or of them
+    in another order, are refused in one line."""
+    first, *others = config.folders
+    vocabulary = collection_vocabulary(first)
+    for folder in others:
+        if not collection_vocabulary(folder).same_looks(vocabulary):
+            raise InvalidInputError(
+                f"'{folder}' was staged among other groceries or cameras than '{first}'; "
+                "collections train together only over the same ones"
+            )
+    if config.init and not read_vocabulary(config.init).same_looks(vocabulary):
+        raise InvalidInputError(
+            f"the init checkpoint '{config.init}' learned other groceries or cameras than "
+            f"the images '{first}' show"
+        )
+    return vocabulary
+
+
+def colour_samples(found: Examples, background: int = BACKGROUND) -> list[tuple[np.ndarray, int]]:
     """(colour features at the centroid, type) of every in-sight object of every image, and
-    (those of `BACKGROUND_PATCHES` patches outside every object, the background class)."""
+    (those of `BACKGROUND_PATCHES` patches outside every object, the class `background`: the
+    one after the types)."""
     out = []
     for e, (image, points, kinds, every) in enumerate(
         zip(found.images, found.keypoints, found.types, found.cuboids, strict=True)
@@ -255,7 +291,7 @@ def colour_samples(found: Examples) -> list[tuple[np.ndarray, int]]:
         for p, t in zip(points, kinds, strict=True):
             if (row := features(pixels, p[-1])) is not None:
                 out.append((row, int(t)))
-        out += [(row, BACKGROUND) for row in _background(pixels, every, np.random.default_rng(e))]
+        out += [(row, background) for row in _background(pixels, every, np.random.default_rng(e))]
     return out
 
 
@@ -287,6 +323,7 @@ def _start_from(model: torch.nn.Module, trained: torch.nn.Module) -> None:
 
 def _train_keypoints(
     config: PerceptionTrainConfig,
+    net_config: PerceptionNetConfig,
     model: torch.nn.Module,
     found: Examples,
     out: Path,
@@ -294,7 +331,6 @@ def _train_keypoints(
     on_epoch: Callable[[int, float], None] | None,
     on_batch: Callable[[int, int], None] | None,
 ) -> None:
-    net_config = config.net_config()
     torch.set_num_threads(config.threads)
     optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start = training.resume(out, model, optim, data_print)

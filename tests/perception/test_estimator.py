@@ -22,6 +22,7 @@ from hsgplan.perception.model import STRIDE
 from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.synthetic import VIEWS, render_sample
 from hsgplan.perception.train import MIN_VISIBLE
+from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY
 from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
 
 TYPES = list(KITCHEN.object_types)
@@ -94,19 +95,21 @@ def test_rotation_error_counts_a_cuboid_symmetry_as_no_error():
 
 def test_a_box_whose_rays_meet_a_centimetre_over_the_table_is_named_a_thin_one():
     probs = torch.tensor([0.0, 0.0, 0.0, 0.5, 0.3, 0.2])  # the colour says popcorn
-    assert TYPES[_of_kind(KITCHEN, probs, "popcorn")[0]] == "popcorn"
+    names = tuple(TYPES)
+    assert _of_kind(KITCHEN, names, probs, "popcorn")[0] == "popcorn"
     low = np.array([0.5, 0.0, 0.012])
-    best, confidence = _of_kind(KITCHEN, probs, "popcorn", low)
-    assert TYPES[best] == "cream_cheese" and confidence == pytest.approx(0.3)
-    assert TYPES[_of_kind(KITCHEN, probs, "popcorn", np.array([0.5, 0.0, 0.063]))[0]] == "popcorn"
+    best, confidence = _of_kind(KITCHEN, names, probs, "popcorn", low)
+    assert best == "cream_cheese" and confidence == pytest.approx(0.3)
+    assert _of_kind(KITCHEN, names, probs, "popcorn", np.array([0.5, 0.0, 0.063]))[0] == "popcorn"
 
 
 def test_a_scene_without_a_type_is_never_read_to_hold_one():
     without = replace(KITCHEN, type_list=tuple(t for t in KITCHEN.type_list if t.name != "popcorn"))
     probs = torch.tensor([0.0, 0.0, 0.0, 0.5, 0.3, 0.2])  # the colour says popcorn
-    assert TYPES[_of_kind(without, probs, "cream_cheese")[0]] == "cream_cheese"
+    names = tuple(TYPES)
+    assert _of_kind(without, names, probs, "cream_cheese")[0] == "cream_cheese"
     over = np.array([0.5, 0.0, 0.063])  # where a popcorn's centre would be, over the table
-    assert TYPES[_of_kind(without, probs, "butter", over)[0]] == "cream_cheese"
+    assert _of_kind(without, names, probs, "butter", over)[0] == "cream_cheese"
 
 
 def test_of_a_soup_and_a_box_found_in_one_place_the_colour_keeps_the_soup():
@@ -114,8 +117,8 @@ def test_of_a_soup_and_a_box_found_in_one_place_the_colour_keeps_the_soup():
     at = Pose.from_xyz_yaw(0.5, 0.0, 0.042, 0.0)
     found = []
     for kind in ("popcorn", "alphabet_soup"):
-        best, confidence = _of_kind(KITCHEN, probs, kind)
-        found.append(Detection(TYPES[best], at, 1.0, 2, 0.0, (), confidence))
+        best, confidence = _of_kind(KITCHEN, tuple(TYPES), probs, kind)
+        found.append(Detection(best, at, 1.0, 2, 0.0, (), confidence))
     assert found[0].type_name == "popcorn"  # the likeliest box, though no box is likely
     assert [d.type_name for d in apart(found, KITCHEN)] == ["alphabet_soup"]
 
@@ -227,6 +230,8 @@ def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand()
 
     class Oracle:
         """Detects every object at its true pose, and the held one in the hand."""
+
+        vocabulary = KITCHEN_VOCABULARY
 
         def __init__(self, scenes):
             self.scenes = iter(scenes)

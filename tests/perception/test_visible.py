@@ -46,6 +46,8 @@ def test_the_upper_box_hides_the_lower_ones_centroid_but_not_its_side():
 class _NearestColour(torch.nn.Module):
     """Type logits: how near the chromaticity is to each type's own colour."""
 
+    objects = len(TYPES)  # no background class
+
     def forward(self, x):
         rgb = torch.tensor([KITCHEN.object_types[t].color[:3] for t in TYPES])
         chroma = rgb / rgb.sum(dim=1, keepdim=True)
