@@ -100,3 +100,14 @@ def test_images_of_new_groceries_train_an_f_p_that_names_them_and_may_look_at_th
         with pytest.raises(InvalidInputError, match=why):
             train_perception(bad, tmp_path / "other")
         assert not (tmp_path / "other").exists()
+
+
+def test_networks_of_another_count_of_types_than_their_vocabulary_are_refused(tmp_path):
+    import shutil
+
+    folder = tmp_path / "f_p"
+    shutil.copytree(PERCEPTION_CHECKPOINT, folder)
+    fewer = replace(NEW, type_list=NEW.type_list[:3])  # six channels, three types named
+    write_vocabulary(folder, Vocabulary(fewer))
+    with pytest.raises(InvalidInputError, match="name 6 and 6 types, its vocabulary 3"):
+        PoseEstimator.load(folder)
