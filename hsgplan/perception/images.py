@@ -35,9 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hsgplan.domain.checks import read_json
+from hsgplan.data.world_trials import collection_worlds
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.scene_file import recorded_worlds
 from hsgplan.domain.world import World
 from hsgplan.files import atomic, write_atomically
 from hsgplan.perception.keypoints import KEYPOINTS
@@ -49,7 +48,7 @@ from hsgplan.perception.synthetic import (
     render_sample,
 )
 from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY, TRAINING_WORLD, Vocabulary
-from hsgplan.runner.run_folder import CONFIG, logged_rows
+from hsgplan.runner.run_folder import logged_rows
 
 FORMAT = 1
 CHUNK = 16
@@ -126,9 +125,7 @@ def pack(
 def collection_vocabulary(run_dir: Path) -> Vocabulary:
     """The types and cameras of the world a collection was staged in (its configuration's
     scene file, else the kitchen): what its `types` index."""
-    made = Path(run_dir) / CONFIG
-    scene = read_json(made, "collection configuration").get("scene") if made.is_file() else None
-    return Vocabulary(recorded_worlds(scene, TRAINING_WORLD, run_dir)[0])
+    return Vocabulary(collection_worlds(run_dir, TRAINING_WORLD)[0])
 
 
 def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:
