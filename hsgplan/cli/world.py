@@ -211,7 +211,8 @@ def evaluate(
         str,
         typer.Option(
             help="What the agent sees with, comma-separated: gt (the simulator's poses), rgb "
-            "(f_p on the fixed cameras' images); one column each, rgb's named METHOD-rgb."
+            "(f_p on the fixed cameras' images), rgb-latest (f_p, each look taken as it "
+            "comes: no steady rule); one column each, rgb's named METHOD-rgb."
         ),
     ] = config_default(EvalConfig, "perception"),
     perception_checkpoint: PerceptionCheckpoint = None,

@@ -18,7 +18,9 @@ from hsgplan.domain.scene_file import MAX_SCENE_BYTES, read_world_text, read_wor
 
 # What an agent sees the simulated world with: `gt` (the simulator's poses) or `rgb` (f_p on
 # the fixed cameras' images); `evaluation.observers` makes them.
-OBSERVERS = ("gt", "rgb")
+# gt: the simulator's poses; rgb: f_p on the cameras' images; rgb-latest: f_p with each look's
+# estimate taken as it comes (`perception.observer`'s `steady` rule off, to measure it)
+OBSERVERS = ("gt", "rgb", "rgb-latest")
 
 
 def check_observer(name: str) -> None:
@@ -34,7 +36,7 @@ def check_seen(
 ) -> None:
     """Refuse f_p (`checkpoint`'s, else the shipped one) a scene it cannot see, in one line
     (`unseeable`)."""
-    if perception == "rgb" and (why := unseeable(worlds, scene, checkpoint)):
+    if perception != "gt" and (why := unseeable(worlds, scene, checkpoint)):
         raise InvalidInputError(f"--perception rgb: {why}; see it with --perception gt")
 
 
@@ -67,7 +69,7 @@ class EvalConfig:
     repeats: int = setting(1, **BOUNDS["repeats"])
     checkpoint: str | None = None  # the task planner's folder (None: the shipped one)
     motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
-    perception: str = "gt"  # what the agent sees: "gt" (the simulator's poses) or "rgb" (f_p)
+    perception: str = "gt"  # what the agent sees: one of OBSERVERS
     perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
     protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
     rules_off: tuple[str, ...] = ()  # recovery rules switched off (the recovering protocol)

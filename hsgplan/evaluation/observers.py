@@ -1,5 +1,6 @@
-"""What an agent sees the simulated world with, by name: `gt` (the simulator's poses) or `rgb`
-(f_p on the fixed cameras' images, `perception.observer.RgbObserver`)."""
+"""What an agent sees the simulated world with, by name: `gt` (the simulator's poses), `rgb`
+(f_p on the fixed cameras' images, `perception.observer.RgbObserver`) or `rgb-latest` (the same
+with its `steady` rule off)."""
 
 from __future__ import annotations
 
@@ -24,4 +25,4 @@ def make_observer(name: str, checkpoint: str | Path | None = None) -> SceneObser
         return GroundTruth()
     from hsgplan.perception.observer import RgbObserver
 
-    return RgbObserver.load(perception_folder(checkpoint))
+    return RgbObserver.load(perception_folder(checkpoint), steady=name == "rgb")

@@ -62,9 +62,9 @@ def where(report: dict) -> str:
 
 
 def label(method: str) -> str:
-    base, seen, observer = method.rpartition("-")
-    if seen and observer == "rgb":  # a column seeing with f_p (`--perception rgb`)
-        return f"{label(base)} (rgb)"
+    for observer in ("rgb-latest", "rgb"):  # a column seeing with f_p (`--perception rgb`)
+        if method.endswith(f"-{observer}"):
+            return f"{label(method.removesuffix(f'-{observer}'))} ({observer})"
     return LABELS.get(method, method)
 
 

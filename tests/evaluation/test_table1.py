@@ -199,6 +199,7 @@ def test_a_column_seeing_with_f_p_is_labelled_so():
     from hsgplan.evaluation.table1 import label
 
     assert label("gnn-rgb") == "GNN (rgb)" and label("gnn") == "GNN"
+    assert label("gnn-rgb-latest") == "GNN (rgb-latest)"
     assert label("forward_gnn") == "forward_gnn"
 
 
