@@ -16,10 +16,9 @@ from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import MAX_SCENE_BYTES, read_world_text, read_worlds
 
-# What an agent sees the simulated world with: `gt` (the simulator's poses) or `rgb` (f_p on
-# the fixed cameras' images); `evaluation.observers` makes them.
-# gt: the simulator's poses; rgb: f_p on the cameras' images; rgb-latest: f_p with each look's
-# estimate taken as it comes (`perception.observer`'s `steady` rule off, to measure it)
+# What an agent sees the simulated world with (`evaluation.observers` makes them): gt, the
+# simulator's poses; rgb, f_p on the fixed cameras' images; rgb-latest, f_p with each look's
+# estimate taken as it comes (`perception.observer`'s `steady` rule off, to measure it).
 OBSERVERS = ("gt", "rgb", "rgb-latest")
 
 
@@ -37,7 +36,7 @@ def check_seen(
     """Refuse f_p (`checkpoint`'s, else the shipped one) a scene it cannot see, in one line
     (`unseeable`)."""
     if perception != "gt" and (why := unseeable(worlds, scene, checkpoint)):
-        raise InvalidInputError(f"--perception rgb: {why}; see it with --perception gt")
+        raise InvalidInputError(f"--perception {perception}: {why}; see it with --perception gt")
 
 
 def unseeable(

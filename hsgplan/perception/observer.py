@@ -67,8 +67,8 @@ STILL = 0.05  # m
 HAND_RADIUS = 0.1
 # m: a detection this close to an object's belief is of the object where it was (it did not move).
 # On the tuning seeds (`eval world --perception rgb --protocol paper --sizes 6 --goals 30
-# --seed 900`) a still box between looks seemed to move 4 to 6 mm while its yaw swung by 40 to
-# 70 degrees, which lost a pick of it; a move of 1 cm is what the pose targets allow.
+# --seed 900`) a still box between looks seemed to move 4 to 6 mm while its yaw swung by 34 to
+# 70 degrees; a move of 1 cm is what the pose targets allow.
 STEADY = 0.01
 
 
