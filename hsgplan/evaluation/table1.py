@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from hsgplan.domain.recovery import RECOVERING
-from hsgplan.evaluation.config import TABLES, EvalConfig
+from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import check_runs, check_world, episode_specs, run_evaluation
 from hsgplan.evaluation.seeds import is_tuning, marked
@@ -62,7 +62,8 @@ def where(report: dict) -> str:
 
 
 def label(method: str) -> str:
-    for observer in ("rgb-latest", "rgb"):  # a column seeing with f_p (`--perception rgb`)
+    # a column seeing with f_p (`--perception rgb`): the longest name first (rgb-latest, rgb)
+    for observer in sorted(set(OBSERVERS) - {"gt"}, key=len, reverse=True):
         if method.endswith(f"-{observer}"):
             return f"{label(method.removesuffix(f'-{observer}'))} ({observer})"
     return LABELS.get(method, method)
