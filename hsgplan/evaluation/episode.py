@@ -26,7 +26,7 @@ from hsgplan.domain.goals import Goal
 from hsgplan.evaluation.failures import Failure
 from hsgplan.scene_graph.symbol_mapping import AnomalyKind
 from hsgplan.sim.env import KitchenStorageEnv, Observation, ResetOptions
-from hsgplan.sim.outcome import Disturbance
+from hsgplan.sim.outcome import BeliefError, Disturbance
 
 _FATAL = {AnomalyKind.TOPPLED: Failure.KNOCKED_OVER, AnomalyKind.OFF_TABLE: Failure.OFF_TABLE}
 
@@ -49,6 +49,9 @@ class StepRecord:
     seen_moved: float = 0.0
     # how far (m) a place's object truly moved after the hand let it go (`sim.outcome.dragged`)
     dragged: float = 0.0
+    # how far the belief it was planned on had its object and a place's target object from
+    # the simulator's poses (zero under the ground truth)
+    misbelieved: tuple[BeliefError, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -99,7 +102,8 @@ class EpisodeRecord:
 
 def _step(d: dict) -> StepRecord:
     moved = tuple(Disturbance(**m) for m in d.get("disturbed", ()))
-    return StepRecord(**{**d, "disturbed": moved})
+    off = tuple(BeliefError(**m) for m in d.get("misbelieved", ()))
+    return StepRecord(**{**d, "disturbed": moved, "misbelieved": off})
 
 
 def unsampled(seed: int, agent: str, goal: Goal, observer: str) -> EpisodeRecord:
@@ -190,6 +194,7 @@ def run_episode(
             info["disturbed"],
             round(info["seen_moved"], 4),
             info["dragged"],
+            info["misbelieved"],
         )
         records.append(record)
         if on_step:

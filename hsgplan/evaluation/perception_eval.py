@@ -20,7 +20,6 @@ found), or every object found and a relation read wrong: between stacked objects
 
 from __future__ import annotations
 
-import math
 from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -32,11 +31,10 @@ from hsgplan.domain.objects import EntityKind
 from hsgplan.domain.world import Kind, World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
-from hsgplan.perception.keypoints import BOX_SYMMETRIES
 from hsgplan.perception.observer import away_from_hand
 from hsgplan.perception.synthetic import VIEWS, ImageSample, render_sample
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.scene_graph.geometry import Pose
+from hsgplan.scene_graph.geometry import Pose, rotation_apart
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 
 MATCH_DISTANCE = 0.10  # m: a detection further than this from every object of its type matched none
@@ -65,12 +63,7 @@ class SceneResult:
 
 def rotation_error(obj: str, truth: Pose, estimate: Pose, world: World) -> float:
     """Degrees between two orientations of an object, up to its cuboid's symmetries."""
-    a, b = truth.rotation, estimate.rotation
-    if world.object_type(obj).kind is Kind.CAN:
-        cos = abs(float(a[:, 2] @ b[:, 2]))  # the axis, either way up
-        return math.degrees(math.acos(min(1.0, cos)))
-    best = max(np.trace(a.T @ b @ s) for s in BOX_SYMMETRIES)
-    return math.degrees(math.acos(float(np.clip((best - 1) / 2, -1.0, 1.0))))
+    return rotation_apart(truth, estimate, world.object_type(obj).kind is Kind.CAN)
 
 
 def match(

@@ -116,6 +116,7 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
             if s.action.startswith("place") and s.dragged > DISTURB_RECORD
         ),
         "still_seen_moved": still_seen_moved(rs),
+        "misbelieved": misbelieved(rs),
         # looks taken again before a primitive or the goal's end, seeing through f_p (`relook`)
         "relooks": sum(s.relooks for r in rs for s in r.steps) + sum(r.closing_relooks for r in rs),
         "median_steps": statistics.median(len(r.steps) for r in rs),
@@ -139,6 +140,21 @@ def still_seen_moved(rs: Sequence[EpisodeRecord]) -> dict:
         "max": moves[-1],
         "beyond_2cm": sum(m > DISTURB_TOL for m in moves),
         "beyond_tolerance": sum(m > SEEN_DISTURB_TOL for m in moves),
+    }
+
+
+def misbelieved(rs: Sequence[EpisodeRecord]) -> dict:
+    """Steps planned on a belief that had an object they acted on off its true pose beyond
+    f_p's targets (`sim.outcome.BELIEF_OFF`, `BELIEF_TURNED`), and the failed primitives among
+    them: how much of what fails seeing through f_p is the belief's. The largest errors are
+    over every step's objects. Zero under the ground truth."""
+    errors = [(s, e) for r in rs for s in r.steps for e in s.misbelieved]
+    off = {id(s): s for s, e in errors if e.beyond}
+    return {
+        "steps": len(off),
+        "failed": sum(1 for s in off.values() if s.status in FAILED_EXECUTION),
+        "max_off": max((e.off for _, e in errors), default=0.0),
+        "max_turned": max((e.turned for _, e in errors), default=0.0),
     }
 
 

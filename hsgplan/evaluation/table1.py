@@ -22,6 +22,7 @@ from hsgplan.evaluation.seeds import is_tuning, marked
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim, read_timing, sittings
+from hsgplan.sim.outcome import BELIEF_OFF, BELIEF_TURNED
 
 # Table 1 of the paper (success rate, subgoal completion), by motion generator and size.
 PAPER_TABLE1: dict[str, dict[int, tuple[float, float]]] = {
@@ -283,6 +284,7 @@ def _failures(report: dict) -> TextTable:
                         )
                     )
                     + ((str(v.get("relooks", "—")),) if seen else ())
+                    + ((str(v.get("misbelieved", {}).get("failed", "—")),) if seen else ())
                     + ((str(skipped),) if unsampled else ())
                 )
     title = (
@@ -294,12 +296,14 @@ def _failures(report: dict) -> TextTable:
     if seen:
         title += (
             "; seeing through f_p, perception (the goal seen reached where it was not, or an "
-            "object no view found) and the looks taken again before a primitive (relook)"
+            "object no view found), the looks taken again before a primitive (relook), and "
+            "failed primitives planned on a belief that had an object they acted on more than "
+            f"{BELIEF_OFF * 100:.0f} cm or {BELIEF_TURNED:.0f}° off its true pose (belief off)"
         )
     header = ("method", "objects", "episodes", "failed", "execution", "overstep")
     header += (PERCEPTION,) if seen else ()
     header += ("failed primitives", "overstep after failures", "disturbing steps")
-    header += ("relooks",) if seen else ()
+    header += ("relooks", "belief off") if seen else ()
     if unsampled:
         title += (
             "; unsampled: goals whose start scene could not be sampled (the world's limit, "

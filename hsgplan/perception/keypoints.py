@@ -24,22 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgplan.domain.world import Kind, ObjectType
-from hsgplan.scene_graph.geometry import Pose
+from hsgplan.scene_graph.geometry import BOX_SYMMETRIES, Pose
 from hsgplan.sim.render import Camera
 
 KEYPOINTS = 9  # 8 corners, then the centroid
 # Corner order: x, y, z signs, x slowest; fixed so that a network's maps name the same corner.
 CORNER_SIGNS = np.array(
     [(sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64
-)
-
-
-# The rotations that leave a box's cuboid where it was: half turns about its axes.
-BOX_SYMMETRIES = (
-    np.eye(3),
-    np.diag([1.0, -1.0, -1.0]),
-    np.diag([-1.0, 1.0, -1.0]),
-    np.diag([-1.0, -1.0, 1.0]),
 )
 
 

@@ -41,6 +41,26 @@ def matrix_to_quat(m: np.ndarray) -> tuple[float, float, float, float]:
     return tuple(float(sign * c) for c in q)  # type: ignore[return-value]
 
 
+# The rotations that leave a box's cuboid where it was: half turns about its axes.
+BOX_SYMMETRIES = (
+    np.eye(3),
+    np.diag([1.0, -1.0, -1.0]),
+    np.diag([-1.0, 1.0, -1.0]),
+    np.diag([-1.0, -1.0, 1.0]),
+)
+
+
+def rotation_apart(a: Pose, b: Pose, round_about_z: bool) -> float:
+    """Degrees between two orientations of one object, up to what its shape cannot tell
+    apart: a cuboid's half turns, and with `round_about_z` (a can) any turn about its axis,
+    either way up."""
+    ra, rb = a.rotation, b.rotation
+    if round_about_z:
+        return math.degrees(math.acos(min(1.0, abs(float(ra[:, 2] @ rb[:, 2])))))
+    best = max(np.trace(ra.T @ rb @ s) for s in BOX_SYMMETRIES)
+    return math.degrees(math.acos(float(np.clip((best - 1) / 2, -1.0, 1.0))))
+
+
 def yaw_quat(yaw: float) -> tuple[float, float, float, float]:
     return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
 

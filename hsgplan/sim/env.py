@@ -41,6 +41,7 @@ from hsgplan.sim.outcome import (
     SEEN_DISTURB_TOL,
     Outcome,
     Status,
+    belief_errors,
     compare,
     disturbances,
     dragged,
@@ -215,6 +216,13 @@ class KitchenStorageEnv(gymnasium.Env):
                 before.scene_graph, typed.scene_graph, acted_on, _sure(before, typed)
             ),
             "goal_truly_holds": self.goal.satisfied_by(typed.true_symbols.state),
+            # how far the belief the step was planned on had its objects (the record's)
+            "misbelieved": belief_errors(
+                before.scene_graph,
+                true_before,
+                tuple(o for o in (acted_on, getattr(params, "target", "")) if o),
+                self.scene.world,
+            ),
         }
         return self._encode(typed), float(done), done, truncated, info
 

@@ -6,8 +6,10 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from hsgplan.domain.predicates import Literal, Predicate
+from hsgplan.domain.scene import World
+from hsgplan.domain.world import Kind
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.scene_graph.geometry import Pose
+from hsgplan.scene_graph.geometry import Pose, rotation_apart
 from hsgplan.scene_graph.symbol_mapping import AnomalyKind, map_symbols
 
 # Another object that moves further than this (horizontally) was disturbed by the primitive.
@@ -85,6 +87,47 @@ def disturbances(
             first = (n for n, poses in phases if before[o].distance(poses[o]) > DISTURB_RECORD)
             out.append(Disturbance(o, moved, next(first, "")))
     return tuple(out)
+
+
+# A belief this far from the truth is off: f_p's targets for one object's pose (docs/perception.md).
+BELIEF_OFF = 0.01  # m
+BELIEF_TURNED = 10.0  # degrees
+
+
+@dataclass(frozen=True)
+class BeliefError:
+    """How far the belief a primitive was planned on had an object it acted on (its own, or
+    the object it places onto) from the simulator's pose: metres, and degrees up to what the
+    object's shape cannot tell apart. The record's, never the robot's."""
+
+    obj: str
+    off: float
+    turned: float
+
+    @property
+    def beyond(self) -> bool:
+        return self.off > BELIEF_OFF or self.turned > BELIEF_TURNED
+
+
+def belief_errors(
+    believed: GeometricSceneGraph,
+    truth: dict[str, Pose],
+    objects: tuple[str, ...],
+    world: World,
+) -> tuple[BeliefError, ...]:
+    """The belief's error of each of `objects` that it and the simulator both hold."""
+    return tuple(
+        BeliefError(
+            o,
+            round(believed.pose(o).distance(truth[o]), 4),
+            round(
+                rotation_apart(believed.pose(o), truth[o], world.object_type(o).kind is Kind.CAN),
+                2,
+            ),
+        )
+        for o in objects
+        if o in believed.objects and o in truth
+    )
 
 
 def dragged(phases: list[tuple[str, dict[str, Pose]]], after: dict[str, Pose], obj: str) -> float:

@@ -87,6 +87,27 @@ def test_summary_spreads_success_over_repeats_and_counts_failure_classes():
     assert summarize([_record(True)])["by_size"]["2"]["success_std"] is None
 
 
+def test_failed_primitives_planned_on_a_belief_off_are_counted():
+    from hsgplan.sim.outcome import BeliefError
+
+    near, far = BeliefError("butter", 0.004, 3.0), BeliefError("butter", 0.02, 3.0)
+    turned = BeliefError("popcorn", 0.002, 40.0)
+    steps = (
+        replace(_step("success", 1), misbelieved=(far,)),  # off, but it did not fail
+        replace(_step("dropped", 2), misbelieved=(near, turned)),  # failed on the popcorn's yaw
+        replace(_step("no_ik", 3), misbelieved=(near,)),  # failed, the belief within targets
+    )
+    record = replace(_record(False, "failed_primitive"), steps=steps)
+    again = EpisodeRecord.from_json(json.loads(json.dumps(record.to_json())))
+    assert again == record
+    entry = summarize([record])["by_size"]["2"]["misbelieved"]
+    assert entry == {"steps": 2, "failed": 1, "max_off": 0.02, "max_turned": 40.0}
+    method = {"agent": "regression+gnn", "perception": "rgb", "wall_seconds": 1.0}
+    report = {"methods": {"gnn-rgb": method | summarize([record])}}
+    (failures,) = tables(report, ("failures",))
+    assert failures.header[-1] == "belief off" and failures.rows[0][-1] == "1"
+
+
 def test_the_table_puts_the_papers_numbers_beside_ours():
     by_size = summarize([_record(True), _record(False, "overstep", ("no_ik",))])
     report = {
