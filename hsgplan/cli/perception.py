@@ -137,6 +137,7 @@ def eval_perception(
     from hsgplan.perception.estimator import PoseEstimator
     from hsgplan.perception.synthetic import first_views
     from hsgplan.perception.vocabulary import read_vocabulary
+    from hsgplan.sim.outcome import BELIEF_OFF, BELIEF_TURNED
 
     cameras = read_vocabulary(shipped(perception_checkpoint)).views
     shown = len(first_views(views, cameras)) if views is not None else len(cameras)
@@ -159,6 +160,7 @@ def eval_perception(
             str(m["objects"]),
             dash(m["translation_cm_median"], ".2f"),
             dash(m["rotation_deg_median"], ".1f"),
+            dash(m.get("off_targets"), ".3f"),
         )
         for t, m in report["by_type"].items()
     ]
@@ -168,6 +170,7 @@ def eval_perception(
             str(report["objects"]),
             dash(report["translation_cm_median"], ".2f"),
             dash(report["rotation_deg_median"], ".1f"),
+            dash(report.get("off_targets"), ".3f"),
         )
     )
     title = (
@@ -185,7 +188,13 @@ def eval_perception(
     title = marked(title, seed, perception=True)
     print_table(
         title,
-        ("type", "objects", "translation cm (median)", "rotation deg (median)"),
+        (
+            "type",
+            "objects",
+            "translation cm (median)",
+            "rotation deg (median)",
+            f"off > {100 * BELIEF_OFF:.0f} cm or {BELIEF_TURNED:.0f}°",
+        ),
         rows,
         markdown,
     )

@@ -36,6 +36,7 @@ from hsgplan.perception.synthetic import VIEWS, ImageSample, render_sample
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose, rotation_apart
 from hsgplan.scene_graph.symbol_mapping import map_symbols
+from hsgplan.sim.outcome import BELIEF_OFF, BELIEF_TURNED
 
 MATCH_DISTANCE = 0.10  # m: a detection further than this from every object of its type matched none
 # what a scene that is no symbolic match was misread by, in the order they are tried
@@ -192,7 +193,8 @@ def evaluate_loop(
 
 
 def summary(results: list[SceneResult]) -> dict:
-    """Medians over matched objects, per type and overall; rates over scenes and objects."""
+    """Medians over matched objects, and the share of them off f_p's targets (more than
+    `BELIEF_OFF` or `BELIEF_TURNED`), per type and overall; rates over scenes and objects."""
     rows = [
         (t, tc, rd)
         for r in results
@@ -206,6 +208,13 @@ def summary(results: list[SceneResult]) -> dict:
             if selected
             else None,
             "rotation_deg_median": float(np.median([x[2] for x in selected])) if selected else None,
+            # the tail a grasp meets: objects off f_p's targets for one pose
+            "off_targets": (
+                sum(x[1] > 100 * BELIEF_OFF or x[2] > BELIEF_TURNED for x in selected)
+                / len(selected)
+                if selected
+                else None
+            ),
         }
 
     objects = sum(r.objects for r in results)

@@ -11,7 +11,7 @@ import torch
 from scipy.spatial.transform import Rotation
 
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.evaluation.perception_eval import rotation_error, score_scene, summary
+from hsgplan.evaluation.perception_eval import SceneResult, rotation_error, score_scene, summary
 from hsgplan.perception.apart import apart
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator, _of_kind
@@ -257,3 +257,20 @@ def test_a_lone_views_box_in_the_space_of_a_can_several_views_saw_is_not_kept():
     assert apart([several, soup], KITCHEN) == [
         several
     ]  # two views against five: the colour decides
+
+
+def test_the_share_off_the_targets_counts_either_error_per_type():
+    result = SceneResult(
+        objects=4,
+        found=4,
+        translation_cm=(0.3, 1.5, 0.2, 0.4),  # the butter 1.5 cm off
+        rotation_deg=(2.0, 1.0, 35.0, 0.0),  # the popcorn turned 35 degrees
+        types=("butter", "butter", "popcorn", "cherries"),
+        symbolic_match=True,
+        detections=4,
+    )
+    report = summary([result])
+    assert report["off_targets"] == 0.5
+    assert report["by_type"]["butter"]["off_targets"] == 0.5
+    assert report["by_type"]["popcorn"]["off_targets"] == 1.0
+    assert report["by_type"]["cherries"]["off_targets"] == 0.0
