@@ -94,6 +94,15 @@ def eval_perception(
             "told: perception/phantoms.py).",
         ),
     ] = False,
+    unquartered: Annotated[
+        bool,
+        typer.Option(
+            "--no-quarter",
+            metavar="",
+            help="Keep each box's yaw as its keypoints say, unchecked by its silhouette "
+            "(perception/quarter.py).",
+        ),
+    ] = False,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the summary as JSON.", metavar="")
     ] = False,
@@ -144,7 +153,9 @@ def eval_perception(
     worlds = (KITCHEN,) if scene is None else tuple(read_worlds(scene).values())
     if why := unseeable(worlds, scene, perception_checkpoint):
         raise InvalidInputError(why)
-    estimator = PoseEstimator.load(perception_checkpoint, settled=not raw, pruned=not unpruned)
+    estimator = PoseEstimator.load(
+        perception_checkpoint, settled=not raw, pruned=not unpruned, quartered=not unquartered
+    )
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         run = evaluate_loop if loop else evaluate

@@ -212,7 +212,8 @@ def evaluate(
         typer.Option(
             help="What the agent sees with, comma-separated: gt (the simulator's poses), rgb "
             "(f_p on the fixed cameras' images), rgb-latest (f_p, each look taken as it "
-            "comes: no steady rule); one column each, rgb's named METHOD-rgb."
+            "comes: no steady rule), rgb-keypoint-yaw (f_p, boxes' yaws as their keypoints "
+            "say: no quarter-turn check); one column each, rgb's named METHOD-rgb."
         ),
     ] = config_default(EvalConfig, "perception"),
     perception_checkpoint: PerceptionCheckpoint = None,
@@ -227,9 +228,8 @@ def evaluate(
     rules_off: Annotated[
         str,
         typer.Option(
-            help="Recovery rules switched off, comma-separated (recovering protocol): "
-            + ", ".join(RecoveryRules.names())
-            + "."
+            help="Rules switched off, comma-separated (under the paper protocol only the "
+            "perception rule relook, which it keeps on): " + ", ".join(RecoveryRules.names()) + "."
         ),
     ] = "",
     ablate_rules: Annotated[

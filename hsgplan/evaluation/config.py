@@ -5,21 +5,22 @@ line takes its options' defaults from here."""
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 
 from hsgplan.domain.checks import BOUNDS, bounded, check_fields, read_text, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
+from hsgplan.domain.recovery import PAPER, PERCEPTION_RULES, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import MAX_SCENE_BYTES, read_world_text, read_worlds
 
 # What an agent sees the simulated world with (`evaluation.observers` makes them): gt, the
 # simulator's poses; rgb, f_p on the fixed cameras' images; rgb-latest, f_p with each look's
-# estimate taken as it comes (`perception.observer`'s `steady` rule off, to measure it).
-OBSERVERS = ("gt", "rgb", "rgb-latest")
+# estimate taken as it comes (`perception.observer`'s `steady` rule off, to measure it);
+# rgb-keypoint-yaw, f_p with each box's yaw as its keypoints say (`perception.quarter` off).
+OBSERVERS = ("gt", "rgb", "rgb-latest", "rgb-keypoint-yaw")
 
 
 def check_observer(name: str) -> None:
@@ -71,7 +72,8 @@ class EvalConfig:
     perception: str = "gt"  # what the agent sees: one of OBSERVERS
     perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
     protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
-    rules_off: tuple[str, ...] = ()  # recovery rules switched off (the recovering protocol)
+    # rules switched off (any under the recovering protocol, the perception rules under both)
+    rules_off: tuple[str, ...] = ()
     scene: str | None = None  # a scene file or a folder of them (None: the kitchen)
 
     def __post_init__(self) -> None:
@@ -80,9 +82,12 @@ class EvalConfig:
         if self.protocol not in PROTOCOLS:
             raise InvalidInputError(f"protocol '{self.protocol}': one of {', '.join(PROTOCOLS)}")
         object.__setattr__(self, "rules_off", tuple(self.rules_off))
-        if self.protocol == PAPER and self.rules_off:
-            raise InvalidInputError("the paper protocol has no recovery rule to switch off")
-        self.rules()  # an unknown rule's name is refused here
+        RecoveryRules().without(self.rules_off)  # an unknown rule's name is refused here
+        if self.protocol == PAPER and (kept := set(self.rules_off) - set(PERCEPTION_RULES)):
+            raise InvalidInputError(
+                f"the paper protocol has no recovery rule to switch off ({', '.join(sorted(kept))}"
+                f"); only the perception rules: {', '.join(PERCEPTION_RULES)}"
+            )
         # a bad scene, too
         check_seen(self.perception, self.worlds().values(), self.scene, self.perception_checkpoint)
 
@@ -93,10 +98,14 @@ class EvalConfig:
         return {str(p): world_of_file(str(p)) for p in read_worlds(self.scene)}
 
     def rules(self) -> RecoveryRules:
-        """The recovery rules its agent runs under: none under the paper's protocol."""
+        """The rules its agent runs under: under the paper's protocol no recovery rule, but the
+        perception rules (they recover from no failure: the robot looks again where it is
+        unsure of what it acts on or judges), unless switched off."""
+        rules = RecoveryRules().without(self.rules_off)
         if self.protocol == PAPER:
-            return RecoveryRules.none()
-        return RecoveryRules().without(self.rules_off)
+            seeing = {r: getattr(rules, r) for r in PERCEPTION_RULES}
+            return replace(RecoveryRules.none(), **seeing)
+        return rules
 
 
 def world_of_file(path: str) -> World:

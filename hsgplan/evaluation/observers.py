@@ -1,6 +1,7 @@
 """What an agent sees the simulated world with, by name: `gt` (the simulator's poses), `rgb`
-(f_p on the fixed cameras' images, `perception.observer.RgbObserver`) or `rgb-latest` (the same
-with its `steady` rule off)."""
+(f_p on the fixed cameras' images, `perception.observer.RgbObserver`), `rgb-latest` (the same
+with its `steady` rule off) or `rgb-keypoint-yaw` (the same with its boxes' quarter turns
+unchecked by their silhouettes, `perception.quarter`)."""
 
 from __future__ import annotations
 
@@ -25,4 +26,5 @@ def make_observer(name: str, checkpoint: str | Path | None = None) -> SceneObser
         return GroundTruth()
     from hsgplan.perception.observer import RgbObserver
 
-    return RgbObserver.load(perception_folder(checkpoint), steady=name == "rgb")
+    folder = perception_folder(checkpoint)
+    return RgbObserver.load(folder, name, name != "rgb-latest", name != "rgb-keypoint-yaw")

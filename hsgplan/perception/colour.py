@@ -130,6 +130,15 @@ def pixel_vote(
     return torch.softmax(logits[votes, : colour.objects], dim=1).mean(dim=0)
 
 
+def named_pixels(colour: ColourNet, image: np.ndarray) -> np.ndarray:
+    """The class the colour network names each pixel of an [H, W, 3] uint8 image, on its own:
+    [H, W] int64 (a type's index; the background's is the last)."""
+    rows = _chromaticity(image.reshape(-1, 3).astype(np.float64) / 255.0)
+    with torch.no_grad():
+        named = colour(torch.from_numpy(rows)).argmax(dim=1).numpy()
+    return named.reshape(image.shape[:2])
+
+
 def _described(pixels: np.ndarray) -> np.ndarray:
     """The features of the mean of [N, 3] uint8 pixels: [FEATURES]."""
     return _chromaticity(pixels.astype(np.float64).mean(axis=0, keepdims=True) / 255.0)[0]

@@ -77,15 +77,20 @@ class RgbObserver:
     estimator: the trained pose estimator.
     cameras: the fixed views it was trained on.
     steady: a still object keeps the sighting of more views (`steadied`, `STEADY`).
+    name: what the episode records it as (`evaluation.observers`' names).
     """
 
     def __init__(
-        self, estimator: PoseEstimator, cameras: tuple[Camera, ...] = VIEWS, steady: bool = True
+        self,
+        estimator: PoseEstimator,
+        cameras: tuple[Camera, ...] = VIEWS,
+        steady: bool = True,
+        name: str = "rgb",
     ) -> None:
         self.estimator = estimator
         self.cameras = cameras
         self.steady = steady
-        self.name = "rgb" if steady else "rgb-latest"  # `evaluation.observers`' names
+        self.name = name
         self._views: dict[str, int] = {}  # the views behind each object's belief
         self.world: World | None = None  # the episode's scene (`start`)
         self._objects: tuple[str, ...] = ()
@@ -94,10 +99,13 @@ class RgbObserver:
         self.detections: tuple[Detection, ...] = ()
 
     @staticmethod
-    def load(folder: Path, steady: bool = True) -> RgbObserver:
-        """The observer of an f_p checkpoint folder, through the cameras it was trained with."""
-        estimator = PoseEstimator.load(folder)
-        return RgbObserver(estimator, estimator.vocabulary.views, steady)
+    def load(
+        folder: Path, name: str = "rgb", steady: bool = True, quartered: bool = True
+    ) -> RgbObserver:
+        """The observer of an f_p checkpoint folder, through the cameras it was trained with
+        (`quartered`: its estimator checks boxes' quarter turns, `perception.quarter`)."""
+        estimator = PoseEstimator.load(folder, quartered=quartered)
+        return RgbObserver(estimator, estimator.vocabulary.views, steady, name)
 
     def start(self, objects: tuple[str, ...], world: World) -> None:
         self.world = world

@@ -311,8 +311,24 @@ class KitchenStorageEnv(gymnasium.Env):
             return Outcome(status, detail, seconds, relooks)
         # the look that judges the step is the next observation's: made once
         self._seen = self._judged = self._look()
+        status, detail = self._verdict(before, params, plan)
+        # A failure seen on a look unsure of the step's objects (the arm, where the step left
+        # it, hides a can it pushed into a shelf) is judged again from the rest pose.
+        if status != Status.SUCCESS and self.relook and self._unsure_of(params):
+            again = self._look_again(on_frame)
+            if again:
+                relooks += again
+                self._judged = self._seen
+                status, detail = self._verdict(before, params, plan)
+            seconds = time.perf_counter() - start - watch.seconds + plan_seconds
+        # the joints' encoders tell whether the arm got where it was driven
+        status, detail = stopped_outcome(status, detail, stopped)
+        return Outcome(status, detail, seconds, relooks)
+
+    def _verdict(self, before: Seen, params: PrimitiveParams, plan: MotionPlan):
+        """(status, detail) of a step from the look before it and the latest look."""
         after = self._seen
-        status, detail = compare(
+        return compare(
             before.scene_graph,
             after.scene_graph,
             params.obj,
@@ -320,9 +336,6 @@ class KitchenStorageEnv(gymnasium.Env):
             SEEN_DISTURB_TOL,
             _sure(before, after),
         )
-        # the joints' encoders tell whether the arm got where it was driven
-        status, detail = stopped_outcome(status, detail, stopped)
-        return Outcome(status, detail, seconds, relooks)
 
     def look_again(self, objects: tuple[str, ...]) -> Observation | None:
         """With a camera observer and the `relook` rule: if the belief is unsure of any of

@@ -53,8 +53,11 @@ def test_a_recovering_episode_out_of_steps_after_failures_is_overstep():
     assert failure_class(record) == (OVERSTEP, "step limit")
 
 
-def test_the_paper_protocol_runs_without_any_recovery_rule():
-    assert EvalConfig("learned", (2,), 1, 0, protocol="paper").rules() == RecoveryRules.none()
+def test_the_paper_protocol_runs_without_any_recovery_rule_but_the_perception_rules():
+    paper = EvalConfig("learned", (2,), 1, 0, protocol="paper").rules()
+    assert paper.off() == tuple(r for r in RecoveryRules.names() if r not in PERCEPTION_RULES)
+    blind = EvalConfig("learned", (2,), 1, 0, protocol="paper", rules_off=PERCEPTION_RULES)
+    assert blind.rules() == RecoveryRules.none()
     assert EvalConfig("learned", (2,), 1, 0).rules() == RecoveryRules()
     some = EvalConfig("learned", (2,), 1, 0, rules_off=("failed_bins", "least_taken"))
     assert some.rules().off() == ("failed_bins", "least_taken")

@@ -1,0 +1,56 @@
+"""A step judged failed on a look unsure of its object is judged again from the rest pose
+(the `relook` rule), under the paper's protocol too; with the rule off the verdict stands."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from hsgplan.agents.registry import make_agent
+from hsgplan.domain.goals import parse_goal
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.evaluation.episode import run_episode
+from hsgplan.perception.estimator import PoseEstimator
+from hsgplan.scene_graph.geometric import GeometricSceneGraph
+from hsgplan.sim.env import KitchenStorageEnv
+from hsgplan.sim.robot import REST
+from hsgplan.sim.sensing import Look, Seen
+from tests.perception.test_observer import _SceneMaps, _Watching
+
+HIDDEN = "butter"
+
+
+class _HiddenByTheArm(_Watching):
+    """Sees the butter where it started, unsure of it, whenever the arm is not at rest and
+    does not hold it: as if the arm hid it from every view."""
+
+    def look(self, look: Look) -> Seen:
+        seen = super().look(look)
+        if self.first is None:  # the episode's first look, from rest
+            self.first = seen.scene_graph
+        if np.allclose(look.q, REST, atol=1e-3) or look.holding == HIDDEN:
+            return seen
+        first = self.first.pose(HIDDEN)
+        poses = {n.name: n.pose for n in seen.scene_graph.nodes} | {HIDDEN: first}
+        graph = GeometricSceneGraph.from_poses(poses, seen.scene_graph.held, world=KITCHEN)
+        uncertain = tuple(sorted({*seen.uncertain, HIDDEN}))
+        return replace(seen, scene_graph=graph, unseen=(HIDDEN,), uncertain=uncertain)
+
+    def start(self, objects, world) -> None:
+        super().start(objects, world)
+        self.first: GeometricSceneGraph | None = None
+
+
+@pytest.mark.parametrize("relook", [True, False])
+def test_a_place_judged_failed_while_the_arm_hides_its_object_is_judged_again_from_rest(relook):
+    observer = _HiddenByTheArm(PoseEstimator(_SceneMaps()))
+    env = KitchenStorageEnv(observer=observer, relook=relook, world=KITCHEN)
+    observer.env = env
+    goal = parse_goal(f"On({HIDDEN}, shelf_b)", world=KITCHEN)
+    record = run_episode(env, make_agent("oracle"), goal, seed=4, end_at_failure=True)
+    place = next(s for s in record.steps if s.action.startswith("place"))
+    if relook:
+        assert record.success and place.status == "success" and place.relooks >= 1
+    else:
+        assert not record.success and place.status == "effect_not_reached"
+        assert place.relooks == 0
