@@ -94,13 +94,13 @@ def eval_perception(
             "told: perception/phantoms.py).",
         ),
     ] = False,
-    unquartered: Annotated[
+    keypoint_yaw: Annotated[
         bool,
         typer.Option(
-            "--no-quarter",
+            "--no-silhouette",
             metavar="",
             help="Keep each box's yaw as its keypoints say, unchecked by its silhouette "
-            "(perception/quarter.py).",
+            "(perception/silhouette.py).",
         ),
     ] = False,
     as_json: Annotated[
@@ -154,7 +154,7 @@ def eval_perception(
     if why := unseeable(worlds, scene, perception_checkpoint):
         raise InvalidInputError(why)
     estimator = PoseEstimator.load(
-        perception_checkpoint, settled=not raw, pruned=not unpruned, quartered=not unquartered
+        perception_checkpoint, settled=not raw, pruned=not unpruned, silhouette=not keypoint_yaw
     )
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)

@@ -1,11 +1,12 @@
 """The recovery rules: what the agent does after a failure, beyond the paper.
 
 The paper's agent has none: a primitive that fails ends its episode (the `paper` protocol,
-`hsgplan.evaluation.protocol`). Our loop lets a failed primitive cost one step and goes on
-(the `recovering` protocol), and these hand-written rules decide how it goes on. Each is named
-here, documented once, and switched off by name (`hsgplan eval world --rules-off NAME,...`), so that
-what each buys is measured (README, "Recovery rules"). None of them consults the domain's
-rules (transition model, feasibility): they read only what the agent saw and did.
+`hsgplan.evaluation.protocol`, which keeps only the perception rule below). Our loop lets a
+failed primitive cost one step and goes on (the `recovering` protocol), and these hand-written
+rules decide how it goes on. Each is named here, documented once, and switched off by name
+(`hsgplan eval world --rules-off NAME,...`), so that what each buys is measured (README,
+"Recovery rules"). None of them consults the domain's rules (transition model, feasibility):
+they read only what the agent saw and did.
 
 Motion level (`hsgplan.motion.generator`):
 - `failed_bins`: parameters that failed for good are remembered with the scene they failed in;
@@ -26,11 +27,13 @@ Task level (`hsgplan.planning.regression.planner`):
   waits while another goal literal can go on.
 
 Perception (`hsgplan.sim.env`, seeing through a camera observer; nothing under the ground
-truth):
+truth). It recovers from no failure, so the paper's protocol keeps it too (`PERCEPTION_RULES`):
 - `relook`: before a primitive on an object the belief is unsure of (not seen at the last
   look, or seen by a single view), or onto one, the arm moves to its rest pose, out of the
   cameras' way, and the robot looks again; the primitive is planned on that look. So too
-  before the agent believes its goal reached while it is unsure of an object of the goal.
+  before the agent believes its goal reached while it is unsure of an object of the goal, and
+  before it judges a step failed on a look unsure of the step's objects (the arm, where the
+  step left it, hides the can it pushed into a shelf).
 """
 
 from __future__ import annotations
@@ -47,7 +50,8 @@ PROTOCOLS = (PAPER, RECOVERING)
 
 @dataclass(frozen=True)
 class RecoveryRules:
-    """Which recovery rules are on (all are, by default; the paper protocol has none)."""
+    """Which recovery rules are on (all are, by default; the paper protocol keeps only the
+    perception rules)."""
 
     failed_bins: bool = True
     push_give_up: bool = True
@@ -80,5 +84,6 @@ class RecoveryRules:
         return tuple(n for n in self.names() if not getattr(self, n))
 
 
-PERCEPTION_RULES = ("relook",)  # rules that act only when the agent sees through a camera observer
+# rules that act only when the agent sees through a camera observer; the paper's protocol keeps them
+PERCEPTION_RULES = ("relook",)
 ALL_RULES = RecoveryRules()  # the recovering protocol's default: every rule on

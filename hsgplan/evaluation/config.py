@@ -19,7 +19,7 @@ from hsgplan.domain.scene_file import MAX_SCENE_BYTES, read_world_text, read_wor
 # What an agent sees the simulated world with (`evaluation.observers` makes them): gt, the
 # simulator's poses; rgb, f_p on the fixed cameras' images; rgb-latest, f_p with each look's
 # estimate taken as it comes (`perception.observer`'s `steady` rule off, to measure it);
-# rgb-keypoint-yaw, f_p with each box's yaw as its keypoints say (`perception.quarter` off).
+# rgb-keypoint-yaw, f_p with each box's yaw as its keypoints say (`perception.silhouette` off).
 OBSERVERS = ("gt", "rgb", "rgb-latest", "rgb-keypoint-yaw")
 
 

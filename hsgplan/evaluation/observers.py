@@ -1,7 +1,7 @@
 """What an agent sees the simulated world with, by name: `gt` (the simulator's poses), `rgb`
 (f_p on the fixed cameras' images, `perception.observer.RgbObserver`), `rgb-latest` (the same
-with its `steady` rule off) or `rgb-keypoint-yaw` (the same with its boxes' quarter turns
-unchecked by their silhouettes, `perception.quarter`)."""
+with its `steady` rule off) or `rgb-keypoint-yaw` (the same with its boxes' yaws as their
+keypoints say, unchecked by their silhouettes: `perception.silhouette`)."""
 
 from __future__ import annotations
 

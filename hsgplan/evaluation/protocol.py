@@ -9,9 +9,10 @@ folder as they finish: an interrupted run, started again with the same command, 
 done. What the episodes sum to is `evaluation/summary.py`.
 
 Two protocols. `paper`, the paper's: the agent decides once per step from the scene it sees,
-with no recovery rule (`hsgplan.domain.recovery`), and the first primitive that fails (refused
-while planning, or failed in execution) ends the episode as an execution failure; the step
-limit ends it as overstep. `recovering`, ours: a failed primitive costs its step and the loop
+with no recovery rule but the perception rule `relook` (`hsgplan.domain.recovery`: it
+recovers from no failure; `rules_off` may switch it off), and the first primitive that fails
+(refused while planning, or failed in execution) ends the episode as an execution failure; the
+step limit ends it as overstep. `recovering`, ours: a failed primitive costs its step and the loop
 goes on from what it observes, under the recovery rules (all of them, or all but `rules_off`).
 """
 

@@ -38,7 +38,6 @@ from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
 from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost
-from hsgplan.perception.quarter import quarter_checked
 from hsgplan.perception.settle import (
     OVERLAP_XY,
     fits_height,
@@ -46,6 +45,7 @@ from hsgplan.perception.settle import (
     settle,
     surfaces_under,
 )
+from hsgplan.perception.silhouette import yaw_checked
 from hsgplan.perception.visible import painted, visible_masks
 from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY, Vocabulary, read_vocabulary
 from hsgplan.scene_graph.geometry import Pose
@@ -76,7 +76,7 @@ class PoseEstimator:
     colour: the colour network that names each object's type (`perception.colour`); without
         it, the keypoint network's type is kept.
     pruned: drop what a lone view found that the other views contradict.
-    quartered: turn a box a quarter where its silhouette says so (`perception.quarter`).
+    silhouette: check each box's yaw by its silhouette (`perception.silhouette`).
     vocabulary: the types the networks' channels name (`perception.vocabulary`).
 
     What it knows of the scene it looks at (its object types' sizes and kinds, its table and
@@ -90,10 +90,10 @@ class PoseEstimator:
         colour: ColourNet | None = None,
         pruned: bool = True,
         vocabulary: Vocabulary = KITCHEN_VOCABULARY,
-        quartered: bool = True,
+        silhouette: bool = True,
     ) -> None:
         self.net = net
-        self.quartered = quartered
+        self.silhouette = silhouette
         self.settled = settled
         self.colour = colour
         self.pruned = pruned
@@ -102,7 +102,7 @@ class PoseEstimator:
 
     @staticmethod
     def load(
-        folder: Path, settled: bool = True, pruned: bool = True, quartered: bool = True
+        folder: Path, settled: bool = True, pruned: bool = True, silhouette: bool = True
     ) -> PoseEstimator:
         """The estimator of a checkpoint folder (the keypoint network, and the colour network
         in its `colour/`), naming its vocabulary's types; one whose networks have another
@@ -115,7 +115,7 @@ class PoseEstimator:
                 f"f_p '{folder}': its networks name {config.types} and {colour.objects} "
                 f"types, its vocabulary {len(vocabulary.types)}"
             )
-        return PoseEstimator(net, settled, colour, pruned, vocabulary, quartered)
+        return PoseEstimator(net, settled, colour, pruned, vocabulary, silhouette)
 
     def _typed(self, world: World, images: np.ndarray, members: list[Seen]) -> tuple[str, float]:
         """The type of an object its members saw, and its probability: by the colour network
@@ -274,8 +274,8 @@ class PoseEstimator:
             return fused
         fused = self._unstacked(world, images, cameras, fused)
         rested = self.rest(world, [replace(d, measured=d.pose) for d in fused])
-        if self.quartered and self.colour is not None:
-            rested = quarter_checked(self.colour, self.types, world, images, cameras, rested, arm)
+        if self.silhouette and self.colour is not None:
+            rested = yaw_checked(self.colour, self.types, world, images, cameras, rested, arm)
         if not self.pruned:
             return rested
         return phantoms.pruned(rested, found, cameras, world, arm)

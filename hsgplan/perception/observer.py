@@ -100,11 +100,12 @@ class RgbObserver:
 
     @staticmethod
     def load(
-        folder: Path, name: str = "rgb", steady: bool = True, quartered: bool = True
+        folder: Path, name: str = "rgb", steady: bool = True, silhouette: bool = True
     ) -> RgbObserver:
         """The observer of an f_p checkpoint folder, through the cameras it was trained with
-        (`quartered`: its estimator checks boxes' quarter turns, `perception.quarter`)."""
-        estimator = PoseEstimator.load(folder, quartered=quartered)
+        (`silhouette`: its estimator checks boxes' yaws by their silhouettes,
+        `perception.silhouette`)."""
+        estimator = PoseEstimator.load(folder, silhouette=silhouette)
         return RgbObserver(estimator, estimator.vocabulary.views, steady, name)
 
     def start(self, objects: tuple[str, ...], world: World) -> None:
@@ -122,10 +123,11 @@ class RgbObserver:
         detections = self.estimator.detect(look.images, look.cameras, world, look.arm)
         held = look.holding
         if look.released is not None:
-            # last seen in the hand: it is where the hand let it go, which the robot knows
+            # last seen in the hand, or before a push: it is where the hand let it go, or where
+            # the push's stroke ended, which the robot knows of its own motion
             name, pose = look.released
             self._last[name] = pose
-            self._views[name] = 0  # where it was let go, not a sighting: any look is better
+            self._views[name] = 0  # not a sighting: any look is better
         if held is not None:
             detections = away_from_hand(detections, look.held_pose)
         self.detections = tuple(detections)

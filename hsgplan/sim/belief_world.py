@@ -15,7 +15,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from hsgplan.domain.parameters import PickParams, PlaceParams
+from hsgplan.domain.parameters import PUSH_LEAD, PickParams, PlaceParams, PushParams, push_values
 from hsgplan.domain.scene import World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -67,8 +67,9 @@ class BeliefWorld:
     def executed(self, plan: MotionPlan, gripper_holds: bool) -> tuple[str, Pose] | None:
         """The model after the real arm ran `plan`: a pick whose fingers closed on something
         holds the object it was planned for (the robot's own record), by the grasp as
-        planned; a place lets it go where the planned hand put it. Returns the object let go
-        and where, if any. The arm is left where the plan ends (`follow` puts it right)."""
+        planned; a place lets it go where the planned hand put it; a push leaves its object
+        where its stroke ends (`_stroke_end`). Returns the object let go or pushed and where,
+        if any. The arm is left where the plan ends (`follow` puts it right)."""
         robot = self.scene.robot
         if isinstance(plan.params, PickParams) and gripper_holds:
             robot.set_q(plan.q_at)
@@ -84,7 +85,20 @@ class BeliefWorld:
             self.holding = None
             robot.set_q(plan.q_above)
             return released
+        if isinstance(plan.params, PushParams) and plan.push_direction is not None:
+            return plan.params.obj, self._stroke_end(plan)
         return None
+
+    def _stroke_end(self, plan: MotionPlan) -> Pose:
+        """Where a push's stroke leaves its object in the model: its centre carried along the
+        push by the stroke's length less `PUSH_LEAD`, as far as the fingertips go (it may
+        slide on, or lag): what the robot's own motion says of an object it may no longer see."""
+        start = self.scene.pose(plan.params.obj)
+        _, dist = push_values(plan.params.angle_bin, plan.params.dist_bin)
+        ux, uy = plan.push_direction
+        x, y, z = start.position
+        moved = max(0.0, dist - PUSH_LEAD)
+        return Pose((x + ux * moved, y + uy * moved, z), start.orientation)
 
     def dropped(self) -> None:
         """The gripper no longer feels the object it held: the model lets it go too."""

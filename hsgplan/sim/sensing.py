@@ -57,7 +57,8 @@ class Look:
             gripper feels something between its fingers.
         held_pose: where that object is by the arm's kinematics and the grasp as planned.
         released: the object let go since the last look and where the hand let it go (the
-            arm's kinematics and the grasp as planned), if any.
+            arm's kinematics and the grasp as planned), or pushed and where the push's stroke
+            ended, if any.
         arm: the arm's links at `q`, as boxes by the robot's model of itself: what of the
             scene it may hide from a camera.
     """

@@ -54,3 +54,34 @@ def test_a_place_judged_failed_while_the_arm_hides_its_object_is_judged_again_fr
     else:
         assert not record.success and place.status == "effect_not_reached"
         assert place.relooks == 0
+
+
+class _HiddenInTheShelf(_Watching):
+    """Never finds the cherries once they are inside shelf A, as if its boards hid them."""
+
+    def look(self, look: Look) -> Seen:
+        x, y = self.env.scene.pose("cherries").position[:2]
+        inside = KITCHEN.shelves["shelf_a"].interior
+        hidden = inside.x_min <= x <= inside.x_max and inside.y_min <= y <= inside.y_max
+        self.estimator.net.hidden = "cherries" if hidden else None
+        return super().look(look)
+
+
+def test_a_can_pushed_out_of_sight_is_believed_where_the_push_left_it():
+    observer = _HiddenInTheShelf(PoseEstimator(_SceneMaps()))
+    env = KitchenStorageEnv(observer=observer, relook=False, world=KITCHEN)
+    observer.env = env
+    goal = parse_goal("In(cherries, shelf_a)", world=KITCHEN)
+    seen = []
+    record = run_episode(
+        env,
+        make_agent("oracle"),
+        goal,
+        seed=4,
+        end_at_failure=True,
+        on_step=lambda step, obs: seen.append(obs),
+        others=("butter",),  # something in sight once the cherries are not
+    )
+    push = next(s for s in record.steps if s.action.startswith("push"))
+    assert push.status == "success" and record.success
+    assert "cherries" in seen[-1].unseen  # judged on where the stroke left it, not on a sighting

@@ -144,3 +144,31 @@ def test_a_disturbance_is_put_in_the_phase_by_whose_end_it_had_moved():
     assert dragged(phases, after, "cherries") == 0.0
     pushed = [phases[0], ("push", phases[0][1]), ("retreat", after)]
     assert dragged(pushed, after, "cherries") == 0.0  # a pushed object slides on by design
+
+
+def test_a_push_leaves_its_object_in_the_model_where_its_stroke_ends():
+    import math
+
+    from hsgplan.domain.parameters import PUSH_LEAD, PushParams, push_values
+    from hsgplan.domain.world import PUSH_ANGLE_BINS, PUSH_DIST_BINS
+
+    can = _on_table("tomato_soup", 0.30, 0.37)  # on shelf A's prepush region
+    world = BeliefWorld(("tomato_soup",), seed=0, world=KITCHEN)
+    try:
+        world.believe(GeometricSceneGraph.from_poses({"tomato_soup": can}, world=KITCHEN))
+        plans = (
+            world.plan(PushParams("tomato_soup", a, d))
+            for a in range(PUSH_ANGLE_BINS)
+            for d in range(PUSH_DIST_BINS - 1, -1, -1)
+        )
+        plan = next(p for p in plans if isinstance(p, MotionPlan))
+        name, end = world.executed(plan, gripper_holds=False)
+        angle, dist = push_values(plan.params.angle_bin, plan.params.dist_bin)
+        assert name == "tomato_soup"
+        along = (dist - PUSH_LEAD) * math.cos(angle), (dist - PUSH_LEAD) * math.sin(angle)
+        assert end.position[0] == pytest.approx(can.position[0] + along[0], abs=1e-6)
+        assert end.position[1] == pytest.approx(can.position[1] + along[1], abs=1e-6)
+        assert end.position[2] == pytest.approx(can.position[2])
+        assert world.holding is None
+    finally:
+        world.close()
