@@ -144,9 +144,7 @@ def _scores(
 def _hull(cuboid: Cuboid, camera: PinholeCamera) -> np.ndarray | None:
     """The cuboid's outline in the image: its corners' convex hull, [K, 2] int32 pixels; None
     where a corner is behind the camera."""
-    signs = np.array([(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    m = cuboid.pose.matrix()
-    corners = (signs * np.asarray(cuboid.half)) @ m[:3, :3].T + m[:3, 3]
+    corners = cuboid.corners()
     if (camera.to_camera(corners)[:, 2] <= 0).any():
         return None
     return cv2.convexHull(np.round(camera.project(corners)).astype(np.int32)).reshape(-1, 2)

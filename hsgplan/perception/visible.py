@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 
 from hsgplan.domain.world import Board, ObjectType, World, shelf_boards
-from hsgplan.perception.keypoints import PinholeCamera
+from hsgplan.perception.keypoints import CORNER_SIGNS, PinholeCamera
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.sensing import Box
 
@@ -38,6 +38,11 @@ class Cuboid:
 
     pose: Pose
     half: tuple[float, float, float]
+
+    def corners(self) -> np.ndarray:
+        """Its 8 corners in the world, [8, 3], in the order of `CORNER_SIGNS`."""
+        m = self.pose.matrix()
+        return (CORNER_SIGNS * np.asarray(self.half)) @ m[:3, :3].T + m[:3, 3]
 
     @staticmethod
     def of_object(t: ObjectType, pose: Pose, shrink: float = SHRINK) -> Cuboid:
@@ -92,14 +97,11 @@ def paint(cuboids: list[Cuboid], camera: PinholeCamera) -> np.ndarray:
     label = np.full((camera.height, camera.width), -1, dtype=np.int32)
     faces = []
     for i, cuboid in enumerate(cuboids):
-        local = np.array(list(itertools.product((-1, 1), repeat=3)), dtype=np.float64)
-        local *= np.asarray(cuboid.half)
-        m = cuboid.pose.matrix()
-        corners = local @ m[:3, :3].T + m[:3, 3]
+        corners, middle = cuboid.corners(), np.asarray(cuboid.pose.position)
         for axis, sign in itertools.product(range(3), (-1, 1)):
-            quad = corners[local[:, axis] * sign > 0]
+            quad = corners[CORNER_SIGNS[:, axis] * sign > 0]
             centre = quad.mean(axis=0)
-            if (centre - m[:3, 3]) @ (camera.eye - centre) <= 0:
+            if (centre - middle) @ (camera.eye - centre) <= 0:
                 continue  # faces away from the camera
             faces.append((float(np.linalg.norm(camera.eye - centre)), i, quad))
     for _, i, quad in sorted(faces, key=lambda f: -f[0]):
