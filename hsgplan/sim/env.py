@@ -14,7 +14,7 @@ With a camera observer (`sim.sensing.CameraObserver`) the robot knows only its b
 primitive is planned in the model of that belief (`sim.belief_world`) and the simulated scene
 runs its joint motions; a step's outcome is judged on what the gripper feels and on the belief
 before and after it (a new look), and before acting on an object the belief is unsure of the
-arm moves out of the cameras' way and looks again (`relook`).
+arm moves out of the cameras' way and looks again (`relook`): `sim/believing.py`.
 """
 
 from __future__ import annotations
@@ -26,30 +26,27 @@ import gymnasium
 import numpy as np
 
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.parameters import PickParams, PrimitiveParams
+from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.scene import World
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.symbol_mapping import map_symbols
-from hsgplan.sim.actuation import holds_something
 from hsgplan.sim.belief_world import BeliefWorld
+from hsgplan.sim.believing import BelievedSteps, sure_in_both
 from hsgplan.sim.env_types import Observation, ResetOptions, reset_options
 from hsgplan.sim.gym_spaces import action_space, decode, encode, observation_space
 from hsgplan.sim.lookahead import Lookahead
-from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive, plan_transit
-from hsgplan.sim.observer import CameraObserver, GroundTruth, Look, SceneObserver, Seen
+from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
+from hsgplan.sim.observer import CameraObserver, GroundTruth, SceneObserver, Seen
 from hsgplan.sim.outcome import (
-    SEEN_DISTURB_TOL,
     Outcome,
     Status,
     belief_errors,
-    compare,
     disturbances,
     dragged,
     largest_move,
 )
-from hsgplan.sim.primitives import Watch, execute, run_path, run_plan, stopped_outcome
+from hsgplan.sim.primitives import execute
 from hsgplan.sim.render import Camera
-from hsgplan.sim.robot import REST
 from hsgplan.sim.sampler import sample_scene
 from hsgplan.sim.scene import Scene
 from hsgplan.symbolic.generator import check_size
@@ -57,7 +54,7 @@ from hsgplan.symbolic.generator import check_size
 ENV_ID = "hsgplan/KitchenStorage-v0"
 
 
-class KitchenStorageEnv(gymnasium.Env):
+class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
     """One episode at a time; `reset` builds a fresh scene from the seed.
 
     The Gymnasium observation is numeric (`gym_spaces.observation_space`); the typed one the
@@ -213,7 +210,7 @@ class KitchenStorageEnv(gymnasium.Env):
             # the largest move the robot saw of an object besides its own, of those it was
             # sure of before and after (its observer's)
             "seen_moved": largest_move(
-                before.scene_graph, typed.scene_graph, acted_on, _sure(before, typed)
+                before.scene_graph, typed.scene_graph, acted_on, sure_in_both(before, typed)
             ),
             "goal_truly_holds": self.goal.satisfied_by(typed.true_symbols.state),
             # how far the belief the step was planned on had its objects (the record's)
@@ -278,118 +275,6 @@ class KitchenStorageEnv(gymnasium.Env):
         """Where primitives are planned: the robot's model of its belief, or the scene."""
         return self.world.scene if self.world is not None else self.scene
 
-    def _step_believed(self, params: PrimitiveParams, on_frame, on_phase) -> Outcome:
-        """One primitive planned in the model of the belief, run in the scene, judged on what
-        the gripper feels and on the belief before and after it."""
-        start = time.perf_counter()
-        watch = Watch(on_frame)
-        on_frame = watch.frame
-        plan, plan_seconds = self._checked_plan(params)
-        relooks = 0
-        if self.relook and self._unsure_of(params):
-            relooks = self._look_again(on_frame)
-            if relooks:  # a dry run's plan was made on the older belief: planned again
-                plan, plan_seconds = None, 0.0
-        before = self._judged_from = self._seen
-        world = self.world
-        world.follow(self.scene.robot.q())
-        if plan is None:
-            plan = world.plan(params)
-        if isinstance(plan, PlanFailure):
-            seconds = time.perf_counter() - start - watch.seconds + plan_seconds
-            return Outcome(plan.status, plan.detail, seconds, relooks)
-        self.last_plan = plan
-        stopped = run_plan(self.scene, plan, on_frame, on_phase)
-        holds = holds_something(self.scene.robot)  # the gripper's width
-        self._released = world.executed(plan, holds)
-        if world.holding is not None and not holds:
-            world.dropped()
-        seconds = time.perf_counter() - start - watch.seconds + plan_seconds
-        if isinstance(params, PickParams) and not holds:
-            detail = f"the fingers closed on nothing where '{params.obj}' was believed"
-            status, detail = stopped_outcome(Status.DROPPED, detail, stopped)
-            return Outcome(status, detail, seconds, relooks)
-        # the look that judges the step is the next observation's: made once
-        self._seen = self._judged = self._look()
-        status, detail = self._verdict(before, params, plan)
-        # A failure seen on a look unsure of the step's objects (the arm, where the step left
-        # it, hides a can it pushed into a shelf) is judged again from the rest pose.
-        if status != Status.SUCCESS and self.relook and self._unsure_of(params):
-            again = self._look_again(on_frame)
-            if again:
-                relooks += again
-                self._judged = self._seen
-                status, detail = self._verdict(before, params, plan)
-            seconds = time.perf_counter() - start - watch.seconds + plan_seconds
-        # the joints' encoders tell whether the arm got where it was driven
-        status, detail = stopped_outcome(status, detail, stopped)
-        return Outcome(status, detail, seconds, relooks)
-
-    def _verdict(self, before: Seen, params: PrimitiveParams, plan: MotionPlan):
-        """(status, detail) of a step from the look before it and the latest look."""
-        after = self._seen
-        return compare(
-            before.scene_graph,
-            after.scene_graph,
-            params.obj,
-            plan.expected,
-            SEEN_DISTURB_TOL,
-            _sure(before, after),
-        )
-
-    def look_again(self, objects: tuple[str, ...]) -> Observation | None:
-        """With a camera observer and the `relook` rule: if the belief is unsure of any of
-        `objects`, the arm moves out of the cameras' way and the robot looks again; the new
-        observation, or None where nothing was done (sure of them, or already at rest). The
-        agent asks before it believes its goal reached."""
-        if not (self.believing and self.relook) or self._seen is None:
-            return None
-        if not set(objects) & set(self._seen.uncertain) or not self._look_again(None):
-            return None
-        self._judged = self._seen
-        return self._observe()
-
-    def _unsure_of(self, params: PrimitiveParams) -> bool:
-        """Whether the belief is unsure of an object the primitive acts on or places onto."""
-        uncertain = self._seen.uncertain
-        target = getattr(params, "target", None)
-        return params.obj in uncertain or target in uncertain
-
-    def _look_again(self, on_frame) -> int:
-        """The arm moves to its rest pose, out of the cameras' way, along a path planned in
-        the model, and the robot looks again: 1 if it did, 0 if it was there already or no
-        path was found."""
-        q = self.scene.robot.q()
-        if np.allclose(q, REST, atol=1e-3):
-            return 0
-        self.world.follow(q)
-        path = plan_transit(self.world.scene, REST)
-        if path is None:
-            return 0
-        run_path(self.scene, path, on_frame)
-        self._seen = self._look()
-        return 1
-
-    def _look(self) -> Seen:
-        """A look at the scene as it stands; the model's arm is brought to the real joints
-        first, since the look carries its links."""
-        scene, world = self.scene, self.world
-        q = scene.robot.q()
-        world.follow(q)
-        look = Look(
-            np.stack([c.capture(scene.bc) for c in self.observer.cameras]),
-            self.observer.cameras,
-            q,
-            world.holding,
-            world.held_pose(),
-            self._released,
-            world.arm(),
-        )
-        self._released = None
-        seen = self.observer.look(look)
-        world.believe(seen.scene_graph)
-        return seen
-
     def _observe(self) -> Observation:
         if not self.believing:
             seen = self.observer.observe(self.scene)
@@ -421,11 +306,3 @@ class KitchenStorageEnv(gymnasium.Env):
 # made in the kitchen unless `world=` is given: the id is an entry point, resolved where the
 # kitchen may be named
 gymnasium.register(id=ENV_ID, entry_point="hsgplan.evaluation.gym_env:kitchen_storage_env")
-
-
-def _sure(before: Seen | Observation, after: Seen | Observation) -> frozenset[str]:
-    """The objects a look before and a look after a step were both sure of (seen by several
-    views): only their poses are compared by distance; a single view's depth is compared by
-    the symbolic location it gives."""
-    unsure = set(before.uncertain) | set(after.uncertain)
-    return frozenset(after.scene_graph.objects) - unsure
