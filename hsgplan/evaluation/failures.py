@@ -14,6 +14,9 @@ class Failure(StrEnum):
     OFF_TABLE = "off_table"  # simulated world: an object fell off the table
     MISPERCEIVED = "misperceived"  # the agent saw the goal reached where it truly was not
     NEVER_SEEN = "never_seen"  # the agent had to decide with no pose for an object of the goal
+    # a primitive seen to fail ended the episode where the goal truly held: a record keeps
+    # `failed_primitive`, and the taxonomy reads it so (`summary.failure_class`)
+    MISJUDGED = "misjudged"
     # no start scene could be sampled for the goal: the world's limit, not the agent's; left
     # out of every rate and counted apart
     UNSAMPLED = "unsampled_scene"

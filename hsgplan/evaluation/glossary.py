@@ -42,6 +42,9 @@ ENDINGS = {
     Failure.MISPERCEIVED: "the robot saw its goal reached where it truly was not.",
     Failure.NEVER_SEEN: "an object of the goal that no view had found when the robot had to "
     "decide.",
+    Failure.MISJUDGED: "paper protocol, seeing through f_p: a primitive the robot saw fail "
+    "ended the episode, but its goal truly held (a push seen short whose can was inside). "
+    "The record keeps `failed_primitive`; tables count it here.",
     Failure.UNSAMPLED: "no start scene could be sampled for the goal's objects (the world's "
     "limit, not the agent's failure): nothing was tried; left out of every rate and counted "
     "apart (`unsampled`).",

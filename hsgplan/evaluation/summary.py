@@ -23,9 +23,11 @@ from hsgplan.sim.outcome import DISTURB_RECORD, DISTURB_TOL, SEEN_DISTURB_TOL, S
 
 EXECUTION = "execution"
 OVERSTEP = "overstep"
-PERCEPTION = "perception"  # the goal seen reached where it truly was not, or an object never seen
+# the goal seen reached where it truly was not, an object never seen, or a step seen to fail
+# where the goal truly held
+PERCEPTION = "perception"
 UNSAMPLED = "unsampled"  # no start scene: left out of every rate, counted apart
-_ENDED_BY_PERCEPTION = {Failure.MISPERCEIVED, Failure.NEVER_SEEN}
+_ENDED_BY_PERCEPTION = {Failure.MISPERCEIVED, Failure.NEVER_SEEN, Failure.MISJUDGED}
 # statuses of a primitive that failed in execution (an inapplicable one is the task level's)
 FAILED_EXECUTION = frozenset(s.value for s in Status) - {Status.SUCCESS, Status.INVALID}
 _ENDED_BY_EXECUTION = {Failure.KNOCKED_OVER, Failure.OFF_TABLE, Failure.NO_PARAMETERS}
@@ -54,6 +56,11 @@ def failure_class(record: EpisodeRecord) -> tuple[str, str] | None:
     if record.success:
         return None
     kind = str(record.failure)
+    # Seeing through cameras, a step may be judged failed where it succeeded; an episode it
+    # ended with every goal literal truly holding failed by what the robot saw, not by what
+    # it did (on the simulator's poses a step cannot end an episode whose goal holds).
+    if record.failure == Failure.FAILED_PRIMITIVE and record.subgoal_completion == 1.0:
+        return PERCEPTION, str(Failure.MISJUDGED)
     if record.failure == Failure.FAILED_PRIMITIVE:
         failed = failed_steps(record)
         kind = failed[-1] if failed else kind

@@ -295,9 +295,10 @@ def _failures(report: dict) -> TextTable:
     )
     if seen:
         title += (
-            "; seeing through f_p, perception (the goal seen reached where it was not, or an "
-            "object no view found), the looks taken again before a primitive (relook), and "
-            "failed primitives planned on a belief that had an object they acted on more than "
+            "; seeing through f_p, perception (the goal seen reached where it was not, an "
+            "object no view found, or a primitive seen to fail where the goal held), the looks "
+            "taken again before a primitive (relook), and failed primitives planned on a belief "
+            "that had an object they acted on more than "
             f"{BELIEF_OFF * 100:.0f} cm or {BELIEF_TURNED:.0f}° off its true pose (belief off)"
         )
     header = ("method", "objects", "episodes", "failed", "execution", "overstep")

@@ -65,6 +65,11 @@ def test_failures_are_classed_as_the_paper_classes_them():
     seen_done = _record(False, "misperceived", ("success",))
     assert failure_class(seen_done) == (PERCEPTION, "misperceived")
     assert failure_class(_record(False, "never_seen", ())) == (PERCEPTION, "never_seen")
+    # a step seen to fail ended the episode, but every goal literal truly held
+    judged = replace(
+        _record(False, "failed_primitive", ("effect_not_reached",)), subgoal_completion=1.0
+    )
+    assert failure_class(judged) == (PERCEPTION, "misjudged")
 
 
 def test_summary_spreads_success_over_repeats_and_counts_failure_classes():
