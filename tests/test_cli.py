@@ -345,3 +345,23 @@ def test_a_recording_without_rerun_installed_is_refused_in_one_line(args, monkey
     assert r.exit_code == 2, r.output
     assert "--rerun needs rerun-sdk" in r.output and "Traceback" not in r.output
     assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def test_a_kill_interrupts_as_ctrl_c_does_so_a_long_job_closes_what_it_opened():
+    import subprocess
+    import sys
+
+    script = (
+        "import os, signal, time\n"
+        "from hsgplan.cli import interrupt_on_terminate\n"
+        "interrupt_on_terminate()\n"
+        "try:\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    time.sleep(30)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=60
+    )
+    assert done.stdout.strip() == "interrupted", done.stderr

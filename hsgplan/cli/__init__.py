@@ -9,6 +9,7 @@ spellings.
 
 from __future__ import annotations
 
+import signal
 import sys
 from importlib.metadata import version
 from typing import Annotated
@@ -86,7 +87,19 @@ def _options(
 learn.train_app.command("perception")(perception.train_perception)
 
 
+def interrupt_on_terminate() -> None:
+    """A `kill` (SIGTERM) interrupts as Ctrl-C does: what a long job does on an interruption
+    (its pool closed, the sitting's time added to its run folder) runs, where the default
+    would end the process on the spot."""
+
+    def interrupted(signum, frame):
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, interrupted)
+
+
 def main() -> None:
+    interrupt_on_terminate()
     try:
         app()
     except BrokenPipeError:
