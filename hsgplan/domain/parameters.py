@@ -114,6 +114,12 @@ def place_centre(
     return x, y, world.surface_rect(target).z + world.object_type(obj).height / 2
 
 
+def push_carry(dist: float) -> float:
+    """How far a push of stroke `dist` carries its object's centre at most: the fingertips
+    start `PUSH_LEAD` short of the object."""
+    return dist - PUSH_LEAD
+
+
 def push_values(angle_bin: int, dist_bin: int) -> tuple[float, float]:
     """(direction in radians from +x, distance in metres) of a push's bins."""
     _check_bin(angle_bin, PUSH_ANGLE_BINS, "angle_bin")

@@ -40,7 +40,7 @@ import torch
 from torch_geometric.data import Data
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.parameters import PUSH_LEAD, place_xy, push_values
+from hsgplan.domain.parameters import place_xy, push_carry, push_values
 from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.scene import Kind, World, check_features
 from hsgplan.domain.world import PLACE_BINS, PUSH_ANGLE_BINS, PUSH_DIST_BINS
@@ -229,7 +229,7 @@ def bin_queries(sg: GeometricSceneGraph, subgoal: Literal) -> torch.Tensor:
         for i in range(PUSH_ANGLE_BINS):
             for j in range(PUSH_DIST_BINS):
                 angle, dist = push_values(i, j)
-                d = SCALE * (dist - PUSH_LEAD)
+                d = SCALE * push_carry(dist)
                 rows.append(
                     [
                         d * math.cos(angle),

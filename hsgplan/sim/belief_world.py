@@ -15,7 +15,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from hsgplan.domain.parameters import PUSH_LEAD, PickParams, PlaceParams, PushParams, push_values
+from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams, push_carry, push_values
 from hsgplan.domain.scene import World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
@@ -91,13 +91,13 @@ class BeliefWorld:
 
     def _stroke_end(self, plan: MotionPlan) -> Pose:
         """Where a push's stroke leaves its object in the model: its centre carried along the
-        push by the stroke's length less `PUSH_LEAD`, as far as the fingertips go (it may
-        slide on, or lag): what the robot's own motion says of an object it may no longer see."""
+        push as far as the fingertips carry it (`push_carry`; it may slide on, or lag): what
+        the robot's own motion says of an object it may no longer see."""
         start = self.scene.pose(plan.params.obj)
         _, dist = push_values(plan.params.angle_bin, plan.params.dist_bin)
         ux, uy = plan.push_direction
         x, y, z = start.position
-        moved = max(0.0, dist - PUSH_LEAD)
+        moved = push_carry(dist)
         return Pose((x + ux * moved, y + uy * moved, z), start.orientation)
 
     def dropped(self) -> None:

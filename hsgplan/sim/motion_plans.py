@@ -21,6 +21,7 @@ from hsgplan.domain.parameters import (
     PrimitiveParams,
     extent_along,
     place_xy,
+    push_carry,
     push_values,
 )
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
@@ -272,7 +273,7 @@ def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
     # 1,600 more, every success had this bound at least 2.63 cm past the shelf's front, while
     # under 2.5 cm ~130 of the 1,600 were carried out in vain; one short of that front plus
     # PUSH_SLACK is refused before it is planned and run.
-    reach = pose.position[0] + (dist - PUSH_LEAD) * u[0]
+    reach = pose.position[0] + push_carry(dist) * u[0]
     if reach < world.shelves[shelf].interior.x_min + PUSH_SLACK:
         return PlanFailure(Status.EFFECT_NOT_REACHED, f"too short to bring '{p.obj}' into {shelf}")
     orn = tilted(angle, PUSH_PITCH)
