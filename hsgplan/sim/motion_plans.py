@@ -199,8 +199,11 @@ def _plan_pick(scene: Scene, p: PickParams, q0: np.ndarray) -> MotionPlan | Plan
     if t.kind is Kind.BOX:
         yaws = [pose.yaw, pose.yaw + math.pi]  # close across the box's narrow (local x) side
     else:
+        # Any yaw closes on a can; the hand turned half round is another arm (its last joint
+        # spans 5.9 rad), so beside the base, where the first four run out of that joint's
+        # range, the other four may not.
         radial = math.atan2(pose.position[1], pose.position[0]) + math.pi / 2
-        yaws = [radial + k * math.pi / 4 for k in (0, 1, -1, 2)]
+        yaws = [radial + k * math.pi / 4 for k in (0, 1, -1, 2, 4, 3, 5, 6)]
     for yaw in yaws:
         grasp = Pose((pose.position[0], pose.position[1], tip_z + TIP_OFFSET), topdown(yaw))
         found = _approach(scene, grasp, (p.obj,), [REST, q0])

@@ -177,3 +177,22 @@ def test_a_grasp_on_another_branch_than_its_descent_is_not_planned(scene, monkey
     monkeypatch.setattr(robot, "ik", flipped)
     refused = motion_plans.plan_primitive(scene, PickParams("cherries"))
     assert refused.status is Status.NO_IK
+
+
+def test_a_can_beside_the_base_is_grasped_with_the_hand_turned_half_round():
+    """Right before the base the four radial grasps of a tall can run the wrist out of its
+    range; the same grasps turned half round reach it."""
+    import math
+
+    from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
+
+    can = "alphabet_soup"
+    with Scene([can], poses={can: standing(can, 0.29, 0.0)}, world=KITCHEN) as s:
+        s.settle()
+        plan = plan_primitive(s, PickParams(can))
+        assert isinstance(plan, MotionPlan)
+        s.robot.set_q(plan.q_at)
+        closing = s.robot.tcp().rotation[:, 1]
+        radial = math.atan2(s.pose(can).position[1], s.pose(can).position[0]) + math.pi / 2
+        turned = math.degrees((math.atan2(closing[1], closing[0]) - radial) % (2 * math.pi))
+        assert 134 < turned < 271  # none of the first four: 0, 45, 90 and -45 degrees
