@@ -1,6 +1,7 @@
 """The planner's cheap refusals and detours: each gives the answer the expensive path would."""
 
 import contextlib
+import math
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams, place
 from hsgplan.domain.world import PLACE_BINS, PUSH_DIST_BINS
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.motion import MotionPlanner
+from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
 from hsgplan.sim.outcome import Status
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.robot import ARM
@@ -182,10 +184,6 @@ def test_a_grasp_on_another_branch_than_its_descent_is_not_planned(scene, monkey
 def test_a_can_beside_the_base_is_grasped_with_the_hand_turned_half_round():
     """Right before the base the four radial grasps of a tall can run the wrist out of its
     range; the same grasps turned half round reach it."""
-    import math
-
-    from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
-
     can = "alphabet_soup"
     with Scene([can], poses={can: standing(can, 0.29, 0.0)}, world=KITCHEN) as s:
         s.settle()
