@@ -21,6 +21,7 @@ from hsgplan.cli.common import (
     err,
     out,
     out_folder,
+    parse_sizes,
     refuses_bad_input,
     shown,
 )
@@ -223,6 +224,39 @@ def reach(
     out.print(
         f"{summary.trials} primitives executed from {summary.staged} of {summary.states} "
         f"states ({statuses or 'none'}); {summary.ran} run now in "
+        f"{summary.seconds:.1f} s; in {shown(out_dir)}",
+        highlight=False,
+        soft_wrap=True,
+    )
+
+
+@app.command("visited")
+@refuses_bad_input
+def visited(
+    episodes: Annotated[
+        int, bounded_option("episodes", "Episodes per size (a rerun may ask for more).")
+    ] = 120,
+    sizes: Annotated[str, typer.Option(help="Goal sizes, e.g. 2-6,8.")] = "2-6,8",
+    seed: Annotated[int, bounded_option("seed", "Seed of the goals, scenes and actions.")] = 0,
+    workers: CollectWorkers = 2,
+    ray: RayAddress = None,
+    out_dir: CollectionFolder = RUNS / "collect-visited",
+) -> None:
+    """f_reach's labels from the states the learned agent visits: in each, before it decides,
+    primitives are executed as `collect reach` executes them from a staged state."""
+    from hsgplan.collect.visited import collect_visited
+
+    check_ray(ray)
+    size_list = tuple(parse_sizes(sizes))
+    with Progress(console=err, transient=True) as progress:
+        bar = progress.add_task("episodes", total=episodes * len(set(size_list)))
+        summary = collect_visited(
+            out_dir, episodes, size_list, seed, workers, ray, lambda _: progress.advance(bar)
+        )
+    statuses = ", ".join(f"{k} {v}" for k, v in summary.by_status.items())
+    out.print(
+        f"{summary.trials} primitives executed from {summary.states} states of "
+        f"{summary.episodes} episodes ({statuses or 'none'}); {summary.ran} run now in "
         f"{summary.seconds:.1f} s; in {shown(out_dir)}",
         highlight=False,
         soft_wrap=True,

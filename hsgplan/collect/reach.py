@@ -187,24 +187,47 @@ def run_trials(
     scene.rng = np.random.default_rng(rng.getrandbits(64))
     if not stage(scene, state, rng):
         return dict(UNSTAGED)
-    snapshot, held = scene.snapshot(), scene.robot.held_body
+    # the next state is staged over whatever the last trial left
+    return state_row(state, trials_from_here(scene, state, actions, max_params, put_back=False))
+
+
+def trials_from_here(
+    scene: Scene,
+    state: SymbolicSceneGraph,
+    actions: list[Action],
+    max_params: int = MAX_PARAMS,
+    put_back: bool = True,
+) -> list[WorldTrial]:
+    """Execute each action from the scene as it stands, which shows `state`; with `put_back`,
+    the scene is left as it was (the hand's grasp included), else with the hand empty."""
+    robot = scene.robot
+    snapshot, held = scene.snapshot(), robot.held_body
+    kept = {k: getattr(robot, k) for k in ("closing", "released")}
     trials = []
     for action in actions:
         # a grasp is a constraint, which a saved state leaves out: the last trial's is let go
-        # and the staged one made again
-        scene.robot.detach()
+        # and the one the scene started with made again
+        robot.detach()
         scene.restore(snapshot)
         if held is not None:
-            scene.robot.attach(held)
+            robot.attach(held)
         status, executed = execute_action(scene, action, max_params)
         after: SymbolicSceneGraph | None = state
         if executed:
             mapping = map_symbols(scene.scene_graph())
             after = None if mapping.anomalies else mapping.state
         trials.append(WorldTrial(state, action, status, after))
+    if put_back:
+        robot.detach()
+        scene.restore(snapshot)
+        if held is not None:
+            robot.attach(held)
+        for k, v in kept.items():
+            setattr(robot, k, v)
     scene.bc.removeState(snapshot)
-    scene.robot.detach()
-    return state_row(state, trials)
+    if not put_back:
+        robot.detach()
+    return trials
 
 
 def record_reach_state(
@@ -301,31 +324,15 @@ def collect_reach(
         worlds = {str(p): w for p, w in read_worlds(scene).items()}
         config["scene"] = str(scene)
     files, in_turn = list(worlds), list(worlds.values())
-    # claimed here first for a refusal that says what differs, and to count what is logged
-    claim(
-        out,
-        "reach",
-        config,
+    refusal = (
         f"'{out}' holds a reach collection made with other settings (seed, "
-        "actions per state, parameter choices, scene, or an older layout); use another --out",
+        "actions per state, parameter choices, scene, or an older layout); use another --out"
     )
-    logged = {str(row.get("key")) for row in logged_rows(out) if isinstance(row, dict)}
     items = [
         ReachItem(seed, i, actions_per_state, max_params, files[i % len(files)])
         for i in range(states)
     ]
-    rows = run_items(
-        run_reach_item,
-        items,
-        key=lambda item: item.key,
-        run_dir=out,
-        kind="reach",
-        config=config,
-        workers=workers,
-        ray=ray,
-        on_result=on_item,
-    )
-    ran = sum(item.key not in logged for item in items)
+    rows, ran = run_collection(out, run_reach_item, items, config, refusal, workers, ray, on_item)
     trials: list[WorldTrial] = [
         t for i, row in enumerate(rows) for t in trials_of(row, in_turn[i % len(in_turn)])
     ]
@@ -337,3 +344,26 @@ def collect_reach(
         ran,
         time.perf_counter() - start,
     )
+
+
+def run_collection(
+    out: Path, work, items: list, config: dict, refusal: str, workers: int, ray: str | None, on_item
+) -> tuple[list[dict], int]:
+    """Every item's row of a collection of executed primitives in the run folder `out` (made
+    with `config`, else refused with `refusal`), and how many of them ran now: those logged
+    before are read back."""
+    # claimed here first for a refusal that says what differs, and to count what is logged
+    claim(out, "reach", config, refusal)
+    logged = {str(row.get("key")) for row in logged_rows(out) if isinstance(row, dict)}
+    rows = run_items(
+        work,
+        items,
+        key=lambda item: item.key,
+        run_dir=out,
+        kind="reach",
+        config=config,
+        workers=workers,
+        ray=ray,
+        on_result=on_item,
+    )
+    return rows, sum(item.key not in logged for item in items)

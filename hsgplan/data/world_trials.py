@@ -1,10 +1,13 @@
 """Primitives executed in the simulated world from staged symbolic states: f_reach's labels.
 
-Made by `hsgplan collect reach` (`collect/reach.py`). A collection is a run folder
-(`runner/items.py`): `config.json` and `episodes.jsonl`, one line per staged state,
-`{"key": "SEED/INDEX", "result": R}`, with
+Made by `hsgplan collect reach` (`collect/reach.py`) and `hsgplan collect visited`
+(`collect/visited.py`). A collection is a run folder (`runner/items.py`): `config.json` and
+`episodes.jsonl`, one line per staged state or episode, `{"key": "SEED/INDEX", "result": R}`
+(`SEED/SIZE/INDEX` for an episode), with
 
     R = {"staged": false}                         the drawn state could not be staged
+    R = {"states": [R, ...], ...}                 the states one episode of the agent visited
+                                                  (`collect visited`), each as below
     R = {"objects": [names], "state": [literals],
          "trials": [{"action": "pick(x)", "status": S, "after": [literals] | null}, ...]}
 
@@ -91,6 +94,8 @@ def trials_of(row: dict, world: World) -> list[WorldTrial]:
     was not staged."""
     if row.get("staged", True) is False:
         return []
+    if "states" in row:
+        return [t for r in row["states"] for t in trials_of(r, world)]
     objects = row["objects"]
     state = read_state(objects, row["state"], world)
     return [

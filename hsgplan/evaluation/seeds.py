@@ -11,6 +11,9 @@ from __future__ import annotations
 TUNING = range(900, 1000)
 # `eval perception` (staged scenes and `--loop`): the seeds its rules were chosen on
 PERCEPTION_TUNING = frozenset({1, 2, 3, 4, 5, 21, 31, 32, 43})
+# the goals of training collections run in the loop (`collect visited`): seed S draws the goals
+# of seed GOAL_SEEDS.start + S, apart from every seed an evaluation is run on
+GOAL_SEEDS = range(1_000_000, 2_000_000)
 
 
 def is_tuning(seed: int, perception: bool = False) -> bool:

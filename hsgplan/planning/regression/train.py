@@ -73,6 +73,9 @@ class TaskTrainConfig:
     vary: bool = True  # f_preimage also asked from varied states (`augment.varied`)
     reach: str = "world"  # f_reach's labels: one of REACH_SOURCES
     world_trials: str = str(REACH_DATA)  # the executed primitives, for reach = "world"
+    # more executed primitives, from the states the agent visited (`collect visited`), for
+    # reach = "world"; None: the staged states alone
+    loop_trials: str | None = None
     # alterations asked alone per state and label (reach = "alterations" or "predicates")
     reach_singles: int = setting(12, lo=1, hi=1000)
     # f_reach sees the max-pooled graph context (`gnn.RelationalLayer`): whether the hand is
@@ -122,10 +125,14 @@ def _examples(
             }
         folder = shipped(config.world_trials)
         trials = load_world_trials(folder, _trial_worlds(config, home))
-        return {
-            "primitives executed in the simulated world": world_reach_examples(trials, []),
-            "demonstrated changes": world_reach_examples([], demos),
-        }
+        out = {"primitives executed in the simulated world": world_reach_examples(trials, [])}
+        if config.loop_trials is not None:
+            folder = shipped(config.loop_trials)
+            visited = load_world_trials(folder, collection_worlds(folder, home))
+            out["primitives executed from states the agent visited"] = world_reach_examples(
+                visited, []
+            )
+        return out | {"demonstrated changes": world_reach_examples([], demos)}
     make = (
         (lambda t: preimage_examples(t, config.seed, config.vary))
         if name == "preimage"
@@ -189,7 +196,9 @@ def train_task(
         demos = demos[: config.demo_limit]
     if config.reach == "world":
         _trial_worlds(config, home)  # refused before anything is trained or written
-    sources = [config.demos] + ([config.world_trials] if config.reach == "world" else [])
+    sources = [config.demos]
+    if config.reach == "world":
+        sources += [config.world_trials] + ([config.loop_trials] if config.loop_trials else [])
     data = fingerprint(Path(s) for s in sources)
     # a checkpoint trained before a setting existed was trained with its default
     training.claim(out, asdict(config), defaults=asdict(TaskTrainConfig()), data=data)

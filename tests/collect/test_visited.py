@@ -1,0 +1,86 @@
+"""f_reach's labels from the states the agent visits (`hsgplan collect visited`)."""
+
+import json
+import random
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hsgplan.cli import app
+from hsgplan.collect.reach import ACTIONS_PER_STATE, choose_actions, trials_from_here
+from hsgplan.collect.visited import VisitedItem, run_visited_item
+from hsgplan.data.world_trials import load_world_trials, trials_of
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.predicates import in_grasp, on
+from hsgplan.evaluation.seeds import GOAL_SEEDS, TUNING
+from hsgplan.planning.regression.train import TaskTrainConfig, _examples
+from hsgplan.scene_graph.symbol_mapping import map_symbols
+from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
+from hsgplan.sim.scene import Scene
+from hsgplan.sim.staging import stage
+
+
+def test_trials_from_a_scene_leave_it_as_it_was_the_grasp_included():
+    state = SymbolicSceneGraph.from_literals(
+        ["cherries", "butter"], [in_grasp("cherries"), on("butter", "open_space")], world=KITCHEN
+    )
+    with Scene(state.objects, world=KITCHEN) as scene:
+        assert stage(scene, state, random.Random(0))
+        before = {n: scene.pose(n) for n in scene.bodies}
+        actions = choose_actions(state, random.Random(1))
+        trials = trials_from_here(scene, state, actions)
+        assert len(trials) == len(actions) and all(t.state == state for t in trials)
+        assert any(t.succeeded for t in trials)  # something moved in a trial, and came back
+        assert scene.held() == "cherries"
+        for name, pose in before.items():
+            assert np.allclose(scene.pose(name).position, pose.position, atol=1e-6), name
+        assert map_symbols(scene.scene_graph()).state == state
+
+
+def test_an_episode_row_holds_every_state_visited_and_is_read_as_trials():
+    row = run_visited_item(VisitedItem(0, 2, 0))
+    assert row["states"] and isinstance(row["success"], bool)
+    trials = trials_of(row, KITCHEN)
+    assert len(trials) == sum(len(s["trials"]) for s in row["states"])
+    assert all(len(s["trials"]) <= ACTIONS_PER_STATE for s in row["states"])
+    # the first state is the episode's start, every trial from it starts there
+    first = trials_of(row["states"][0], KITCHEN)
+    assert len({t.state for t in first}) == 1
+    assert row == run_visited_item(VisitedItem(0, 2, 0))  # the same item, the same row
+
+
+def test_the_goals_are_drawn_apart_from_every_evaluated_seed():
+    item = VisitedItem(3, 4, 7)
+    assert item.episode_seed >= GOAL_SEEDS.start and not set(TUNING) & set(GOAL_SEEDS)
+
+
+@pytest.mark.slow
+def test_collect_visited_end_to_end_a_rerun_repeats_nothing_and_training_reads_it(tmp_path):
+    out = tmp_path / "visited"
+    args = ["collect", "visited", "--episodes", "1", "--sizes", "2", "--workers", "1"]
+    r = CliRunner().invoke(app, [*args, "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    lines = (out / "episodes.jsonl").read_text().splitlines()
+    assert [json.loads(x)["key"] for x in lines] == ["0/2/0"]
+    trials = load_world_trials(out, KITCHEN)
+    assert trials and f"{len(trials)} primitives executed" in r.stdout
+    r = CliRunner().invoke(app, [*args, "--out", str(out)])
+    assert r.exit_code == 0 and "; 0 run now" in r.stdout
+    config = TaskTrainConfig(loop_trials=str(out))
+    sources = _examples("reach", [], [], config, KITCHEN, KITCHEN)
+    visited = sources["primitives executed from states the agent visited"]
+    assert visited and "primitives executed in the simulated world" in sources
+
+
+@pytest.mark.parametrize(("option", "value"), [("--episodes", "0"), ("--episodes", "-2")])
+def test_bad_counts_are_refused_in_one_line(tmp_path, option, value):
+    r = CliRunner().invoke(app, ["collect", "visited", option, value, "--out", str(tmp_path)])
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "config.json").exists()
+
+
+def test_sizes_below_two_are_refused_in_one_line(tmp_path):
+    r = CliRunner().invoke(app, ["collect", "visited", "--sizes", "1", "--out", str(tmp_path)])
+    assert r.exit_code == 2 and "between 2 and" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "config.json").exists()
