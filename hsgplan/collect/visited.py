@@ -3,9 +3,9 @@
 `collect reach` stages its states with every object where the scene sampler puts it. In the
 loop, most objects on a shelf top were put there by the place network, which learned to leave
 its neighbours free to be taken up again (`data/motion_trials.py`): a box among three others
-there is taken up far more often than a staged one (staged, 16 to 32 of 100). f_reach, which
-reads only the symbolic state, learns the staged odds, and the planner then finds nothing
-reachable where one pick would do (`no_subgoal`).
+there is taken up far more often than a staged one. f_reach, which reads only the symbolic
+state, learns the staged odds, and the planner then finds nothing reachable where one pick
+would do (`no_subgoal`).
 
 Here the learned agent (`learned`: the regression planner and the GNN motion networks of the
 shipped checkpoints, every recovery rule on, going on after a failed primitive) runs episodes
