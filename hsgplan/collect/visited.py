@@ -90,6 +90,12 @@ def _goal(item: VisitedItem):
 def run_visited_item(item: VisitedItem) -> dict:
     """The worker entry point: one episode, and the trials run from every state it visited,
     as one row."""
+    return explore_episode(item, _goal(item))
+
+
+def explore_episode(item: VisitedItem, goal) -> dict:
+    """The agent's episode towards `goal`, with the trials from every state it met, as one
+    row. Only drawing the goal asks the symbolic package (its generator); nothing here does."""
     from hsgplan.evaluation.episode import run_episode
     from hsgplan.sim.env import KitchenStorageEnv
 
@@ -108,7 +114,6 @@ def run_visited_item(item: VisitedItem) -> dict:
         states.append(state_row(state, trials_from_here(scene, state, actions, item.max_params)))
         scene.rng = rng_before  # the agent's episode goes on as it would have
 
-    goal = _goal(item)
     record = run_episode(env, _agent(), goal, item.episode_seed, on_step=explore)
     return {"states": states, "goal": str(goal), "success": record.success}
 

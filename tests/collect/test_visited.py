@@ -2,14 +2,17 @@
 
 import json
 import random
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+import hsgplan
 from hsgplan.cli import app
 from hsgplan.collect.reach import ACTIONS_PER_STATE, choose_actions, trials_from_here
-from hsgplan.collect.visited import VisitedItem, run_visited_item
+from hsgplan.collect.visited import VisitedItem, _goal, explore_episode, run_visited_item
 from hsgplan.data.world_trials import load_world_trials, trials_of
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import in_grasp, on
@@ -84,3 +87,30 @@ def test_sizes_below_two_are_refused_in_one_line(tmp_path):
     r = CliRunner().invoke(app, ["collect", "visited", "--sizes", "1", "--out", str(tmp_path)])
     assert r.exit_code == 2 and "between 2 and" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "config.json").exists()
+
+
+def test_the_episode_and_its_trials_never_ask_the_hand_written_rules(monkeypatch):
+    def forbidden(*args, **kwargs):
+        raise AssertionError("the transition model was asked")
+
+    for name in ("why_not", "apply", "applicable_actions"):
+        monkeypatch.setattr(f"hsgplan.symbolic.transition.{name}", forbidden)
+    package = Path(hsgplan.__file__).resolve().parent
+    rules = (package / "symbolic", package / "planning" / "fast_downward.py")
+    # the goal and the start scene are drawn by the generator, as every evaluation's are
+    drawn = package / "symbolic" / "generator.py"
+    calls = []
+
+    def profile(frame, event, arg):
+        path = Path(frame.f_code.co_filename)
+        if event == "call" and path != drawn and any(r == path or r in path.parents for r in rules):
+            calls.append(frame.f_code.co_name)
+
+    item = VisitedItem(2, 3, 0)
+    goal = _goal(item)
+    sys.setprofile(profile)
+    try:
+        row = explore_episode(item, goal)
+    finally:
+        sys.setprofile(None)
+    assert calls == [] and trials_of(row, KITCHEN)
