@@ -99,3 +99,13 @@ def test_the_episode_and_its_trials_never_ask_the_hand_written_rules():
     with rules_forbidden(calls, tuple(rules)):
         row = explore_episode(item, goal)
     assert calls == [] and trials_of(row, KITCHEN)
+
+
+def test_training_on_a_missing_visited_collection_is_refused_before_anything_is_written(tmp_path):
+    from hsgplan.domain.errors import InvalidInputError
+    from hsgplan.planning.regression.train import train_task
+
+    config = TaskTrainConfig(loop_trials=str(tmp_path / "none"), epochs=1)
+    with pytest.raises(InvalidInputError, match="holds no collection"):
+        train_task(config, tmp_path / "m", world=KITCHEN)
+    assert not (tmp_path / "m").exists()

@@ -22,7 +22,7 @@ from torch_geometric.data import Batch
 
 from hsgplan import training
 from hsgplan.checkpoint import fingerprint
-from hsgplan.data.world_trials import collection_worlds, load_world_trials
+from hsgplan.data.world_trials import RESULTS, collection_worlds, load_world_trials
 from hsgplan.domain.checks import BOUNDS, check_fields, from_settings, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import World
@@ -196,6 +196,10 @@ def train_task(
         demos = demos[: config.demo_limit]
     if config.reach == "world":
         _trial_worlds(config, home)  # refused before anything is trained or written
+        if config.loop_trials is not None and not (shipped(config.loop_trials) / RESULTS).is_file():
+            raise InvalidInputError(
+                f"loop_trials '{config.loop_trials}' holds no collection of executed primitives"
+            )
     sources = [config.demos]
     if config.reach == "world":
         sources += [config.world_trials] + ([config.loop_trials] if config.loop_trials else [])
