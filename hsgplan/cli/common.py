@@ -241,6 +241,12 @@ def input_path(text) -> Path:
     return Path(str(text)).expanduser()
 
 
+TaskCheckpoint = Annotated[
+    Path | None,
+    typer.Option(help="Task planner checkpoint (default: the shipped one).", parser=input_path),
+]
+
+
 SceneFiles = Annotated[
     Path | None,
     typer.Option(

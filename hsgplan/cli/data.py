@@ -14,6 +14,7 @@ from hsgplan.cli.common import (
     RayAddress,
     SceneOption,
     Summaries,
+    TaskCheckpoint,
     bounded_option,
     check_ray,
     config_default,
@@ -241,6 +242,7 @@ def visited(
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     out_dir: CollectionFolder = RUNS / "collect-visited",
+    checkpoint: TaskCheckpoint = None,
 ) -> None:
     """f_reach's labels from the states the learned agent visits: in each, before it decides,
     primitives are executed as `collect reach` executes them from a staged state."""
@@ -251,7 +253,14 @@ def visited(
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("episodes", total=episodes * len(set(size_list)))
         summary = collect_visited(
-            out_dir, episodes, size_list, seed, workers, ray, lambda _: progress.advance(bar)
+            out_dir,
+            episodes,
+            size_list,
+            seed,
+            workers,
+            ray,
+            lambda _: progress.advance(bar),
+            checkpoint,
         )
     statuses = ", ".join(f"{k} {v}" for k, v in summary.by_status.items())
     out.print(

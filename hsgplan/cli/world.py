@@ -20,6 +20,7 @@ from hsgplan.cli.common import (
     RunFolder,
     SceneFiles,
     SceneOption,
+    TaskCheckpoint,
     bounded_option,
     check_ray,
     choice,
@@ -63,10 +64,6 @@ MotionOption = Annotated[
 ]
 
 
-TaskCheckpoint = Annotated[
-    Path | None,
-    typer.Option(help="Task planner checkpoint (default: the shipped one).", parser=input_path),
-]
 MotionCheckpoints = Annotated[
     Path | None,
     typer.Option(

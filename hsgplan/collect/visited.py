@@ -42,7 +42,7 @@ from hsgplan.collect.reach import (
 from hsgplan.data.world_trials import WorldTrial, state_row, trials_of
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.evaluation.seeds import GOAL_SEEDS
+from hsgplan.evaluation.seeds import GOAL_SEEDS, episode_seed
 
 AGENT = "learned"
 
@@ -56,6 +56,7 @@ class VisitedItem:
     index: int
     actions_per_state: int = ACTIONS_PER_STATE
     max_params: int = MAX_PARAMS
+    checkpoint: str | None = None  # the agent's task planner (None: the shipped one)
 
     @property
     def key(self) -> str:
@@ -63,14 +64,15 @@ class VisitedItem:
 
     @property
     def episode_seed(self) -> int:
-        return GOAL_SEEDS.start + self.seed * 1_000_003 + self.size * 10_007 + self.index
+        return GOAL_SEEDS.start + episode_seed(self.seed, self.size, self.index)
 
 
 @functools.cache
-def _agent():
+def _agent(checkpoint: str | None = None):
     from hsgplan.agents.registry import make_agent
+    from hsgplan.paths import TASK_CHECKPOINT
 
-    return make_agent(AGENT)
+    return make_agent(AGENT, Path(checkpoint or TASK_CHECKPOINT))
 
 
 def _goal(item: VisitedItem):
@@ -114,7 +116,7 @@ def explore_episode(item: VisitedItem, goal) -> dict:
         states.append(state_row(state, trials_from_here(scene, state, actions, item.max_params)))
         scene.rng = rng_before  # the agent's episode goes on as it would have
 
-    record = run_episode(env, _agent(), goal, item.episode_seed, on_step=explore)
+    record = run_episode(env, _agent(item.checkpoint), goal, item.episode_seed, on_step=explore)
     return {"states": states, "goal": str(goal), "success": record.success}
 
 
@@ -136,11 +138,13 @@ def collect_visited(
     workers: int = 2,
     ray: str | None = None,
     on_item: Callable[[dict], None] | None = None,
+    checkpoint: Path | None = None,
 ) -> VisitedSummary:
     """`episodes` episodes of each size, logged to the run folder `out` (a collection of
-    executed primitives, as `collect reach` makes: `train task` reads it as `loop_trials`). A
-    rerun keeps what is logged and runs only the missing episodes; a folder made with other
-    settings is refused."""
+    executed primitives, as `collect reach` makes: `train task` reads it as `loop_trials`), the
+    agent's task planner from `checkpoint` (None: the shipped one). A rerun keeps what is logged
+    and runs only the missing episodes; a folder made with other settings or checkpoints is
+    refused."""
     if episodes < 1:
         raise InvalidInputError(f"--episodes {episodes}: need at least one")
     if not sizes or min(sizes) < 2:
@@ -149,6 +153,8 @@ def collect_visited(
     from hsgplan.checkpoint import fingerprint
     from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
 
+    folder = None if checkpoint is None else str(checkpoint)
+    _agent(folder)  # a missing or unreadable checkpoint is refused before anything is written
     config = {
         "kind": "reach",
         "unit": "visited episode",
@@ -156,12 +162,16 @@ def collect_visited(
         "agent": AGENT,
         "actions_per_state": ACTIONS_PER_STATE,
         "max_params": MAX_PARAMS,
-        "fingerprint": fingerprint([Path(TASK_CHECKPOINT), Path(MOTION_CHECKPOINTS)]),
+        "fingerprint": fingerprint([Path(folder or TASK_CHECKPOINT), Path(MOTION_CHECKPOINTS)]),
     }
     refusal = (
         f"'{out}' holds a collection made with other settings or checkpoints; use another --out"
     )
-    items = [VisitedItem(seed, n, i) for n in sorted(set(sizes)) for i in range(episodes)]
+    items = [
+        VisitedItem(seed, n, i, checkpoint=folder)
+        for n in sorted(set(sizes))
+        for i in range(episodes)
+    ]
     rows, ran = run_collection(out, run_visited_item, items, config, refusal, workers, ray, on_item)
     trials: list[WorldTrial] = [t for row in rows for t in trials_of(row, KITCHEN)]
     return VisitedSummary(

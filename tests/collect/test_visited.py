@@ -68,6 +68,11 @@ def test_collect_visited_end_to_end_a_rerun_repeats_nothing_and_training_reads_i
     assert trials and f"{len(trials)} primitives executed" in r.stdout
     r = CliRunner().invoke(app, [*args, "--out", str(out)])
     assert r.exit_code == 0 and "; 0 run now" in r.stdout
+    # another agent's episodes are never mixed into the collection
+    other = ["--checkpoint", "checkpoints/task-paper", "--out", str(out)]
+    r = CliRunner().invoke(app, [*args, *other])
+    assert r.exit_code == 2 and "other settings or checkpoints" in r.stderr
+    assert (out / "episodes.jsonl").read_text().splitlines() == lines
     config = TaskTrainConfig(loop_trials=str(out))
     sources = _examples("reach", [], [], config, KITCHEN, KITCHEN)
     visited = sources["primitives executed from states the agent visited"]
@@ -79,6 +84,13 @@ def test_bad_counts_are_refused_in_one_line(tmp_path, option, value):
     r = CliRunner().invoke(app, ["collect", "visited", option, value, "--out", str(tmp_path)])
     assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "config.json").exists()
+
+
+def test_a_missing_checkpoint_is_refused_in_one_line_before_anything_is_written(tmp_path):
+    args = ["collect", "visited", "--checkpoint", str(tmp_path / "none"), "--out", str(tmp_path)]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "no trained network" in r.stderr and not (tmp_path / "config.json").exists()
 
 
 def test_sizes_below_two_are_refused_in_one_line(tmp_path):
