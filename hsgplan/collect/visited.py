@@ -7,8 +7,9 @@ there is taken up far more often than a staged one. f_reach, which reads only th
 state, learns the staged odds, and the planner then finds nothing reachable where one pick
 would do (`no_subgoal`).
 
-Here the learned agent (`learned`: the regression planner and the GNN motion networks of the
-shipped checkpoints, every recovery rule on, going on after a failed primitive) runs episodes
+Here the learned agent (`learned`: the regression planner of the checkpoint named, by default
+the shipped one, and the shipped GNN motion networks, every recovery rule on, going on after a
+failed primitive; `data/reach/visited` was collected by `checkpoints/task-staged`) runs episodes
 towards random goals, and in every state it meets, before it decides, up to `ACTIONS_PER_STATE`
 actions are executed from that state as `collect reach` executes them from a staged one
 (`choose_actions`, `execute_action`), the scene put back after each; then the agent's own step
