@@ -15,6 +15,7 @@ from hsgplan.domain.actions import Pick, Place
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import clear, in_grasp, inside, on
+from hsgplan.paths import home, shipped
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.planning.regression.examples import (
     paper_reach_examples,
@@ -322,3 +323,19 @@ def test_executed_primitives_are_learnt_in_the_worlds_they_were_staged_in(tmp_pa
     with pytest.raises(InvalidInputError, match="know the kitchen's names alone"):
         train_task(TaskTrainConfig.from_json(config), tmp_path / "m", world=KITCHEN)
     assert not (tmp_path / "m").exists()  # refused before anything was trained
+
+
+SHIPPED_TASK = sorted(p.parent.name for p in (home() / "checkpoints").glob("task*/train_config.*"))
+
+
+@pytest.mark.parametrize("folder", SHIPPED_TASK)
+def test_every_shipped_task_configuration_names_data_the_repository_holds(folder):
+    # a shipped configuration retrains its checkpoint from what is shipped, or from `runs/`,
+    # which a documented command makes (docs/retraining.md)
+    config = TaskTrainConfig.from_json(
+        json.loads((home() / "checkpoints" / folder / "train_config.json").read_text())
+    )
+    named = [config.demos] + ([config.world_trials] if config.reach == "world" else [])
+    named += [config.loop_trials] if config.loop_trials else []
+    for path in named:
+        assert path.startswith("runs/") or shipped(path).is_dir(), path
