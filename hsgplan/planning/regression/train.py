@@ -123,15 +123,16 @@ def _examples(
                     demos, config.seed, config.reach_singles
                 )
             }
-        folder = shipped(config.world_trials)
-        trials = load_world_trials(folder, _trial_worlds(config, home))
-        out = {"primitives executed in the simulated world": world_reach_examples(trials, [])}
-        if config.loop_trials is not None:
-            folder = shipped(config.loop_trials)
-            visited = load_world_trials(folder, collection_worlds(folder, home))
-            out["primitives executed from states the agent visited"] = world_reach_examples(
-                visited, []
+        names = (
+            "primitives executed in the simulated world",
+            "primitives executed from states the agent visited",
+        )
+        out = {
+            name: world_reach_examples(
+                load_world_trials(shipped(f), _trial_worlds(f, config.features, home)), []
             )
+            for name, f in zip(names, _trial_folders(config), strict=False)
+        }
         return out | {"demonstrated changes": world_reach_examples([], demos)}
     make = (
         (lambda t: preimage_examples(t, config.seed, config.vary))
@@ -144,18 +145,26 @@ def _examples(
     return out
 
 
-def _trial_worlds(config: TaskTrainConfig, home: World) -> list[World]:
-    """The worlds f_reach's executed primitives were staged in. Each state is described in its
-    own (`Example.world`), which need not be the demonstrations': f_reach may learn round other
-    layouts. InvalidInputError for worlds the networks' features cannot read."""
-    worlds = collection_worlds(shipped(config.world_trials), home)
-    unread = sorted({w.name for w in worlds if not reads(config.features, w)})
+def _trial_folders(config: TaskTrainConfig) -> list[str]:
+    """The collections of executed primitives f_reach learns from: the staged, then the visited."""
+    return [config.world_trials] + ([config.loop_trials] if config.loop_trials else [])
+
+
+def _trial_worlds(folder: str, features: str, home: World) -> list[World]:
+    """The worlds a collection of f_reach's executed primitives was staged in. Each state is
+    described in its own (`Example.world`), which need not be the demonstrations': f_reach may
+    learn round other layouts. InvalidInputError for a folder holding no collection, or worlds
+    the networks' features cannot read."""
+    worlds = collection_worlds(shipped(folder), home)
+    unread = sorted({w.name for w in worlds if not reads(features, w)})
     if unread:
         raise InvalidInputError(
-            f"'{config.world_trials}' was collected in scenes of other groceries than the "
+            f"'{folder}' was collected in scenes of other groceries than the "
             f"kitchen's ({', '.join(unread)}); networks of features names know the "
             "kitchen's names alone: train with features geometry"
         )
+    if not (shipped(folder) / RESULTS).is_file():
+        raise InvalidInputError(f"'{folder}' holds no collection of executed primitives")
     return worlds
 
 
@@ -195,14 +204,9 @@ def train_task(
             )
         demos = demos[: config.demo_limit]
     if config.reach == "world":
-        _trial_worlds(config, home)  # refused before anything is trained or written
-        if config.loop_trials is not None and not (shipped(config.loop_trials) / RESULTS).is_file():
-            raise InvalidInputError(
-                f"loop_trials '{config.loop_trials}' holds no collection of executed primitives"
-            )
-    sources = [config.demos]
-    if config.reach == "world":
-        sources += [config.world_trials] + ([config.loop_trials] if config.loop_trials else [])
+        for folder in _trial_folders(config):  # refused before anything is trained or written
+            _trial_worlds(folder, config.features, home)
+    sources = [config.demos] + (_trial_folders(config) if config.reach == "world" else [])
     data = fingerprint(Path(s) for s in sources)
     # a checkpoint trained before a setting existed was trained with its default
     training.claim(out, asdict(config), defaults=asdict(TaskTrainConfig()), data=data)
