@@ -226,7 +226,7 @@ def evaluate(
         str,
         typer.Option(
             help="Rules switched off, comma-separated (under the paper protocol only the "
-            "perception rule relook, which it keeps on): " + ", ".join(RecoveryRules.names()) + "."
+            "perception rules, which it keeps on): " + ", ".join(RecoveryRules.names()) + "."
         ),
     ] = "",
     ablate_rules: Annotated[

@@ -83,6 +83,12 @@ class Goal:
             for orders in itertools.product(*(itertools.permutations(g) for g in groups))
         ]
 
+    def without(self, objects) -> Goal | None:
+        """The goal's literals that name none of `objects`; None if none is left."""
+        gone = set(objects)
+        kept = frozenset(lit for lit in self.literals if not gone & set(lit.objects(self.world)))
+        return Goal(kept, self.world) if kept else None
+
     def renamed(self, names: dict[str, str]) -> Goal:
         """The goal with each object named in `names` called by its value instead."""
         return Goal(

@@ -1,7 +1,7 @@
 """The recovery rules: what the agent does after a failure, beyond the paper.
 
 The paper's agent has none: a primitive that fails ends its episode (the `paper` protocol,
-`hsgplan.evaluation.protocol`, which keeps only the perception rule below). Our loop lets a
+`hsgplan.evaluation.protocol`, which keeps only the perception rules below). Our loop lets a
 failed primitive cost one step and goes on (the `recovering` protocol), and these hand-written
 rules decide how it goes on. Each is named here, documented once, and switched off by name
 (`hsgplan eval world --rules-off NAME,...`), so that what each buys is measured (README,
@@ -27,13 +27,24 @@ Task level (`hsgplan.planning.regression.planner`):
   waits while another goal literal can go on.
 
 Perception (`hsgplan.sim.env`, seeing through a camera observer; nothing under the ground
-truth). It recovers from no failure, so the paper's protocol keeps it too (`PERCEPTION_RULES`):
+truth). They recover from no failure, so the paper's protocol keeps them (`PERCEPTION_RULES`):
 - `relook`: before a primitive on an object the belief is unsure of (not seen at the last
   look, or seen by a single view), or onto one, the arm moves to its rest pose, out of the
   cameras' way, and the robot looks again; the primitive is planned on that look. So too
   before the agent believes its goal reached while it is unsure of an object of the goal, and
   before it judges a step failed on a look unsure of the step's objects (the arm, where the
   step left it, hides the can it pushed into a shelf).
+- `relook_failed`: before it judges any step failed on a look taken with the arm away from its
+  rest pose, the arm moves there and the robot looks again (the arm, where a place left it,
+  made a still can seem 17 cm off).
+- `near_moves_only`: a neighbour whose belief moved between the looks before and after a step
+  is judged moved by it only if the arm's links, what they carried or the object acted on came
+  within 10 cm of it, in the robot's model along the joints the plan drove (`sim/reach.py`); a
+  belief that moved farther off was put right by the new look.
+- `seek_unseen`: while an object of the goal has been found by no view (a thin box under
+  another object), the agent acts on the literals of the goal that name only objects it has
+  seen, since moving them may bring the missing one into view; with no such literal left to
+  reach, the episode ends as `never_seen`, as it does at once without the rule.
 """
 
 from __future__ import annotations
@@ -60,6 +71,9 @@ class RecoveryRules:
     likeliest_literal: bool = True
     failed_goal_waits: bool = True
     relook: bool = True
+    relook_failed: bool = True
+    near_moves_only: bool = True
+    seek_unseen: bool = True
 
     @staticmethod
     def names() -> tuple[str, ...]:
@@ -85,5 +99,5 @@ class RecoveryRules:
 
 
 # rules that act only when the agent sees through a camera observer; the paper's protocol keeps them
-PERCEPTION_RULES = ("relook",)
+PERCEPTION_RULES = ("relook", "relook_failed", "near_moves_only", "seek_unseen")
 ALL_RULES = RecoveryRules()  # the recovering protocol's default: every rule on

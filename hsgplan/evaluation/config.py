@@ -100,7 +100,8 @@ class EvalConfig:
     def rules(self) -> RecoveryRules:
         """The rules its agent runs under: under the paper's protocol no recovery rule, but the
         perception rules (they recover from no failure: the robot looks again where it is
-        unsure of what it acts on or judges), unless switched off."""
+        unsure of what it acts on or judges, and judges a step on what it came near), unless
+        switched off."""
         rules = RecoveryRules().without(self.rules_off)
         if self.protocol == PAPER:
             seeing = {r: getattr(rules, r) for r in PERCEPTION_RULES}

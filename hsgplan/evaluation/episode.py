@@ -165,10 +165,14 @@ def run_episode(
         if env.steps >= env.max_steps:
             failure = Failure.OVERSTEP
             break
-        if obs.unknown:  # nothing to plan with: no view has found it yet
-            failure = Failure.NEVER_SEEN
-            break
-        d = agent.decide(obs.scene_graph, obs.symbols.state, goal, feasible=env.lookahead)
+        aim = goal
+        if obs.unknown:  # no view has found it yet: nothing to plan it with
+            # `seek_unseen`: what is seen of the goal goes on, and may bring it into view
+            aim = goal.without(obs.unknown) if env.rules.seek_unseen else None
+            if aim is None or aim.satisfied_by(obs.symbols.state):
+                failure = Failure.NEVER_SEEN
+                break
+        d = agent.decide(obs.scene_graph, obs.symbols.state, aim, feasible=env.lookahead)
         if d.params is None:
             failure = Failure.NO_SUBGOAL if d.action is None else Failure.NO_PARAMETERS
             unexecuted = (d.task_seconds, d.motion_seconds)

@@ -9,11 +9,12 @@ folder as they finish: an interrupted run, started again with the same command, 
 done. What the episodes sum to is `evaluation/summary.py`.
 
 Two protocols. `paper`, the paper's: the agent decides once per step from the scene it sees,
-with no recovery rule but the perception rule `relook` (`hsgplan.domain.recovery`: it
-recovers from no failure; `rules_off` may switch it off), and the first primitive that fails
-(refused while planning, or failed in execution) ends the episode as an execution failure; the
-step limit ends it as overstep. `recovering`, ours: a failed primitive costs its step and the loop
-goes on from what it observes, under the recovery rules (all of them, or all but `rules_off`).
+with no recovery rule but the perception rules (`hsgplan.domain.recovery`, `PERCEPTION_RULES`:
+they recover from no failure; `rules_off` may switch them off), and the first primitive that
+fails (refused while planning, or failed in execution) ends the episode as an execution
+failure; the step limit ends it as overstep. `recovering`, ours: a failed primitive costs its
+step and the loop goes on from what it observes, under the recovery rules (all of them, or all
+but `rules_off`).
 """
 
 from __future__ import annotations
@@ -192,7 +193,7 @@ def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
     agent = _worker_agent(config)
     world = world_of_file(spec.scene) if spec.scene else KITCHEN
     env = KitchenStorageEnv(
-        observer=_worker_observer(config), relook=config.rules().relook, visuals=False, world=world
+        observer=_worker_observer(config), rules=config.rules(), visuals=False, world=world
     )
     goal = parse_goal(spec.goal, world=world)
     record = run_episode(env, agent, goal, spec.seed, end_at_failure=config.protocol == PAPER)

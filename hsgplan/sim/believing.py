@@ -5,17 +5,20 @@ observer; the module there says what the robot knows)."""
 from __future__ import annotations
 
 import time
+from functools import partial
 
 import numpy as np
 
-from hsgplan.domain.parameters import PickParams, PrimitiveParams
+from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams
+from hsgplan.domain.recovery import RecoveryRules
 from hsgplan.sim.actuation import holds_something
 from hsgplan.sim.belief_world import BeliefWorld
 from hsgplan.sim.env_types import Observation
-from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_transit
+from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, overlapped, plan_transit
 from hsgplan.sim.observer import CameraObserver, Look, Seen
 from hsgplan.sim.outcome import SEEN_DISTURB_TOL, Outcome, Status, compare
 from hsgplan.sim.primitives import Watch, run_path, run_plan, stopped_outcome
+from hsgplan.sim.reach import driven, near, swept_boxes
 from hsgplan.sim.robot import REST
 from hsgplan.sim.scene import Scene
 
@@ -24,8 +27,9 @@ class BelievedSteps:
     """The env's steps and looks under a camera observer.
 
     What it reads of the env: `scene` (the simulated one), `world` (the robot's model of its
-    belief), `observer`, `relook`, `believing`, `_checked_plan` (a dry run's plan) and
-    `_observe` (the observation the agent reads); what it keeps there: `_seen` (the belief's
+    belief), `observer`, the perception rules (`rules`),
+    `believing`, `_checked_plan` (a dry run's plan) and `_observe` (the observation the agent
+    reads); what it keeps there: `_seen` (the belief's
     last look), `_judged` (the look that judged the last step), `_judged_from` (the last
     observation), `_released` (where the last step let its object go, for the next look) and
     `last_plan`.
@@ -34,7 +38,7 @@ class BelievedSteps:
     scene: Scene
     world: BeliefWorld | None
     observer: CameraObserver
-    relook: bool
+    rules: RecoveryRules
     believing: bool
     _seen: Seen | None
     _judged: Seen | None
@@ -48,7 +52,7 @@ class BelievedSteps:
         on_frame = watch.frame
         plan, plan_seconds = self._checked_plan(params)
         relooks = 0
-        if self.relook and self._unsure_of(params):
+        if self.rules.relook and self._unsure_of(params):
             relooks = self._look_again(on_frame)
             if relooks:  # a dry run's plan was made on the older belief: planned again
                 plan, plan_seconds = None, 0.0
@@ -75,8 +79,10 @@ class BelievedSteps:
         self._seen = self._judged = self._look()
         status, detail = self._verdict(before, params, plan)
         # A failure seen on a look unsure of the step's objects (the arm, where the step left
-        # it, hides a can it pushed into a shelf) is judged again from the rest pose.
-        if status != Status.SUCCESS and self.relook and self._unsure_of(params):
+        # it, hides a can it pushed into a shelf), or on any look away from the rest pose
+        # (`relook_failed`), is judged again from the rest pose.
+        unsure = self.rules.relook and self._unsure_of(params)
+        if status != Status.SUCCESS and (unsure or self.rules.relook_failed):
             again = self._look_again(on_frame)
             if again:
                 relooks += again
@@ -90,7 +96,8 @@ class BelievedSteps:
     def _verdict(self, before: Seen, params: PrimitiveParams, plan: MotionPlan):
         """(status, detail) of a step from the look before it and the latest look."""
         after = self._seen
-        return compare(
+        judge = partial(
+            compare,
             before.scene_graph,
             after.scene_graph,
             params.obj,
@@ -98,13 +105,36 @@ class BelievedSteps:
             SEEN_DISTURB_TOL,
             sure_in_both(before, after),
         )
+        status, detail = judge()
+        if status is Status.DISTURBED and self.rules.near_moves_only:
+            status, detail = judge(self._reached(before.scene_graph, after.scene_graph, plan))
+        return status, detail
+
+    def _reached(self, before, after, plan: MotionPlan) -> frozenset[str]:
+        """The objects the step could have moved, by the robot's model: believed, before or
+        after it, near the boxes the arm's links swept along the plan's joints (grown down by
+        the height of what a pick or place carries) or near the acted object's track."""
+        obj = plan.params.obj
+        carried = 0.0
+        if isinstance(plan.params, PickParams | PlaceParams):
+            carried = self.world.scene.world.object_type(obj).height
+        boxes = swept_boxes(self.world.scene.robot, driven(plan), carried)
+        track = None
+        if obj in before.objects and obj in after.objects:
+            track = (before.pose(obj).position, after.pose(obj).position)
+        return frozenset(
+            o
+            for o in after.objects
+            if o != obj
+            and near([g.pose(o).position for g in (before, after) if o in g.objects], boxes, track)
+        )
 
     def look_again(self, objects: tuple[str, ...]) -> Observation | None:
         """With a camera observer and the `relook` rule: if the belief is unsure of any of
         `objects`, the arm moves out of the cameras' way and the robot looks again; the new
         observation, or None where nothing was done (sure of them, or already at rest). The
         agent asks before it believes its goal reached."""
-        if not (self.believing and self.relook) or self._seen is None:
+        if not (self.believing and self.rules.relook) or self._seen is None:
             return None
         if not set(objects) & set(self._seen.uncertain) or not self._look_again(None):
             return None
@@ -125,7 +155,8 @@ class BelievedSteps:
         if np.allclose(q, REST, atol=1e-3):
             return 0
         self.world.follow(q)
-        path = plan_transit(self.world.scene, REST)
+        # a belief the arm stands in is wrong, and would keep the arm where it hides things
+        path = plan_transit(self.world.scene, REST, overlapped(self.world.scene))
         if path is None:
             return 0
         run_path(self.scene, path, on_frame)

@@ -27,6 +27,7 @@ import numpy as np
 
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
+from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.domain.scene import World
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -69,8 +70,9 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         render_mode: "rgb_array" (what `render()` returns) or None.
         observer: what the agent sees of the scene (default: the ground truth); a camera
             observer makes the robot act on its belief (see the module).
-        relook: with a camera observer, look again from out of the cameras' way before acting
-            on an object the belief is unsure of (a recovery rule of perception's, switchable).
+        rules: the rules in force; the env reads the perception rules (`PERCEPTION_RULES`:
+            `relook`, `relook_failed`, `near_moves_only`, `seek_unseen`), which act only with a
+            camera observer (`hsgplan.domain.recovery` documents each).
         visuals: load the arm's visual meshes, for pictures of the scene (rendering, a camera
             observer, a demo's frames); an env nothing pictures resets faster without them,
             and runs the same episodes.
@@ -88,7 +90,7 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         objects: int = 3,
         render_mode: str | None = None,
         observer: SceneObserver | CameraObserver | None = None,
-        relook: bool = True,
+        rules: RecoveryRules = ALL_RULES,
         visuals: bool = True,
         *,
         world: World,
@@ -106,7 +108,7 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         self.objects = objects
         self.observer = observer or GroundTruth()
         self.believing = isinstance(self.observer, CameraObserver)
-        self.relook = relook
+        self.rules = rules
         self.visuals = visuals or render or render_mode is not None or self.believing
         self.world: BeliefWorld | None = None  # the robot's model, with a camera observer
         self._seen: Seen | None = None  # the belief's last look

@@ -93,12 +93,30 @@ def plan_primitive(scene: Scene, params: PrimitiveParams) -> MotionPlan | PlanFa
         return PlanFailure(Status.INVALID, str(e))
 
 
-def plan_transit(scene: Scene, q_goal: np.ndarray) -> tuple[np.ndarray, ...] | None:
-    """A collision-free path of the arm (and what it holds) from where it is to `q_goal`."""
+def plan_transit(
+    scene: Scene, q_goal: np.ndarray, ignore: tuple[str, ...] = ()
+) -> tuple[np.ndarray, ...] | None:
+    """A collision-free path of the arm (and what it holds) from where it is to `q_goal`,
+    through objects `ignore`d."""
     held = scene.held()
     with scene.robot.preserved():
         q0 = scene.robot.q_in_limits()
-        return _path(scene, q0, q_goal, ignore=() if held is None else (held,))
+        return _path(scene, q0, q_goal, ignore=ignore + (() if held is None else (held,)))
+
+
+def overlapped(scene: Scene) -> tuple[str, ...]:
+    """The objects the arm (and what it holds) stands in where it is, in a model of a belief:
+    the arm is truly there, so a belief that puts an object there is wrong, and no path could
+    start while it counts as an obstacle. None where the arm meets the arena too."""
+    held = scene.held()
+    objects = [n for n in scene.objects if n != held]
+    with scene.robot.preserved():
+        q0 = scene.robot.q_in_limits()
+        if scene.checker(ignore=objects).collides(q0):
+            return ()
+        return tuple(
+            n for n in objects if scene.checker(ignore=[m for m in objects if m != n]).collides(q0)
+        )
 
 
 def can_pick(scene: Scene, obj: str) -> bool:

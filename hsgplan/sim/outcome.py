@@ -170,12 +170,14 @@ def compare(
     expected: Literal,
     tolerance: float = DISTURB_TOL,
     sure: frozenset[str] | None = None,
+    judged: frozenset[str] | None = None,
 ) -> tuple[Status, str]:
     """A primitive's outcome from the scene graphs before and after it: the simulator's, or
     what a camera observer believed before and believes after (objects in one and not the
     other are not compared). Another object is disturbed if its symbolic location changed or
     it moved further than `tolerance` (SEEN_DISTURB_TOL for a belief); of a belief, only the
-    objects it is `sure` of in both looks are judged by distance (None: every object)."""
+    objects it is `sure` of in both looks are judged by distance (None: every object). Only
+    the objects in `judged` can be found disturbed (None: every object)."""
     mapping = map_symbols(after)
     prior_mapping = map_symbols(before)
     prior = prior_mapping.state
@@ -195,7 +197,7 @@ def compare(
         )
         return status, f"'{expected}' does not hold: '{mapping.state.location(obj)}' instead"
     for o in after.objects:
-        if o == obj or o not in before.objects:
+        if o == obj or o not in before.objects or (judged is not None and o not in judged):
             continue
         moved = before.pose(o).distance(after.pose(o))
         far = moved > tolerance and (sure is None or o in sure)

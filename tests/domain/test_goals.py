@@ -204,3 +204,16 @@ def test_a_goal_over_look_alikes_is_read_with_them_swapped_in_every_way():
     assert parse_goal("On(popcorn, shelf_b) & On(cherries, butter)", world=KITCHEN).readings() == [
         parse_goal("On(popcorn, shelf_b) & On(cherries, butter)", world=KITCHEN)
     ]
+
+
+def test_a_goal_without_some_objects_keeps_the_literals_naming_none_of_them():
+    g = parse_goal(
+        "On(butter, shelf_b) & On(cherries, butter) & In(tomato_soup, shelf_a)", world=KITCHEN
+    )
+    assert g.without(("cherries",)).literals == {
+        on("butter", "shelf_b"),
+        inside("tomato_soup", "shelf_a"),
+    }
+    assert str(g.without(("butter",))) == "In(tomato_soup, shelf_a)"
+    assert g.without(()) == g
+    assert g.without(("butter", "tomato_soup")) is None

@@ -9,6 +9,7 @@ import pytest
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.recovery import RecoveryRules
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -44,7 +45,9 @@ class _HiddenByTheArm(_Watching):
 @pytest.mark.parametrize("relook", [True, False])
 def test_a_place_judged_failed_while_the_arm_hides_its_object_is_judged_again_from_rest(relook):
     observer = _HiddenByTheArm(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer, relook=relook, world=KITCHEN)
+    # `relook_failed` would judge any failure again from rest: off, to see `relook` alone
+    rules = replace(RecoveryRules(), relook=relook, relook_failed=False)
+    env = KitchenStorageEnv(observer=observer, rules=rules, world=KITCHEN)
     observer.env = env
     goal = parse_goal(f"On({HIDDEN}, shelf_b)", world=KITCHEN)
     record = run_episode(env, make_agent("oracle"), goal, seed=4, end_at_failure=True)
@@ -69,7 +72,9 @@ class _HiddenInTheShelf(_Watching):
 
 def test_a_can_pushed_out_of_sight_is_believed_where_the_push_left_it():
     observer = _HiddenInTheShelf(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer, relook=False, world=KITCHEN)
+    env = KitchenStorageEnv(
+        observer=observer, rules=replace(RecoveryRules(), relook=False), world=KITCHEN
+    )
     observer.env = env
     goal = parse_goal("In(cherries, shelf_a)", world=KITCHEN)
     seen = []

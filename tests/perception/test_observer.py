@@ -15,6 +15,7 @@ from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
+from hsgplan.domain.recovery import RecoveryRules
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.failures import Failure
 from hsgplan.perception.detection import Detection
@@ -394,7 +395,8 @@ def test_an_uncertain_object_is_looked_at_again_from_out_of_the_way_unless_the_r
     relook,
 ):
     observer = _Unsure(PoseEstimator(_SceneMaps()))
-    env = KitchenStorageEnv(observer=observer, relook=relook, world=KITCHEN)
+    rules = replace(RecoveryRules(), relook=relook)
+    env = KitchenStorageEnv(observer=observer, rules=rules, world=KITCHEN)
     observer.env = env
     goal = parse_goal("On(butter, shelf_b) & On(cherries, shelf_a)", world=KITCHEN)
     record = run_episode(env, make_agent("oracle"), goal, seed=4)
