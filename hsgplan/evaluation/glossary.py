@@ -41,7 +41,7 @@ ENDINGS = {
     Failure.OFF_TABLE: "an object fell off the table.",
     Failure.MISPERCEIVED: "the robot saw its goal reached where it truly was not.",
     Failure.NEVER_SEEN: "an object of the goal that no view had found when the robot had to "
-    "decide.",
+    "decide on it (with `seek_unseen`, once the part of the goal it had seen held).",
     Failure.MISJUDGED: "paper protocol, seeing through f_p: a primitive the robot saw fail "
     "ended the episode, but its goal truly held (a push seen short whose can was inside). "
     "The record keeps `failed_primitive`; tables count it here.",
