@@ -27,12 +27,11 @@ class BelievedSteps:
     """The env's steps and looks under a camera observer.
 
     What it reads of the env: `scene` (the simulated one), `world` (the robot's model of its
-    belief), `observer`, the perception rules (`rules`),
-    `believing`, `_checked_plan` (a dry run's plan) and `_observe` (the observation the agent
-    reads); what it keeps there: `_seen` (the belief's
-    last look), `_judged` (the look that judged the last step), `_judged_from` (the last
-    observation), `_released` (where the last step let its object go, for the next look) and
-    `last_plan`.
+    belief), `observer`, `rules` (the perception rules in force), `believing`, `_checked_plan`
+    (a dry run's plan) and `_observe` (the observation the agent reads); what it keeps there:
+    `_seen` (the belief's last look), `_judged` (the look that judged the last step),
+    `_judged_from` (the last observation), `_released` (where the last step let its object go,
+    for the next look) and `last_plan`.
     """
 
     scene: Scene

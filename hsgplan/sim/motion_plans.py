@@ -107,7 +107,7 @@ def plan_transit(
 def overlapped(scene: Scene) -> tuple[str, ...]:
     """The objects the arm (and what it holds) stands in where it is, in a model of a belief:
     the arm is truly there, so a belief that puts an object there is wrong, and no path could
-    start while it counts as an obstacle. None where the arm meets the arena too."""
+    start while it counts as an obstacle. None are named where the arm meets the arena too."""
     held = scene.held()
     objects = [n for n in scene.objects if n != held]
     with scene.robot.preserved():

@@ -11,6 +11,7 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
+from hsgplan.sim.motion import densify
 from hsgplan.sim.motion_plans import MotionPlan
 from hsgplan.sim.robot import Panda
 from hsgplan.sim.sensing import Box
@@ -28,12 +29,7 @@ def driven(plan: MotionPlan) -> list[np.ndarray]:
     """The joints a plan drives the arm through, densely enough for the sweep: its path, the
     approach (and the retreat back along it) and a push's line."""
     waypoints = [*plan.path, plan.q_above, *plan.descent, plan.q_at, *plan.line]
-    out = [np.asarray(waypoints[0], dtype=float)]
-    for q in waypoints[1:]:
-        q, last = np.asarray(q, dtype=float), out[-1]
-        n = max(1, int(np.ceil(np.abs(q - last).max() / SWEEP_STEP)))
-        out.extend(last + (q - last) * k / n for k in range(1, n + 1))
-    return out
+    return densify([np.asarray(q, dtype=float) for q in waypoints], SWEEP_STEP)
 
 
 def swept_boxes(robot: Panda, joints: Iterable[np.ndarray], below: float = 0.0) -> list[Box]:
