@@ -247,6 +247,14 @@ TaskCheckpoint = Annotated[
 ]
 
 
+MotionCheckpoints = Annotated[
+    Path | None,
+    typer.Option(
+        help="Folder of motion networks, KIND-MODEL each (default: shipped).", parser=input_path
+    ),
+]
+
+
 SceneFiles = Annotated[
     Path | None,
     typer.Option(

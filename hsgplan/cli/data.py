@@ -11,7 +11,9 @@ from rich.progress import Progress
 
 from hsgplan.cli.common import (
     CollectWorkers,
+    MotionCheckpoints,
     RayAddress,
+    SceneFiles,
     SceneOption,
     Summaries,
     TaskCheckpoint,
@@ -243,6 +245,8 @@ def visited(
     ray: RayAddress = None,
     out_dir: CollectionFolder = RUNS / "collect-visited",
     checkpoint: TaskCheckpoint = None,
+    motion_checkpoints: MotionCheckpoints = None,
+    scene: SceneFiles = None,
 ) -> None:
     """f_reach's labels from the states the learned agent visits: in each, before it decides,
     primitives are executed as `collect reach` executes them from a staged state."""
@@ -261,6 +265,8 @@ def visited(
             ray,
             lambda _: progress.advance(bar),
             checkpoint,
+            scene=scene,
+            motion_checkpoints=motion_checkpoints,
         )
     statuses = ", ".join(f"{k} {v}" for k, v in summary.by_status.items())
     out.print(

@@ -12,6 +12,7 @@ from rich.progress import Progress
 from hsgplan.agents.registry import agent_name, agent_parts
 from hsgplan.cli.common import (
     AgentName,
+    MotionCheckpoints,
     MotionName,
     PerceptionCheckpoint,
     PlannerName,
@@ -60,14 +61,6 @@ MotionOption = Annotated[
     typer.Option(
         help=f"Motion generator in place of the agent's: {', '.join(MotionName)}.",
         metavar="MOTION",
-    ),
-]
-
-
-MotionCheckpoints = Annotated[
-    Path | None,
-    typer.Option(
-        help="Folder of motion networks, KIND-MODEL each (default: shipped).", parser=input_path
     ),
 ]
 

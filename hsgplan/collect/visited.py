@@ -13,7 +13,8 @@ failed primitive; `data/reach/visited` was collected by `checkpoints/task-staged
 towards random goals, and in every state it meets, before it decides, up to `ACTIONS_PER_STATE`
 actions are executed from that state as `collect reach` executes them from a staged one
 (`choose_actions`, `execute_action`), the scene put back after each; then the agent's own step
-goes on. Nothing here asks the hand-written rules: what the world shows is the label.
+goes on. Nothing here asks the hand-written rules: what the world shows is the label. The
+episodes run in the kitchen, or in the world of a scene file, or round a folder of them.
 
 The goals are drawn from `GOAL_SEEDS.start + seed`, apart from every seed an evaluation
 reports on or tunes on (`evaluation.seeds`). A work item is one episode; its row holds every
@@ -43,6 +44,8 @@ from hsgplan.collect.reach import (
 from hsgplan.data.world_trials import WorldTrial, state_row, trials_of
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import read_world, read_worlds
 from hsgplan.evaluation.seeds import GOAL_SEEDS, episode_seed
 
 AGENT = "learned"
@@ -58,6 +61,8 @@ class VisitedItem:
     actions_per_state: int = ACTIONS_PER_STATE
     max_params: int = MAX_PARAMS
     checkpoint: str | None = None  # the agent's task planner (None: the shipped one)
+    scene: str | None = None  # a scene file's path (None: the kitchen)
+    motion_checkpoints: str | None = None  # the agent's motion networks (None: the shipped ones)
 
     @property
     def key(self) -> str:
@@ -69,11 +74,18 @@ class VisitedItem:
 
 
 @functools.cache
-def _agent(checkpoint: str | None = None):
+def _agent(checkpoint: str | None = None, motion_checkpoints: str | None = None):
     from hsgplan.agents.registry import make_agent
-    from hsgplan.paths import TASK_CHECKPOINT
+    from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
 
-    return make_agent(AGENT, Path(checkpoint or TASK_CHECKPOINT))
+    return make_agent(
+        AGENT, Path(checkpoint or TASK_CHECKPOINT), Path(motion_checkpoints or MOTION_CHECKPOINTS)
+    )
+
+
+@functools.cache
+def _world(scene: str | None) -> World:
+    return KITCHEN if scene is None else read_world(Path(scene))
 
 
 def _goal(item: VisitedItem):
@@ -85,7 +97,7 @@ def _goal(item: VisitedItem):
         item.index + 1,
         GOAL_SEEDS.start + item.seed,
         stacking=item.size > 2,
-        world=KITCHEN,
+        world=_world(item.scene),
     )
     return goals[item.index]
 
@@ -102,7 +114,7 @@ def explore_episode(item: VisitedItem, goal) -> dict:
     from hsgplan.evaluation.episode import run_episode
     from hsgplan.sim.env import KitchenStorageEnv
 
-    env = KitchenStorageEnv(visuals=False, world=KITCHEN)
+    env = KitchenStorageEnv(visuals=False, world=_world(item.scene))
     rng = random.Random(f"visited-actions-{item.key}")
     states: list[dict] = []
 
@@ -117,7 +129,8 @@ def explore_episode(item: VisitedItem, goal) -> dict:
         states.append(state_row(state, trials_from_here(scene, state, actions, item.max_params)))
         scene.rng = rng_before  # the agent's episode goes on as it would have
 
-    record = run_episode(env, _agent(item.checkpoint), goal, item.episode_seed, on_step=explore)
+    agent = _agent(item.checkpoint, item.motion_checkpoints)
+    record = run_episode(env, agent, goal, item.episode_seed, on_step=explore)
     return {"states": states, "goal": str(goal), "success": record.success}
 
 
@@ -140,22 +153,38 @@ def collect_visited(
     ray: str | None = None,
     on_item: Callable[[dict], None] | None = None,
     checkpoint: Path | None = None,
+    *,
+    scene: Path | None = None,
+    motion_checkpoints: Path | None = None,
 ) -> VisitedSummary:
     """`episodes` episodes of each size, logged to the run folder `out` (a collection of
     executed primitives, as `collect reach` makes: `train task` reads it as `loop_trials`), the
-    agent's task planner from `checkpoint` (None: the shipped one). A rerun keeps what is logged
-    and runs only the missing episodes; a folder made with other settings or checkpoints is
-    refused."""
+    agent's task planner from `checkpoint` and its motion networks from `motion_checkpoints`
+    (None: the shipped ones). `scene`: the episodes run in this scene file's world, or round a
+    folder of them, episode i of a size in the i-th file (default: the kitchen); the path is
+    kept in the folder's configuration, where `train task` finds it. A rerun keeps what is
+    logged and runs only the missing episodes; a folder made with other settings, checkpoints
+    or scene is refused."""
     if episodes < 1:
         raise InvalidInputError(f"--episodes {episodes}: need at least one")
     if not sizes or min(sizes) < 2:
         raise InvalidInputError("--sizes: episodes need at least two objects")
     start = time.perf_counter()
+    from hsgplan.agents.registry import agent_checkpoints, check_reads
     from hsgplan.checkpoint import fingerprint
     from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
 
     folder = None if checkpoint is None else str(checkpoint)
-    _agent(folder)  # a missing or unreadable checkpoint is refused before anything is written
+    motion = None if motion_checkpoints is None else str(motion_checkpoints)
+    read = [Path(folder or TASK_CHECKPOINT), Path(motion or MOTION_CHECKPOINTS)]
+    worlds: dict[str | None, World] = {None: KITCHEN}
+    if scene is not None:  # a kitchen collection records no scene, as before scenes were given
+        worlds = {str(p): w for p, w in read_worlds(scene).items()}
+    # a missing or unreadable checkpoint, or one that cannot read a scene's names, is refused
+    # before anything is written
+    _agent(folder, motion)
+    for world in worlds.values():
+        check_reads(agent_checkpoints(AGENT, *read), world, scene)
     config = {
         "kind": "reach",
         "unit": "visited episode",
@@ -163,18 +192,26 @@ def collect_visited(
         "agent": AGENT,
         "actions_per_state": ACTIONS_PER_STATE,
         "max_params": MAX_PARAMS,
-        "fingerprint": fingerprint([Path(folder or TASK_CHECKPOINT), Path(MOTION_CHECKPOINTS)]),
+        "fingerprint": fingerprint(read),
     }
+    if scene is not None:
+        config["scene"] = str(scene)
     refusal = (
-        f"'{out}' holds a collection made with other settings or checkpoints; use another --out"
+        f"'{out}' holds a collection made with other settings, checkpoints or scene; "
+        "use another --out"
     )
+    files = list(worlds)
     items = [
-        VisitedItem(seed, n, i, checkpoint=folder)
+        VisitedItem(
+            seed, n, i, checkpoint=folder, scene=files[i % len(files)], motion_checkpoints=motion
+        )
         for n in sorted(set(sizes))
         for i in range(episodes)
     ]
     rows, ran = run_collection(out, run_visited_item, items, config, refusal, workers, ray, on_item)
-    trials: list[WorldTrial] = [t for row in rows for t in trials_of(row, KITCHEN)]
+    trials: list[WorldTrial] = [
+        t for item, row in zip(items, rows, strict=True) for t in trials_of(row, _world(item.scene))
+    ]
     return VisitedSummary(
         len(items),
         sum(len(row["states"]) for row in rows),

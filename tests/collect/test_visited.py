@@ -2,6 +2,7 @@
 
 import json
 import random
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,10 +10,18 @@ from typer.testing import CliRunner
 
 from hsgplan.cli import app
 from hsgplan.collect.reach import ACTIONS_PER_STATE, choose_actions, trials_from_here
-from hsgplan.collect.visited import VisitedItem, _goal, explore_episode, run_visited_item
+from hsgplan.collect.visited import (
+    VisitedItem,
+    _goal,
+    collect_visited,
+    explore_episode,
+    run_visited_item,
+)
 from hsgplan.data.world_trials import load_world_trials, trials_of
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.predicates import in_grasp, on
+from hsgplan.domain.scene_file import read_world
 from hsgplan.evaluation.seeds import GOAL_SEEDS, TUNING
 from hsgplan.planning.regression.train import TaskTrainConfig, _examples
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -71,7 +80,7 @@ def test_collect_visited_end_to_end_a_rerun_repeats_nothing_and_training_reads_i
     # another agent's episodes are never mixed into the collection
     other = ["--checkpoint", "checkpoints/task-paper", "--out", str(out)]
     r = CliRunner().invoke(app, [*args, *other])
-    assert r.exit_code == 2 and "other settings or checkpoints" in r.stderr
+    assert r.exit_code == 2 and "other settings, checkpoints or scene" in r.stderr
     assert (out / "episodes.jsonl").read_text().splitlines() == lines
     config = TaskTrainConfig(loop_trials=str(out))
     sources = _examples("reach", [], [], config, KITCHEN, KITCHEN)
@@ -121,3 +130,34 @@ def test_training_on_a_missing_visited_collection_is_refused_before_anything_is_
     with pytest.raises(InvalidInputError, match="holds no collection"):
         train_task(config, tmp_path / "m", world=KITCHEN)
     assert not (tmp_path / "m").exists()
+
+
+LAYOUT = Path(__file__).parents[2] / "scenes/layouts/layout-000.toml"
+NEW_OBJECTS = Path(__file__).parents[2] / "scenes/new-objects/new-objects-000.toml"
+
+
+def test_an_episode_runs_in_the_scene_files_world_and_its_trials_are_read_there():
+    world = read_world(LAYOUT)
+    item = VisitedItem(0, 2, 0, scene=str(LAYOUT))
+    goal = _goal(item)
+    row = explore_episode(item, goal)
+    trials = trials_of(row, world)
+    assert trials and all(t.state.world == world for t in trials)
+
+
+def test_a_collection_in_a_scene_records_it_and_another_scene_is_refused(tmp_path):
+    out = tmp_path / "visited"
+    summary = collect_visited(out, 1, (2,), workers=1, scene=LAYOUT)
+    assert summary.trials > 0
+    assert json.loads((out / "config.json").read_text())["scene"] == str(LAYOUT)
+    with pytest.raises(InvalidInputError, match="other settings, checkpoints or scene"):
+        collect_visited(out, 1, (2,), workers=1)
+
+
+def test_a_scene_the_networks_cannot_read_is_refused_in_one_line_before_anything_is_written(
+    tmp_path,
+):
+    args = ["collect", "visited", "--scene", str(NEW_OBJECTS), "--out", str(tmp_path / "v")]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "know the kitchen's objects" in r.stderr and not (tmp_path / "v").exists()
