@@ -9,6 +9,8 @@ motion planner, no domain rule): the primitive must plan and, for a pick the pla
 follow with a place or a stack, that place must plan once the pick is done (tried in the model
 and taken back). An action that fails the check is refused: the task planner is asked again
 without it, up to `REFUSALS` times, after which its first choice is taken as without checks.
+With `clear_way` as well, before it takes that doomed choice it looks for a neighbour to move
+aside first (`agents/clearing.py`).
 """
 
 from __future__ import annotations
@@ -17,10 +19,11 @@ import time
 from dataclasses import dataclass, replace
 
 from hsgplan.agents.base import Decision
-from hsgplan.domain.actions import Action, Pick, Push, push_after
+from hsgplan.agents.clearing import CLEARINGS, find_clearing
+from hsgplan.domain.actions import Action, Pick, Place, Push, push_after
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
-from hsgplan.domain.predicates import in_grasp
+from hsgplan.domain.predicates import in_grasp, on
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.motion.interface import Feasibility, MotionGenerator
 from hsgplan.planning.base import TaskPlanner
@@ -52,6 +55,8 @@ class HierarchicalAgent:
         task half of `push_give_up` (a push with no parameters becomes a pick).
     check_actions: try each action in the model of the scene before taking it, and refuse
         those that fail (see the module's docstring).
+    clear_way: with `check_actions`, when every action offered failed its check, move a
+        neighbour that stands in the way aside first (`agents/clearing.py`).
     """
 
     def __init__(
@@ -61,16 +66,22 @@ class HierarchicalAgent:
         motion: MotionGenerator,
         rules: RecoveryRules = ALL_RULES,
         check_actions: bool = False,
+        clear_way: bool = False,
     ) -> None:
         self.name = name
         self.planner = planner
         self.motion = motion
         self.rules = rules
         self.check_actions = check_actions
+        self.clear_way = clear_way
+        # what clearing the way still has to do: neighbours' picks and places, then the action
+        self._queued: list[tuple[Action, Action | None]] = []
+        self._clearings = 0
 
     def reset(self, goal: Goal, seed: int) -> None:
         self.planner.reset(goal, seed)
         self.motion.reset(seed)
+        self._queued, self._clearings = [], 0
 
     def decide(
         self,
@@ -82,8 +93,12 @@ class HierarchicalAgent:
         if not self.check_actions or feasible is None:
             return self._decide(sg, state, goal, feasible, frozenset()).decision
         start = time.perf_counter()
+        if self._queued:
+            queued = self._next_queued(sg, feasible, start)
+            if queued is not None:
+                return queued
         refused: list[Action] = []
-        first: _Choice | None = None
+        tried: list[_Choice] = []
         task_seconds = 0.0
         for _ in range(REFUSALS + 1):
             choice = self._decide(sg, state, goal, feasible, frozenset(refused))
@@ -92,14 +107,14 @@ class HierarchicalAgent:
             if choice.named is None:
                 break
             if self._carried_out(sg, d, choice.following, feasible):
-                first = None
+                tried = []
                 break
-            first = first or choice
+            tried.append(choice)
             refused.append(choice.named)
-        if first is not None:
-            d = first.decision
-            if d.params is not None:  # the generator's memory back on this action
-                self.motion.propose(sg, d.action, first.following, feasible)
+        if tried:
+            d = self._clear(sg, state, goal, tried, feasible) or tried[0].decision
+            if d is tried[0].decision and d.params is not None:  # the generator's memory back
+                self.motion.propose(sg, d.action, tried[0].following, feasible)
         motion_seconds = time.perf_counter() - start - task_seconds
         return replace(d, task_seconds=task_seconds, motion_seconds=motion_seconds)
 
@@ -156,6 +171,55 @@ class HierarchicalAgent:
                 ok = params is not None and feasible(params)
         self.motion.propose(sg, d.action, following, feasible)  # its memory back in this scene
         return ok
+
+    def _clear(
+        self,
+        sg: GeometricSceneGraph,
+        state: SymbolicSceneGraph,
+        goal: Goal,
+        tried: list[_Choice],
+        feasible: Feasibility,
+    ) -> Decision | None:
+        """The first move of a way cleared for a refused action, if clearing is on, its budget
+        not spent, and a way is found; the rest is queued."""
+        if not self.clear_way or self._clearings >= CLEARINGS:
+            return None
+        blocked = [(c.decision.action, c.following) for c in tried]
+        found = find_clearing(
+            sg,
+            state,
+            goal,
+            blocked,
+            lambda g, a, f: self.motion.propose(g, a, f, feasible),
+            feasible,
+        )
+        if found is None:
+            return None
+        self._clearings += 1
+        for n in found.moves:
+            self._queued += [(Pick(n), None), (Place(n, found.target), None)]
+        self._queued.append((found.action, found.following))
+        return self._next_queued(sg, feasible, time.perf_counter())
+
+    def _next_queued(
+        self, sg: GeometricSceneGraph, feasible: Feasibility | None, start: float
+    ) -> Decision | None:
+        """The next action of a way being cleared, with parameters proposed in this scene; None
+        (and nothing left queued) where the scene is not as the way expects or the generator
+        offers nothing: the task planner decides again."""
+        action, following = self._queued.pop(0)
+        expected_held = action.obj if isinstance(action, Place) else None
+        params = None
+        if sg.held == expected_held:
+            params = self.motion.propose(sg, action, following, feasible)
+        if params is None:
+            self._queued = []
+            return None
+        subgoal = (
+            on(action.obj, action.target) if isinstance(action, Place) else in_grasp(action.obj)
+        )
+        note = f"clearing the way for {self._queued[-1][0]}" if self._queued else "way cleared"
+        return Decision(action, params, 0.0, time.perf_counter() - start, note, subgoal)
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
         self.motion.observe(params, outcome)

@@ -73,6 +73,9 @@ TASK_PLANNERS: dict[str, Callable[[Path, RecoveryRules], TaskPlanner]] = {
     # the same planner; the agent tries each action in its model first and refuses those
     # that do not plan (`agents/hierarchical.py`)
     "regression-ahead-checked": _regression_ahead,
+    # the same, and when every action offered fails its check, a neighbour in the way is moved
+    # aside first (`agents/clearing.py`)
+    "regression-ahead-clearing": _regression_ahead,
     "regression-paper": _regression_paper,  # the paper's loop (`paper_loop.py`), no rules
     "forward": _forward,
     "fd": _fast_downward,
@@ -137,7 +140,9 @@ WHOLE_AGENTS: dict[str, str] = {
     "stream-focused-goal": "the same with the goal-directed streams of stream-goal",
 }
 # task planners whose agent checks each action in its model before taking it
-CHECKED_PLANNERS = ("regression-ahead-checked",)
+CHECKED_PLANNERS = ("regression-ahead-checked", "regression-ahead-clearing")
+# ... and whose agent also moves a neighbour aside when every action offered fails its check
+CLEARING_PLANNERS = ("regression-ahead-clearing",)
 STREAM_AGENTS = ("stream", "stream-goal", "stream-focused", "stream-focused-goal")
 AGENT_NAMES = [*AGENTS, *WHOLE_AGENTS]
 # The search-based baselines Table 2 may time against ours (`hsgplan bench timing --search`),
@@ -198,6 +203,7 @@ LEARNED_PLANNERS = (
     "regression",
     "regression-ahead",
     "regression-ahead-checked",
+    "regression-ahead-clearing",
     "regression-ahead-chain",
     "regression-paper",
     "forward",
@@ -279,4 +285,5 @@ def make_agent(
         make_motion(motion, motion_checkpoints, rules),
         rules,
         check_actions=planner in CHECKED_PLANNERS,
+        clear_way=planner in CLEARING_PLANNERS,
     )
