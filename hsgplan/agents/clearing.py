@@ -152,9 +152,15 @@ def _plans(trial, sg, action, following, propose, feasible) -> bool:
         return True
     mark = trial.mark()
     try:
-        if not trial.run(params).ok:
-            return False
-        then = propose(trial.scene_graph(), following, push_after(following, sg.world))
-        return then is not None and feasible(then)
+        return follows(trial, params, following, propose, feasible, sg.world)
     finally:
         trial.back(mark)
+
+
+def follows(trial, pick: PrimitiveParams, following: Action, propose: Propose, feasible, world):
+    """Whether the pick runs in the trial and `following` then plans; the trial is left after
+    the pick (the caller takes it back)."""
+    if not trial.run(pick).ok:
+        return False
+    then = propose(trial.scene_graph(), following, push_after(following, world))
+    return then is not None and feasible(then)

@@ -19,8 +19,8 @@ import time
 from dataclasses import dataclass, replace
 
 from hsgplan.agents.base import Decision
-from hsgplan.agents.clearing import CLEARINGS, find_clearing
-from hsgplan.domain.actions import Action, Pick, Place, Push, push_after
+from hsgplan.agents.clearing import CLEARINGS, find_clearing, follows
+from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.domain.predicates import in_grasp, on
@@ -112,9 +112,11 @@ class HierarchicalAgent:
             tried.append(choice)
             refused.append(choice.named)
         if tried:
-            d = self._clear(sg, state, goal, tried, feasible) or tried[0].decision
-            if d is tried[0].decision and d.params is not None:  # the generator's memory back
-                self.motion.propose(sg, d.action, tried[0].following, feasible)
+            d = self._clear(sg, state, goal, tried, feasible)
+            if d is None:  # the planner's first choice, as without checks
+                d = tried[0].decision
+                if d.params is not None:  # the generator's memory back on this action
+                    self.motion.propose(sg, d.action, tried[0].following, feasible)
         motion_seconds = time.perf_counter() - start - task_seconds
         return replace(d, task_seconds=task_seconds, motion_seconds=motion_seconds)
 
@@ -163,12 +165,7 @@ class HierarchicalAgent:
         if not isinstance(d.action, Pick) or following is None or trial_of is None:
             return True
         with trial_of() as trial:
-            ok = trial.run(d.params).ok
-            if ok:
-                after = trial.scene_graph()
-                then = push_after(following, sg.world)
-                params = self.motion.propose(after, following, then, feasible)
-                ok = params is not None and feasible(params)
+            ok = follows(trial, d.params, following, self._proposer(feasible), feasible, sg.world)
         self.motion.propose(sg, d.action, following, feasible)  # its memory back in this scene
         return ok
 
@@ -185,14 +182,7 @@ class HierarchicalAgent:
         if not self.clear_way or self._clearings >= CLEARINGS:
             return None
         blocked = [(c.decision.action, c.following) for c in tried]
-        found = find_clearing(
-            sg,
-            state,
-            goal,
-            blocked,
-            lambda g, a, f: self.motion.propose(g, a, f, feasible),
-            feasible,
-        )
+        found = find_clearing(sg, state, goal, blocked, self._proposer(feasible), feasible)
         if found is None:
             return None
         self._clearings += 1
@@ -200,6 +190,10 @@ class HierarchicalAgent:
             self._queued += [(Pick(n), None), (Place(n, found.target), None)]
         self._queued.append((found.action, found.following))
         return self._next_queued(sg, feasible, time.perf_counter())
+
+    def _proposer(self, feasible: Feasibility):
+        """The motion generator's proposals, dry-run by `feasible`, as `clearing` asks them."""
+        return lambda sg, action, following: self.motion.propose(sg, action, following, feasible)
 
     def _next_queued(
         self, sg: GeometricSceneGraph, feasible: Feasibility | None, start: float

@@ -210,7 +210,7 @@ def collect_visited(
     ]
     rows, ran = run_collection(out, run_visited_item, items, config, refusal, workers, ray, on_item)
     trials: list[WorldTrial] = [
-        t for item, row in zip(items, rows, strict=True) for t in trials_of(row, _world(item.scene))
+        t for item, row in zip(items, rows, strict=True) for t in trials_of(row, worlds[item.scene])
     ]
     return VisitedSummary(
         len(items),
