@@ -10,7 +10,8 @@ follow with a place or a stack, that place must plan once the pick is done (trie
 and taken back). An action that fails the check is refused: the task planner is asked again
 without it, up to `REFUSALS` times, after which its first choice is taken as without checks.
 With `clear_way` as well, before it takes that doomed choice it looks for a neighbour to move
-aside first (`agents/clearing.py`).
+aside first (`agents/clearing.py`). Under the recovery rule `refuse_repeats` it also refuses an
+action that succeeded from the very state it observes now: the world came back here after it.
 """
 
 from __future__ import annotations
@@ -77,11 +78,16 @@ class HierarchicalAgent:
         # what clearing the way still has to do: neighbours' picks and places, then the action
         self._queued: list[tuple[Action, Action | None]] = []
         self._clearings = 0
+        # `refuse_repeats`: the actions that succeeded from each state (with each goal), and
+        # the decision being executed, recorded once its outcome is known
+        self._succeeded: dict[tuple[Goal, SymbolicSceneGraph], set[Action]] = {}
+        self._deciding: tuple[Goal, SymbolicSceneGraph, Action] | None = None
 
     def reset(self, goal: Goal, seed: int) -> None:
         self.planner.reset(goal, seed)
         self.motion.reset(seed)
         self._queued, self._clearings = [], 0
+        self._succeeded, self._deciding = {}, None
 
     def decide(
         self,
@@ -93,11 +99,54 @@ class HierarchicalAgent:
         if not self.check_actions or feasible is None:
             return self._decide(sg, state, goal, feasible, frozenset()).decision
         start = time.perf_counter()
+        d = self._decide_checked(sg, state, goal, feasible, start)
+        self._deciding = (goal, state, d.action) if d.action is not None else None
+        return d
+
+    def _decide_checked(
+        self,
+        sg: GeometricSceneGraph,
+        state: SymbolicSceneGraph,
+        goal: Goal,
+        feasible: Feasibility,
+        start: float,
+    ) -> Decision:
         if self._queued:
             queued = self._next_queued(sg, feasible, start)
             if queued is not None:
                 return queued
-        refused: list[Action] = []
+        repeats = self._repeats(goal, state)
+        d, tried, task_seconds = self._ask(sg, state, goal, feasible, repeats)
+        if d.action is None and not tried and repeats:  # nothing but the repeats: as without
+            d, tried, more = self._ask(sg, state, goal, feasible, [])
+            task_seconds += more
+        if tried:
+            d = self._clear(sg, state, goal, tried, feasible)
+            if d is None:  # the planner's first choice, as without checks
+                d = tried[0].decision
+                if d.params is not None:  # the generator's memory back on this action
+                    self.motion.propose(sg, d.action, tried[0].following, feasible)
+        motion_seconds = time.perf_counter() - start - task_seconds
+        return replace(d, task_seconds=task_seconds, motion_seconds=motion_seconds)
+
+    def _repeats(self, goal: Goal, state: SymbolicSceneGraph) -> list[Action]:
+        """The actions refused for having succeeded from this very state (`refuse_repeats`)."""
+        if not self.rules.refuse_repeats:
+            return []
+        return sorted(self._succeeded.get((goal, state), ()), key=str)
+
+    def _ask(
+        self,
+        sg: GeometricSceneGraph,
+        state: SymbolicSceneGraph,
+        goal: Goal,
+        feasible: Feasibility,
+        refused: list[Action],
+    ) -> tuple[Decision, list[_Choice], float]:
+        """The planner asked until an action passes its check, `refused` and those failing it
+        refused (up to REFUSALS asks past the first): the last decision, the choices that
+        failed (none once one passes) and the task level's seconds."""
+        refused = list(refused)
         tried: list[_Choice] = []
         task_seconds = 0.0
         for _ in range(REFUSALS + 1):
@@ -107,18 +156,10 @@ class HierarchicalAgent:
             if choice.named is None:
                 break
             if self._carried_out(sg, d, choice.following, feasible):
-                tried = []
-                break
+                return d, [], task_seconds
             tried.append(choice)
             refused.append(choice.named)
-        if tried:
-            d = self._clear(sg, state, goal, tried, feasible)
-            if d is None:  # the planner's first choice, as without checks
-                d = tried[0].decision
-                if d.params is not None:  # the generator's memory back on this action
-                    self.motion.propose(sg, d.action, tried[0].following, feasible)
-        motion_seconds = time.perf_counter() - start - task_seconds
-        return replace(d, task_seconds=task_seconds, motion_seconds=motion_seconds)
+        return d, tried, task_seconds
 
     def _decide(
         self,
@@ -216,4 +257,8 @@ class HierarchicalAgent:
         return Decision(action, params, 0.0, time.perf_counter() - start, note, subgoal)
 
     def observe(self, params: PrimitiveParams, outcome: Outcome) -> None:
+        if self._deciding is not None and outcome.ok:
+            goal, state, action = self._deciding
+            self._succeeded.setdefault((goal, state), set()).add(action)
+        self._deciding = None
         self.motion.observe(params, outcome)

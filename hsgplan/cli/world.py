@@ -39,7 +39,7 @@ from hsgplan.cli.common import (
     shown,
 )
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.recovery import RecoveryRules
+from hsgplan.domain.recovery import NO_FAILURE_RULES, RecoveryRules
 from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
 from hsgplan.paths import MOTION_CHECKPOINTS, RUNS, TASK_CHECKPOINT, shipped
 from hsgplan.runner.run_folder import check_own
@@ -218,8 +218,12 @@ def evaluate(
     rules_off: Annotated[
         str,
         typer.Option(
-            help="Rules switched off, comma-separated (under the paper protocol only the "
-            "perception rules, which it keeps on): " + ", ".join(RecoveryRules.names()) + "."
+            help="Rules switched off, comma-separated (under the paper protocol only those "
+            "it keeps on, which recover from no failure: "
+            + ", ".join(NO_FAILURE_RULES)
+            + "): "
+            + ", ".join(RecoveryRules.names())
+            + "."
         ),
     ] = "",
     ablate_rules: Annotated[

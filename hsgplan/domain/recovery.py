@@ -26,6 +26,15 @@ Task level (`hsgplan.planning.regression.planner`):
 - `failed_goal_waits`: a goal literal whose action came back to the same state (it failed)
   waits while another goal literal can go on.
 
+Agents that check their actions (`hsgplan.agents.hierarchical`; the paper's does not):
+- `refuse_repeats`: an action that succeeded from the very state observed now (with this goal)
+  is refused as one that fails its check is: the agent came back here after it, so taking it
+  again comes back again (a pick whose place the planner then trades for the open space, the
+  object put down and taken up to the step limit). With every other action refused too, the
+  refused ones go to clearing the way as they would; with none found but the repeats, they
+  are taken as without the rule. It recovers from no failure (a state recurs without one), so
+  the paper's protocol keeps it.
+
 Perception (`hsgplan.sim.env`, seeing through a camera observer; nothing under the ground
 truth). They recover from no failure, so the paper's protocol keeps them (`PERCEPTION_RULES`):
 - `relook`: before a primitive on an object the belief is unsure of (not seen at the last
@@ -70,6 +79,7 @@ class RecoveryRules:
     least_taken: bool = True
     likeliest_literal: bool = True
     failed_goal_waits: bool = True
+    refuse_repeats: bool = True
     relook: bool = True
     relook_failed: bool = True
     near_moves_only: bool = True
@@ -100,4 +110,7 @@ class RecoveryRules:
 
 # rules that act only when the agent sees through a camera observer; the paper's protocol keeps them
 PERCEPTION_RULES = ("relook", "relook_failed", "near_moves_only", "seek_unseen")
+# rules that recover from no failure (a failed primitive ends an episode before any could act
+# on it): the paper's protocol keeps them, switchable there too
+NO_FAILURE_RULES = ("refuse_repeats", *PERCEPTION_RULES)
 ALL_RULES = RecoveryRules()  # the recovering protocol's default: every rule on

@@ -12,7 +12,13 @@ from pathlib import Path
 from hsgplan.domain.checks import BOUNDS, bounded, check_fields, read_text, setting
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.recovery import PAPER, PERCEPTION_RULES, PROTOCOLS, RECOVERING, RecoveryRules
+from hsgplan.domain.recovery import (
+    NO_FAILURE_RULES,
+    PAPER,
+    PROTOCOLS,
+    RECOVERING,
+    RecoveryRules,
+)
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import MAX_SCENE_BYTES, read_world_text, read_worlds
 
@@ -83,10 +89,10 @@ class EvalConfig:
             raise InvalidInputError(f"protocol '{self.protocol}': one of {', '.join(PROTOCOLS)}")
         object.__setattr__(self, "rules_off", tuple(self.rules_off))
         RecoveryRules().without(self.rules_off)  # an unknown rule's name is refused here
-        if self.protocol == PAPER and (kept := set(self.rules_off) - set(PERCEPTION_RULES)):
+        if self.protocol == PAPER and (kept := set(self.rules_off) - set(NO_FAILURE_RULES)):
             raise InvalidInputError(
                 f"the paper protocol has no recovery rule to switch off ({', '.join(sorted(kept))}"
-                f"); only the perception rules: {', '.join(PERCEPTION_RULES)}"
+                f"); only those that recover from no failure: {', '.join(NO_FAILURE_RULES)}"
             )
         # a bad scene, too
         check_seen(self.perception, self.worlds().values(), self.scene, self.perception_checkpoint)
@@ -98,14 +104,14 @@ class EvalConfig:
         return {str(p): world_of_file(str(p)) for p in read_worlds(self.scene)}
 
     def rules(self) -> RecoveryRules:
-        """The rules its agent runs under: under the paper's protocol no recovery rule, but the
-        perception rules (they recover from no failure: the robot looks again where it is
-        unsure of what it acts on or judges, and judges a step on what it came near), unless
-        switched off."""
+        """The rules its agent runs under: under the paper's protocol no recovery rule but
+        those that recover from no failure (the perception rules: the robot looks again where
+        it is unsure of what it acts on or judges, and judges a step on what it came near; a
+        checking agent's refusal of repeats), unless switched off."""
         rules = RecoveryRules().without(self.rules_off)
         if self.protocol == PAPER:
-            seeing = {r: getattr(rules, r) for r in PERCEPTION_RULES}
-            return replace(RecoveryRules.none(), **seeing)
+            kept = {r: getattr(rules, r) for r in NO_FAILURE_RULES}
+            return replace(RecoveryRules.none(), **kept)
         return rules
 
 

@@ -3,6 +3,7 @@ task planner again; one that does not takes the planner's action as it comes. Ti
 for the planner, the motion generator and the model of the scene."""
 
 from contextlib import contextmanager
+from dataclasses import replace
 from types import SimpleNamespace
 
 from hsgplan.agents.hierarchical import REFUSALS, HierarchicalAgent
@@ -10,6 +11,7 @@ from hsgplan.domain.actions import Action, Pick, Place
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams, PlaceParams
 from hsgplan.domain.predicates import in_grasp
+from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.planning.base import TaskDecision
 from hsgplan.sim.outcome import Outcome, Status
 
@@ -136,3 +138,42 @@ def test_refusals_stop_at_the_budget():
     d = agent(planner, True).decide(SG, None, None, model)
     assert d.action == Pick("o0")
     assert len(planner.asked) == REFUSALS + 1
+
+
+def checking_agent(planner, rules=ALL_RULES) -> HierarchicalAgent:
+    return HierarchicalAgent("fake", planner, Motion(), rules, check_actions=True)
+
+
+def step(a: HierarchicalAgent, state: str, status: Status = Status.SUCCESS) -> Action:
+    """One decision in `state` (the symbolic state stands as a name), its outcome told."""
+    d = a.decide(SG, state, "goal", Model())
+    a.observe(d.params, Outcome(status, "", 0.0))
+    return d.action
+
+
+def test_an_action_that_succeeded_from_this_very_state_is_refused_there():
+    planner = Planner([Pick("cherries"), Pick("butter")])
+    a = checking_agent(planner)
+    assert step(a, "S") == Pick("cherries")
+    assert step(a, "T") == Pick("cherries")  # another state: nothing refused
+    assert step(a, "S") == Pick("butter")  # back where it succeeded: the world came back
+    assert planner.asked[-1] == frozenset({Pick("cherries")})
+
+
+def test_an_action_that_failed_there_is_not_refused_as_a_repeat():
+    a = checking_agent(Planner([Pick("cherries"), Pick("butter")]))
+    assert step(a, "S", Status.NO_PATH) == Pick("cherries")
+    assert step(a, "S") == Pick("cherries")
+
+
+def test_with_nothing_but_repeats_left_the_repeat_is_taken_and_the_rule_switches_off():
+    a = checking_agent(Planner([Pick("cherries")]))
+    assert [step(a, "S") for _ in range(3)] == [Pick("cherries")] * 3
+    planner = Planner([Pick("cherries"), Pick("butter")])
+    off = checking_agent(planner, replace(RecoveryRules(), refuse_repeats=False))
+    assert [step(off, "S") for _ in range(2)] == [Pick("cherries")] * 2
+    assert frozenset({Pick("cherries")}) not in planner.asked
+    reset = checking_agent(Planner([Pick("cherries"), Pick("butter")]))
+    step(reset, "S")
+    reset.reset("goal", 0)  # a new episode remembers nothing
+    assert step(reset, "S") == Pick("cherries")

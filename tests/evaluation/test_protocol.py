@@ -10,7 +10,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
-from hsgplan.domain.recovery import PERCEPTION_RULES, RecoveryRules
+from hsgplan.domain.recovery import NO_FAILURE_RULES, PERCEPTION_RULES, RecoveryRules
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.protocol import run_config
@@ -53,10 +53,11 @@ def test_a_recovering_episode_out_of_steps_after_failures_is_overstep():
     assert failure_class(record) == (OVERSTEP, "step limit")
 
 
-def test_the_paper_protocol_runs_without_any_recovery_rule_but_the_perception_rules():
+def test_the_paper_protocol_runs_without_any_recovery_rule_but_those_of_no_failure():
     paper = EvalConfig("learned", (2,), 1, 0, protocol="paper").rules()
-    assert paper.off() == tuple(r for r in RecoveryRules.names() if r not in PERCEPTION_RULES)
-    blind = EvalConfig("learned", (2,), 1, 0, protocol="paper", rules_off=PERCEPTION_RULES)
+    assert paper.off() == tuple(r for r in RecoveryRules.names() if r not in NO_FAILURE_RULES)
+    assert set(PERCEPTION_RULES) < set(NO_FAILURE_RULES)
+    blind = EvalConfig("learned", (2,), 1, 0, protocol="paper", rules_off=NO_FAILURE_RULES)
     assert blind.rules() == RecoveryRules.none()
     assert EvalConfig("learned", (2,), 1, 0).rules() == RecoveryRules()
     some = EvalConfig("learned", (2,), 1, 0, rules_off=("failed_bins", "least_taken"))
