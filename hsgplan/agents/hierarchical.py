@@ -11,7 +11,9 @@ and taken back). An action that fails the check is refused: the task planner is 
 without it, up to `REFUSALS` times, after which its first choice is taken as without checks.
 With `clear_way` as well, before it takes that doomed choice it looks for a neighbour to move
 aside first (`agents/clearing.py`). Under the recovery rule `refuse_repeats` it also refuses an
-action that succeeded from the very state it observes now: the world came back here after it.
+action that succeeded from the very state it observes now: the world came back here after it;
+under `stuck_goal_literals`, when the task planner finds nothing, it offers the checks the
+actions of the goal's unsatisfied literals (`agents/stuck.py`).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from dataclasses import dataclass, replace
 
 from hsgplan.agents.base import Decision
 from hsgplan.agents.clearing import CLEARINGS, find_clearing, follows
+from hsgplan.agents.stuck import goal_actions
 from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.goals import Goal
 from hsgplan.domain.parameters import PrimitiveParams
@@ -120,9 +123,14 @@ class HierarchicalAgent:
         if d.action is None and not tried and repeats:  # nothing but the repeats: as without
             d, tried, more = self._ask(sg, state, goal, feasible, [])
             task_seconds += more
+        stuck = d.action is None and not tried and self.rules.stuck_goal_literals
+        if stuck:
+            d, tried = self._goal_literals(sg, state, goal, feasible, d)
         if tried:
-            d = self._clear(sg, state, goal, tried, feasible)
-            if d is None:  # the planner's first choice, as without checks
+            cleared = self._clear(sg, state, goal, tried, feasible)
+            if cleared is not None:
+                d = cleared
+            elif not stuck:  # the planner's first choice, as without checks
                 d = tried[0].decision
                 if d.params is not None:  # the generator's memory back on this action
                     self.motion.propose(sg, d.action, tried[0].following, feasible)
@@ -134,6 +142,26 @@ class HierarchicalAgent:
         if not self.rules.refuse_repeats:
             return []
         return sorted(self._succeeded.get((goal, state), ()), key=str)
+
+    def _goal_literals(
+        self,
+        sg: GeometricSceneGraph,
+        state: SymbolicSceneGraph,
+        goal: Goal,
+        feasible: Feasibility,
+        stuck: Decision,
+    ) -> tuple[Decision, list[_Choice]]:
+        """`stuck_goal_literals`: the first action offered for a goal literal that passes the
+        checks (none failing then), or the planner's `stuck` decision and those that failed."""
+        tried: list[_Choice] = []
+        for offer in goal_actions(state, goal, sg.held)[: REFUSALS + 1]:
+            params = self.motion.propose(sg, offer.action, offer.following, feasible)
+            note = f"the task planner found nothing ({stuck.note}): a goal literal's action"
+            d = Decision(offer.action, params, 0.0, 0.0, note, offer.subgoal)
+            if self._carried_out(sg, d, offer.following, feasible):
+                return d, []
+            tried.append(_Choice(d, offer.action, offer.following))
+        return stuck, tried
 
     def _ask(
         self,

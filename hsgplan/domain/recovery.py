@@ -34,6 +34,12 @@ Agents that check their actions (`hsgplan.agents.hierarchical`; the paper's does
   refused ones go to clearing the way as they would; with none found but the repeats, they
   are taken as without the rule. It recovers from no failure (a state recurs without one), so
   the paper's protocol keeps it.
+- `stuck_goal_literals`: when the task planner finds nothing ("regression stuck") while goal
+  literals do not hold, the agent offers the action the paper's heuristic names for each of
+  them, in the goal's order (the object's pick first where it is not held), to the same checks;
+  the first that passes is taken, and those that fail go to clearing the way; with none taken
+  the episode ends as the planner's would (`agents/stuck.py`). It too recovers from no
+  failure, and the paper's protocol keeps it.
 
 Perception (`hsgplan.sim.env`, seeing through a camera observer; nothing under the ground
 truth). They recover from no failure, so the paper's protocol keeps them (`PERCEPTION_RULES`):
@@ -80,6 +86,7 @@ class RecoveryRules:
     likeliest_literal: bool = True
     failed_goal_waits: bool = True
     refuse_repeats: bool = True
+    stuck_goal_literals: bool = True
     relook: bool = True
     relook_failed: bool = True
     near_moves_only: bool = True
@@ -112,5 +119,5 @@ class RecoveryRules:
 PERCEPTION_RULES = ("relook", "relook_failed", "near_moves_only", "seek_unseen")
 # rules that recover from no failure (a failed primitive ends an episode before any could act
 # on it): the paper's protocol keeps them, switchable there too
-NO_FAILURE_RULES = ("refuse_repeats", *PERCEPTION_RULES)
+NO_FAILURE_RULES = ("refuse_repeats", "stuck_goal_literals", *PERCEPTION_RULES)
 ALL_RULES = RecoveryRules()  # the recovering protocol's default: every rule on

@@ -7,9 +7,9 @@ from dataclasses import replace
 from types import SimpleNamespace
 
 from hsgplan.agents.hierarchical import REFUSALS, HierarchicalAgent
-from hsgplan.domain.actions import Action, Pick, Place
+from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.parameters import PickParams, PlaceParams
+from hsgplan.domain.parameters import PickParams, PlaceParams, PushParams
 from hsgplan.domain.predicates import in_grasp
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
 from hsgplan.planning.base import TaskDecision
@@ -53,6 +53,8 @@ class Motion:
         self.scene = sg.name
         if isinstance(action, Pick):
             return PickParams(action.obj)
+        if isinstance(action, Push):
+            return PushParams(action.obj, 0, 0)
         return PlaceParams(action.obj, action.target, 0, 0)
 
     def observe(self, params, outcome):
