@@ -33,20 +33,3 @@ def test_a_trial_is_undone_and_the_world_then_runs_as_the_trial_did(scene):
     again = execute(scene, PickParams("butter"))
     assert again.status == picked.status
     np.testing.assert_allclose(scene.pose("butter").position, in_hand, atol=1e-6)
-
-
-def test_a_trial_runs_a_step_with_the_plan_its_dry_run_made(scene):
-    from hsgplan.sim.motion_plans import PlanFailure
-    from hsgplan.sim.outcome import Status
-
-    pick = PickParams("butter")
-    kept = PlanFailure(Status.NO_IK, "the dry run's answer")  # what a fresh plan would not say
-    asked = []
-    look = Lookahead(lambda: scene, lambda p: True, lambda p: asked.append(p) or kept)
-    with look.trial() as trial:
-        outcome = trial.run_as_step(pick)
-        assert (outcome.status, outcome.detail, asked) == (Status.NO_IK, kept.detail, [pick])
-        assert trial.run(pick).ok  # planned afresh
-    without = Lookahead(lambda: scene, lambda p: True)  # no dry run kept: planned afresh
-    with without.trial() as trial:
-        assert trial.run_as_step(pick).ok

@@ -103,8 +103,6 @@ def test_a_dry_run_is_answered_once_per_state_and_its_plan_is_what_the_step_runs
         assert env.check(far) is False and env.check(far) is False
         assert env.check(place) is True and env.check(place) is True
         assert plans == [far, place]
-        kept = env.planned(place)  # what a trial run as the step runs
-        assert kept is not None and kept.params == place and env.planned(far) is None
         # planning puts the held object back only to within rounding: the plan is kept with
         # the state it leaves, so the step runs it rather than planning again
         assert env.step(place)[4]["outcome"].ok
