@@ -4,12 +4,11 @@ A dry run asks the motion planner alone: a place onto a tower's top plans, and t
 slides off the front of the shelf as it settles; a place at a shelf top's front edge plans, and
 the box tips onto the prepush region below. An agent made with `try_outcomes`
 (`agents/hierarchical.py`) wraps its model's dry run in this check: a primitive that plans is
-also run in a trial of the model (taken back at once), with the plan its dry run made, which
-the step would run, and passes only where its intended effect holds with nothing knocked over,
-dropped or disturbed (the outcome execution would judge). The motion generator's proposals go
-down its ranking through the same check, so a bin that tips its object is passed over for the
-next. The model is the robot's: the simulator's poses under the ground truth, its belief seen
-through f_p; no domain rule.
+also run in a trial of the model (taken back at once) and passes only where its intended effect
+holds with nothing knocked over, dropped or disturbed (the outcome execution would judge). The
+motion generator's proposals go down its ranking through the same check, so a bin that tips
+its object is passed over for the next. The model is the robot's: the simulator's poses under
+the ground truth, its belief seen through f_p; no domain rule.
 """
 
 from __future__ import annotations
@@ -36,7 +35,7 @@ class OutcomeChecks:
         with self._feasible.trial() as trial:
             key = (params, trial.scene_graph())
             if key not in self._seen:
-                self._seen[key] = trial.run_as_step(params).ok
+                self._seen[key] = trial.run(params).ok
             return self._seen[key]
 
     def trial(self):

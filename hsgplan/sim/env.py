@@ -126,7 +126,7 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         # the answer is the same
         self._unplannable: set[tuple[PrimitiveParams, tuple]] = set()
         # dry runs (as a feasibility check) and trials of whole plans, for agents that look ahead
-        self.lookahead = Lookahead(self._planning_scene, self.check, self.planned)
+        self.lookahead = Lookahead(self._planning_scene, self.check)
 
     def reset(
         self, *, seed: int | None = None, options: ResetOptions | dict | None = None
@@ -251,11 +251,6 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         scene = self._planning_scene()
         poses = tuple(p.position + p.orientation for p in scene.poses().values())
         return tuple(scene.robot.q()), poses, scene.held()
-
-    def planned(self, params: PrimitiveParams) -> MotionPlan | None:
-        """The plan a dry run made for `params` in the scene as it is now, kept for the step."""
-        kept = self._checked.get(params)
-        return kept[0] if kept is not None and kept[2] == self._state() else None
 
     def _checked_plan(self, params: PrimitiveParams) -> tuple[MotionPlan | None, float]:
         """A dry run's plan for `params` if it was made in the scene as it is now."""

@@ -15,7 +15,6 @@ from typing import Any
 
 from hsgplan.domain.parameters import PrimitiveParams
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.sim.motion_plans import MotionPlan
 from hsgplan.sim.outcome import Outcome
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.scene import Scene
@@ -37,15 +36,10 @@ class Trial:
     Args:
         scene: the episode's scene; it is back as it was (random state included, so that
             the primitive executed next plans as it would have) once `close` returns.
-        planned: a dry run's plan for a primitive, made in the scene as it is now (None where
-            there is none), which `run_as_step` runs.
     """
 
-    def __init__(
-        self, scene: Scene, planned: Callable[[PrimitiveParams], MotionPlan | None] | None = None
-    ) -> None:
+    def __init__(self, scene: Scene) -> None:
         self.scene = scene
-        self._planned = planned
         # bodies made on first use (the closed hand of a push) must exist before any state
         # is saved: PyBullet restores a state only into the same set of bodies
         scene.closed_hand()
@@ -70,14 +64,7 @@ class Trial:
         self.scene.rng.bit_generator.state = mark.rng
 
     def run(self, params: PrimitiveParams) -> Outcome:
-        """The primitive planned afresh and run."""
         return execute(self.scene, params)
-
-    def run_as_step(self, params: PrimitiveParams) -> Outcome:
-        """The primitive run as a step taken next would run it: with the plan its dry run made
-        in the scene as it is now, where there is one (a fresh plan may take another path)."""
-        plan = self._planned(params) if self._planned is not None else None
-        return execute(self.scene, params, plan=plan)
 
     def scene_graph(self) -> GeometricSceneGraph:
         return self.scene.scene_graph()
@@ -95,26 +82,18 @@ class Lookahead:
     Args:
         scene: gives the episode's scene as it is now (a new one after every reset).
         check: the dry run of one primitive (`KitchenStorageEnv.check`).
-        planned: the plan a dry run made in the scene as it is now (`KitchenStorageEnv.planned`),
-            which a trial's `run_as_step` runs.
     """
 
-    def __init__(
-        self,
-        scene: Callable[[], Scene],
-        check: Callable[[PrimitiveParams], bool],
-        planned: Callable[[PrimitiveParams], MotionPlan | None] | None = None,
-    ):
+    def __init__(self, scene: Callable[[], Scene], check: Callable[[PrimitiveParams], bool]):
         self._scene = scene
         self._check = check
-        self._planned = planned
 
     def __call__(self, params: PrimitiveParams) -> bool:
         return self._check(params)
 
     @contextmanager
     def trial(self) -> Iterator[Trial]:
-        t = Trial(self._scene(), self._planned)
+        t = Trial(self._scene())
         try:
             yield t
         finally:

@@ -33,7 +33,7 @@ class Model:
             ok = params != TIPS
             return Outcome(Status.SUCCESS if ok else Status.EFFECT_NOT_REACHED, "", 0.0)
 
-        yield SimpleNamespace(run_as_step=run, scene_graph=lambda: self.scene)
+        yield SimpleNamespace(run=run, scene_graph=lambda: self.scene)
 
 
 def test_a_primitive_passes_only_where_it_plans_and_reaches_its_effect_in_the_model():
