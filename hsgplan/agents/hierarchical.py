@@ -13,8 +13,7 @@ With `clear_way` as well, before it takes that doomed choice it looks for a neig
 aside first (`agents/clearing.py`). Under the recovery rule `refuse_repeats` it also refuses an
 action that succeeded from the very state it observes now: the world came back here after it;
 under `stuck_goal_literals`, when the task planner finds nothing, it offers the checks the
-actions of the goal's unsatisfied literals (`agents/stuck.py`). With `try_outcomes` a check
-also runs the primitive in a trial of the model and wants its effect (`agents/outcomes.py`).
+actions of the goal's unsatisfied literals (`agents/stuck.py`).
 """
 
 from __future__ import annotations
@@ -24,7 +23,6 @@ from dataclasses import dataclass, replace
 
 from hsgplan.agents.base import Decision
 from hsgplan.agents.clearing import CLEARINGS, find_clearing, follows
-from hsgplan.agents.outcomes import OutcomeChecks
 from hsgplan.agents.stuck import goal_actions
 from hsgplan.domain.actions import Action, Pick, Place, Push
 from hsgplan.domain.goals import Goal
@@ -73,7 +71,6 @@ class HierarchicalAgent:
         rules: RecoveryRules = ALL_RULES,
         check_actions: bool = False,
         clear_way: bool = False,
-        try_outcomes: bool = False,
     ) -> None:
         self.name = name
         self.planner = planner
@@ -81,7 +78,6 @@ class HierarchicalAgent:
         self.rules = rules
         self.check_actions = check_actions
         self.clear_way = clear_way
-        self.try_outcomes = try_outcomes
         # what clearing the way still has to do: neighbours' picks and places, then the action
         self._queued: list[tuple[Action, Action | None]] = []
         self._clearings = 0
@@ -106,8 +102,6 @@ class HierarchicalAgent:
         if not self.check_actions or feasible is None:
             return self._decide(sg, state, goal, feasible, frozenset()).decision
         start = time.perf_counter()
-        if self.try_outcomes and getattr(feasible, "trial", None) is not None:
-            feasible = OutcomeChecks(feasible)
         d = self._decide_checked(sg, state, goal, feasible, start)
         self._deciding = (goal, state, d.action) if d.action is not None else None
         return d

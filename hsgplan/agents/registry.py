@@ -76,9 +76,6 @@ TASK_PLANNERS: dict[str, Callable[[Path, RecoveryRules], TaskPlanner]] = {
     # the same, and when every action offered fails its check, a neighbour in the way is moved
     # aside first (`agents/clearing.py`)
     "regression-ahead-clearing": _regression_ahead,
-    # the same, each check also running the primitive in the model for its effect
-    # (`agents/outcomes.py`)
-    "regression-ahead-tried": _regression_ahead,
     "regression-paper": _regression_paper,  # the paper's loop (`paper_loop.py`), no rules
     "forward": _forward,
     "fd": _fast_downward,
@@ -143,15 +140,9 @@ WHOLE_AGENTS: dict[str, str] = {
     "stream-focused-goal": "the same with the goal-directed streams of stream-goal",
 }
 # task planners whose agent checks each action in its model before taking it
-CHECKED_PLANNERS = (
-    "regression-ahead-checked",
-    "regression-ahead-clearing",
-    "regression-ahead-tried",
-)
+CHECKED_PLANNERS = ("regression-ahead-checked", "regression-ahead-clearing")
 # ... and whose agent also moves a neighbour aside when every action offered fails its check
-CLEARING_PLANNERS = ("regression-ahead-clearing", "regression-ahead-tried")
-# ... and whose checks also run each primitive in the model and want its effect reached
-TRIED_PLANNERS = ("regression-ahead-tried",)
+CLEARING_PLANNERS = ("regression-ahead-clearing",)
 STREAM_AGENTS = ("stream", "stream-goal", "stream-focused", "stream-focused-goal")
 AGENT_NAMES = [*AGENTS, *WHOLE_AGENTS]
 # The search-based baselines Table 2 may time against ours (`hsgplan bench timing --search`),
@@ -213,7 +204,6 @@ LEARNED_PLANNERS = (
     "regression-ahead",
     "regression-ahead-checked",
     "regression-ahead-clearing",
-    "regression-ahead-tried",
     "regression-ahead-chain",
     "regression-paper",
     "forward",
@@ -296,5 +286,4 @@ def make_agent(
         rules,
         check_actions=planner in CHECKED_PLANNERS,
         clear_way=planner in CLEARING_PLANNERS,
-        try_outcomes=planner in TRIED_PLANNERS,
     )
