@@ -89,13 +89,21 @@ def compare(
             "may differ, the episodes per size may not.",
         ),
     ] = False,
+    across_rules: Annotated[
+        bool,
+        typer.Option(
+            "--across-rules",
+            help="Runs under different recovery rules (--rules-off): each row's rules may "
+            "differ, its name says which.",
+        ),
+    ] = False,
     markdown: MarkdownFlag = False,
 ) -> None:
     """A method's success per size across eval world runs, one row each: a ladder from one
     recipe to another, one change per row. The runs must be like for like (protocol, goals,
-    repeats, seed, sizes, scene); only their checkpoints, and the method when one is named per
-    run, may differ (and with --across-scenes the scene). Eval task runs (the symbolic loop)
-    are compared the same way, on the same episodes."""
+    repeats, seed, sizes, scene, rules off); only their checkpoints, and the method when one is
+    named per run, may differ (with --across-scenes the scene, with --across-rules the rules
+    off). Eval task runs (the symbolic loop) are compared the same way, on the same episodes."""
     from hsgplan.evaluation.compare import all_task_runs, compare_task
     from hsgplan.evaluation.compare import compare as compare_runs
 
@@ -103,9 +111,11 @@ def compare(
     default = methods if len(set(methods)) == len(runs) > 1 else [r.name for r in runs]
     row_names = names_of(names, "--names", "run") if names else tuple(default)
     if all_task_runs(runs):
-        if across_scenes:
-            raise InvalidInputError("--across-scenes compares eval world runs only")
+        if across_scenes or across_rules:
+            raise InvalidInputError(
+                "--across-scenes and --across-rules compare eval world runs only"
+            )
         t = compare_task(runs, row_names)
     else:
-        t = compare_runs(runs, row_names, methods, across_scenes)
+        t = compare_runs(runs, row_names, methods, across_scenes, across_rules)
     print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

@@ -41,11 +41,14 @@ def compare(
     names: Sequence[str],
     methods: Sequence[str],
     across_scenes: bool = False,
+    across_rules: bool = False,
 ) -> TextTable:
     """One row per run folder (`names[i]` for `runs[i]`): its method's success rate and subgoal
     completion per size (`methods`: one for every run, or one per run), and the paper's row
     where it reports the one method compared. With `across_scenes`, the runs may have run in
-    different scenes (and so with different goals per scene file), as many episodes per size.
+    different scenes (and so with different goals per scene file), as many episodes per size;
+    with `across_rules`, under different recovery rules switched off (a ladder of rules, each
+    row's named in its name; the title then names none).
 
     Raises InvalidInputError for a folder that is no finished eval world run, one without its
     method, or runs that are not like for like (the first setting that differs is named)."""
@@ -61,7 +64,7 @@ def compare(
             known = ", ".join(summary["methods"])
             raise InvalidInputError(f"'{run}' holds no method '{method}' (it holds {known})")
         for key in LIKE_FOR_LIKE:
-            if across_scenes and key in ACROSS_SCENES:
+            if (across_scenes and key in ACROSS_SCENES) or (across_rules and key == "rules_off"):
                 continue
             if s.get(key) != settings[0].get(key):
                 raise InvalidInputError(
@@ -89,9 +92,10 @@ def compare(
         source, by, place = f"{episodes} episodes per size in each run's scenes", "scene", ""
     else:
         by, place = "run", where(first)
+    protocol = protocol_name({**first, "rules_off": []}) + ", rules by row"
     title = (
         f"Success rate / subgoal completion of {what} "
-        f"by {by} ({protocol_name(first)}): "
+        f"by {by} ({protocol if across_rules else protocol_name(first)}): "
         f"{source}, {repeats}, seed {first['seed']}{place}"
     )
     header = ("run", *(f"{n} objects" for n in sizes))

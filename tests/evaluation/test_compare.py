@@ -23,17 +23,20 @@ def _record(seed: int, size: int, success: bool) -> EpisodeRecord:
     )
 
 
-def _run(folder, wins, seed=0, protocol="paper", motion="m", method="gnn", scene=None):
+def _run(
+    folder, wins, seed=0, protocol="paper", motion="m", method="gnn", scene=None, rules_off=()
+):
     """A finished table folder whose `method` column won `wins[size]`."""
     folder.mkdir(parents=True)
     records = [_record(k, n, won) for n, outcomes in wins.items() for k, won in enumerate(outcomes)]
     settings = {"kind": "eval-table", "goals": len(next(iter(wins.values()))), "seed": seed}
-    settings |= {"protocol": protocol, "rules_off": [], "repeats": 1, "goals_file": None}
+    settings |= {"protocol": protocol, "rules_off": list(rules_off), "repeats": 1}
+    settings |= {"goals_file": None}
     settings |= {"sizes": sorted(wins), "motion_checkpoints": motion, "scene": scene}
     (folder / CONFIG).write_text(json.dumps(settings))
     summary = {
         "protocol": protocol,
-        "rules_off": [],
+        "rules_off": list(rules_off),
         "methods": {
             method: {"agent": "learned", "wall_seconds": 1.0, "sittings": []} | summarize(records)
         },
@@ -64,6 +67,7 @@ def test_each_run_is_a_row_of_its_success_per_size_and_the_paper_is_the_last(tmp
         ({"seed": 1}, "differ in seed"),
         ({"protocol": "recovering"}, "differ in protocol"),
         ({"scene": "scenes/layouts"}, "differ in scene"),
+        ({"rules_off": ("refuse_repeats",)}, "differ in rules_off"),
     ],
 )
 def test_runs_that_are_not_like_for_like_are_refused(tmp_path, other, says):
@@ -149,3 +153,14 @@ def test_runs_of_one_agent_in_different_scenes_stand_side_by_side_on_as_many_epi
     other = _run(tmp_path / "other", {2: (True, True, True, True)}, seed=3, scene="x")
     with pytest.raises(InvalidInputError, match="differ in seed"):
         compare([kitchen, other], ["kitchen", "other"], ["gnn"], across_scenes=True)
+
+
+def test_a_ladder_of_recovery_rules_stands_side_by_side_when_told(tmp_path):
+    off = _run(tmp_path / "off", {2: (True, False)}, rules_off=("refuse_repeats",))
+    on = _run(tmp_path / "on", {2: (True, True)})
+    table = compare([off, on], ["without", "with"], ["gnn"], across_rules=True)
+    assert table.rows[0][1].startswith("0.50") and table.rows[1][1].startswith("1.00")
+    assert "rules by row" in table.title and "without refuse_repeats" not in table.title
+    seeded = _run(tmp_path / "seeded", {2: (True, True)}, seed=4)
+    with pytest.raises(InvalidInputError, match="differ in seed"):  # the rest stays like for like
+        compare([off, seeded], ["off", "seeded"], ["gnn"], across_rules=True)
