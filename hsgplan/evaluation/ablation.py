@@ -13,8 +13,9 @@ from collections.abc import Callable
 from dataclasses import asdict, replace
 from pathlib import Path
 
+from hsgplan.agents.registry import CHECKED_PLANNERS, WHOLE_AGENTS, agent_parts
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.recovery import PAPER, PERCEPTION_RULES, RecoveryRules
+from hsgplan.domain.recovery import CHECKING_RULES, PAPER, PERCEPTION_RULES, RecoveryRules
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.table1 import (
@@ -30,23 +31,35 @@ from hsgplan.runner.run_folder import check_claim, claim
 ALL_RULES_ON = "all-rules"
 
 
-def variants(config: EvalConfig, seeing: bool = False) -> dict[str, EvalConfig]:
+def variants(
+    config: EvalConfig, seeing: bool = False, checking: bool = False
+) -> dict[str, EvalConfig]:
     """The configurations compared, by folder name: every rule on, then each one off (the
     perception rules only where some method sees through f_p, `seeing`: under the ground
-    truth they do nothing)."""
+    truth they do nothing; the checking agents' rules only where some method's agent checks
+    its actions, `checking`)."""
     if config.protocol == PAPER or config.rules_off:
         raise InvalidInputError(
             "--ablate-rules switches each recovery rule off in turn under the recovering "
             "protocol; give neither --protocol paper nor --rules-off"
         )
     out = {ALL_RULES_ON: config}
-    rules = [r for r in RecoveryRules.names() if seeing or r not in PERCEPTION_RULES]
+    rules = [
+        r
+        for r in RecoveryRules.names()
+        if (seeing or r not in PERCEPTION_RULES) and (checking or r not in CHECKING_RULES)
+    ]
     out |= {f"no-{rule}": replace(config, rules_off=(rule,)) for rule in rules}
     return out
 
 
 def _seeing(methods: list[Method]) -> bool:
     return any(m.perception != "gt" for m in methods)
+
+
+def _checking(methods: list[Method]) -> bool:
+    parts = [agent_parts(m.agent) for m in methods if m.agent not in WHOLE_AGENTS]
+    return any(planner in CHECKED_PLANNERS for planner, _ in parts)
 
 
 ABLATION_KIND = "eval-ablation"
@@ -61,7 +74,7 @@ def check_ablation(methods: list[Method], config: EvalConfig, out: Path) -> list
     """Every refusal of the ablation's folder and its variants', before anything is written;
     the variants."""
     check_claim(out, ABLATION_KIND, *_claimed_with(methods, config))
-    names = variants(config, _seeing(methods))
+    names = variants(config, _seeing(methods), _checking(methods))
     for name, variant in names.items():
         check_table(methods, variant, out / name)
     return list(names)
@@ -80,7 +93,7 @@ def run_ablation(
     claim(out, ABLATION_KIND, *_claimed_with(methods, config))
     reports = {
         name: run_table(methods, variant, out / name, workers, ray, on_episode)
-        for name, variant in variants(config, _seeing(methods)).items()
+        for name, variant in variants(config, _seeing(methods), _checking(methods)).items()
     }
     return {"protocol": config.protocol, "variants": reports, "run": str(out)}
 

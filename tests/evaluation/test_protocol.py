@@ -10,7 +10,12 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PickParams
-from hsgplan.domain.recovery import NO_FAILURE_RULES, PERCEPTION_RULES, RecoveryRules
+from hsgplan.domain.recovery import (
+    CHECKING_RULES,
+    NO_FAILURE_RULES,
+    PERCEPTION_RULES,
+    RecoveryRules,
+)
 from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.evaluation.protocol import run_config
@@ -85,10 +90,14 @@ def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
     config = EvalConfig("learned", (2,), 1, 0)
     found = variants(config)
     assert list(found)[0] == "all-rules" and found["all-rules"].rules_off == ()
-    rules = [r for r in RecoveryRules.names() if r not in PERCEPTION_RULES]
-    assert [v.rules_off for v in list(found.values())[1:]] == [(r,) for r in rules]
+    acting = [r for r in RecoveryRules.names() if r not in PERCEPTION_RULES + CHECKING_RULES]
+    assert [v.rules_off for v in list(found.values())[1:]] == [(r,) for r in acting]
     seeing = variants(config, seeing=True)  # relook acts only through the cameras
-    assert [v.rules_off for v in list(seeing.values())[1:]] == [(r,) for r in RecoveryRules.names()]
+    assert [v.rules_off for v in list(seeing.values())[1:]] == [
+        (r,) for r in RecoveryRules.names() if r not in CHECKING_RULES
+    ]
+    checking = variants(config, checking=True)  # refuse_repeats acts only in a checking agent
+    assert {v.rules_off for v in checking.values()} >= {(r,) for r in CHECKING_RULES}
     with pytest.raises(InvalidInputError, match="ablate-rules"):
         variants(EvalConfig("learned", (2,), 1, 0, protocol="paper"))
     run = {"goals": 1, "goals_file": None, "repeats": 1, "seed": 0}
@@ -119,3 +128,11 @@ def test_a_table_folder_claimed_under_a_protocol_is_its_own_again(tmp_path, prot
     if protocol == "recovering":  # read back from JSON, a resumed ablation is the same one
         claim(tmp_path / "ablation", ABLATION_KIND, *_claimed_with(methods, config))
         assert check_claim(tmp_path / "ablation", ABLATION_KIND, *_claimed_with(methods, config))
+
+
+def test_the_checking_agents_rules_are_ablated_only_where_some_method_checks_its_actions():
+    from hsgplan.evaluation.ablation import _checking
+    from hsgplan.evaluation.table1 import Method
+
+    assert not _checking([Method("GNN", "learned"), Method("search", "search")])
+    assert _checking([Method("GNN", "learned"), Method("c", "regression-ahead-clearing+gnn")])
