@@ -154,9 +154,9 @@ class HierarchicalAgent:
         """`stuck_goal_literals`: the first action offered for a goal literal that passes the
         checks (none failing then), or the planner's `stuck` decision and those that failed."""
         tried: list[_Choice] = []
+        note = f"the task planner found nothing ({stuck.note}): a goal literal's action"
         for offer in goal_actions(state, goal, sg.held)[: REFUSALS + 1]:
             params = self.motion.propose(sg, offer.action, offer.following, feasible)
-            note = f"the task planner found nothing ({stuck.note}): a goal literal's action"
             d = Decision(offer.action, params, 0.0, 0.0, note, offer.subgoal)
             if self._carried_out(sg, d, offer.following, feasible):
                 return d, []

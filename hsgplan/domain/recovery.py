@@ -117,9 +117,9 @@ class RecoveryRules:
 
 # rules that act only when the agent sees through a camera observer; the paper's protocol keeps them
 PERCEPTION_RULES = ("relook", "relook_failed", "near_moves_only", "seek_unseen")
-# rules that recover from no failure (a failed primitive ends an episode before any could act
-# on it): the paper's protocol keeps them, switchable there too
 # rules that act only in an agent that checks its actions
 CHECKING_RULES = ("refuse_repeats", "stuck_goal_literals")
+# rules that recover from no failure (a failed primitive ends an episode before any could act
+# on it): the paper's protocol keeps them, switchable there too
 NO_FAILURE_RULES = (*CHECKING_RULES, *PERCEPTION_RULES)
 ALL_RULES = RecoveryRules()  # the recovering protocol's default: every rule on

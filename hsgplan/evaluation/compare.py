@@ -92,10 +92,10 @@ def compare(
         source, by, place = f"{episodes} episodes per size in each run's scenes", "scene", ""
     else:
         by, place = "run", where(first)
-    protocol = protocol_name({**first, "rules_off": []}) + ", rules by row"
+    protocol = protocol_name({**first, "rules_off": []} if across_rules else first)
     title = (
         f"Success rate / subgoal completion of {what} "
-        f"by {by} ({protocol if across_rules else protocol_name(first)}): "
+        f"by {by} ({protocol}{', rules by row' if across_rules else ''}): "
         f"{source}, {repeats}, seed {first['seed']}{place}"
     )
     header = ("run", *(f"{n} objects" for n in sizes))

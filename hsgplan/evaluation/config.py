@@ -106,8 +106,8 @@ class EvalConfig:
     def rules(self) -> RecoveryRules:
         """The rules its agent runs under: under the paper's protocol no recovery rule but
         those that recover from no failure (the perception rules: the robot looks again where
-        it is unsure of what it acts on or judges, and judges a step on what it came near; a
-        checking agent's refusal of repeats), unless switched off."""
+        it is unsure of what it acts on or judges, and judges a step on what it came near; the
+        checking agents' `CHECKING_RULES`), unless switched off."""
         rules = RecoveryRules().without(self.rules_off)
         if self.protocol == PAPER:
             kept = {r: getattr(rules, r) for r in NO_FAILURE_RULES}
