@@ -201,7 +201,7 @@ def trials_from_here(
     """Execute each action from the scene as it stands, which shows `state`; with `put_back`,
     the scene is left as it was (the hand's grasp included), else with the hand empty."""
     robot = scene.robot
-    snapshot, held = scene.snapshot(), robot.held_body
+    snapshot, grip = scene.snapshot(), robot.grip()
     kept = {k: getattr(robot, k) for k in ("closing", "released")}
     trials = []
     for action in actions:
@@ -209,8 +209,7 @@ def trials_from_here(
         # and the one the scene started with made again
         robot.detach()
         scene.restore(snapshot)
-        if held is not None:
-            robot.attach(held)
+        robot.regrip(grip)
         status, executed = execute_action(scene, action, max_params)
         after: SymbolicSceneGraph | None = state
         if executed:
@@ -220,8 +219,7 @@ def trials_from_here(
     if put_back:
         robot.detach()
         scene.restore(snapshot)
-        if held is not None:
-            robot.attach(held)
+        robot.regrip(grip)
         for k, v in kept.items():
             setattr(robot, k, v)
     scene.bc.removeState(snapshot)

@@ -105,7 +105,7 @@ class StagedTask:
 
     task: MotionTask
     snapshot: int  # the physics state, saved
-    held: int | None  # the body in the gripper (constraints are not part of a saved state)
+    grip: tuple[int | None, bool]  # the hand's hold (`Panda.grip`: not part of a saved state)
     before: GeometricSceneGraph
     rng: random.Random
 
@@ -125,15 +125,13 @@ def stage_task(scene: Scene, task: MotionTask) -> StagedTask | None:
         scene, task.state, task.obj, task.target, task.front_gap
     ):
         return None
-    return StagedTask(task, scene.snapshot(), scene.robot.held_body, scene.scene_graph(), rng)
+    return StagedTask(task, scene.snapshot(), scene.robot.grip(), scene.scene_graph(), rng)
 
 
 def try_params(scene: Scene, staged: StagedTask, params) -> Outcome:
     """Run one primitive from the staged state."""
     scene.restore(staged.snapshot)
-    if staged.held is not None:
-        scene.robot.detach()
-        scene.robot.attach(staged.held)
+    scene.robot.regrip(staged.grip)
     return execute(scene, params)
 
 

@@ -2,13 +2,17 @@
 
 The agent acts on what the env's observer makes of the scene, and the episode ends on what it
 senses: the goal seen reached, a toppled or fallen object seen, the step limit. It is judged
-on the truth (the simulator's poses) once, at the end: a goal the agent believes reached that
-does not truly hold is a failure (`MISPERCEIVED`). With the ground truth as observer the two
-are one.
+on the truth (the simulator's state) once, at the end, by one judge for every observer: each
+executed step's verdict (`sim.outcome.judge`, kept by the env) joins its record, and a goal the
+agent believes reached that does not truly hold is a failure (`MISPERCEIVED`). With the ground
+truth as observer the robot's reading and the judge's are one.
 
-Under the paper's protocol (`end_at_failure`) a primitive that fails (refused while planning,
-or failed in execution) ends the episode, unless the goal holds all the same; otherwise a
-failed primitive costs its step and the agent goes on from what it observes.
+Under the paper's protocol (`end_at_failure`) a primitive the robot sees fail (refused while
+planning, or failed in execution) ends the episode, unless the goal holds all the same, and the
+episode succeeds only where every executed step truly succeeded and the goal truly holds at
+the end; a robot that stopped on a step it saw fail where the step truly succeeded, short of
+its goal, failed by what it saw (`MISJUDGED`). Otherwise (recovering) a failed primitive costs
+its step and the agent goes on from what it observes; the verdicts are counted all the same.
 
 Every episode records its seed; the same seed, goal and agent give the same record (timings
 aside).
@@ -18,7 +22,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 from hsgplan.agents.base import Agent, Decision
 from hsgplan.domain.errors import UnsampledSceneError
@@ -52,6 +56,15 @@ class StepRecord:
     # how far the belief it was planned on had its object and a place's target object from
     # the simulator's poses (zero under the ground truth)
     misbelieved: tuple[BeliefError, ...] = ()
+    # the one judge's verdict on the step, on the simulator's state (`sim.outcome.judge`),
+    # and why: under the ground truth the status itself; "" in records made before it
+    truth: str = ""
+    truth_detail: str = ""
+
+    @property
+    def verdict(self) -> str:
+        """The judge's status of the step (the status, in records that hold none)."""
+        return self.truth or self.status
 
 
 @dataclass(frozen=True)
@@ -112,6 +125,24 @@ def unsampled(seed: int, agent: str, goal: Goal, observer: str) -> EpisodeRecord
     return EpisodeRecord(
         seed, agent, str(goal), goal.size, False, 0.0, failure, (), 0.0, observer=observer
     )
+
+
+def judged_failure(
+    seen: Failure | None, records: list[StepRecord], goal_holds: bool, end_at_failure: bool
+) -> Failure | None:
+    """What an episode failed by on the truth, given what ended it as the robot saw it
+    (`seen`: None where it believed its goal reached), its steps with their verdicts and
+    whether the goal truly holds. Under the paper's protocol a step that truly failed fails
+    the episode, whatever the robot saw; a stop on a step seen to fail that truly succeeded,
+    short of the goal, is the robot's misjudgment; its stop where the goal holds and every
+    step truly succeeded is a success."""
+    if end_at_failure and any(r.verdict != "success" for r in records):
+        return Failure.FAILED_PRIMITIVE
+    if seen == Failure.FAILED_PRIMITIVE:
+        return None if goal_holds else Failure.MISJUDGED
+    if seen is None and not goal_holds:
+        return Failure.MISPERCEIVED
+    return seen
 
 
 def params_text(params) -> str:
@@ -206,13 +237,17 @@ def run_episode(
         if end_at_failure and not outcome.ok and not goal.satisfied_by(obs.symbols.state):
             failure = Failure.FAILED_PRIMITIVE
             break
+    # the truth, read once the robot is done: the judge's verdict on each step, the goal
+    records = [
+        replace(r, truth=v.status.value, truth_detail=v.detail)
+        for r, v in zip(records, env.verdicts, strict=True)
+    ]
     state = obs.true_symbols.state
     # Seeing through cameras, look-alike duplicates are named by the robot's first look, not
     # by the simulator's bodies: the goal is judged under every naming of them.
     readings = goal.readings() if env.believing else [goal]
     done = max(sum(state.holds(lit) for lit in g.literals) for g in readings)
-    if failure is None and done < len(goal.literals):
-        failure = Failure.MISPERCEIVED
+    failure = judged_failure(failure, records, done == len(goal.literals), end_at_failure)
     env.close()
     return EpisodeRecord(
         seed,

@@ -34,10 +34,17 @@ _ENDED_BY_EXECUTION = {Failure.KNOCKED_OVER, Failure.OFF_TABLE, Failure.NO_PARAM
 
 
 def failed_steps(record: EpisodeRecord) -> list[str]:
-    """The statuses of the episode's primitives that did not succeed, in order: those that
-    failed in execution and those the world refused as inapplicable (`invalid`, nothing moved)
-    alike, as the paper's protocol ends an episode at either."""
-    return [s.status for s in record.steps if s.status != Status.SUCCESS]
+    """The judge's statuses of the episode's primitives that did not succeed, in order (the
+    same judge for every observer: `StepRecord.verdict`): those that failed in execution and
+    those the world refused as inapplicable (`invalid`, nothing moved) alike, as the paper's
+    protocol ends an episode at either."""
+    return [s.verdict for s in record.steps if s.verdict != Status.SUCCESS]
+
+
+def judged(record: EpisodeRecord) -> bool:
+    """Whether the record holds the judge's verdicts (records made before it hold the robot's
+    statuses alone)."""
+    return any(s.truth for s in record.steps)
 
 
 def class_of(failure: Failure) -> str:
@@ -56,14 +63,17 @@ def failure_class(record: EpisodeRecord) -> tuple[str, str] | None:
     if record.success:
         return None
     kind = str(record.failure)
-    # Seeing through cameras, a step may be judged failed where it succeeded; an episode it
-    # ended with every goal literal truly holding failed by what the robot saw, not by what
-    # it did (on the simulator's poses a step cannot end an episode whose goal holds).
-    if record.failure == Failure.FAILED_PRIMITIVE and record.subgoal_completion == 1.0:
+    # Records made before the judge: seeing through cameras, a step may be judged failed
+    # where it succeeded; an episode it ended with every goal literal truly holding failed by
+    # what the robot saw, not by what it did.
+    legacy = not judged(record)
+    if legacy and record.failure == Failure.FAILED_PRIMITIVE and record.subgoal_completion == 1:
         return PERCEPTION, str(Failure.MISJUDGED)
     if record.failure == Failure.FAILED_PRIMITIVE:
+        # the step that failed the episode: the first the judge failed (in a record before
+        # it, the last the robot saw fail, which ended it)
         failed = failed_steps(record)
-        kind = failed[-1] if failed else kind
+        kind = (failed[-1] if legacy else failed[0]) if failed else kind
     elif record.failure == Failure.OVERSTEP:
         kind = "step limit"
     return class_of(Failure(record.failure)), kind
@@ -123,6 +133,9 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
             if s.action.startswith("place") and s.dragged > DISTURB_RECORD
         ),
         "still_seen_moved": still_seen_moved(rs),
+        # steps the robot read otherwise than the judge (seeing through f_p; none under the
+        # ground truth, whose reading is the judge's)
+        "misread_steps": misread_steps(rs),
         "misbelieved": misbelieved(rs),
         # looks taken again before a primitive or the goal's end, seeing through f_p (`relook`)
         "relooks": sum(s.relooks for r in rs for s in r.steps) + sum(r.closing_relooks for r in rs),
@@ -150,6 +163,17 @@ def still_seen_moved(rs: Sequence[EpisodeRecord]) -> dict:
     }
 
 
+def misread_steps(rs: Sequence[EpisodeRecord]) -> dict:
+    """Executed steps the robot saw succeed that the judge failed, and those it saw fail that
+    the judge passed (records made before the judge count none)."""
+    steps = [s for r in rs for s in r.steps if s.truth]
+    ok = Status.SUCCESS
+    return {
+        "seen_ok_truly_failed": sum(1 for s in steps if s.status == ok and s.truth != ok),
+        "seen_failed_truly_ok": sum(1 for s in steps if s.status != ok and s.truth == ok),
+    }
+
+
 def misbelieved(rs: Sequence[EpisodeRecord]) -> dict:
     """Steps planned on a belief that had an object they acted on off its true pose beyond
     f_p's targets (`sim.outcome.BELIEF_OFF`, `BELIEF_TURNED`), and the failed primitives among
@@ -159,7 +183,7 @@ def misbelieved(rs: Sequence[EpisodeRecord]) -> dict:
     off = {id(s): s for s, e in errors if e.beyond}
     return {
         "steps": len(off),
-        "failed": sum(1 for s in off.values() if s.status in FAILED_EXECUTION),
+        "failed": sum(1 for s in off.values() if s.verdict in FAILED_EXECUTION),
         "max_off": max((e.off for _, e in errors), default=0.0),
         "max_turned": max((e.turned for _, e in errors), default=0.0),
     }

@@ -172,6 +172,14 @@ def body_in_grasp(robot: Panda, bodies: Sequence[int]) -> int | None:
     return None
 
 
+def rests_in_hand(robot: Panda, body: int) -> bool:
+    """Whether the body touches the robot and nothing else: off whatever it stood on, it is
+    held up by the hand alone (by a grasp's constraint or by friction). Read from the contacts
+    of the last physics step."""
+    contacts = robot.bc.getContactPoints(bodyA=body)
+    return bool(contacts) and all(c[2] == robot.body for c in contacts)
+
+
 def holds_something(robot: Panda) -> bool:
     """What the gripper tells the robot: fingers told to close, held apart by something."""
     return robot.closing and robot.finger_opening() > HOLD_MIN_WIDTH

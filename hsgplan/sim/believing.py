@@ -16,8 +16,8 @@ from hsgplan.sim.belief_world import BeliefWorld
 from hsgplan.sim.env_types import Observation
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, overlapped, plan_transit
 from hsgplan.sim.observer import CameraObserver, Look, Seen
-from hsgplan.sim.outcome import SEEN_DISTURB_TOL, Outcome, Status, compare
-from hsgplan.sim.primitives import Watch, run_path, run_plan, stopped_outcome
+from hsgplan.sim.outcome import SEEN_DISTURB_TOL, Outcome, Status, compare, stopped_outcome
+from hsgplan.sim.primitives import Watch, run_path, run_plan
 from hsgplan.sim.reach import driven, near, swept_boxes
 from hsgplan.sim.robot import REST
 from hsgplan.sim.scene import Scene
@@ -31,7 +31,8 @@ class BelievedSteps:
     (a dry run's plan) and `_observe` (the observation the agent reads); what it keeps there:
     `_seen` (the belief's last look), `_judged` (the look that judged the last step),
     `_judged_from` (the last observation), `_released` (where the last step let its object go,
-    for the next look) and `last_plan`.
+    for the next look), `_stopped` (why the arm was stopped short, for the judge's record) and
+    `last_plan`.
     """
 
     scene: Scene
@@ -64,7 +65,7 @@ class BelievedSteps:
             seconds = time.perf_counter() - start - watch.seconds + plan_seconds
             return Outcome(plan.status, plan.detail, seconds, relooks)
         self.last_plan = plan
-        stopped = run_plan(self.scene, plan, on_frame, on_phase)
+        stopped = self._stopped = run_plan(self.scene, plan, on_frame, on_phase)
         holds = holds_something(self.scene.robot)  # the gripper's width
         self._released = world.executed(plan, holds)
         if world.holding is not None and not holds:

@@ -7,8 +7,10 @@ RGB image from the fixed camera) is in `info["observation"]`: what the env's obs
 (`sim.observer`, the ground truth by default) makes of the scene, with the true symbols beside
 it to judge by. The reward is 1, and the episode terminates, on the step where the goal holds
 in what the observer sees (with a camera observer, the robot's belief); whether it truly
-holds is `info["goal_truly_holds"]`, and what a step truly moved besides its object is
-`info["disturbed"]`.
+holds is `info["goal_truly_holds"]`, what a step truly moved besides its object is
+`info["disturbed"]`, and the one judge's verdict on the step, on the simulator's state, is
+`info["verdict"]` (`sim.outcome.judge`), kept for the episode's record in `verdicts`: under the
+ground truth it is the step's outcome; seeing through cameras the robot reads its own.
 
 With a camera observer (`sim.sensing.CameraObserver`) the robot knows only its belief: every
 primitive is planned in the model of that belief (`sim.belief_world`) and the simulated scene
@@ -41,9 +43,11 @@ from hsgplan.sim.observer import CameraObserver, GroundTruth, SceneObserver, See
 from hsgplan.sim.outcome import (
     Outcome,
     Status,
+    Verdict,
     belief_errors,
     disturbances,
     dragged,
+    judge,
     largest_move,
 )
 from hsgplan.sim.primitives import execute
@@ -122,6 +126,10 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         self.last_plan: MotionPlan | None = None
         # dry runs' plans, each with the state of the scene it was made in (`_state`)
         self._checked: dict[PrimitiveParams, tuple[MotionPlan, float, tuple]] = {}
+        # the judge's verdict on each step of the episode, on the simulator's state: the
+        # record's, which no decision reads
+        self.verdicts: list[Verdict] = []
+        self._stopped: str | None = None
         # dry runs that found no plan, with the state they were made in: asked again there,
         # the answer is the same
         self._unplannable: set[tuple[PrimitiveParams, tuple]] = set()
@@ -150,6 +158,7 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
             world=options.goal.world,
         )
         self.steps = 0
+        self.verdicts = []
         self._checked.clear()
         self._unplannable.clear()
         self._seen = self._judged = self._released = None
@@ -171,8 +180,10 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
             if isinstance(action, PrimitiveParams)
             else decode(self.scene.objects, action, self.scene.world)
         )
-        true_before = self.scene.poses()
+        truth_before = self.scene.scene_graph()
+        true_before = {o: truth_before.pose(o) for o in truth_before.objects}
         self.last_plan = None
+        self._stopped = None
         phases: list[tuple[str, dict]] = []  # the record's: where each phase left the objects
 
         def ended(name: str) -> None:
@@ -193,6 +204,8 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
             outcome = execute(self.scene, params, on_frame, plan, ended)
             # The plan is part of this primitive's cost: its time is added back.
             outcome = Outcome(outcome.status, outcome.detail, outcome.seconds + plan_seconds)
+        verdict = self._judge(params, outcome, truth_before)
+        self.verdicts.append(verdict)
         self._checked.clear()
         self._unplannable.clear()
         self.steps += 1
@@ -215,6 +228,7 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
                 before.scene_graph, typed.scene_graph, acted_on, sure_in_both(before, typed)
             ),
             "goal_truly_holds": self.goal.satisfied_by(typed.true_symbols.state),
+            "verdict": verdict,
             # how far the belief the step was planned on had its objects (the record's)
             "misbelieved": belief_errors(
                 before.scene_graph,
@@ -224,6 +238,15 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
             ),
         }
         return self._encode(typed), float(done), done, truncated, info
+
+    def _judge(self, params, outcome: Outcome, before) -> Verdict:
+        """The judge's verdict on the step just run, from the simulator's scene graph before
+        it. Under the ground truth the outcome is the judge's own; a step no plan was run for
+        (refused while planning, an undecodable action) moved nothing and is what it was."""
+        if not self.believing or self.last_plan is None:
+            return Verdict(outcome.status, outcome.detail)
+        plan = self.last_plan
+        return judge(before, self.scene.scene_graph(), params.obj, plan.expected, self._stopped)
 
     def check(self, action: PrimitiveParams) -> bool:
         """A dry run: whether the primitive can be planned in the scene as it is. Nothing

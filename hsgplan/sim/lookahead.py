@@ -26,7 +26,7 @@ class Mark:
     saved state leaves out) and the random state that motion planning draws from."""
 
     state: int
-    held: int | None
+    grip: tuple[int | None, bool]  # `Panda.grip`
     rng: dict[str, Any]
 
 
@@ -49,18 +49,16 @@ class Trial:
     def mark(self) -> Mark:
         m = Mark(
             self.scene.snapshot(),
-            self.scene.robot.held_body,
+            self.scene.robot.grip(),
             self.scene.rng.bit_generator.state,
         )
         self._marks.append(m)
         return m
 
     def back(self, mark: Mark) -> None:
-        robot = self.scene.robot
-        robot.detach()
+        self.scene.robot.detach()
         self.scene.restore(mark.state)
-        if mark.held is not None:
-            robot.attach(mark.held)
+        self.scene.robot.regrip(mark.grip)
         self.scene.rng.bit_generator.state = mark.rng
 
     def run(self, params: PrimitiveParams) -> Outcome:

@@ -1,4 +1,10 @@
-"""What a primitive's execution came to, and the check that decides it."""
+"""What a primitive's execution came to, and the one judge of it (`judge`).
+
+Every executed step is judged by `judge` on the simulator's scene graphs before and after it,
+whatever the robot saw: under the ground truth that verdict is the step's outcome; seeing
+through cameras the robot decides on its own reading (`sim.believing`) and the env keeps the
+judge's verdict for the record (`KitchenStorageEnv.verdicts`, read after the episode).
+"""
 
 from __future__ import annotations
 
@@ -12,9 +18,11 @@ from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose, rotation_apart
 from hsgplan.scene_graph.symbol_mapping import AnomalyKind, map_symbols
 
-# Another object that moves further than this (horizontally) was disturbed by the primitive.
+# Another object that moves further than this (horizontally) was disturbed by the primitive:
+# the judge's, for every observer.
 DISTURB_TOL = 0.02
-# The same judged on what the robot sees (f_p's looks before and after the step), of objects
+# The robot's own reading of the same, seeing through cameras (what it decides, retries and
+# stops on; never the judge's): judged on f_p's looks before and after the step, of objects
 # both looks saw from several views: a move the looks cannot tell from their own spread is none.
 # On the tuning seeds (`eval world --perception rgb --protocol paper --sizes 4-6 --goals 30
 # --seed 900`), objects a step truly left still (none moved 5 mm) seemed to move up to 5.2 cm
@@ -158,9 +166,40 @@ def largest_move(
     )
 
 
-def verify(scene, before: GeometricSceneGraph, obj: str, expected: Literal) -> tuple[Status, str]:
-    """Compare the scene after a primitive with its intended symbolic effect."""
-    return compare(before, scene.scene_graph(), obj, expected)
+@dataclass(frozen=True)
+class Verdict:
+    """The judge's word on one executed step: its status on the simulator's state, and why."""
+
+    status: Status
+    detail: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.status is Status.SUCCESS
+
+
+def judge(
+    before: GeometricSceneGraph,
+    after: GeometricSceneGraph,
+    obj: str,
+    expected: Literal,
+    stopped: str | None = None,
+) -> Verdict:
+    """The one judge of an executed step, on the simulator's scene graphs before and after it
+    (in which an object is held when it rose with the hand, whatever holds it:
+    `Scene.held`): an object toppled or off the table, the intended literal missed (a pick's
+    object not held: dropped), another object moved more than DISTURB_TOL or out of its
+    place; an arm stopped short (`stopped`, from its encoders) where the effect was missed is
+    blocked."""
+    return Verdict(*stopped_outcome(*compare(before, after, obj, expected), stopped))
+
+
+def stopped_outcome(status: Status, detail: str, stopped: str | None) -> tuple[Status, str]:
+    """A primitive whose arm was stopped short and whose effect does not hold failed because
+    it was stopped (unless something fell or toppled, which says more)."""
+    if stopped is None or status in (Status.SUCCESS, Status.KNOCKED_OVER, Status.OFF_TABLE):
+        return status, detail
+    return Status.BLOCKED, stopped
 
 
 def compare(

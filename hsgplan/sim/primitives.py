@@ -17,9 +17,15 @@ import numpy as np
 
 from hsgplan.domain.parameters import PickParams, PlaceParams, PrimitiveParams
 from hsgplan.domain.world import GRIPPER_MAX_OPENING
-from hsgplan.sim.actuation import body_in_grasp, drive_fingers, drive_path, press_towards
+from hsgplan.sim.actuation import (
+    body_in_grasp,
+    drive_fingers,
+    drive_path,
+    press_towards,
+    rests_in_hand,
+)
 from hsgplan.sim.motion_plans import MotionPlan, PlanFailure, plan_primitive
-from hsgplan.sim.outcome import Outcome, Status, verify
+from hsgplan.sim.outcome import Outcome, judge
 from hsgplan.sim.scene import TIME_STEP, Scene
 
 PUSH_SUBSTEPS = 3  # physics steps per 5 mm of push: 0.4 m/s (docs/decisions.md)
@@ -70,17 +76,8 @@ def execute(
     if isinstance(planned, PlanFailure):
         return Outcome(planned.status, planned.detail, time.perf_counter() - start)
     stopped = run_plan(scene, planned, watch.frame, on_phase)
-    status, detail = verify(scene, before, params.obj, planned.expected)
-    status, detail = stopped_outcome(status, detail, stopped)
-    return Outcome(status, detail, time.perf_counter() - start - watch.seconds)
-
-
-def stopped_outcome(status: Status, detail: str, stopped: str | None) -> tuple[Status, str]:
-    """A primitive whose arm was stopped short and whose effect does not hold failed because
-    it was stopped (unless something fell or toppled, which says more)."""
-    if stopped is None or status in (Status.SUCCESS, Status.KNOCKED_OVER, Status.OFF_TABLE):
-        return status, detail
-    return Status.BLOCKED, stopped
+    verdict = judge(before, scene.scene_graph(), params.obj, planned.expected, stopped)
+    return Outcome(verdict.status, verdict.detail, time.perf_counter() - start - watch.seconds)
 
 
 def run_plan(
@@ -98,10 +95,13 @@ def run_plan(
     held = scene.held()
     with scene.asleep(awake=() if held is None else (held,)):
         if isinstance(plan.params, PickParams):
-            return _run_pick(scene, plan, on_frame, on_phase)
-        if isinstance(plan.params, PlaceParams):
-            return _run_place(scene, plan, on_frame, on_phase)
-        return _run_push(scene, plan, on_frame, on_phase)
+            stopped = _run_pick(scene, plan, on_frame, on_phase)
+        elif isinstance(plan.params, PlaceParams):
+            stopped = _run_place(scene, plan, on_frame, on_phase)
+        else:
+            stopped = _run_push(scene, plan, on_frame, on_phase)
+    scene.feel_hold()
+    return stopped
 
 
 def run_path(scene: Scene, path, on_frame: Frame | None = None) -> bool:
@@ -143,7 +143,14 @@ def _run_pick(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:
     if (body := body_in_grasp(robot, tuple(scene.bodies.values()))) is not None:
         robot.attach(body)
     on_phase("grasp")
-    return _retreat(scene, plan, on_frame, on_phase)
+    stopped = _retreat(scene, plan, on_frame, on_phase)
+    if robot.held_body is None:
+        # no constraint was made (the fingers met no opposite faces), yet what rose with the
+        # hand, resting in it alone, is held by friction: held all the same
+        lifted = (b for b in scene.bodies.values() if rests_in_hand(robot, b))
+        if (body := next(lifted, None)) is not None:
+            robot.carry(body)
+    return stopped
 
 
 def _run_place(scene: Scene, plan: MotionPlan, on_frame, on_phase) -> str | None:

@@ -266,6 +266,26 @@ class Panda:
         )
         self.bc.changeConstraint(self.grasp_constraint, maxForce=200.0)
 
+    def carry(self, body: int) -> None:
+        """Take as held an object the closed fingers lifted by friction alone (`attach` makes
+        a constraint only on opposite faces): planning's queries carry it with the hand, while
+        under physics friction alone holds it, until it slips (`Scene.feel_hold`)."""
+        obj = Pose(*self.bc.getBasePositionAndOrientation(body))
+        self.held_offset = obj.relative_to(self.tcp())
+        self.held_body = body
+
+    def grip(self) -> tuple[int | None, bool]:
+        """What the hand holds (a body or None) and whether by friction alone: what a saved
+        physics state leaves out (`regrip` makes it again after a restore)."""
+        return self.held_body, self.held_body is not None and self.grasp_constraint is None
+
+    def regrip(self, grip: tuple[int | None, bool]) -> None:
+        """After a physics state was restored: the hand holds again what `grip` said."""
+        self.detach()
+        body, by_friction = grip
+        if body is not None:
+            (self.carry if by_friction else self.attach)(body)
+
     def detach(self) -> None:
         if self.held_body is not None and self.held_offset is not None:
             self.released = (self.held_body, self.tcp().compose(self.held_offset))

@@ -17,6 +17,7 @@ from pybullet_utils.bullet_client import BulletClient
 from hsgplan.domain.scene import World
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
+from hsgplan.sim.actuation import rests_in_hand
 from hsgplan.sim.arena import Arena, build_arena
 from hsgplan.sim.bodies import spawn_object
 from hsgplan.sim.collision import CollisionChecker
@@ -143,10 +144,20 @@ class Scene:
         return {n: self.pose(n) for n in self.bodies}
 
     def held(self) -> str | None:
+        """The object that rose with the hand: fixed to it by the grasp's constraint, or
+        lifted by friction alone and not yet slipped out (`feel_hold`)."""
         for name, body in self.bodies.items():
             if body == self.robot.held_body:
                 return name
         return None
+
+    def feel_hold(self) -> None:
+        """After the arm moved under physics: an object the fingers lifted by friction alone
+        that no longer rests in the hand has slipped out, and is held no more."""
+        robot = self.robot
+        body = robot.held_body
+        if body is not None and robot.grasp_constraint is None and not rests_in_hand(robot, body):
+            robot.detach()
 
     def scene_graph(self) -> GeometricSceneGraph:
         """s_g from the simulator's ground truth."""

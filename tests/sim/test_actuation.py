@@ -144,8 +144,7 @@ def test_fingers_both_on_top_of_a_can_are_no_grasp():
 
 
 def test_a_stopped_arm_is_the_failure_unless_the_effect_holds_or_something_fell():
-    from hsgplan.sim.outcome import Status
-    from hsgplan.sim.primitives import stopped_outcome
+    from hsgplan.sim.outcome import Status, stopped_outcome
 
     why = "the arm was stopped on its way by something it met"
     assert stopped_outcome(Status.DROPPED, "nothing held", why) == (Status.BLOCKED, why)
