@@ -16,13 +16,14 @@ STATUSES = {
     "crowded that no grasp of the can fits); refused before the arm moves.",
     Status.NO_PATH: "the motion planner found no path to it, or a push line left the arm's "
     "reach; refused before the arm moves.",
-    Status.DROPPED: "the gripper holds nothing after a pick (it closed where the object was "
-    "believed to be), or lost the object on the way.",
+    Status.DROPPED: "after a pick the object did not rise with the hand (it closed where the "
+    "object was believed to be, or the object slipped out), or was lost on the way.",
     Status.KNOCKED_OVER: "an object toppled (a can put down on a box's edge).",
     Status.OFF_TABLE: "an object fell off the table.",
     Status.DISTURBED: f"another object moved: more than {100 * DISTURB_TOL:.0f} cm in the "
-    "simulator, or its place changed; seeing through f_p, seen in another place, or, seen by "
-    f"several views both times, more than {100 * SEEN_DISTURB_TOL:.0f} cm away.",
+    "simulator, or its place changed (the judge's); the robot seeing through f_p reads it as "
+    "seen in another place, or, seen by several views both times, more than "
+    f"{100 * SEEN_DISTURB_TOL:.0f} cm away.",
     Status.EFFECT_NOT_REACHED: "the primitive ran but its intended literal does not hold (a "
     "push too short to bring the can into the shelf).",
     Status.BLOCKS_PICK: "motion data only: the place reached its effect but left an object "
@@ -35,16 +36,17 @@ ENDINGS = {
     Failure.NO_SUBGOAL: "the task planner found nothing reachable to do next.",
     Failure.NO_PARAMETERS: "every choice of parameters for the next action had failed "
     "(recovering protocol).",
-    Failure.FAILED_PRIMITIVE: "paper protocol: a primitive failed, which ends the episode; "
-    "tables show its status (`no_ik 4`: four episodes ended by a refused arm configuration).",
+    Failure.FAILED_PRIMITIVE: "paper protocol: a primitive truly failed (the judge's verdict, "
+    "for every observer), which fails the episode; tables show that verdict (`no_ik 4`: four "
+    "episodes failed by a refused arm configuration).",
     Failure.KNOCKED_OVER: "an object toppled.",
     Failure.OFF_TABLE: "an object fell off the table.",
     Failure.MISPERCEIVED: "the robot saw its goal reached where it truly was not.",
     Failure.NEVER_SEEN: "an object of the goal that no view had found when the robot had to "
     "decide on it (with `seek_unseen`, once the part of the goal it had seen held).",
-    Failure.MISJUDGED: "paper protocol, seeing through f_p: a primitive the robot saw fail "
-    "ended the episode, but its goal truly held (a push seen short whose can was inside). "
-    "The record keeps `failed_primitive`; tables count it here.",
+    Failure.MISJUDGED: "paper protocol, seeing through f_p: the robot stopped on a primitive "
+    "it saw fail that truly succeeded, short of its goal (records made before the one judge: "
+    "`failed_primitive` where the goal truly held).",
     Failure.UNSAMPLED: "no start scene could be sampled for the goal's objects (the world's "
     "limit, not the agent's failure): nothing was tried; left out of every rate and counted "
     "apart (`unsampled`).",
@@ -53,7 +55,11 @@ ENDINGS = {
 
 def glossary() -> str:
     """The two tables of `docs/failures.md`, in Markdown."""
-    lines = ["A primitive's status (each step's `status` in `episodes.jsonl`):", ""]
+    lines = [
+        "A primitive's status (each step's `status` in `episodes.jsonl`, as the robot read it, "
+        "and `truth`, the judge's verdict on the simulator's state):",
+        "",
+    ]
     lines += ["| status | meaning |", "|---|---|"]
     lines += [f"| `{s}` | {STATUSES[s]} |" for s in Status]
     lines += ["", "What ended a failed episode (its `failure`), and the class tables count it in:"]

@@ -285,6 +285,7 @@ def _failures(report: dict) -> TextTable:
                     )
                     + ((str(v.get("relooks", "—")),) if seen else ())
                     + ((str(v.get("misbelieved", {}).get("failed", "—")),) if seen else ())
+                    + ((_misread(v),) if seen else ())
                     + ((str(skipped),) if unsampled else ())
                 )
     title = (
@@ -296,15 +297,17 @@ def _failures(report: dict) -> TextTable:
     if seen:
         title += (
             "; seeing through f_p, perception (the goal seen reached where it was not, an "
-            "object no view found, or a primitive seen to fail where the goal held), the looks "
-            "taken again before a primitive (relook), and failed primitives planned on a belief "
-            "that had an object they acted on more than "
-            f"{BELIEF_OFF * 100:.0f} cm or {BELIEF_TURNED:.0f}° off its true pose (belief off)"
+            "object no view found, or a stop on a primitive seen to fail that truly succeeded), "
+            "the looks taken again before a primitive (relook), failed primitives planned on a "
+            "belief that had an object they acted on more than "
+            f"{BELIEF_OFF * 100:.0f} cm or {BELIEF_TURNED:.0f}° off its true pose (belief off), "
+            "and steps the robot read otherwise than the judge (misread: seen to succeed where "
+            "they truly failed / seen to fail where they truly succeeded)"
         )
     header = ("method", "objects", "episodes", "failed", "execution", "overstep")
     header += (PERCEPTION,) if seen else ()
     header += ("failed primitives", "overstep after failures", "disturbing steps")
-    header += ("relooks", "belief off") if seen else ()
+    header += ("relooks", "belief off", "misread") if seen else ()
     if unsampled:
         title += (
             "; unsampled: goals whose start scene could not be sampled (the world's limit, "
@@ -312,6 +315,13 @@ def _failures(report: dict) -> TextTable:
         )
         header += ("unsampled",)
     return TextTable(title, header, tuple(rows))
+
+
+def _misread(v: dict) -> str:
+    """The misread steps of one size, "seen ok / seen failed" (— in a summary from before the
+    one judge)."""
+    m = v.get("misread_steps")
+    return "—" if m is None else f"{m['seen_ok_truly_failed']} / {m['seen_failed_truly_ok']}"
 
 
 def _times(report: dict) -> TextTable:

@@ -1,5 +1,7 @@
-"""The robot's own model of the scene, for a camera observer's belief: a second physics client
-with the arena, the arm and the objects where the robot believes them.
+"""The robot's own model of the scene: a second physics client with the arena, the arm and the
+objects where the robot believes them (a camera observer's belief), or where they truly are
+(the ground truth observer's, `know`): dry runs, trials and plans are made in it, never in the
+simulated scene.
 
 Every primitive is planned here (inverse kinematics, collision checks, paths, push lines), so
 that the arm acts at the believed poses; the simulated scene only runs the planned joint
@@ -48,6 +50,20 @@ class BeliefWorld:
                 self.scene.set_pose(name, sg.pose(name))
             else:
                 self.scene.park(name)
+
+    def know(self, sg: GeometricSceneGraph, q: np.ndarray, fingers: float) -> None:
+        """The model put to the truth, under the ground truth observer: the arm at the real
+        joints and finger opening, every object at its pose, and the held one in the model's
+        hand where it truly is."""
+        robot = self.scene.robot
+        robot.detach()
+        self.holding = None
+        robot.set_fingers(fingers)
+        robot.set_q(q)
+        self.believe(sg)
+        if sg.held is not None:
+            robot.attach(self.scene.bodies[sg.held])
+            self.holding = sg.held
 
     def follow(self, q: np.ndarray) -> None:
         """The model's arm to the real arm's joints (carrying what it holds)."""

@@ -114,7 +114,7 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         self.believing = isinstance(self.observer, CameraObserver)
         self.rules = rules
         self.visuals = visuals or render or render_mode is not None or self.believing
-        self.world: BeliefWorld | None = None  # the robot's model, with a camera observer
+        self.world: BeliefWorld | None = None  # the robot's model (made at reset)
         self._seen: Seen | None = None  # the belief's last look
         self._judged: Seen | None = None  # the look that judged the last step, if one did
         self._released = None
@@ -162,8 +162,10 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         self._checked.clear()
         self._unplannable.clear()
         self._seen = self._judged = self._released = None
+        # the robot's model, where it plans, dry-runs and tries: of its belief seeing through
+        # cameras, of the truth under the ground truth (`_observe` puts it right)
+        self.world = BeliefWorld(options.objects(), scene_seed, options.goal.world)
         if self.believing:
-            self.world = BeliefWorld(options.objects(), scene_seed, options.goal.world)
             self.observer.start(options.objects(), options.goal.world)
         else:
             self.observer.reset(self.scene)
@@ -195,9 +197,9 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
             outcome = self._step_believed(params, on_frame, ended)
         else:
             plan, plan_seconds = self._checked_plan(params)
-            if plan is None:
+            if plan is None:  # planned in the model, which `_observe` put to the truth
                 start = time.perf_counter()
-                plan = plan_primitive(self.scene, params)
+                plan = self.world.plan(params)
                 plan_seconds = time.perf_counter() - start
             if isinstance(plan, MotionPlan):
                 self.last_plan = plan
@@ -297,12 +299,15 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
             self.world = None
 
     def _planning_scene(self) -> Scene:
-        """Where primitives are planned: the robot's model of its belief, or the scene."""
-        return self.world.scene if self.world is not None else self.scene
+        """Where primitives are planned, dry-run and tried: the robot's model, never the
+        simulated scene."""
+        return self.world.scene
 
     def _observe(self) -> Observation:
         if not self.believing:
             seen = self.observer.observe(self.scene)
+            robot = self.scene.robot
+            self.world.know(seen.scene_graph, robot.q(), robot.finger_opening())
         elif self._judged is not None:
             seen, self._judged = self._judged, None
         else:

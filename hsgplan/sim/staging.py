@@ -3,7 +3,9 @@ scene sampler poses them), inside a shelf, or already in the gripper.
 
 Used to make the situations of self-supervised motion data. Unlike `sample_scene` it makes no
 grasp dry-runs (only the one primitive tried in a staged scene matters) and reuses the scene's
-robot: objects are added and removed, which costs a fraction of building a new client.
+robot: objects are added and removed, which costs a fraction of building a new client. A held
+object is taken up by a pick under physics, so that what follows starts from a grasp the
+fingers made.
 """
 
 from __future__ import annotations
@@ -13,19 +15,22 @@ import random
 
 import numpy as np
 
+from hsgplan.domain.parameters import PickParams
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.world import GRIPPER_MAX_OPENING, Kind
 from hsgplan.scene_graph.geometry import Pose, yaw_quat
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
-from hsgplan.sim.motion_plans import FLOOR_GAP, GRASP_DEPTH
-from hsgplan.sim.robot import REST, TIP_OFFSET, topdown
+from hsgplan.sim.motion_plans import PlanFailure, plan_primitive
+from hsgplan.sim.primitives import run_path, run_plan
+from hsgplan.sim.robot import REST
 from hsgplan.sim.sampler import place_all
 from hsgplan.sim.scene import Scene
 
 ATTEMPTS = 20
-# Where a held object waits: the hand above the table's middle, pointing down.
+# Where a held object is picked from (the table's middle) and how high the hand then waits.
 HOLD_X, HOLD_Y, HOLD_Z = (0.30, 0.55), (-0.25, 0.25), (0.28, 0.38)
+HOLD_CLEAR = 0.15  # m: no other object's centre this near the spot it is picked from
 # Objects inside a shelf stand in one of its slots, this far behind the open front (beyond
 # their half width): where pushes leave them, and somewhat deeper.
 INSIDE_DEPTH = (0.01, 0.06)
@@ -98,21 +103,30 @@ def move_short_of(
 
 
 def hold(scene: Scene, obj: str, rng: random.Random) -> bool:
-    """Put an object in the gripper as a top-down pick would leave it, the hand somewhere
-    above the table's middle. False if that hand pose has no IK solution."""
+    """Put an object in the gripper by a pick the fingers make, as an episode's would: the
+    object stood on the table's middle, clear of the others, picked under physics (held by a
+    grasp's constraint or by friction, at whatever offset the closing fingers left), and the
+    hand driven up with it. False where that spot is crowded, the pick plans nothing or
+    takes nothing up, or the object slips out on the way up."""
     t = scene.world.object_type(obj)
-    closing = rng.uniform(-math.pi, math.pi) if t.kind is Kind.CAN else rng.choice([0, math.pi])
-    target = Pose(
-        (rng.uniform(*HOLD_X), rng.uniform(*HOLD_Y), rng.uniform(*HOLD_Z)), topdown(closing)
-    )
-    q = scene.robot.ik(target, scene.rng, seeds=[REST])
-    if q is None:
+    yaw = rng.uniform(-math.pi, math.pi) if t.kind is Kind.CAN else rng.choice([0, math.pi])
+    x, y = rng.uniform(*HOLD_X), rng.uniform(*HOLD_Y)
+    for o in scene.objects:
+        p = scene.pose(o).position
+        if o != obj and math.hypot(p[0] - x, p[1] - y) < HOLD_CLEAR:
+            return False
+    scene.set_pose(obj, Pose((x, y, t.height / 2 + 0.001), yaw_quat(yaw)))
+    scene.settle()
+    plan = plan_primitive(scene, PickParams(obj))
+    if isinstance(plan, PlanFailure):
         return False
-    scene.robot.set_q(q)
+    run_plan(scene, plan)
+    if scene.held() != obj:
+        return False
     tcp = scene.robot.tcp()
-    depth = min(GRASP_DEPTH, t.height - FLOOR_GAP)
-    z = tcp.position[2] - TIP_OFFSET + depth - t.height / 2
-    scene.set_pose(obj, Pose((tcp.position[0], tcp.position[1], z), yaw_quat(closing)))
-    scene.robot.set_fingers(max(0.0, t.grasp_width - 0.002))
-    scene.robot.attach(scene.bodies[obj])
-    return True
+    up = Pose((*tcp.position[:2], rng.uniform(*HOLD_Z)), tcp.orientation)
+    q = scene.robot.ik(up, scene.rng, seeds=[scene.robot.q()])
+    if q is None or not run_path(scene, [scene.robot.q(), q]):
+        return False
+    scene.feel_hold()
+    return scene.held() == obj

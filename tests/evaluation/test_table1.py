@@ -110,7 +110,13 @@ def test_failed_primitives_planned_on_a_belief_off_are_counted():
     method = {"agent": "regression+gnn", "perception": "rgb", "wall_seconds": 1.0}
     report = {"methods": {"gnn-rgb": method | summarize([record])}}
     (failures,) = tables(report, ("failures",))
-    assert failures.header[-1] == "belief off" and failures.rows[0][-1] == "1"
+    assert failures.header[-2] == "belief off" and failures.rows[0][-2] == "1"
+    # a record from before the one judge holds no verdicts: nothing misread is counted
+    assert failures.header[-1] == "misread" and failures.rows[0][-1] == "0 / 0"
+    judged = replace(record, steps=(replace(steps[0], truth="disturbed"), *steps[1:]))
+    report = {"methods": {"gnn-rgb": method | summarize([judged])}}
+    (failures,) = tables(report, ("failures",))
+    assert failures.rows[0][-1] == "1 / 0"
 
 
 def test_the_table_puts_the_papers_numbers_beside_ours():

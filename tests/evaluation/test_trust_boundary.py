@@ -1,8 +1,8 @@
-"""Seeing through f_p, the robot decides on its belief: during a decision the simulated scene
-is a tripwire (any query of it raises), and one object moved 3 cm behind the robot's back
-between a look and a decision leaves the decision and every dry run as they were. Two kept
-mutations (an agent that reads the truth; dry runs sent to the true scene) show the check
-catching each."""
+"""Seeing through f_p, the robot decides on its belief (under the ground truth, on its model of
+the truth): during a decision the simulated scene is a tripwire (any query of it raises), and
+one object moved 3 cm behind the robot's back between a look and a decision leaves the
+decision and every dry run as they were. Two kept mutations (an agent that reads the truth;
+dry runs sent to the true scene) show the check catching each."""
 
 from dataclasses import dataclass
 
@@ -109,3 +109,14 @@ def test_the_check_catches_an_agent_that_reads_the_truth(env):
 def test_the_check_catches_dry_runs_made_in_the_true_scene(env, monkeypatch):
     monkeypatch.setattr(KitchenStorageEnv, "_planning_scene", lambda self: self.scene)
     assert not blind_to_the_truth(env, CHECKING, True)
+
+
+@pytest.mark.slow
+def test_dry_runs_and_trials_under_the_ground_truth_run_in_a_model_of_their_own():
+    """Under the ground truth the robot sees the simulator's poses, yet plans, dry-runs and
+    tries in its own model of them: the simulated scene is not touched while it decides."""
+    env = KitchenStorageEnv(observer=make_observer("gt"), world=KITCHEN)
+    try:
+        assert blind_to_the_truth(env, CHECKING, True)
+    finally:
+        env.close()
