@@ -140,6 +140,11 @@ def demo(
         f"{verdict} in {len(record.steps)} steps ({record.seconds:.0f} s with the pictures); "
         f"subgoal completion {record.subgoal_completion:.2f}"
     )
+    # the judge read each step on the simulator's state once the episode was over
+    for s in record.steps:
+        if s.truth and s.truth != s.status:
+            why = f" ({s.truth_detail})" if s.truth_detail else ""
+            out.print(f"the judge: step {s.step} truly {s.truth}{why}", highlight=False)
     out.print(f"wrote {shown(out_dir)}/episode.gif, graphs/, episode.json")
     if rerun is not None:
         out.print(f"wrote {shown(rerun)}: open it with `rerun {shown(rerun)}`", highlight=False)

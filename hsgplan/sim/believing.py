@@ -160,6 +160,7 @@ class BelievedSteps:
         if path is None:
             return 0
         run_path(self.scene, path, on_frame)
+        self.scene.feel_hold()  # what friction alone held may have slipped out on the way
         self._seen = self._look()
         return 1
 

@@ -105,6 +105,9 @@ def test_the_typed_path_of_the_agents_still_works():
         _, _, _, _, info = env.step(PickParams("butter"))
         assert info["outcome"].ok, info["outcome"]
         assert info["observation"].scene_graph.held == "butter" != before.held
+        # the one judge's verdict rides in info, and is the outcome under the ground truth
+        assert info["verdict"].status is info["outcome"].status
+        assert env.verdicts == [info["verdict"]]
     finally:
         env.close()
 
