@@ -205,11 +205,7 @@ def trials_from_here(
     kept = {k: getattr(robot, k) for k in ("closing", "released")}
     trials = []
     for action in actions:
-        # a grasp is a constraint, which a saved state leaves out: the last trial's is let go
-        # and the one the scene started with made again
-        robot.detach()
-        scene.restore(snapshot)
-        robot.regrip(grip)
+        scene.back_to(snapshot, grip)  # the hand's hold is no part of the saved state
         status, executed = execute_action(scene, action, max_params)
         after: SymbolicSceneGraph | None = state
         if executed:
@@ -217,9 +213,7 @@ def trials_from_here(
             after = None if mapping.anomalies else mapping.state
         trials.append(WorldTrial(state, action, status, after))
     if put_back:
-        robot.detach()
-        scene.restore(snapshot)
-        robot.regrip(grip)
+        scene.back_to(snapshot, grip)
         for k, v in kept.items():
             setattr(robot, k, v)
     scene.bc.removeState(snapshot)

@@ -130,8 +130,7 @@ def stage_task(scene: Scene, task: MotionTask) -> StagedTask | None:
 
 def try_params(scene: Scene, staged: StagedTask, params) -> Outcome:
     """Run one primitive from the staged state."""
-    scene.restore(staged.snapshot)
-    scene.robot.regrip(staged.grip)
+    scene.back_to(staged.snapshot, staged.grip)
     return execute(scene, params)
 
 

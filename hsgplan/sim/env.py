@@ -183,7 +183,7 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
             else decode(self.scene.objects, action, self.scene.world)
         )
         truth_before = self.scene.scene_graph()
-        true_before = {o: truth_before.pose(o) for o in truth_before.objects}
+        true_before = {n.name: n.pose for n in truth_before.nodes}
         self.last_plan = None
         self._stopped = None
         phases: list[tuple[str, dict]] = []  # the record's: where each phase left the objects

@@ -56,9 +56,7 @@ class Trial:
         return m
 
     def back(self, mark: Mark) -> None:
-        self.scene.robot.detach()
-        self.scene.restore(mark.state)
-        self.scene.robot.regrip(mark.grip)
+        self.scene.back_to(mark.state, mark.grip)
         self.scene.rng.bit_generator.state = mark.rng
 
     def run(self, params: PrimitiveParams) -> Outcome:

@@ -280,8 +280,8 @@ class Panda:
         return self.held_body, self.held_body is not None and self.grasp_constraint is None
 
     def regrip(self, grip: tuple[int | None, bool]) -> None:
-        """After a physics state was restored: the hand holds again what `grip` said."""
-        self.detach()
+        """After a physics state was restored, the hand let go: it holds again what `grip`
+        said (`Scene.back_to`)."""
         body, by_friction = grip
         if body is not None:
             (self.carry if by_friction else self.attach)(body)

@@ -219,6 +219,14 @@ class Scene:
             bc.resetBasePositionAndOrientation(b, *pose)
             bc.resetBaseVelocity(b, *velocity)
 
+    def back_to(self, state: int, grip: tuple[int | None, bool]) -> None:
+        """Back to a snapshot with the hand's hold as `grip` (`Panda.grip`) says: a grasp's
+        constraint is no part of a saved state, so the one made since is let go first and
+        the snapshot's made again after."""
+        self.robot.detach()
+        self.restore(state)
+        self.robot.regrip(grip)
+
     # --- planning queries --------------------------------------------------------------------
 
     def obstacles(self, ignore: Iterable[str] = ()) -> tuple[int, ...]:
