@@ -25,6 +25,7 @@ from hsgplan.cli import (
     perception,
     runs,
     scenes,
+    splits,
     symbolic,
     world,
 )
@@ -59,6 +60,7 @@ app.command()(runs.report)
 app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
 app.add_typer(bench.app, name="bench")
+app.add_typer(splits.app, name="splits")
 bench.app.command("push-reach")(bench_motion.push_reach)
 bench.app.command("line-error")(bench_motion.line_error)
 bench.app.command("push-settings")(bench_motion.push_settings)

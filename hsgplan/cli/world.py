@@ -21,6 +21,8 @@ from hsgplan.cli.common import (
     RunFolder,
     SceneFiles,
     SceneOption,
+    SeedOrSplitStart,
+    SplitOption,
     TaskCheckpoint,
     bounded_option,
     check_ray,
@@ -37,6 +39,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     scene_world,
     shown,
+    split_seed,
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import NO_FAILURE_RULES, RecoveryRules
@@ -196,7 +199,8 @@ def evaluate(
         int,
         config_option(EvalConfig, "repeats", "Episodes per goal, each from its own scene."),
     ] = config_default(EvalConfig, "repeats"),
-    seed: Annotated[int, bounded_option("seed", "Seed of the goals and the episodes.")] = 0,
+    seed: SeedOrSplitStart = None,
+    split: SplitOption = None,
     goals_file: Annotated[
         Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
     ] = None,
@@ -291,7 +295,7 @@ def evaluate(
         "",
         tuple(parse_sizes(sizes)),
         goals,
-        seed,
+        split_seed(seed, split),
         str(goals_file) if goals_file else None,
         repeats,
         checkpoint and str(shipped(checkpoint)),
@@ -300,6 +304,7 @@ def evaluate(
         protocol=protocol.value,
         rules_off=names_of(rules_off, "--rules-off", "rule", none=True),
         scene=str(scene) if scene else None,
+        split=split and split.value,
     )
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
         make_observer(p, config.perception_checkpoint)
@@ -349,4 +354,5 @@ def _run_name(methods, config) -> str:
     protocol = "" if config.protocol == DEFAULT_PROTOCOL.value else f"-{config.protocol}"
     protocol += "".join(f"-no_{rule}" for rule in config.rules_off)
     where = f"-{Path(config.scene).stem}" if config.scene else ""
-    return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-seed{config.seed}{where}"
+    seed = config.split or f"seed{config.seed}"
+    return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-{seed}{where}"

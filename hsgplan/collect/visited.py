@@ -16,10 +16,11 @@ actions are executed from that state as `collect reach` executes them from a sta
 goes on. Nothing here asks the hand-written rules: what the world shows is the label. The
 episodes run in the kitchen, or in the world of a scene file, or round a folder of them.
 
-The goals are drawn from `GOAL_SEEDS.start + seed`, apart from every seed an evaluation
-reports on or tunes on (`evaluation.seeds`). A work item is one episode; its row holds every
-state it visited (`data/world_trials.py`), so an interruption loses at most the episodes in
-flight and repeats nothing logged.
+The goals are the train split's (`evaluation.splits`), drawn from `GOAL_SEEDS.start + seed`,
+apart from every seed an evaluation reports on or tunes on; each row records its goal and its
+start scene's seed, which `hsgplan splits check` holds apart from the test split. A work item
+is one episode; its row holds every state it visited (`data/world_trials.py`), so an
+interruption loses at most the episodes in flight and repeats nothing logged.
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import read_world, read_worlds
 from hsgplan.evaluation.seeds import GOAL_SEEDS, episode_seed
+from hsgplan.evaluation.splits import TRAIN, split_goals
 
 AGENT = "learned"
 
@@ -89,10 +91,9 @@ def _world(scene: str | None) -> World:
 
 
 def _goal(item: VisitedItem):
-    from hsgplan.symbolic.generator import random_goals
-
     # the first k goals of a seed are the same however many are drawn: a rerun may ask for more
-    goals = random_goals(
+    goals = split_goals(
+        TRAIN,
         item.size,
         item.index + 1,
         GOAL_SEEDS.start + item.seed,
@@ -131,7 +132,13 @@ def explore_episode(item: VisitedItem, goal) -> dict:
 
     agent = _agent(item.checkpoint, item.motion_checkpoints)
     record = run_episode(env, agent, goal, item.episode_seed, on_step=explore)
-    return {"states": states, "goal": str(goal), "success": record.success}
+    # the goal and the start scene's seed it drew: what `hsgplan splits check` reads
+    return {
+        "states": states,
+        "goal": str(goal),
+        "seed": item.episode_seed,
+        "success": record.success,
+    }
 
 
 @dataclass(frozen=True)
@@ -193,11 +200,12 @@ def collect_visited(
         "actions_per_state": ACTIONS_PER_STATE,
         "max_params": MAX_PARAMS,
         "fingerprint": fingerprint(read),
+        "goals": TRAIN.name,  # its goals' split (`evaluation.splits`)
     }
     if scene is not None:
         config["scene"] = str(scene)
     refusal = (
-        f"'{out}' holds a collection made with other settings, checkpoints or scene; "
+        f"'{out}' holds a collection made with other settings, checkpoints, scene or goals; "
         "use another --out"
     )
     files = list(worlds)

@@ -15,7 +15,7 @@ from pathlib import Path
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.report import read_summary
-from hsgplan.evaluation.seeds import marked
+from hsgplan.evaluation.seeds import marked, seed_words
 from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable, cell, label, protocol_name, where
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 
@@ -27,6 +27,7 @@ LIKE_FOR_LIKE = (
     "goals_file",
     "repeats",
     "seed",
+    "split",
     "sizes",
     "scene",
 )
@@ -96,10 +97,10 @@ def compare(
     title = (
         f"Success rate / subgoal completion of {what} "
         f"by {by} ({protocol}{', rules by row' if across_rules else ''}): "
-        f"{source}, {repeats}, seed {first['seed']}{place}"
+        f"{source}, {repeats}, {seed_words(first['seed'], first.get('split'))}{place}"
     )
     header = ("run", *(f"{n} objects" for n in sizes))
-    return TextTable(marked(title, first["seed"]), header, tuple(rows))
+    return TextTable(marked(title, first["seed"], split=first.get("split")), header, tuple(rows))
 
 
 def _check_episodes(runs: Sequence[Path], by_run: list[dict]) -> None:

@@ -81,9 +81,18 @@ class EvalConfig:
     # rules switched off (any under the recovering protocol, the perception rules under both)
     rules_off: tuple[str, ...] = ()
     scene: str | None = None  # a scene file or a folder of them (None: the kitchen)
+    # the split its goals and start scenes are drawn from (`evaluation.splits`; None: a bare
+    # seed, exploration, its goals drawn from the whole goal space)
+    split: str | None = None
 
     def __post_init__(self) -> None:
         check_fields(self)
+        if self.split is not None:
+            from hsgplan.evaluation.splits import check_seed, split_named
+
+            if self.goals_file:
+                raise InvalidInputError("--split draws its goals: give no --goals-file with it")
+            check_seed(split_named(self.split), self.seed)
         check_observer(self.perception)
         if self.protocol not in PROTOCOLS:
             raise InvalidInputError(f"protocol '{self.protocol}': one of {', '.join(PROTOCOLS)}")

@@ -37,9 +37,9 @@ from hsgplan.evaluation.config import EvalConfig, world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer, perception_folder
 from hsgplan.evaluation.seeds import episode_seed
+from hsgplan.evaluation.splits import split_goals, split_named
 from hsgplan.runner.items import run_items
 from hsgplan.runner.run_folder import CONFIG, add_wall_seconds, check_claim
-from hsgplan.symbolic.generator import random_goals
 
 
 @dataclass(frozen=True)
@@ -95,8 +95,11 @@ def _specs(config: EvalConfig, scene: str | None, world: World) -> list[EpisodeS
         if not by_size:
             raise InvalidInputError(f"'{config.goals_file}' holds no goal of the sizes asked for")
     else:
+        split = split_named(config.split) if config.split else None
         for n in config.sizes:
-            by_size[n] = random_goals(n, config.goals, config.seed, stacking=n > 2, world=world)
+            by_size[n] = split_goals(
+                split, n, config.goals, config.seed, stacking=n > 2, world=world
+            )
     return [
         EpisodeSpec(n, i, str(g), episode_seed(config.seed, n, i, r), r, scene)
         for n in sorted(by_size)
@@ -141,6 +144,8 @@ def run_config(config: EvalConfig) -> dict:
         settings["rules_off"] = list(config.rules_off)
     if config.scene is None:  # as runs were claimed before scenes were files
         del settings["scene"]
+    if config.split is None:  # as runs were claimed before splits
+        del settings["split"]
     files = [Path(p) for p in (config.goals_file, *config.worlds()) if p]
     return settings | {
         "sizes": list(config.sizes),

@@ -18,7 +18,7 @@ from hsgplan.domain.recovery import RECOVERING
 from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.protocol import check_runs, check_world, episode_specs, run_evaluation
-from hsgplan.evaluation.seeds import is_tuning, marked
+from hsgplan.evaluation.seeds import is_tuning, marked, seed_words
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim, read_timing, sittings
@@ -130,6 +130,7 @@ def run_table(
         "goals_file": config.goals_file,
         "repeats": config.repeats,
         "seed": config.seed,
+        "split": config.split,
         "tuning_seed": is_tuning(config.seed),
         "run": str(out),
         **({"scenes": [str(p) for p in config.worlds()]} if config.scene else {}),
@@ -238,14 +239,14 @@ def _results(report: dict) -> TextTable:
     )
     title = (
         f"Success rate / subgoal completion ({protocol_name(report)}): {source}{repeats}, "
-        f"seed {report['seed']}{where(report)}"
+        f"{seed_words(report['seed'], report.get('split'))}{where(report)}"
     )
     if unsampled := _unsampled(report):
         title += (
             f"; {unsampled} episode(s) whose start scene could not be sampled are left out "
             "(the failure table)"
         )
-    title = marked(title, report["seed"])
+    title = marked(title, report["seed"], split=report.get("split"))
     return TextTable(title, tuple(header), tuple(rows))
 
 

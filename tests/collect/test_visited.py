@@ -80,7 +80,7 @@ def test_collect_visited_end_to_end_a_rerun_repeats_nothing_and_training_reads_i
     # another agent's episodes are never mixed into the collection
     other = ["--checkpoint", "checkpoints/task-paper", "--out", str(out)]
     r = CliRunner().invoke(app, [*args, *other])
-    assert r.exit_code == 2 and "other settings, checkpoints or scene" in r.stderr
+    assert r.exit_code == 2 and "other settings, checkpoints, scene or goals" in r.stderr
     assert (out / "episodes.jsonl").read_text().splitlines() == lines
     config = TaskTrainConfig(loop_trials=str(out))
     sources = _examples("reach", [], [], config, KITCHEN, KITCHEN)
@@ -150,7 +150,7 @@ def test_a_collection_in_a_scene_records_it_and_another_scene_is_refused(tmp_pat
     summary = collect_visited(out, 1, (2,), workers=1, scene=LAYOUT)
     assert summary.trials > 0
     assert json.loads((out / "config.json").read_text())["scene"] == str(LAYOUT)
-    with pytest.raises(InvalidInputError, match="other settings, checkpoints or scene"):
+    with pytest.raises(InvalidInputError, match="other settings, checkpoints, scene or goals"):
         collect_visited(out, 1, (2,), workers=1)
 
 

@@ -151,6 +151,9 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
         for t in tables(report)[::2]  # in the tables' own order
     ]
     assert "(a tuning seed: for choosing rules, not a result)" in markdown(report | {"seed": 901})
+    assert "(exploration: a bare seed" in text  # seed 0 and no split
+    test = markdown(report | {"seed": 2_000_000, "split": "test"})
+    assert "test split (seed 2000000)" in test and "exploration" not in test
 
 
 def test_repeats_run_each_goal_from_scenes_of_their_own():
