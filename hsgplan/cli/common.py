@@ -337,6 +337,17 @@ SeedOrSplitStart = Annotated[
 ]
 
 
+TrainingSeeds = Annotated[
+    int | None,
+    typer.Option(
+        help="Train K times, with the configuration's seed and the K-1 after it, seed S into "
+        "OUT/seed-S (docs/retraining.md, Trainings).",
+        min=1,
+        metavar="K",
+    ),
+]
+
+
 def split_seed(seed: int | None, split) -> int:
     """The run's seed: the one given, else the split's first seed, else 0."""
     if seed is not None:

@@ -18,6 +18,7 @@ from hsgplan.cli.common import (
     SceneFiles,
     Summaries,
     SymbolicPlannerName,
+    TrainingSeeds,
     bounded_option,
     check_ray,
     dash,
@@ -60,16 +61,31 @@ def train_task(
         int | None,
         bounded_option("seed", "Overrides the configuration's seed."),
     ] = None,
+    seeds: TrainingSeeds = None,
 ) -> None:
     """Train f_preimage, f_reach and the forward baseline on the demonstrations."""
-    from hsgplan.domain.kitchen import KITCHEN
+    from dataclasses import replace
+
     from hsgplan.planning.regression.train import TaskTrainConfig
-    from hsgplan.planning.regression.train import train_task as run
+    from hsgplan.trainings import record, seed_folder, training_seeds
 
     settings = read_config(config)
     if seed is not None:
         settings["seed"] = seed
     cfg = TaskTrainConfig.from_json(settings)
+    every = training_seeds(cfg.seed, seeds) if seeds else [None]
+    for s in every:
+        folder = out_dir if s is None else seed_folder(out_dir, s)
+        _train_task_once(cfg if s is None else replace(cfg, seed=s), folder)
+        if s is not None:
+            record(out_dir, [s], "task")
+        out.print(f"trained f_preimage, f_reach and the forward baseline into {shown(folder)}")
+
+
+def _train_task_once(cfg, folder: Path) -> None:
+    from hsgplan.domain.kitchen import KITCHEN
+    from hsgplan.planning.regression.train import train_task as run
+
     with Progress(console=err, transient=True) as progress:
         bars = {}
 
@@ -78,8 +94,7 @@ def train_task(
                 bars[name] = progress.add_task(name, total=cfg.epochs)
             progress.update(bars[name], completed=epoch, description=f"{name} loss {loss:.4f}")
 
-        run(cfg, out_dir, on_epoch, world=KITCHEN)  # of data recorded without a scene file
-    out.print(f"trained f_preimage, f_reach and the forward baseline into {shown(out_dir)}")
+        run(cfg, folder, on_epoch, world=KITCHEN)  # of data recorded without a scene file
 
 
 @train_app.command("combine")

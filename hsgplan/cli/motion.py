@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import replace
 from enum import StrEnum
 from pathlib import Path
@@ -16,6 +17,7 @@ from hsgplan.cli.common import (
     MarkdownFlag,
     RayAddress,
     SceneFiles,
+    TrainingSeeds,
     bounded_option,
     check_ray,
     err,
@@ -65,35 +67,60 @@ def train_motion(
         Path | None,
         typer.Option(help="Dataset folder (overrides the config).", parser=input_path),
     ] = None,
+    seeds: TrainingSeeds = None,
+    name: Annotated[
+        str | None,
+        typer.Option(
+            help="With --seeds, the network's folder in each OUT/seed-S (default: PRIMITIVE-MODEL)."
+        ),
+    ] = None,
 ) -> None:
     """Train a motion network (config loss: ce on the successes, bce on every trial)."""
     from hsgplan.motion.train import MotionTrainConfig
-    from hsgplan.motion.train import train_motion as run
+    from hsgplan.trainings import record, seed_folder, training_seeds
 
     settings = read_config(config)
-    for name, given in (("primitive", primitive), ("model", model)):
-        if given is not None and settings.get(name, given.value) != given.value:
+    for option, given in (("primitive", primitive), ("model", model)):
+        if given is not None and settings.get(option, given.value) != given.value:
             raise InvalidInputError(
-                f"--{name} {given.value}: the configuration '{config}' trains "
-                f"{name} {settings[name]!r}"
+                f"--{option} {given.value}: the configuration '{config}' trains "
+                f"{option} {settings[option]!r}"
             )
         if given is not None:
-            settings[name] = given.value
+            settings[option] = given.value
     cfg = MotionTrainConfig.from_json(settings)
     primitive, model = cfg.primitive, cfg.model
     if data is not None:
         cfg = replace(cfg, data=str(data))
+    if name is not None and (seeds is None or not _FOLDER_NAME.match(name)):
+        raise InvalidInputError(
+            f"--name '{name}': a folder name (letters, digits, - and _), with --seeds"
+        )
     folder = out_dir or RUNS / f"train-motion-{primitive}-{model}"
+    every = training_seeds(cfg.seed, seeds) if seeds else [None]
+    for s in every:
+        into = folder if s is None else seed_folder(folder, s) / (name or f"{primitive}-{model}")
+        _train_motion_once(cfg if s is None else replace(cfg, seed=s), into)
+        if s is not None:
+            record(folder, [s], into.name)
+        out.print(f"trained the {model} {primitive} network into {shown(into)}")
+
+
+_FOLDER_NAME = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def _train_motion_once(cfg, into: Path) -> None:
+    from hsgplan.motion.train import train_motion as run
+
     with Progress(console=err, transient=True) as progress:
-        bar = progress.add_task(f"{primitive} {model}", total=cfg.epochs)
+        bar = progress.add_task(f"{cfg.primitive} {cfg.model}", total=cfg.epochs)
 
         def on_epoch(epoch: int, loss: float) -> None:
             progress.update(
-                bar, completed=epoch, description=f"{primitive} {model} loss {loss:.3f}"
+                bar, completed=epoch, description=f"{cfg.primitive} {cfg.model} loss {loss:.3f}"
             )
 
-        run(cfg, folder, on_epoch)
-    out.print(f"trained the {model} {primitive} network into {shown(folder)}")
+        run(cfg, into, on_epoch)
 
 
 @refuses_bad_input

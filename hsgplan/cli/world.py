@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -269,8 +270,8 @@ def evaluate(
     from hsgplan.evaluation.ablation import ablation_table, check_ablation, run_ablation
     from hsgplan.evaluation.config import TABLES, EvalConfig
     from hsgplan.evaluation.observers import make_observer
-    from hsgplan.evaluation.protocol import checkpoints, episode_specs
-    from hsgplan.evaluation.table1 import Method, check_table, run_table, tables
+    from hsgplan.evaluation.protocol import checkpoints, trained
+    from hsgplan.evaluation.table1 import Method, check_table, run_table, tables, total_episodes
 
     planner_name = planner and planner.value
     if motion is None:
@@ -308,7 +309,7 @@ def evaluate(
     )
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
         make_observer(p, config.perception_checkpoint)
-    total = len(episode_specs(config)) * len(methods)
+    total = total_episodes(methods, config)
     folder = run_dir or RUNS / (_run_name(methods, config) + ("-ablation" if ablate_rules else ""))
     check_ray(ray)
     which = names_of(shown_tables, "--tables", "table")
@@ -319,7 +320,8 @@ def evaluate(
     else:
         check_table(methods, config, folder)
     for m in methods:  # an unknown name or a missing checkpoint: refused before any work
-        make_agent(m.agent, *checkpoints(config))
+        for c in trained(replace(config, agent=m.agent)).values():
+            make_agent(m.agent, *checkpoints(c))
     run = run_ablation if ablate_rules else run_table
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task(", ".join(m.agent for m in methods), total=total)

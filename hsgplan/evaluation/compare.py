@@ -16,7 +16,15 @@ from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.report import read_summary
 from hsgplan.evaluation.seeds import marked, seed_words
-from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable, cell, label, protocol_name, where
+from hsgplan.evaluation.table1 import (
+    PAPER_TABLE1,
+    TextTable,
+    cell,
+    label,
+    protocol_name,
+    runs_words,
+    where,
+)
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 
 # what rows must share; the checkpoints are what a ladder's rows change
@@ -86,7 +94,7 @@ def compare(
         rows.append((f"{label(method)} (paper)", *cells))
     first = summaries[0]
     source = first["goals_file"] or f"{first['goals']} random goals per size"
-    repeats = "each run once" if first["repeats"] == 1 else f"each run {first['repeats']} times"
+    repeats = runs_words(first).removeprefix(", ")
     what = label(method) if one else "each run's method"
     if across_scenes:
         episodes = next(iter(by_run[0].values()))["episodes"]

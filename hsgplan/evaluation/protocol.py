@@ -167,17 +167,35 @@ def read_eval_config(run_dir: Path) -> EvalConfig:
 
 
 def check_runs(config: EvalConfig, out: Path, agents: dict[str, tuple[str, str]]) -> None:
-    """Refuse, before anything is written, a folder `out/NAME` (one per agent and perception)
-    that is no evaluation's or holds episodes of another configuration, checkpoint or goal
-    file."""
+    """Refuse, before anything is written, a folder `out/NAME` (one per agent and perception;
+    `out/NAME/seed-S` per training) that is no evaluation's or holds episodes of another
+    configuration, checkpoint or goal file."""
     for name, (agent, perception) in agents.items():
-        run_dir = out / name
-        refusal = (
-            f"'{run_dir}' holds episodes of another configuration, checkpoint or goal file; "
-            "use another --out"
-        )
-        run = run_config(replace(config, agent=agent, perception=perception))
-        check_claim(run_dir, EVAL_KIND, run, refusal)
+        method = replace(config, agent=agent, perception=perception)
+        for seed, trained_config in trained(method).items():
+            run_dir = training_dir(out / name, seed)
+            refusal = (
+                f"'{run_dir}' holds episodes of another configuration, checkpoint or goal file; "
+                "use another --out"
+            )
+            check_claim(run_dir, EVAL_KIND, run_config(trained_config), refusal)
+
+
+def trained(config: EvalConfig) -> dict[int | None, EvalConfig]:
+    """The configuration of each training an evaluation runs, by training seed: one for each
+    `seed-S` of a trainings folder named by `checkpoint` or `motion_checkpoints`
+    (`hsgplan.trainings`); {None: config} where neither is one."""
+    from hsgplan.trainings import paired
+
+    return {
+        seed: replace(config, checkpoint=task, motion_checkpoints=motion)
+        for seed, (task, motion) in paired(config.checkpoint, config.motion_checkpoints).items()
+    }
+
+
+def training_dir(run_dir: Path, seed: int | None) -> Path:
+    """Where one training's episodes are logged: the method's folder, or its `seed-S`."""
+    return run_dir if seed is None else run_dir / f"seed-{seed}"
 
 
 def checkpoints(config: EvalConfig) -> tuple[Path, Path]:

@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import statistics
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.failures import Failure
+from hsgplan.evaluation.intervals import stratified_interval
 from hsgplan.sim.outcome import DISTURB_RECORD, DISTURB_TOL, SEEN_DISTURB_TOL, Status
 
 EXECUTION = "execution"
@@ -85,6 +86,13 @@ def _spread(values_by_repeat: dict[int, list[float]]) -> float | None:
     return statistics.pstdev(means) if len(means) > 1 else None
 
 
+def _by_goal(rs: Sequence[EpisodeRecord]) -> dict[str, list[float]]:
+    goals: dict[str, list[float]] = {}
+    for r in rs:
+        goals.setdefault(r.goal, []).append(float(r.success))
+    return goals
+
+
 def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
     by_repeat: dict[int, list[EpisodeRecord]] = {}
     for r in rs:
@@ -97,6 +105,8 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "episodes": len(rs),
         "repeats": len(by_repeat),
         "success_std": _spread({k: [r.success for r in v] for k, v in by_repeat.items()}),
+        # each goal a stratum; its episodes (trainings, repeats) resampled within it
+        "success_ci": stratified_interval(_by_goal(rs)),
         "completion_std": _spread(
             {k: [r.subgoal_completion for r in v] for k, v in by_repeat.items()}
         ),
@@ -187,6 +197,26 @@ def misbelieved(rs: Sequence[EpisodeRecord]) -> dict:
         "max_off": max((e.off for _, e in errors), default=0.0),
         "max_turned": max((e.turned for _, e in errors), default=0.0),
     }
+
+
+def summarize_trainings(runs: Mapping[int | None, Sequence[EpisodeRecord]]) -> dict:
+    """`summarize` over every training's records (`{None: records}`: one training), each
+    size's success rate with its interval over goals, trainings and repeats (`intervals`),
+    and with several trainings each one's rate."""
+    summary = summarize([r for rs in runs.values() for r in rs])
+    seeds = [s for s in runs if s is not None]
+    summary["trainings"] = seeds
+    for n, entry in summary["by_size"].items():
+        if seeds:
+            entry["success_by_training"] = [
+                _rate([r for r in runs[s] if str(r.size) == n and r.failure != Failure.UNSAMPLED])
+                for s in seeds
+            ]
+    return summary
+
+
+def _rate(rs: Sequence[EpisodeRecord]) -> float | None:
+    return sum(r.success for r in rs) / len(rs) if rs else None
 
 
 def summarize(records: Sequence[EpisodeRecord]) -> dict:

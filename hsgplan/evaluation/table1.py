@@ -17,9 +17,16 @@ from pathlib import Path
 from hsgplan.domain.recovery import RECOVERING
 from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.protocol import check_runs, check_world, episode_specs, run_evaluation
+from hsgplan.evaluation.protocol import (
+    check_runs,
+    check_world,
+    episode_specs,
+    run_evaluation,
+    trained,
+    training_dir,
+)
 from hsgplan.evaluation.seeds import is_tuning, marked, seed_words
-from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize
+from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize_trainings
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim, read_timing, sittings
 from hsgplan.sim.outcome import BELIEF_OFF, BELIEF_TURNED
@@ -81,6 +88,8 @@ def table_settings(config: EvalConfig) -> dict:
     } | {"sizes": list(config.sizes), "rules_off": list(config.rules_off)}
     if config.protocol == RECOVERING and not config.rules_off:
         del table["protocol"], table["rules_off"]
+    if config.split is None:  # as tables were claimed before splits
+        del table["split"]
     return table
 
 
@@ -106,24 +115,23 @@ def run_table(
     summary, also written as `summary.json`, `table1.md` and `table1.png` in `out`."""
     table, refusal = check_table(methods, config, out)
     for m in methods:  # an agent refused a scene is refused before the folder is claimed
-        check_world(replace(config, agent=m.agent, perception=m.perception))
+        for c in trained(replace(config, agent=m.agent, perception=m.perception)).values():
+            check_world(c)
     claim(out, TABLE_KIND, table, refusal)
-    records = {}
+    runs: dict[str, dict[int | None, list[EpisodeRecord]]] = {}
     for m in methods:
-        records[m.name] = run_evaluation(
-            replace(config, agent=m.agent, perception=m.perception),
-            out / m.name,
-            workers,
-            on_episode,
-            ray,
-        )
+        method = replace(config, agent=m.agent, perception=m.perception)
+        runs[m.name] = {
+            seed: run_evaluation(c, training_dir(out / m.name, seed), workers, on_episode, ray)
+            for seed, c in trained(method).items()
+        }
     report = {
         "protocol": config.protocol,
         "rules_off": list(config.rules_off),
         "methods": {
             m.name: {"agent": m.agent, "perception": m.perception}
-            | read_timing(out / m.name)
-            | summarize(records[m.name])
+            | _timing(out / m.name, runs[m.name])
+            | summarize_trainings(runs[m.name])
             for m in methods
         },
         "goals": config.goals,
@@ -156,13 +164,29 @@ def run_table(
     return report
 
 
+def _timing(run_dir: Path, runs: dict) -> dict:
+    """A method's wall clock: its folder's, or the sum of its trainings' folders'."""
+    timings = [read_timing(training_dir(run_dir, seed)) for seed in runs]
+    return {
+        "wall_seconds": sum(t["wall_seconds"] for t in timings),
+        "sittings": [s for t in timings for s in t["sittings"]],
+    }
+
+
 def total_episodes(methods: list[Method], config: EvalConfig) -> int:
-    return len(methods) * len(episode_specs(config))
+    return sum(
+        len(trained(replace(config, agent=m.agent))) * len(episode_specs(config)) for m in methods
+    )
 
 
 def cell(v: dict) -> str:
+    """Success rate (its 95% interval, or ± its spread over repeats in summaries from before
+    intervals) / subgoal completion."""
     sr, sc = f"{v['success_rate']:.2f}", f"{v['subgoal_completion']:.2f}"
-    if v.get("success_std") is not None:
+    if v.get("success_ci") is not None:
+        lo, hi = v["success_ci"]
+        sr += f" ({lo:.2f}–{hi:.2f})"
+    elif v.get("success_std") is not None:
         sr += f" ± {v['success_std']:.2f}"
     return f"{sr} / {sc}"
 
@@ -231,12 +255,7 @@ def _results(report: dict) -> TextTable:
                 row.append(f"{paper[0]:.2f} / {paper[1]:.2f}" if paper else "—")
         rows.append(tuple(row))
     source = report["goals_file"] or f"{report['goals']} random goals per size"
-    repeats = (
-        f", each run {report['repeats']} times (± the standard deviation of the success rate "
-        "over the repeats)"
-        if report["repeats"] > 1
-        else ", each run once"
-    )
+    repeats = runs_words(report)
     title = (
         f"Success rate / subgoal completion ({protocol_name(report)}): {source}{repeats}, "
         f"{seed_words(report['seed'], report.get('split'))}{where(report)}"
@@ -248,6 +267,24 @@ def _results(report: dict) -> TextTable:
         )
     title = marked(title, report["seed"], split=report.get("split"))
     return TextTable(title, tuple(header), tuple(rows))
+
+
+def runs_words(report: dict) -> str:
+    """How often each goal ran, and what the spread beside a rate is."""
+    methods = report["methods"].values()
+    trained = max((len(s.get("trainings") or []) for s in methods), default=0)
+    with_ci = any(v.get("success_ci") for s in methods for v in s["by_size"].values())
+    words = f", each run {report['repeats']} times" if report["repeats"] > 1 else ", each run once"
+    if trained:
+        words += f" under each of {trained} trainings"
+    if with_ci:
+        return words + (
+            " (in brackets the 95% interval: a bootstrap over goals, each goal's episodes "
+            "resampled within it)"
+        )
+    if report["repeats"] > 1:
+        return words + " (± the standard deviation of the success rate over the repeats)"
+    return words
 
 
 def _unsampled(report: dict) -> int:

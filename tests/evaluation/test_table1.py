@@ -141,7 +141,8 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
     header = next(line for line in text.splitlines() if line.startswith("| objects"))
     assert header == "| objects | GNN | GNN (paper) | sampler |"
     paper = PAPER_TABLE1["gnn"][2]
-    assert f"| 2 | 0.50 / 0.75 | {paper[0]:.2f} / {paper[1]:.2f} | 0.50 / 0.75 |" in text
+    ours = "0.50 (0.00–1.00) / 0.75"  # one goal, run twice: its 95% interval
+    assert f"| 2 | {ours} | {paper[0]:.2f} / {paper[1]:.2f} | {ours} |" in text
     assert "| GNN | 2 | 2 | 1 | 0 | 1 (step limit 1) | 1 | 1 |" in text
     assert "(recovering protocol)" in text  # a report without a protocol predates the paper's
     assert "whole run: GNN 1.5 min (2 workers), sampler 0.0 min (? workers)" in text

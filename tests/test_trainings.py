@@ -1,0 +1,108 @@
+"""One configuration trained several times (a folder per seed), and intervals over trainings,
+goals and repeats."""
+
+import json
+import random
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from hsgplan.cli import app
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.evaluation.config import EvalConfig
+from hsgplan.evaluation.intervals import separate, stratified_interval
+from hsgplan.evaluation.protocol import trained, training_dir
+from hsgplan.trainings import RECORD, paired, record, seed_folders
+
+TINY_MOTION = {"epochs": 1, "samples": 64, "hidden": 16, "embed": 8, "rounds": 1, "loss": "ce"}
+
+
+def _trainings(root, seeds):
+    for s in seeds:
+        (root / f"seed-{s}").mkdir(parents=True)
+    record(root, list(seeds), "task")
+    return root
+
+
+def test_a_trainings_folder_is_known_by_its_record(tmp_path):
+    root = _trainings(tmp_path / "t", [0, 1, 2])
+    assert list(seed_folders(root)) == [0, 1, 2]
+    (root / RECORD).unlink()
+    assert seed_folders(root) is None  # seed-S folders alone are no trainings folder
+    assert seed_folders(None) is None
+
+
+def test_trainings_pair_by_seed_and_a_plain_folder_serves_every_seed(tmp_path):
+    task = _trainings(tmp_path / "task", [0, 1])
+    motion = _trainings(tmp_path / "motion", [0, 1])
+    assert paired(task, motion)[1] == (str(task / "seed-1"), str(motion / "seed-1"))
+    assert paired(task, "plain")[0] == (str(task / "seed-0"), "plain")
+    assert paired("a", "b") == {None: ("a", "b")}
+    other = _trainings(tmp_path / "other", [5, 6])
+    with pytest.raises(InvalidInputError, match="same seeds"):
+        paired(task, other)
+
+
+def test_an_evaluation_runs_each_training_in_a_folder_of_its_own(tmp_path):
+    task = _trainings(tmp_path / "task", [3, 4])
+    config = EvalConfig("learned", (3,), 2, 0, checkpoint=str(task))
+    runs = trained(config)
+    assert list(runs) == [3, 4] and runs[4].checkpoint == str(task / "seed-4")
+    assert training_dir(tmp_path / "gnn", 4) == tmp_path / "gnn" / "seed-4"
+    assert trained(EvalConfig("learned", (3,), 2, 0)) == {None: EvalConfig("learned", (3,), 2, 0)}
+
+
+def test_train_motion_seeds_trains_each_seed_into_its_folder(tmp_path):
+    config = tmp_path / "tiny.json"
+    config.write_text(json.dumps(TINY_MOTION))
+    out = tmp_path / "motion"
+    args = ["train", "motion", "--config", str(config), "--seeds", "2", "--out", str(out)]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 0, r.output
+    weights = [(out / f"seed-{s}" / "place-gnn" / "model.safetensors").read_bytes() for s in (0, 1)]
+    assert weights[0] != weights[1]  # another seed, another network
+    saved = [
+        json.loads((out / f"seed-{s}" / "place-gnn" / "config.json").read_text()) for s in (0, 1)
+    ]
+    assert [c.get("seed") for c in saved] in ([0, 1], [None, None])
+    assert json.loads((out / RECORD).read_text()) == {
+        "trained": {"place-gnn": [0, 1]},
+        "shipped_seed": 0,
+    }
+    assert list(seed_folders(out)) == [0, 1]
+    bad = CliRunner().invoke(app, [*args[:-2], "--out", str(out), "--name", "../x"])
+    assert bad.exit_code == 2
+
+
+def test_an_interval_needs_two_episodes_of_every_goal():
+    assert stratified_interval({"a": [1.0], "b": [0.0, 1.0]}) is None
+    assert stratified_interval({"a": [1.0, 1.0], "b": [0.0, 0.0]}) == (0.5, 0.5)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 10_000), st.integers(2, 5))
+def test_an_interval_holds_its_mean_and_is_the_same_every_time(seed, runs):
+    rng = random.Random(seed)
+    strata = {str(g): [float(rng.random() < 0.7) for _ in range(runs)] for g in range(30)}
+    low, high = stratified_interval(strata)
+    mean = sum(sum(v) / len(v) for v in strata.values()) / len(strata)
+    assert low - 1e-9 <= mean <= high + 1e-9
+    assert stratified_interval(strata) == (low, high)
+
+
+def test_an_interval_is_as_wide_as_each_goals_episodes_disagree():
+    # each goal's trainings and repeats are what is resampled: goals that differ from one
+    # another, each the same under every training, leave nothing to resample
+    agree = {str(g): [1.0] * 4 if g % 2 else [0.0] * 4 for g in range(40)}
+    disagree = {str(g): [1.0, 0.0, 1.0, 0.0] for g in range(40)}
+    assert stratified_interval(agree) == (0.5, 0.5)
+    low, high = stratified_interval(disagree)
+    assert low < 0.5 < high
+
+
+def test_a_gain_is_called_only_where_intervals_separate():
+    assert separate((0.5, 0.6), (0.65, 0.7)) and separate((0.65, 0.7), (0.5, 0.6))
+    assert not separate((0.5, 0.66), (0.65, 0.7))
+    assert not separate(None, (0.1, 0.2))
