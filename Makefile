@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-fast lint clean
+.PHONY: demo test test-fast lint results clean
 
 # torch is installed first and alone so that nothing resolves it to a CUDA build.
 $(STAMP): pyproject.toml
@@ -25,6 +25,11 @@ test: lint
 # Everything but the tests marked slow: under two minutes, for the edit-test loop.
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist worksteal -m "not slow" tests
+
+# Every published table made again: data, three trainings of each network, the test split's
+# runs, pasted into the README and docs (configs/results/plan.toml; resumes where it stopped).
+results: $(STAMP)
+	$(BIN)/hsgplan results --paste $(RESULTS_FLAGS)
 
 # Style, and the layer contracts in pyproject.toml ([tool.importlinter]).
 lint: $(STAMP)

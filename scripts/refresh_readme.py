@@ -4,14 +4,15 @@ Usage: python scripts/refresh_readme.py NAME [--saved FILE] -- hsgplan bench sym
 
 The block is the text between `<!-- BEGIN NAME -->` and `<!-- END NAME -->`, in the README or in
 one of the pages under docs/; it becomes the command's standard output followed by a line naming
-the command, the date and the machine. With `--saved FILE`, the command is not run again: FILE
-is its standard output, saved when it ran (`COMMAND > FILE`), for runs that take long and keep
-no run folder to read back.
+the command, the commit it ran at, the date and the machine. With `--saved FILE`, the command is
+not run again: FILE must be a table `hsgplan results` kept (`runs/results/blocks/NAME.md`, its
+record beside it), and the stamp names the command and commit that made it.
 """
 
 from __future__ import annotations
 
 import datetime
+import json
 import os
 import platform
 import re
@@ -40,15 +41,23 @@ def main(argv: list[str]) -> int:
         print(f"no page (README.md, docs/*.md) has a block named '{name}'", file=sys.stderr)
         return 2
     if saved is not None:
-        output = saved.read_text()
+        record = saved.with_suffix(".json")
+        if saved.suffix != ".md" or not record.is_file():
+            print(f"'{saved}' is no table `hsgplan results` kept", file=sys.stderr)
+            return 2
+        made = json.loads(record.read_text())
+        if shlex.split(made["command"]) != command[1:]:
+            print(f"'{saved}' was made by `hsgplan {made['command']}`", file=sys.stderr)
+            return 2
+        output, at = saved.read_text(), made["commit"]
     else:
         result = subprocess.run(command, capture_output=True, text=True, check=False)
         if result.returncode != 0:
             print(result.stderr, file=sys.stderr)
             return result.returncode
-        output = result.stdout
+        output, at = result.stdout, commit()
     stamp = (
-        f"\n_Produced by `{shlex.join(command)}` on {datetime.date.today()} "
+        f"\n_Produced by `{shlex.join(command)}` at commit {at} on {datetime.date.today()} "
         f"({platform.machine()}, {os.cpu_count()} cores)._\n"
     )
     block = output.strip() + "\n" + stamp
@@ -56,6 +65,16 @@ def main(argv: list[str]) -> int:
     text = page.read_text()
     page.write_text(pattern.sub(lambda m: m.group(1) + block + m.group(2), text))
     return 0
+
+
+def commit() -> str:
+    """The commit the tree is at, `+` where tracked files hold changes."""
+    git = ["git", "-C", str(ROOT)]
+    head = subprocess.run([*git, "rev-parse", "--short=12", "HEAD"], capture_output=True, text=True)
+    dirty = subprocess.run(
+        [*git, "status", "--porcelain", "--untracked-files=no"], capture_output=True, text=True
+    )
+    return head.stdout.strip() + ("+" if dirty.stdout.strip() else "") or "unknown"
 
 
 if __name__ == "__main__":

@@ -23,6 +23,7 @@ from hsgplan.cli import (
     learn,
     motion,
     perception,
+    results,
     runs,
     scenes,
     splits,
@@ -61,6 +62,7 @@ app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
 app.add_typer(bench.app, name="bench")
 app.add_typer(splits.app, name="splits")
+app.command()(results.results)
 bench.app.command("push-reach")(bench_motion.push_reach)
 bench.app.command("line-error")(bench_motion.line_error)
 bench.app.command("push-settings")(bench_motion.push_settings)

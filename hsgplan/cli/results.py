@@ -1,0 +1,64 @@
+"""`hsgplan results`: collect, train and run every published table again (`make results`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from hsgplan.cli.common import RayAddress, check_ray, input_path, out, refuses_bad_input
+
+
+def _names(text: str) -> list[str]:
+    return [n.strip() for n in text.split(",") if n.strip()]
+
+
+@refuses_bad_input
+def results(
+    plan: Annotated[
+        Path, typer.Option(help="The plan: its steps in order.", parser=input_path)
+    ] = Path("configs/results/plan.toml"),
+    only: Annotated[str, typer.Option(help="Run only these steps, comma-separated.")] = "",
+    skip: Annotated[
+        str,
+        typer.Option(help="Leave out steps of these names or tags, comma-separated (slow, rgb)."),
+    ] = "",
+    ray: RayAddress = None,
+    dry_run: Annotated[
+        bool,
+        typer.Option(
+            "--dry-run", help="List the steps and what is finished; run none.", metavar=""
+        ),
+    ] = False,
+    paste: Annotated[
+        bool,
+        typer.Option(
+            "--paste",
+            help="Then put every finished step's table in its README or docs block, stamped "
+            "with its command and commit.",
+            metavar="",
+        ),
+    ] = False,
+) -> None:
+    """Every published table made again from the repository (configs/results/plan.toml): the
+    data collected with today's code, each network trained three times, each table run on the
+    test split; resumable, a finished step skipped while its command is unchanged."""
+    from hsgplan.runner import results as pipeline
+
+    check_ray(ray)
+    steps = pipeline.chosen(pipeline.read_plan(plan), _names(only), _names(skip))
+    if dry_run:
+        for s in steps:
+            made = pipeline.finished(pipeline.OUT, s)
+            state = f"finished at {made['commit']}" if made else "to run"
+            out.print(
+                f"{s.name:<20} {state:<24} hsgplan {s.command}", highlight=False, soft_wrap=True
+            )
+        return
+    pipeline.run_plan(steps, ray=ray, echo=lambda line: out.print(line, highlight=False))
+    if paste:
+        pages = [Path("README.md"), *sorted(Path("docs").glob("*.md"))]
+        names = [s.block for s in steps if s.block]
+        pasted = pipeline.paste(pages, blocks=names)
+        out.print(f"pasted {', '.join(pasted) or 'nothing'}", highlight=False)

@@ -1,0 +1,82 @@
+"""`hsgplan results`: the plan's steps run in order, a finished one skipped while its command is
+unchanged, and its table pasted stamped with its command and commit."""
+
+import json
+import shlex
+from pathlib import Path
+
+import pytest
+
+from hsgplan.domain.errors import InvalidInputError
+from hsgplan.runner import results
+from hsgplan.runner.results import Step, chosen, finished, paste, read_plan, run_plan
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_the_shipped_plan_names_configs_that_exist_and_tables_a_page_holds():
+    steps = read_plan(ROOT / results.PLAN)
+    pages = "".join(p.read_text() for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")])
+    for s in steps:
+        args = shlex.split(s.command)
+        for option, value in zip(args, args[1:], strict=False):
+            if option == "--config":
+                assert (ROOT / value).is_file(), (s.name, value)
+        if s.block:
+            assert f"<!-- BEGIN {s.block} -->" in pages, s.block
+            assert "--split test" in s.command  # every published table is the test split's
+    assert [s.name for s in chosen(steps, skip=["slow"])] == [
+        s.name for s in steps if "slow" not in s.tags
+    ]
+
+
+def test_only_and_skip_choose_steps_and_refuse_unknown_names():
+    steps = [Step("a", "x"), Step("b", "y", tags=("slow",)), Step("c", "z")]
+    assert [s.name for s in chosen(steps, only=["a", "b"], skip=["slow"])] == ["a"]
+    with pytest.raises(InvalidInputError, match="no step or tag 'd'"):
+        chosen(steps, skip=["d"])
+
+
+def test_a_plan_without_names_is_refused_in_one_line(tmp_path):
+    plan = tmp_path / "plan.toml"
+    plan.write_text('[[step]]\ncommand = "splits show"\n')
+    with pytest.raises(InvalidInputError, match="needs a name"):
+        read_plan(plan)
+
+
+def test_a_finished_step_is_skipped_until_its_command_changes(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(results, "commit", lambda: "abc123")
+    step = Step("show", "splits show --markdown", block="splits-table")
+    lines: list[str] = []
+    run_plan([step], tmp_path / "out", echo=lines.append)
+    made = finished(tmp_path / "out", step)
+    assert made["commit"] == "abc123" and made["command"] == step.command
+    assert "| test |" in (tmp_path / "out" / "blocks" / "splits-table.md").read_text()
+    run_plan([step], tmp_path / "out", echo=lines.append)
+    assert lines[-1].startswith("show: finished at abc123")
+    assert finished(tmp_path / "out", Step("show", "splits show")) is None  # another command
+
+
+def test_a_failed_step_stops_the_pass_and_leaves_no_record(tmp_path):
+    bad = Step("bad", "eval world --split nowhere")
+    with pytest.raises(InvalidInputError, match="step 'bad' failed"):
+        run_plan([bad, Step("after", "splits show")], tmp_path, echo=lambda _: None)
+    assert not (tmp_path / "steps").exists()
+
+
+def test_paste_stamps_each_block_with_its_command_and_commit(tmp_path):
+    blocks = tmp_path / "out" / "blocks"
+    blocks.mkdir(parents=True)
+    (blocks / "t.md").write_text("| a |\n|---:|\n| 1 |\n")
+    made = {"command": "eval world --split test", "commit": "abc123", "date": "d", "machine": "m"}
+    (blocks / "t.json").write_text(json.dumps(made))
+    page = tmp_path / "README.md"
+    page.write_text("x\n<!-- BEGIN t -->\nold\n<!-- END t -->\ny\n")
+    assert paste([page], tmp_path / "out") == ["t"]
+    text = page.read_text()
+    assert "old" not in text and "| 1 |" in text
+    assert "`hsgplan eval world --split test`) at commit abc123" in text
+    page.write_text("no blocks here\n")
+    with pytest.raises(InvalidInputError, match="no page holds a block named 't'"):
+        paste([page], tmp_path / "out")
