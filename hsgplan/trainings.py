@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
@@ -50,6 +51,30 @@ def record(root: Path, seeds: list[int], what: str) -> None:
     trained[what] = sorted(set(trained.get(what, [])) | set(seeds))
     known["shipped_seed"] = known.get("shipped_seed", seeds[0])
     write_atomically(path, json.dumps(known, indent=2) + "\n")
+
+
+def train_each(
+    train: Callable[..., None], jobs: list[tuple[object, Path]], workers: int = 1
+) -> None:
+    """`train(config, folder)` for every job, `workers` at a time in processes of their own
+    (one core each: a training is seeded, so where it runs changes nothing); in this process,
+    with its progress shown, where one worker is asked for."""
+    if workers <= 1 or len(jobs) <= 1:
+        for config, folder in jobs:
+            train(config, folder)
+        return
+    import multiprocessing
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+
+    from hsgplan.runner.engines import worker_start
+
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(
+        workers, mp_context=context, initializer=worker_start, initargs=(os.getpid(),)
+    ) as pool:
+        for done in [pool.submit(train, config, folder, False) for config, folder in jobs]:
+            done.result()  # a failed training raises here, as it would alone
 
 
 def paired(task: Path | str | None, motion: Path | str | None) -> dict[int | None, tuple]:

@@ -74,6 +74,14 @@ def test_train_motion_seeds_trains_each_seed_into_its_folder(tmp_path):
     assert list(seed_folders(out)) == [0, 1]
     bad = CliRunner().invoke(app, [*args[:-2], "--out", str(out), "--name", "../x"])
     assert bad.exit_code == 2
+    # side by side, each training in a process of its own: the same networks
+    side = CliRunner().invoke(app, [*args[:-2], "--out", str(tmp_path / "side"), "--workers", "2"])
+    assert side.exit_code == 0, side.output
+    again = [
+        (tmp_path / "side" / f"seed-{s}" / "place-gnn" / "model.safetensors").read_bytes()
+        for s in (0, 1)
+    ]
+    assert again == weights
 
 
 def test_an_interval_needs_two_episodes_of_every_goal():

@@ -62,30 +62,39 @@ def train_task(
         bounded_option("seed", "Overrides the configuration's seed."),
     ] = None,
     seeds: TrainingSeeds = None,
+    workers: Annotated[
+        int, bounded_option("workers", "With --seeds, trainings run side by side.")
+    ] = 1,
 ) -> None:
     """Train f_preimage, f_reach and the forward baseline on the demonstrations."""
     from dataclasses import replace
 
     from hsgplan.planning.regression.train import TaskTrainConfig
-    from hsgplan.trainings import record, seed_folder, training_seeds
+    from hsgplan.trainings import record, seed_folder, train_each, training_seeds
 
     settings = read_config(config)
     if seed is not None:
         settings["seed"] = seed
     cfg = TaskTrainConfig.from_json(settings)
-    every = training_seeds(cfg.seed, seeds) if seeds else [None]
-    for s in every:
-        folder = out_dir if s is None else seed_folder(out_dir, s)
-        _train_task_once(cfg if s is None else replace(cfg, seed=s), folder)
-        if s is not None:
-            record(out_dir, [s], "task")
+    if seeds is None:
+        _train_task_once(cfg, out_dir)
+        out.print(f"trained f_preimage, f_reach and the forward baseline into {shown(out_dir)}")
+        return
+    every = training_seeds(cfg.seed, seeds)
+    jobs = [(replace(cfg, seed=s), seed_folder(out_dir, s)) for s in every]
+    train_each(_train_task_once, jobs, workers)
+    record(out_dir, every, "task")
+    for _, folder in jobs:
         out.print(f"trained f_preimage, f_reach and the forward baseline into {shown(folder)}")
 
 
-def _train_task_once(cfg, folder: Path) -> None:
+def _train_task_once(cfg, folder: Path, show: bool = True) -> None:
     from hsgplan.domain.kitchen import KITCHEN
     from hsgplan.planning.regression.train import train_task as run
 
+    if not show:
+        run(cfg, folder, None, world=KITCHEN)
+        return
     with Progress(console=err, transient=True) as progress:
         bars = {}
 

@@ -68,6 +68,9 @@ def train_motion(
         typer.Option(help="Dataset folder (overrides the config).", parser=input_path),
     ] = None,
     seeds: TrainingSeeds = None,
+    workers: Annotated[
+        int, bounded_option("workers", "With --seeds, trainings run side by side.")
+    ] = 1,
     name: Annotated[
         str | None,
         typer.Option(
@@ -77,7 +80,7 @@ def train_motion(
 ) -> None:
     """Train a motion network (config loss: ce on the successes, bce on every trial)."""
     from hsgplan.motion.train import MotionTrainConfig
-    from hsgplan.trainings import record, seed_folder, training_seeds
+    from hsgplan.trainings import record, seed_folder, train_each, training_seeds
 
     settings = read_config(config)
     for option, given in (("primitive", primitive), ("model", model)):
@@ -97,21 +100,28 @@ def train_motion(
             f"--name '{name}': a folder name (letters, digits, - and _), with --seeds"
         )
     folder = out_dir or RUNS / f"train-motion-{primitive}-{model}"
-    every = training_seeds(cfg.seed, seeds) if seeds else [None]
-    for s in every:
-        into = folder if s is None else seed_folder(folder, s) / (name or f"{primitive}-{model}")
-        _train_motion_once(cfg if s is None else replace(cfg, seed=s), into)
-        if s is not None:
-            record(folder, [s], into.name)
-        out.print(f"trained the {model} {primitive} network into {shown(into)}")
+    if seeds is None:
+        _train_motion_once(cfg, folder)
+        out.print(f"trained the {model} {primitive} network into {shown(folder)}")
+        return
+    every = training_seeds(cfg.seed, seeds)
+    into = [seed_folder(folder, s) / (name or f"{primitive}-{model}") for s in every]
+    jobs = [(replace(cfg, seed=s), f) for s, f in zip(every, into, strict=True)]
+    train_each(_train_motion_once, jobs, workers)
+    record(folder, every, into[0].name)
+    for f in into:
+        out.print(f"trained the {model} {primitive} network into {shown(f)}")
 
 
 _FOLDER_NAME = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
-def _train_motion_once(cfg, into: Path) -> None:
+def _train_motion_once(cfg, into: Path, show: bool = True) -> None:
     from hsgplan.motion.train import train_motion as run
 
+    if not show:
+        run(cfg, into, None)
+        return
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task(f"{cfg.primitive} {cfg.model}", total=cfg.epochs)
 

@@ -7,7 +7,14 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli.common import RayAddress, check_ray, input_path, out, refuses_bad_input
+from hsgplan.cli.common import (
+    RayAddress,
+    check_ray,
+    input_path,
+    out,
+    print_table,
+    refuses_bad_input,
+)
 
 
 def _names(text: str) -> list[str]:
@@ -31,6 +38,9 @@ def results(
             "--dry-run", help="List the steps and what is finished; run none.", metavar=""
         ),
     ] = False,
+    markdown: Annotated[
+        bool, typer.Option("--markdown", help="With --dry-run, print Markdown.", metavar="")
+    ] = False,
     paste: Annotated[
         bool,
         typer.Option(
@@ -49,12 +59,22 @@ def results(
     check_ray(ray)
     steps = pipeline.chosen(pipeline.read_plan(plan), _names(only), _names(skip))
     if dry_run:
+        rows = []
         for s in steps:
             made = pipeline.finished(pipeline.OUT, s)
-            state = f"finished at {made['commit']}" if made else "to run"
-            out.print(
-                f"{s.name:<20} {state:<24} hsgplan {s.command}", highlight=False, soft_wrap=True
+            rows.append(
+                (
+                    s.name,
+                    ", ".join(s.tags) or "—",
+                    f"{made['wall_seconds'] / 60:.1f}" if made else "—",
+                    made["commit"] if made else "to run",
+                )
             )
+        done = sum(r[2] != "—" for r in rows)
+        title = (
+            f"The steps of {plan}: {done} of {len(steps)} finished (wall minutes on this machine)"
+        )
+        print_table(title, ("step", "tags", "minutes", "finished at"), rows, markdown)
         return
     pipeline.run_plan(steps, ray=ray, echo=lambda line: out.print(line, highlight=False))
     if paste:

@@ -7,7 +7,14 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli.common import Summaries, out, parse_sizes, print_table, refuses_bad_input
+from hsgplan.cli.common import (
+    Summaries,
+    input_path,
+    out,
+    parse_sizes,
+    print_table,
+    refuses_bad_input,
+)
 
 app = typer.Typer(
     cls=Summaries,
@@ -85,3 +92,39 @@ def check(
     if leaks:
         raise typer.Exit(1)
     out.print("the test split is sealed", highlight=False)
+
+
+@app.command()
+@refuses_bad_input
+def decisions(
+    record: Annotated[Path, typer.Option(help="The record of choices.", parser=input_path)] = Path(
+        "configs/decisions.toml"
+    ),
+    markdown: Markdown = False,
+) -> None:
+    """Every recorded choice, the split and seeds it was made on and where it stands; exit 1
+    where a row cites a test seed or calls a seed a tuning seed that is none."""
+    from hsgplan.evaluation import decisions as record_of
+    from hsgplan.evaluation.split_check import drawn_by_test
+
+    rows = record_of.read_decisions(record)
+    episodes = frozenset(d.seed for d in drawn_by_test())
+    opened = sum(d.open for d in rows)
+    title = (
+        f"{len(rows)} recorded choices; {opened} made on a reporting seed are still to be "
+        "made again on the tune split"
+    )
+    print_table(title, record_of.HEADER, record_of.rows(rows), markdown)
+    bad = [
+        f"{d.name} cites test seed(s) {', '.join(map(str, cited))}"
+        for d in rows
+        if (cited := record_of.cited_test_seeds(d, episodes))
+    ] + [
+        f"{d.name} is said chosen on tune, but {', '.join(map(str, seeds))} is no tuning seed"
+        for d in rows
+        if (seeds := record_of.misfiled(d))
+    ]
+    for line in bad:
+        out.print(line, highlight=False)
+    if bad:
+        raise typer.Exit(1)
