@@ -27,6 +27,7 @@ from hsgplan.evaluation.config import EvalConfig
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.protocol import check_runs, episode_specs, run_evaluation
+from hsgplan.evaluation.seeds import marked, seed_words
 from hsgplan.evaluation.table1 import TextTable
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim
@@ -108,12 +109,15 @@ def check_timing_folder(
     out: Path,
     search: str = DEFAULT_SEARCH,
     scene: str | None = None,
+    split: str | None = None,
 ) -> tuple[dict, str]:
     """Every refusal of the run folders before anything is written; what the top folder is
     claimed with and its refusal."""
     agents = timing_agents(search)
-    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene)
+    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene, split=split)
     table = {"sizes": list(config.sizes), "goals": goals, "seed": seed}
+    if split is not None:  # folders from before splits keep their claim
+        table["split"] = split
     if search != "search":  # folders made before there was a choice timed `search`, unnamed
         table["search"] = search
     if scene is not None:  # folders of the kitchen keep the claim they had before scenes
@@ -137,6 +141,7 @@ def run_timing(
     search: str = DEFAULT_SEARCH,
     ray: str | None = None,
     scene: str | None = None,
+    split: str | None = None,
 ) -> dict:
     """Both agents' episodes into `out/AGENT/` (on Ray at `ray`, one core an episode as on
     the local pool); the summary, also written as `summary.json`, `table2.md` and
@@ -146,8 +151,8 @@ def run_timing(
     "search": "search", ...}`: the baseline's entries are under its name (`search` or
     `stream`), which `"search"` names.
     """
-    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene)
-    table, refusal = check_timing_folder(sizes, goals, seed, out, search, scene)
+    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene, split=split)
+    table, refusal = check_timing_folder(sizes, goals, seed, out, search, scene, split)
     claim(out, TIMING_KIND, table, refusal)
     records = {
         key: run_evaluation(replace(config, agent=agent), out / key, workers, on_episode, ray)
@@ -161,6 +166,7 @@ def run_timing(
         "search": search,
         "goals": goals,
         "seed": seed,
+        "split": split,
         "workers": workers,
         "run": str(out),
     } | ({} if scene is None else {"scene": scene})
@@ -170,8 +176,10 @@ def run_timing(
     return report
 
 
-def total_episodes(sizes: Sequence[int], goals: int, seed: int, scene: str | None = None) -> int:
-    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene)
+def total_episodes(
+    sizes: Sequence[int], goals: int, seed: int, scene: str | None = None, split: str | None = None
+) -> int:
+    config = EvalConfig("", tuple(sizes), goals, seed, scene=scene, split=split)
     return len(timing_agents()) * len(episode_specs(config))
 
 
@@ -224,9 +232,11 @@ def tables(report: dict) -> list[TextTable]:
         "theirs task / motion (paper)",
     )
     title = (
-        f"Seconds per episode, {report['goals']} goals per size, seed {report['seed']}, "
+        f"Seconds per episode, {report['goals']} goals per size, "
+        f"{seed_words(report['seed'], report.get('split'))}, "
         + (f"in {report['scene']}, " if "scene" in report else "")
         + f"{report['workers']} worker(s): the search baseline ({LABELS[name]}) against ours, "
         "beside the paper's Table 2; task medians (quartiles), their ratio, motion medians"
     )
+    title = marked(title, report["seed"], split=report.get("split"))
     return [TextTable(title, header, tuple(rows))]

@@ -17,6 +17,8 @@ from hsgplan.cli.common import (
     RunFolder,
     SceneFiles,
     SceneOption,
+    SeedOrSplitStart,
+    SplitOption,
     Summaries,
     bounded_option,
     check_ray,
@@ -30,6 +32,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     scene_world,
     shown,
+    split_seed,
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import MAX_OBJECTS
@@ -185,7 +188,8 @@ def bench_timing(
         int,
         bounded_option("goals", "Goals per size, the same for both agents."),
     ] = 10,
-    seed: Annotated[int, bounded_option("seed", "Seed of the goals and the episodes.")] = 0,
+    seed: SeedOrSplitStart = None,
+    split: SplitOption = None,
     workers: Annotated[
         int,
         bounded_option("workers", "Episodes side by side (1: nothing competes for the core)."),
@@ -218,19 +222,22 @@ def bench_timing(
     )
 
     size_list = parse_sizes(sizes)
+    seed = split_seed(seed, split)
+    split_name = split and split.value
     baseline = search.value
     agents = timing_agents(baseline)
     # the default folder of the `search` baseline keeps the name it had before the choice
     which = "" if baseline == "search" else f"-{baseline}"
-    folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-seed{seed}{which}"
+    named = split_name or f"seed{seed}"
+    folder = run_dir or RUNS / f"timing-s{sizes.replace(',', '_')}-g{goals}-{named}{which}"
     # cheap refusals before the agents load
     where = None if scene is None else str(scene)
-    check_timing_folder(size_list, goals, seed, folder, baseline, where)
+    check_timing_folder(size_list, goals, seed, folder, baseline, where, split_name)
     check_ray(ray)
     for agent in agents.values():  # a missing checkpoint is refused before any work
         make_agent(agent)
     with Progress(console=err, transient=True) as progress:
-        total = total_episodes(size_list, goals, seed, where)
+        total = total_episodes(size_list, goals, seed, where, split_name)
         task = progress.add_task(f"ours, {baseline}", total=total)
         report = run_timing(
             size_list,
@@ -242,6 +249,7 @@ def bench_timing(
             baseline,
             ray,
             where,
+            split_name,
         )
     if as_json:
         print(json.dumps(report, indent=2))

@@ -17,6 +17,7 @@ from hsgplan.cli.common import (
     MarkdownFlag,
     RayAddress,
     SceneFiles,
+    SplitOption,
     TrainingSeeds,
     bounded_option,
     check_ray,
@@ -28,6 +29,7 @@ from hsgplan.cli.common import (
     read_config,
     refuses_bad_input,
     shown,
+    split_seed,
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import MOTION_CHECKPOINTS, RUNS
@@ -133,10 +135,21 @@ def _train_motion_once(cfg, into: Path, show: bool = True) -> None:
         run(cfg, into, on_epoch)
 
 
+def _rate_cell(r: dict) -> str:
+    cell = f"{r['success_rate']:.3f}"
+    if r.get("success_ci"):
+        cell += f" ({r['success_ci'][0]:.2f}–{r['success_ci'][1]:.2f})"
+    return cell
+
+
 @refuses_bad_input
 def eval_motion(
     trials: Annotated[int, bounded_option("trials", "Fresh scenes per primitive.")] = 200,
-    seed: Annotated[int, bounded_option("seed", "Seed of the evaluation scenes.")] = 0,
+    seed: Annotated[
+        int | None,
+        bounded_option("seed", "Seed of the evaluation scenes (default: 0, or the split's first)."),
+    ] = None,
+    split: SplitOption = None,
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
     motion_checkpoints: Annotated[
         Path, typer.Option(help="Folder of motion checkpoints.", parser=input_path)
@@ -161,11 +174,18 @@ def eval_motion(
     training scenes), per primitive and crowding level; every model sees the same scenes."""
     from hsgplan.domain.scene_file import read_worlds
     from hsgplan.evaluation.motion_eval import LABELS, MODELS, evaluate_motion
+    from hsgplan.evaluation.seeds import marked, seed_words
+    from hsgplan.evaluation.splits import check_seed, split_named
+    from hsgplan.trainings import seed_folders
 
     kinds = [p.strip() for p in primitives.split(",")]
     if "" in kinds or len(set(kinds)) != len(kinds):
         raise InvalidInputError(f"--primitives '{primitives}': name place, push or both, each once")
     check_ray(ray)
+    seed = split_seed(seed, split)
+    if split is not None:
+        check_seed(split_named(split.value), seed)
+    trainings = seed_folders(motion_checkpoints)
     with Progress(console=err, transient=True) as progress:
         worlds = len(read_worlds(scene)) if scene else 1
         bar = progress.add_task("scenes", total=trials * len(kinds) * worlds)
@@ -194,12 +214,18 @@ def eval_motion(
             found = [pick(by_model[m]) if m in by_model else None for m in MODELS]
             if all(r is None for r in found):
                 continue
-            cells = ["—" if r is None else f"{r['success_rate']:.3f}" for r in found]
+            cells = ["—" if r is None else _rate_cell(r) for r in found]
             n = next(r["trials"] for r in found if r is not None)
             rows.append((kind, label, str(n), *cells))
+    title = f"Single-shot motion success on fresh scenes, {seed_words(seed, split and split.value)}"
+    if trainings:
+        title += (
+            f", each network trained {len(trainings)} times (in brackets the 95% interval: a "
+            "bootstrap over scenes, each scene's trials under every training resampled within it)"
+        )
+    title += f", in each scene of {scene}" if scene else ""
     print_table(
-        f"Single-shot motion success on fresh scenes, seed {seed}"
-        + (f", in each scene of {scene}" if scene else ""),
+        marked(title, seed, split=split and split.value),
         ("primitive", "crowding", "scenes", *(LABELS[m] for m in MODELS)),
         rows,
         markdown,

@@ -25,9 +25,11 @@ from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import read_worlds
 from hsgplan.evaluation.config import world_of_file
+from hsgplan.evaluation.intervals import stratified_interval
 from hsgplan.paths import shipped
 from hsgplan.runner.items import run_items
 from hsgplan.sim.scene import Scene
+from hsgplan.trainings import seed_folders
 
 MODELS = ("gnn", "gnn_paper", "mlp", "mlp_paper", "mlp_bce", "random")
 # Where their checkpoints exist, shown beside ours so that differences are measured, not
@@ -122,7 +124,17 @@ def run_eval_chunk(
 
 
 def _rate(rows: list[dict]) -> dict:
-    return {"success_rate": sum(r["ok"] for r in rows) / len(rows), "trials": len(rows)}
+    """The success rate, and its 95% interval where each scene was tried under several
+    trainings (each scene a stratum: `evaluation.intervals`)."""
+    by_scene: dict[tuple, list[float]] = defaultdict(list)
+    for r in rows:
+        by_scene[(r.get("scene"), r["task"])].append(float(r["ok"]))
+    ci = stratified_interval(list(by_scene.values()))
+    return {
+        "success_rate": sum(r["ok"] for r in rows) / len(rows),
+        "trials": len(by_scene),
+        **({"success_ci": list(ci)} if ci is not None else {}),
+    }
 
 
 def summarize(rows: list[dict]) -> dict:
@@ -187,6 +199,34 @@ def evaluate_motion(
         if p not in ("place", "push"):
             raise InvalidInputError(f"primitive '{p}': place or push")
         kinds.append(MotionPrimitive(p))
+    trainings = seed_folders(checkpoints) or {None: Path(checkpoints)}
+    rows: dict[str, list[dict]] = {k.value: [] for k in kinds}
+    for seed_of, folder in trainings.items():
+        into = run_dir if run_dir is None or seed_of is None else run_dir / f"seed-{seed_of}"
+        for kind, got in _rows(kinds, trials, seed, folder, workers, progress, into, ray, scene):
+            rows[kind] += got
+    report = {}
+    first = next(iter(trainings.values()))  # the shipped seed's networks: what each learnt from
+    for kind in kinds:
+        report[kind.value] = summarize(rows[kind.value])
+        for name, record in _trained_on(kind, first).items():
+            if name in report[kind.value]:  # left out where it cannot read the scene's names
+                report[kind.value][name] |= asdict(record)
+    return report
+
+
+def _rows(
+    kinds: list[MotionPrimitive],
+    trials: int,
+    seed: int,
+    checkpoints: Path,
+    workers: int,
+    progress: Callable[[], None] | None,
+    run_dir: Path | None,
+    ray: str | None,
+    scene: Path | None,
+) -> list[tuple[str, list[dict]]]:
+    """Every trial of one set of networks, by primitive, in the order of the tasks."""
     worlds = {None: KITCHEN} if scene is None else read_worlds(scene)
     for kind in kinds:  # missing checkpoints, or a GNN that cannot read a scene: before work
         _learned(kind, checkpoints)
@@ -225,21 +265,18 @@ def evaluate_motion(
         ray=ray,
         on_result=on_chunk,
     )
-    report = {}
+    by_kind = []
     for kind in kinds:
-        rows = [
-            r
-            for chunk, got in zip(chunks, results, strict=True)
+        got = [
+            r | {"scene": chunk.scene}  # a task's index is a scene's own in each scene file
+            for chunk, part in zip(chunks, results, strict=True)
             if chunk.primitive == kind.value
-            for r in got
+            for r in part
             if r["task"] < trials
         ]
-        rows.sort(key=lambda r: (r["task"], MODELS.index(r["model"])))
-        report[kind.value] = summarize(rows)
-        for name, record in _trained_on(kind, checkpoints).items():
-            if name in report[kind.value]:  # left out where it cannot read the scene's names
-                report[kind.value][name] |= asdict(record)
-    return report
+        got.sort(key=lambda r: (r["task"], MODELS.index(r["model"])))
+        by_kind.append((kind.value, got))
+    return by_kind
 
 
 def _trained_on(kind: MotionPrimitive, checkpoints: Path) -> dict:

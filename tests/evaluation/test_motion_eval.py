@@ -125,3 +125,22 @@ def test_a_network_of_geometry_features_is_measured_in_a_scene_of_new_objects(ch
     assert report["place"]["gnn"]["trials"] == report["place"]["random"]["trials"] == 1
     with pytest.raises(InvalidInputError, match="know the kitchen's objects"):
         evaluate_motion(["place"], 1, 0, checkpoints, workers=1, scene=scene)
+
+
+@pytest.mark.slow
+def test_trainings_are_tried_in_the_same_scenes_and_given_an_interval(checkpoints, tmp_path):
+    import shutil
+
+    from hsgplan.trainings import record
+
+    root = tmp_path / "trainings"
+    for s in (0, 1):
+        shutil.copytree(checkpoints / "place-gnn", root / f"seed-{s}" / "place-gnn")
+    record(root, [0, 1], "place-gnn")
+    report = evaluate_motion(["place"], 2, 0, root, workers=1, run_dir=tmp_path / "run")
+    gnn = report["place"]["gnn"]
+    one = evaluate_motion(["place"], 2, 0, root / "seed-0", workers=1)["place"]["gnn"]
+    assert gnn["trials"] == one["trials"]  # scenes, not trials: each scene once per training
+    assert gnn["success_rate"] == one["success_rate"]  # two copies of one network
+    assert gnn["success_ci"] == [one["success_rate"]] * 2
+    assert {p.name for p in (tmp_path / "run").iterdir()} >= {"seed-0", "seed-1"}
