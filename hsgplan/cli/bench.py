@@ -17,8 +17,6 @@ from hsgplan.cli.common import (
     RunFolder,
     SceneFiles,
     SceneOption,
-    SeedOrSplitStart,
-    SplitOption,
     Summaries,
     bounded_option,
     check_ray,
@@ -32,8 +30,8 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     scene_world,
     shown,
-    split_seed,
 )
+from hsgplan.cli.seeding import SeedOrSplitStart, SplitOption, split_seed
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.world import MAX_OBJECTS
 from hsgplan.paths import RUNS, TASK_CHECKPOINT

@@ -320,43 +320,6 @@ SymbolicPlannerName = choice(
 )
 MotionName = choice("MotionName", MOTION_GENERATORS)
 ProtocolName = choice("ProtocolName", PROTOCOLS)
-SplitName = choice("SplitName", ("tune", "test"))
-SplitOption = Annotated[
-    SplitName | None,
-    typer.Option(
-        help="Draw the goals and start scenes from a split (docs/splits.md): test, for a "
-        "published number; tune, for choosing. Without it a run is exploration.",
-        metavar="SPLIT",
-    ),
-]
-SeedOrSplitStart = Annotated[
-    int | None,
-    bounded_option(
-        "seed", "Seed of the goals and the episodes (default: 0, or the split's first)."
-    ),
-]
-
-
-TrainingSeeds = Annotated[
-    int | None,
-    typer.Option(
-        help="Train K times, with the configuration's seed and the K-1 after it, seed S into "
-        "OUT/seed-S (docs/retraining.md, Trainings).",
-        min=1,
-        metavar="K",
-    ),
-]
-
-
-def split_seed(seed: int | None, split) -> int:
-    """The run's seed: the one given, else the split's first seed, else 0."""
-    if seed is not None:
-        return seed
-    if split is None:
-        return 0
-    from hsgplan.evaluation.splits import split_named
-
-    return split_named(split.value).seeds.start
 
 
 def read_config(path: Path | None) -> dict:

@@ -18,7 +18,6 @@ from hsgplan.cli.common import (
     SceneFiles,
     Summaries,
     SymbolicPlannerName,
-    TrainingSeeds,
     bounded_option,
     check_ray,
     dash,
@@ -33,6 +32,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
+from hsgplan.cli.seeding import TrainingSeeds
 from hsgplan.domain.checks import resolve
 from hsgplan.paths import REACH_HELD_OUT, RUNS, TASK_CHECKPOINT
 

@@ -17,8 +17,6 @@ from hsgplan.cli.common import (
     MarkdownFlag,
     RayAddress,
     SceneFiles,
-    SplitOption,
-    TrainingSeeds,
     bounded_option,
     check_ray,
     err,
@@ -29,8 +27,8 @@ from hsgplan.cli.common import (
     read_config,
     refuses_bad_input,
     shown,
-    split_seed,
 )
+from hsgplan.cli.seeding import SplitOption, TrainingSeeds, split_seed
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.paths import MOTION_CHECKPOINTS, RUNS
 

@@ -8,7 +8,6 @@ from typing import Annotated
 import typer
 
 from hsgplan.cli.common import (
-    SplitName,
     bounded_option,
     err,
     input_path,
@@ -16,6 +15,7 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
+from hsgplan.cli.seeding import SplitName
 from hsgplan.domain.errors import InvalidInputError
 
 

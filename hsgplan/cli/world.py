@@ -22,8 +22,6 @@ from hsgplan.cli.common import (
     RunFolder,
     SceneFiles,
     SceneOption,
-    SeedOrSplitStart,
-    SplitOption,
     TaskCheckpoint,
     bounded_option,
     check_ray,
@@ -40,8 +38,8 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     scene_world,
     shown,
-    split_seed,
 )
+from hsgplan.cli.seeding import SeedOrSplitStart, SplitOption, split_seed
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import NO_FAILURE_RULES, RecoveryRules
 from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
