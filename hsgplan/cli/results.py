@@ -15,6 +15,7 @@ from hsgplan.cli.common import (
     print_table,
     refuses_bad_input,
 )
+from hsgplan.domain.errors import InvalidInputError
 
 
 def _names(text: str) -> list[str]:
@@ -41,6 +42,15 @@ def results(
     markdown: Annotated[
         bool, typer.Option("--markdown", help="With --dry-run, print Markdown.", metavar="")
     ] = False,
+    ship: Annotated[
+        bool,
+        typer.Option(
+            "--ship",
+            help="Once every step has finished: copy the data and each configuration's own "
+            "training into data/ and checkpoints/ (the plan's [[ship]] entries).",
+            metavar="",
+        ),
+    ] = False,
     paste: Annotated[
         bool,
         typer.Option(
@@ -57,6 +67,9 @@ def results(
     from hsgplan.runner import results as pipeline
 
     check_ray(ray)
+    if ship:
+        _ship(plan)
+        return
     steps = pipeline.chosen(pipeline.read_plan(plan), _names(only), _names(skip))
     if dry_run:
         rows = []
@@ -82,3 +95,18 @@ def results(
         names = [s.block for s in steps if s.block]
         pasted = pipeline.paste(pages, blocks=names)
         out.print(f"pasted {', '.join(pasted) or 'nothing'}", highlight=False)
+
+
+def _ship(plan: Path) -> None:
+    from hsgplan.runner import results as pipeline
+    from hsgplan.runner.ship import read_shipments
+    from hsgplan.runner.ship import ship as copy_over
+
+    steps = pipeline.read_plan(plan)
+    if waiting := [s.name for s in steps if pipeline.finished(pipeline.OUT, s) is None]:
+        raise InvalidInputError(
+            f"{len(waiting)} step(s) of {plan} have not finished (the first: {waiting[0]}); "
+            "nothing shipped"
+        )
+    for destination in copy_over(read_shipments(plan)):
+        out.print(f"shipped {destination}", highlight=False)

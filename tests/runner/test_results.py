@@ -81,3 +81,56 @@ def test_paste_stamps_each_block_with_its_command_and_commit(tmp_path):
     page.write_text("no blocks here\n")
     with pytest.raises(InvalidInputError, match="no page holds a block named 't'"):
         paste([page], tmp_path / "out")
+
+
+def _folder(path: Path, files: dict[str, str]) -> Path:
+    for name, text in files.items():
+        (path / name).parent.mkdir(parents=True, exist_ok=True)
+        (path / name).write_text(text)
+    return path
+
+
+def test_ship_copies_the_made_files_and_renames_the_paths_inside_them(tmp_path):
+    from hsgplan.runner.ship import Shipment, ship
+
+    config = {"data": "runs/r/motion", "loop_trials": "runs/r/task-staged/x", "seed": 0}
+    _folder(
+        tmp_path / "runs/r/nets/seed-0/place-gnn",
+        {"train_config.json": json.dumps(config), "manifest.json": '{"data": "runs/r/motion"}'},
+    )
+    _folder(
+        tmp_path / "runs/r/motion",
+        {"place.npz": "x", "work/chunk-0.npz": "c", ".lock": "l", "timing.json": "{}"},
+    )
+    _folder(tmp_path / "data/motion", {"old.npz": "old"})
+    moves = [
+        Shipment("runs/r/motion", "data/motion"),
+        Shipment("runs/r/nets/seed-0/place-gnn", "checkpoints/motion/place-gnn"),
+        Shipment("runs/r/task-staged", "checkpoints/task-staged"),
+    ]
+    with pytest.raises(InvalidInputError, match="finish the pass first"):
+        ship(moves, tmp_path)  # task-staged is not there: nothing is copied
+    assert (tmp_path / "data/motion/old.npz").exists()
+    _folder(tmp_path / "runs/r/task-staged", {"x": "x"})
+    assert ship(moves, tmp_path)[:2] == ["data/motion", "checkpoints/motion/place-gnn"]
+    assert sorted(p.name for p in (tmp_path / "data/motion").iterdir()) == ["place.npz"]
+    net = tmp_path / "checkpoints/motion/place-gnn"
+    shipped = json.loads((net / "train_config.json").read_text())
+    assert shipped == {"data": "data/motion", "loop_trials": "checkpoints/task-staged/x", "seed": 0}
+    assert json.loads((net / "manifest.json").read_text()) == {"data": "runs/r/motion"}  # as is
+    assert not list(tmp_path.rglob("*.shipping")) and not list(tmp_path.rglob("*.old"))
+
+
+def test_the_shipped_plan_ships_what_its_steps_make():
+    from hsgplan.runner.ship import read_shipments
+
+    steps = read_plan(ROOT / results.PLAN)
+    outs = [
+        a
+        for s in steps
+        for o, a in zip(shlex.split(s.command), shlex.split(s.command)[1:], strict=False)
+        if o == "--out"
+    ]
+    for m in read_shipments(ROOT / results.PLAN):
+        assert any(m.source == o or m.source.startswith(o + "/") for o in outs), m.source
+        assert m.destination.split("/")[0] in ("data", "checkpoints")
