@@ -176,6 +176,12 @@ def collect_visited(
         raise InvalidInputError(f"--episodes {episodes}: need at least one")
     if not sizes or min(sizes) < 2:
         raise InvalidInputError("--sizes: episodes need at least two objects")
+    if GOAL_SEEDS.start + seed not in TRAIN.seeds:
+        raise InvalidInputError(
+            f"--seed {seed}: a collection draws from the train split's seeds "
+            f"({TRAIN.seeds.start}..{TRAIN.seeds.stop - 1}), so at most "
+            f"{TRAIN.seeds.stop - 1 - GOAL_SEEDS.start}"
+        )
     start = time.perf_counter()
     from hsgplan.agents.registry import agent_checkpoints, check_reads
     from hsgplan.checkpoint import fingerprint

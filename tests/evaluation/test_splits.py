@@ -142,3 +142,11 @@ def test_the_command_exits_1_on_a_leak_and_0_when_sealed(tmp_path):
     missing = runner.invoke(app, ["splits", "check", str(tmp_path / "nowhere")])
     assert missing.exit_code == 2
     assert runner.invoke(app, ["splits", "show"]).exit_code == 0
+
+
+def test_a_collection_refuses_a_seed_beyond_the_train_split(tmp_path):
+    from hsgplan.collect.visited import collect_visited
+
+    with pytest.raises(InvalidInputError, match="train split"):
+        collect_visited(tmp_path / "v", 1, (2,), seed=TRAIN.seeds.stop - GOAL_SEEDS.start)
+    assert not (tmp_path / "v").exists()
