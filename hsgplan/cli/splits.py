@@ -89,7 +89,9 @@ def check(
         if r.shared_training or r.shared_tuning:
             goal = sorted(r.shared_training | r.shared_tuning)[0]
             out.print(f"{r.size} objects: goal {goal} is drawn by training or tuning too")
-    if leaks:
+    for line in found.leaks():
+        out.print(line, highlight=False)
+    if leaks or found.leaks():
         raise typer.Exit(1)
     out.print("the test split is sealed", highlight=False)
 

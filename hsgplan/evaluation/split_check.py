@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import random
+import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -121,6 +122,42 @@ class Found:
     tuning: list[Draw] = field(default_factory=list)
     test: list[Draw] = field(default_factory=list)
     folders: dict[str, int] = field(default_factory=dict)  # kind -> folders read
+    # the layout seed of every generated scene file a folder names, by folder
+    layouts: dict[str, set[int]] = field(default_factory=dict)  # collections and tuning runs
+    test_layouts: dict[str, set[int]] = field(default_factory=dict)  # test-split runs
+
+    def leaks(self) -> list[str]:
+        """Where layouts cross: a collection or tuning run in a test layout, or a test run in
+        one of another split."""
+        found = [
+            f"{folder} ran in test-split layouts (seeds {sorted(s & set(TEST.layouts))[:3]})"
+            for folder, s in sorted(self.layouts.items())
+            if s & set(TEST.layouts)
+        ]
+        return found + [
+            f"{folder}, a test-split run, ran in layouts of seeds {sorted(s)[:3]}: not the test's"
+            for folder, s in sorted(self.test_layouts.items())
+            if s - set(TEST.layouts)
+        ]
+
+
+_LAYOUT_SEED = re.compile(r"^# hsgplan scenes .*--seed (\d+)")
+
+
+def layout_seeds(scene: str | Path) -> set[int]:
+    """The layout seeds of the generated scene files at `scene` (a file or a folder of them),
+    read from the command each names in its first line; hand-written scenes have none."""
+    path = Path(scene)
+    files = sorted(path.glob("*.toml")) if path.is_dir() else [path]
+    seeds = set()
+    for f in files:
+        try:
+            first = f.read_text().splitlines()[0]
+        except (OSError, IndexError):
+            continue
+        if m := _LAYOUT_SEED.match(first):
+            seeds.add(int(m.group(1)))
+    return seeds
 
 
 def find(roots: Iterable[Path]) -> Found:
@@ -134,6 +171,12 @@ def find(roots: Iterable[Path]) -> Found:
                 continue
             data = _read_json(path) or {}
             folder = path.parent
+            if scene := data.get("scene"):
+                test_run = data.get("kind") == "eval" and data.get("split") == TEST.name
+                into = found.test_layouts if test_run else found.layouts
+                tuning = data.get("split") == TUNE.name or is_tuning(int(data.get("seed", -1)))
+                if data.get("kind") != "eval" or test_run or tuning:
+                    into.setdefault(str(folder), set()).update(layout_seeds(scene))
             if data.get("format") == "hsgplan-demos":
                 kind, draws = "demonstrations", found.training
                 draws += _demos(folder)

@@ -150,3 +150,32 @@ def test_a_collection_refuses_a_seed_beyond_the_train_split(tmp_path):
     with pytest.raises(InvalidInputError, match="train split"):
         collect_visited(tmp_path / "v", 1, (2,), seed=TRAIN.seeds.stop - GOAL_SEEDS.start)
     assert not (tmp_path / "v").exists()
+
+
+def _layouts(folder: Path, seed: int) -> Path:
+    folder.mkdir(parents=True)
+    (folder / "layout-000.toml").write_text(f"# hsgplan scenes --layouts 1 --seed {seed}\n")
+    return folder
+
+
+def test_the_check_fails_a_collection_round_test_layouts_and_a_test_run_in_others(tmp_path):
+    train = _layouts(tmp_path / "train-layouts", TRAIN.layouts.start + 2)
+    test = _layouts(tmp_path / "test-layouts", TEST.layouts.start)
+    for name, scene, settings in (
+        ("reach-train", train, {"kind": "reach", "unit": "state"}),
+        ("test-run", test, {"kind": "eval", "split": "test", "seed": TEST.seeds.start}),
+    ):
+        (tmp_path / "runs" / name).mkdir(parents=True)
+        config = settings | {"scene": str(scene)}
+        (tmp_path / "runs" / name / "config.json").write_text(json.dumps(config))
+    _, found = check([tmp_path / "runs"], [3])
+    assert found.leaks() == []
+    (tmp_path / "runs" / "reach-test").mkdir()
+    config = {"kind": "reach", "unit": "state", "scene": str(test)}
+    (tmp_path / "runs" / "reach-test" / "config.json").write_text(json.dumps(config))
+    run = tmp_path / "runs" / "test-run" / "config.json"
+    run.write_text(json.dumps({"kind": "eval", "split": "test", "scene": str(train)}))
+    _, found = check([tmp_path / "runs"], [3])
+    assert len(found.leaks()) == 2
+    r = runner.invoke(app, ["splits", "check", str(tmp_path / "runs"), "--sizes", "3"])
+    assert r.exit_code == 1 and "ran in test-split layouts" in r.stdout
