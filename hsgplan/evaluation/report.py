@@ -103,16 +103,18 @@ def sample_failures(
     queues: list[list[tuple[str, EpisodeRecord]]] = []
     for m in methods:
         by_kind: dict[tuple[str, str], list[tuple[str, EpisodeRecord]]] = {}
-        rows = logged_rows(run_dir / m)
+        # a method run under several trainings logs each in `METHOD/seed-S`
+        folders = [m] + [f"{m}/{p.name}" for p in sorted((run_dir / m).glob("seed-*"))]
         records = []
-        for r in rows:
-            try:
-                records.append(EpisodeRecord.from_json(r["result"]))
-            except (KeyError, TypeError, ValueError):
-                continue  # a damaged row is not shown (the eval would run its episode again)
-        for r in sorted(records, key=lambda r: (r.size, r.seed)):
+        for folder in folders:
+            for r in logged_rows(run_dir / folder):
+                try:
+                    records.append((folder, EpisodeRecord.from_json(r["result"])))
+                except (KeyError, TypeError, ValueError):
+                    continue  # a damaged row is not shown (the eval would run it again)
+        for folder, r in sorted(records, key=lambda fr: (fr[1].size, fr[1].seed, fr[0])):
             if c := failure_class(r):
-                by_kind.setdefault(c, []).append((m, r))
+                by_kind.setdefault(c, []).append((folder, r))
         queues.append(_round_robin(sorted(by_kind.values(), key=lambda v: -len(v))))
     return _round_robin(queues)[:count]
 
@@ -185,7 +187,7 @@ def build_report(
     if not sample:
         parts.append(paragraph("No episode of this run failed."))
     for method, record in sample:
-        agent = summary["methods"][method]["agent"]
+        agent = summary["methods"][method.split("/")[0]]["agent"]
         r = rollout(run_dir, method, agent, record, recordings)
         parts.append(_episode(r, run_dir))
         if on_rollout:

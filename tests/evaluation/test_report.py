@@ -139,3 +139,11 @@ def test_a_run_of_identical_failed_steps_is_one_row():
     ]
     rows = _collapsed(steps)
     assert [r[0] for r in rows] == ["1", "2–4 (×3)"] and rows[1][3] == "no_ik"
+
+
+def test_the_sample_reads_every_training_of_a_method(tmp_path):
+    config = EvalConfig("learned", (2,), 2, 0)
+    _run_folder(tmp_path, "gnn/seed-0", [_record(1, None)], config)
+    _run_folder(tmp_path, "gnn/seed-1", [_record(1, "knocked_over")], config)
+    sample = sample_failures(tmp_path, ["gnn"], 4)
+    assert [(folder, r.seed) for folder, r in sample] == [("gnn/seed-1", 1)]
