@@ -89,7 +89,7 @@ def _read_json(path: Path) -> dict | None:
     return value if isinstance(value, dict) else None
 
 
-def _visited(folder: Path, config: dict) -> Iterator[Draw]:
+def _visited(folder: Path) -> Iterator[Draw]:
     for row in _rows(folder, "episodes.jsonl"):
         result = row.get("result", {})
         if "goal" not in result:
@@ -182,7 +182,7 @@ def find(roots: Iterable[Path]) -> Found:
                 draws += _demos(folder)
             elif data.get("kind") == "reach" and data.get("unit") == "visited episode":
                 kind, draws = "visited collections", found.training
-                draws += _visited(folder, data)
+                draws += _visited(folder)
             elif data.get("kind") == "eval" and data.get("split") == TEST.name:
                 kind = "test runs"
                 found.test += _episodes(folder)
