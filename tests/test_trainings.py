@@ -114,3 +114,27 @@ def test_a_gain_is_called_only_where_intervals_separate():
     assert separate((0.5, 0.6), (0.65, 0.7)) and separate((0.65, 0.7), (0.5, 0.6))
     assert not separate((0.5, 0.66), (0.65, 0.7))
     assert not separate(None, (0.1, 0.2))
+
+
+@pytest.mark.slow
+def test_a_table_runs_every_training_and_reports_over_them(tmp_path):
+    import shutil
+
+    from hsgplan.evaluation.table1 import Method, run_table, tables
+    from hsgplan.paths import TASK_CHECKPOINT
+
+    task = tmp_path / "task"
+    for s in (0, 1):
+        shutil.copytree(TASK_CHECKPOINT, task / f"seed-{s}")
+    record(task, [0, 1], "task")
+    config = EvalConfig(
+        "", (2,), 2, 2_000_000, checkpoint=str(task), protocol="paper", split="test"
+    )
+    report = run_table([Method("gnn", "learned")], config, tmp_path / "run", workers=1)
+    gnn = report["methods"]["gnn"]
+    assert gnn["trainings"] == [0, 1] and gnn["by_size"]["2"]["episodes"] == 4
+    assert len(gnn["by_size"]["2"]["success_by_training"]) == 2
+    assert gnn["by_size"]["2"]["success_ci"] is not None  # each goal run under both trainings
+    assert {p.name for p in (tmp_path / "run" / "gnn").iterdir()} == {"seed-0", "seed-1"}
+    title = tables(report, ("success",))[0].title
+    assert "under each of 2 trainings" in title and "test split" in title
