@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from hsgplan.cli import app
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.config import EvalConfig
-from hsgplan.evaluation.intervals import separate, stratified_interval
+from hsgplan.evaluation.intervals import goal_interval, separate
 from hsgplan.evaluation.protocol import trained, training_dir
 from hsgplan.trainings import RECORD, paired, record, seed_folders
 
@@ -84,9 +84,11 @@ def test_train_motion_seeds_trains_each_seed_into_its_folder(tmp_path):
     assert again == weights
 
 
-def test_an_interval_needs_two_episodes_of_every_goal():
-    assert stratified_interval({"a": [1.0], "b": [0.0, 1.0]}) is None
-    assert stratified_interval({"a": [1.0, 1.0], "b": [0.0, 0.0]}) == (0.5, 0.5)
+def test_an_interval_needs_two_goals():
+    assert goal_interval({"a": [1.0, 0.0, 1.0]}) is None
+    assert goal_interval({"a": [1.0, 1.0], "b": [1.0]}) == (1.0, 1.0)
+    low, high = goal_interval({"a": [1.0], "b": [0.0]})
+    assert low == 0.0 and high == 1.0
 
 
 @settings(max_examples=20, deadline=None)
@@ -94,20 +96,22 @@ def test_an_interval_needs_two_episodes_of_every_goal():
 def test_an_interval_holds_its_mean_and_is_the_same_every_time(seed, runs):
     rng = random.Random(seed)
     strata = {str(g): [float(rng.random() < 0.7) for _ in range(runs)] for g in range(30)}
-    low, high = stratified_interval(strata)
+    low, high = goal_interval(strata)
     mean = sum(sum(v) / len(v) for v in strata.values()) / len(strata)
     assert low - 1e-9 <= mean <= high + 1e-9
-    assert stratified_interval(strata) == (low, high)
+    assert goal_interval(strata) == (low, high)
 
 
-def test_an_interval_is_as_wide_as_each_goals_episodes_disagree():
-    # each goal's trainings and repeats are what is resampled: goals that differ from one
-    # another, each the same under every training, leave nothing to resample
-    agree = {str(g): [1.0] * 4 if g % 2 else [0.0] * 4 for g in range(40)}
-    disagree = {str(g): [1.0, 0.0, 1.0, 0.0] for g in range(40)}
-    assert stratified_interval(agree) == (0.5, 0.5)
-    low, high = stratified_interval(disagree)
+def test_an_interval_is_as_wide_as_goals_differ_and_each_goal_counts_once():
+    # goals that differ from one another widen it; how many episodes a goal had does not
+    # weigh it more: a goal is the unit drawn
+    alike = {str(g): [1.0, 0.0] for g in range(40)}
+    differ = {str(g): [1.0, 1.0] if g % 2 else [0.0, 0.0] for g in range(40)}
+    assert goal_interval(alike) == (0.5, 0.5)
+    low, high = goal_interval(differ)
     assert low < 0.5 < high
+    heavy = differ | {"0": [0.0] * 50}
+    assert goal_interval(heavy) == (low, high)
 
 
 def test_a_gain_is_called_only_where_intervals_separate():

@@ -217,10 +217,8 @@ def eval_motion(
             rows.append((kind, label, str(n), *cells))
     title = f"Single-shot motion success on fresh scenes, {seed_words(seed, split and split.value)}"
     if trainings:
-        title += (
-            f", each network trained {len(trainings)} times (in brackets the 95% interval: a "
-            "bootstrap over scenes, each scene's trials under every training resampled within it)"
-        )
+        title += f", each network trained {len(trainings)} times"
+    title += " (in brackets the 95% interval of a bootstrap over scenes)"
     title += f", in each scene of {scene}" if scene else ""
     print_table(
         marked(title, seed, split=split and split.value),

@@ -1,11 +1,11 @@
-"""95% intervals of a success rate over trainings, goals and repeats.
+"""95% intervals of a success rate over goals, whichever trainings and repeats ran them.
 
-The rate's interval is a stratified bootstrap (scipy's `bootstrap`, percentile method), the
-recipe of rliable (Agarwal et al., 2021): each goal is a stratum, and its episodes (one per
-training and repeat) are resampled within it; the statistic is the mean over goals of each
-goal's mean. A goal met once has nothing to resample: an interval needs every goal run at
-least twice (two trainings, or two repeats). The resampling is seeded, so a summary is the
-same every time it is made.
+The interval is a bootstrap over goals (scipy's `bootstrap`, percentile method): a goal is the
+unit drawn, its episodes under every training and repeat kept together as its mean, so the
+interval says how far the rate would move with another draw of goals as the split draws them.
+How far it moves with another training is each training's own rate, which the summaries keep
+beside it (`success_by_training`). Fewer than two goals give no interval. The resampling is
+seeded, so a summary is the same every time it is made.
 """
 
 from __future__ import annotations
@@ -20,25 +20,20 @@ RESAMPLES = 2000
 SEED = 0
 
 
-def _mean_over_strata(*samples: np.ndarray, axis: int = -1) -> np.ndarray:
-    return np.mean([np.mean(s, axis=axis) for s in samples], axis=0)
-
-
-def stratified_interval(
+def goal_interval(
     strata: Mapping[str, Sequence[float]] | Sequence[Sequence[float]],
 ) -> tuple[float, float] | None:
-    """The 95% interval of the mean over strata of each stratum's mean; None where a stratum
-    holds fewer than two values."""
+    """The 95% interval of the mean over goals of each goal's mean (`strata`: each goal's
+    episodes); None for fewer than two goals."""
     groups = list(strata.values()) if isinstance(strata, Mapping) else list(strata)
-    if not groups or min(len(g) for g in groups) < 2:
+    means = np.array([np.mean(g) for g in groups if len(g)], dtype=float)
+    if len(means) < 2:
         return None
-    samples = tuple(np.asarray(g, dtype=float) for g in groups)
-    if all(np.all(s == s[0]) for s in samples):  # nothing varies: the interval is the point
-        point = float(_mean_over_strata(*samples))
-        return point, point
+    if np.all(means == means[0]):  # nothing varies: the interval is the point
+        return float(means[0]), float(means[0])
     result = bootstrap(
-        samples,
-        _mean_over_strata,
+        (means,),
+        np.mean,
         n_resamples=RESAMPLES,
         confidence_level=CONFIDENCE,
         method="percentile",

@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence
 
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.failures import Failure
-from hsgplan.evaluation.intervals import stratified_interval
+from hsgplan.evaluation.intervals import goal_interval
 from hsgplan.sim.outcome import DISTURB_RECORD, DISTURB_TOL, SEEN_DISTURB_TOL, Status
 
 EXECUTION = "execution"
@@ -105,8 +105,8 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "episodes": len(rs),
         "repeats": len(by_repeat),
         "success_std": _spread({k: [r.success for r in v] for k, v in by_repeat.items()}),
-        # each goal a stratum; its episodes (trainings, repeats) resampled within it
-        "success_ci": stratified_interval(_by_goal(rs)),
+        # a bootstrap over goals, each goal's episodes (trainings, repeats) kept together
+        "success_ci": goal_interval(_by_goal(rs)),
         "completion_std": _spread(
             {k: [r.subgoal_completion for r in v] for k, v in by_repeat.items()}
         ),

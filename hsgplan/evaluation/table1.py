@@ -279,8 +279,8 @@ def runs_words(report: dict) -> str:
         words += f" under each of {trained} trainings"
     if with_ci:
         return words + (
-            " (in brackets the 95% interval: a bootstrap over goals, each goal's episodes "
-            "resampled within it)"
+            " (in brackets the 95% interval of a bootstrap over goals, each goal's episodes "
+            "under every training and repeat kept together)"
         )
     if report["repeats"] > 1:
         return words + " (± the standard deviation of the success rate over the repeats)"

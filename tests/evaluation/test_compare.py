@@ -82,14 +82,14 @@ def test_each_run_may_name_its_own_method_and_then_no_paper_row_is_set_beside(tm
     b = _run(tmp_path / "b", {2: (True, True)}, method="gnn-next")
     table = compare([a, b], ["gnn", "gnn-next"], ["gnn", "gnn-next"])
     assert [r[:2] for r in table.rows] == [
-        ("gnn", "0.50 (0.00–1.00) / 0.50"),  # one goal run twice: its interval
-        ("gnn-next", "1.00 (1.00–1.00) / 0.50"),
+        ("gnn", "0.50 / 0.50"),  # one goal, run twice: no interval over goals
+        ("gnn-next", "1.00 / 0.50"),
     ]
     assert "each run's method" in table.title
     with pytest.raises(InvalidInputError, match="one, or one per run"):
         compare([a, b], ["a", "b"], ["gnn", "gnn", "gnn"])
     r = CliRunner().invoke(app, ["eval", "compare", str(a), str(b), "--method", "gnn,gnn-next"])
-    assert r.exit_code == 0 and "1.00 (1.00–1.00) / 0.50" in r.stdout
+    assert r.exit_code == 0 and "1.00 / 0.50" in r.stdout
 
 
 def test_a_missing_method_or_a_name_short_is_one_line_exit_2(tmp_path):

@@ -141,7 +141,7 @@ def test_the_table_puts_the_papers_numbers_beside_ours():
     header = next(line for line in text.splitlines() if line.startswith("| objects"))
     assert header == "| objects | GNN | GNN (paper) | sampler |"
     paper = PAPER_TABLE1["gnn"][2]
-    ours = "0.50 (0.00–1.00) / 0.75"  # one goal, run twice: its 95% interval
+    ours = "0.50 / 0.75"  # one goal, run twice: no interval over goals
     assert f"| 2 | {ours} | {paper[0]:.2f} / {paper[1]:.2f} | {ours} |" in text
     assert "| GNN | 2 | 2 | 1 | 0 | 1 (step limit 1) | 1 | 1 |" in text
     assert "(recovering protocol)" in text  # a report without a protocol predates the paper's
@@ -286,3 +286,11 @@ def test_what_the_observer_saw_move_is_summed_over_steps_that_truly_moved_nothin
     assert still == {"steps": 2, "p99": 0.025, "max": 0.025, "beyond_2cm": 1, "beyond_tolerance": 0}
     no_steps = summarize([replace(_record(True), steps=())])["by_size"]["2"]
     assert no_steps["still_seen_moved"] == {"steps": 0}
+
+
+def test_a_cell_gives_its_interval_where_the_summary_has_one():
+    from hsgplan.evaluation.table1 import cell
+
+    v = {"success_rate": 0.5, "subgoal_completion": 0.75, "success_std": 0.1}
+    assert cell(v) == "0.50 ± 0.10 / 0.75"  # a summary from before intervals
+    assert cell(v | {"success_ci": [0.25, 0.75]}) == "0.50 (0.25–0.75) / 0.75"
