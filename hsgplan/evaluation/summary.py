@@ -86,6 +86,10 @@ def _spread(values_by_repeat: dict[int, list[float]]) -> float | None:
     return statistics.pstdev(means) if len(means) > 1 else None
 
 
+def _as_list(interval: tuple[float, float] | None) -> list[float] | None:
+    return None if interval is None else list(interval)
+
+
 def _by_goal(rs: Sequence[EpisodeRecord]) -> dict[str, list[float]]:
     goals: dict[str, list[float]] = {}
     for r in rs:
@@ -106,7 +110,7 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "repeats": len(by_repeat),
         "success_std": _spread({k: [r.success for r in v] for k, v in by_repeat.items()}),
         # a bootstrap over goals, each goal's episodes (trainings, repeats) kept together
-        "success_ci": goal_interval(_by_goal(rs)),
+        "success_ci": _as_list(goal_interval(_by_goal(rs))),  # as JSON gives it back
         "completion_std": _spread(
             {k: [r.subgoal_completion for r in v] for k, v in by_repeat.items()}
         ),
