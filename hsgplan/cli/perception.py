@@ -21,7 +21,8 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
-from hsgplan.evaluation.seeds import marked
+from hsgplan.cli.seeding import PerceptionRulesOption, SplitOption, rule_settings
+from hsgplan.evaluation.seeds import marked, seed_words
 from hsgplan.paths import PERCEPTION_CHECKPOINT, RUNS
 
 
@@ -77,8 +78,13 @@ def eval_perception(
     ] = PERCEPTION_CHECKPOINT,
     scenes: Annotated[int, bounded_option("scenes", "Fresh scenes.")] = 100,
     seed: Annotated[
-        int, bounded_option("seed", "Seed of the scenes (not a tuning seed: docs/perception.md).")
-    ] = 6,
+        int | None,
+        bounded_option(
+            "seed", "Seed of the scenes (default: 6, or the split's first; docs/perception.md)."
+        ),
+    ] = None,
+    split: SplitOption = None,
+    perception_rules: PerceptionRulesOption = "",
     raw: Annotated[
         bool,
         typer.Option(
@@ -142,8 +148,10 @@ def eval_perception(
     from hsgplan.domain.scene_file import read_worlds
     from hsgplan.evaluation.config import unseeable
     from hsgplan.evaluation.perception_eval import evaluate, evaluate_loop, summary
+    from hsgplan.evaluation.splits import check_seed, split_named
     from hsgplan.paths import shipped
     from hsgplan.perception.estimator import PoseEstimator
+    from hsgplan.perception.rules import PerceptionRules
     from hsgplan.perception.synthetic import first_views
     from hsgplan.perception.vocabulary import read_vocabulary
     from hsgplan.sim.outcome import BELIEF_OFF, BELIEF_TURNED
@@ -153,14 +161,24 @@ def eval_perception(
     worlds = (KITCHEN,) if scene is None else tuple(read_worlds(scene).values())
     if why := unseeable(worlds, scene, perception_checkpoint):
         raise InvalidInputError(why)
+    if split is not None:
+        seed = split_named(split.value).seeds.start if seed is None else seed
+        check_seed(split_named(split.value), seed)
+    seed = 6 if seed is None else seed
+    settings = rule_settings(perception_rules)
     estimator = PoseEstimator.load(
-        perception_checkpoint, settled=not raw, pruned=not unpruned, silhouette=not keypoint_yaw
+        perception_checkpoint,
+        settled=not raw,
+        pruned=not unpruned,
+        silhouette=not keypoint_yaw,
+        rules=PerceptionRules.parse(settings),
     )
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         run = evaluate_loop if loop else evaluate
         found = run(estimator, scenes, seed, lambda: progress.advance(task), shown, worlds)
-        report = summary(found)
+        report = summary(found) | {"seed": seed, "split": split and split.value}
+        report["perception_rules"] = list(settings)
     if as_json:
         print(json.dumps(report, indent=2))
         return
@@ -186,7 +204,8 @@ def eval_perception(
     )
     title = (
         f"f_p on {report['scenes']} {'scenes from inside the loop' if loop else 'fresh scenes'}, "
-        f"seed {seed}"
+        f"{seed_words(seed, split and split.value)}"
+        f"{', rules ' + ', '.join(settings) if settings else ''}"
         f"{f', in {scene}' if scene is not None else ''}"
         f"{f' (the first {views} views)' if views else ''}: objects found (recall) "
         f"{report['found_rate']:.3f}, detections matching an object (precision) "
@@ -196,7 +215,7 @@ def eval_perception(
     if report["misreads"]:
         misreads = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in report["misreads"].items())
         title += f"; scenes misread by: {misreads}"
-    title = marked(title, seed, perception=True)
+    title = marked(title, seed, perception=True, split=split and split.value)
     print_table(
         title,
         (

@@ -36,6 +36,25 @@ TrainingSeeds = Annotated[
 ]
 
 
+PerceptionRulesOption = Annotated[
+    str,
+    typer.Option(
+        "--perception-rules",
+        help="f_p's rules set otherwise, comma-separated NAME=VALUE (e.g. pixel_vote=off,"
+        "ray_gap=0.03): cliques, ray_gap, pixel_vote, found_again_can, rest, near_ray, "
+        "track_distance, lone_still (docs/perception.md, Rules).",
+        metavar="RULES",
+    ),
+]
+
+
+def rule_settings(text: str) -> tuple[str, ...]:
+    """The `--perception-rules` settings, each checked (a bad one refused in one line)."""
+    from hsgplan.perception.rules import PerceptionRules
+
+    return PerceptionRules.parse(text).changed()
+
+
 def split_seed(seed: int | None, split) -> int:
     """The run's seed: the one given, else the split's first seed, else 0."""
     if seed is not None:

@@ -39,7 +39,13 @@ from hsgplan.cli.common import (
     scene_world,
     shown,
 )
-from hsgplan.cli.seeding import SeedOrSplitStart, SplitOption, split_seed
+from hsgplan.cli.seeding import (
+    PerceptionRulesOption,
+    SeedOrSplitStart,
+    SplitOption,
+    rule_settings,
+    split_seed,
+)
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import NO_FAILURE_RULES, RecoveryRules
 from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
@@ -234,6 +240,7 @@ def evaluate(
             + "."
         ),
     ] = "",
+    perception_rules: PerceptionRulesOption = "",
     ablate_rules: Annotated[
         bool,
         typer.Option(
@@ -302,9 +309,12 @@ def evaluate(
         perception_checkpoint=perception_checkpoint and str(shipped(perception_checkpoint)),
         protocol=protocol.value,
         rules_off=names_of(rules_off, "--rules-off", "rule", none=True),
+        perception_rules=rule_settings(perception_rules),
         scene=str(scene) if scene else None,
         split=split and split.value,
     )
+    if config.perception_rules and seeing == ("gt",):
+        raise InvalidInputError("--perception-rules: f_p's rules act only where it sees (rgb)")
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
         make_observer(p, config.perception_checkpoint)
     total = total_episodes(methods, config)
@@ -353,6 +363,7 @@ def _run_name(methods, config) -> str:
     )
     protocol = "" if config.protocol == DEFAULT_PROTOCOL.value else f"-{config.protocol}"
     protocol += "".join(f"-no_{rule}" for rule in config.rules_off)
+    protocol += "".join(f"-{rule}" for rule in config.perception_rules)
     where = f"-{Path(config.scene).stem}" if config.scene else ""
     seed = config.split or f"seed{config.seed}"
     return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-{seed}{where}"

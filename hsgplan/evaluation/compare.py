@@ -31,6 +31,7 @@ from hsgplan.runner.run_folder import CONFIG, logged_rows
 LIKE_FOR_LIKE = (
     "protocol",
     "rules_off",
+    "perception_rules",
     "goals",
     "goals_file",
     "repeats",
@@ -43,6 +44,8 @@ LIKE_FOR_LIKE = (
 # file (a folder of 20 scenes with 5 goals each against the kitchen's 100), as long as every
 # size has as many episodes in each run
 ACROSS_SCENES = ("scene", "goals")
+# what a ladder of rules changes from row to row (`across_rules`)
+RULES = ("rules_off", "perception_rules")
 
 
 def compare(
@@ -73,7 +76,7 @@ def compare(
             known = ", ".join(summary["methods"])
             raise InvalidInputError(f"'{run}' holds no method '{method}' (it holds {known})")
         for key in LIKE_FOR_LIKE:
-            if (across_scenes and key in ACROSS_SCENES) or (across_rules and key == "rules_off"):
+            if (across_scenes and key in ACROSS_SCENES) or (across_rules and key in RULES):
                 continue
             if s.get(key) != settings[0].get(key):
                 raise InvalidInputError(

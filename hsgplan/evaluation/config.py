@@ -80,6 +80,8 @@ class EvalConfig:
     protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
     # rules switched off (any under the recovering protocol, the perception rules under both)
     rules_off: tuple[str, ...] = ()
+    # f_p's and its tracker's rules set otherwise than shipped, NAME=VALUE (`perception.rules`)
+    perception_rules: tuple[str, ...] = ()
     scene: str | None = None  # a scene file or a folder of them (None: the kitchen)
     # the split its goals and start scenes are drawn from (`evaluation.splits`; None: a bare
     # seed, exploration, its goals drawn from the whole goal space)
@@ -98,6 +100,11 @@ class EvalConfig:
             raise InvalidInputError(f"protocol '{self.protocol}': one of {', '.join(PROTOCOLS)}")
         object.__setattr__(self, "rules_off", tuple(self.rules_off))
         RecoveryRules().without(self.rules_off)  # an unknown rule's name is refused here
+        object.__setattr__(self, "perception_rules", tuple(self.perception_rules))
+        if self.perception_rules:
+            from hsgplan.perception.rules import PerceptionRules
+
+            PerceptionRules.parse(self.perception_rules)  # a bad setting refused here
         if self.protocol == PAPER and (kept := set(self.rules_off) - set(NO_FAILURE_RULES)):
             raise InvalidInputError(
                 f"the paper protocol has no recovery rule to switch off ({', '.join(sorted(kept))}"

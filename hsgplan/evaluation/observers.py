@@ -18,13 +18,17 @@ def perception_folder(checkpoint: str | Path | None) -> Path:
     return Path(checkpoint or PERCEPTION_CHECKPOINT)
 
 
-def make_observer(name: str, checkpoint: str | Path | None = None) -> SceneObserver:
+def make_observer(
+    name: str, checkpoint: str | Path | None = None, rules: tuple[str, ...] = ()
+) -> SceneObserver:
     """The observer `name`; for `rgb` its network is loaded (a missing or damaged checkpoint
-    refused in one line)."""
+    refused in one line), its rules set by `rules` (`perception.rules`, NAME=VALUE)."""
     check_observer(name)
     if name == "gt":
         return GroundTruth()
     from hsgplan.perception.observer import RgbObserver
+    from hsgplan.perception.rules import PerceptionRules
 
     folder = perception_folder(checkpoint)
-    return RgbObserver.load(folder, name, name != "rgb-latest", name != "rgb-keypoint-yaw")
+    steady, silhouette = name != "rgb-latest", name != "rgb-keypoint-yaw"
+    return RgbObserver.load(folder, name, steady, silhouette, PerceptionRules.parse(rules))

@@ -119,7 +119,7 @@ def _worker_agent(config: EvalConfig):
 
 @lru_cache(maxsize=2)
 def _worker_observer(config: EvalConfig):
-    return make_observer(config.perception, config.perception_checkpoint)
+    return make_observer(config.perception, config.perception_checkpoint, config.perception_rules)
 
 
 EVAL_KIND = "eval"
@@ -144,6 +144,10 @@ def run_config(config: EvalConfig) -> dict:
         settings["rules_off"] = list(config.rules_off)
     if config.scene is None:  # as runs were claimed before scenes were files
         del settings["scene"]
+    if not config.perception_rules:  # as runs were claimed before f_p's rules could be set
+        del settings["perception_rules"]
+    else:
+        settings["perception_rules"] = list(config.perception_rules)
     if config.split is None:  # as runs were claimed before splits
         del settings["split"]
     files = [Path(p) for p in (config.goals_file, *config.worlds()) if p]
@@ -159,7 +163,12 @@ def read_eval_config(run_dir: Path) -> EvalConfig:
     names = {f.name for f in fields(EvalConfig)}
     try:
         config = EvalConfig(**{k: v for k, v in saved.items() if k in names})
-        return replace(config, sizes=tuple(config.sizes), rules_off=tuple(config.rules_off))
+        return replace(
+            config,
+            sizes=tuple(config.sizes),
+            rules_off=tuple(config.rules_off),
+            perception_rules=tuple(config.perception_rules),
+        )
     except TypeError:
         raise InvalidInputError(
             f"'{run_dir / CONFIG}' is not an evaluation's configuration"

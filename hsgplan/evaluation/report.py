@@ -145,7 +145,9 @@ def rollout(
             partial,
             scale=GIF_SCALE,
             frame_every=FRAME_EVERY,
-            observer=make_observer(config.perception, config.perception_checkpoint),
+            observer=make_observer(
+                config.perception, config.perception_checkpoint, config.perception_rules
+            ),
             end_at_failure=config.protocol == PAPER,
             recording=partial / RECORDING if recording else None,
         )

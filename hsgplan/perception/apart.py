@@ -7,7 +7,9 @@ from hsgplan.perception.detection import Detection
 from hsgplan.perception.settle import same_place
 
 
-def apart(detections: list[Detection], world: World) -> list[Detection]:
+def apart(
+    detections: list[Detection], world: World, found_again_can: bool = True
+) -> list[Detection]:
     """Two objects cannot fill one space. Detections that fill one (`settle.same_place`) are
     one object found twice, mostly once in each look-alike type's maps; the one whose type the
     colour network is surest of, among every type, is kept (then the stronger). Choosing among
@@ -23,11 +25,12 @@ def apart(detections: list[Detection], world: World) -> list[Detection]:
     under a butter shows the butter's yellow at its centroid's pixel in the views from above,
     so its type's mean probability is low, while one view's duplicate of the butter, found too
     low (a single view's depth is its weak axis), filled the soup's space surer of its colour,
-    and the soup was lost (2 of 6 look-alikes on 300 tuning scenes, seeds 900 to 902)."""
+    and the soup was lost (2 of 6 look-alikes on 300 tuning scenes, seeds 900 to 902).
+    (`found_again_can` off: a lone can is told from the other by colour, as any detection.)"""
     several = [d for d in detections if d.views > 1]
     kept: list[Detection] = []
     for d in sorted(detections, key=lambda d: (-d.type_confidence, -d.score)):
-        if d.views == 1 and any(_found_again(d, k, world) for k in several):
+        if d.views == 1 and any(_found_again(d, k, world, found_again_can) for k in several):
             continue
         if not any(_same_place(d, k, world) for k in kept):
             kept.append(d)
@@ -39,7 +42,7 @@ def _same_place(d: Detection, k: Detection, world: World) -> bool:
     return same_place(a, d.pose, b, k.pose)
 
 
-def _found_again(d: Detection, k: Detection, world: World) -> bool:
+def _found_again(d: Detection, k: Detection, world: World, cans: bool = True) -> bool:
     """Whether a lone view's `d` is `k`, which several views saw, found again: in its space, a
     can of its type or anything of the other kind."""
     if not _same_place(d, k, world):
@@ -47,4 +50,4 @@ def _found_again(d: Detection, k: Detection, world: World) -> bool:
     kind = world.object_type(d.type_name).kind
     if kind is not world.object_type(k.type_name).kind:
         return True
-    return kind is Kind.CAN and k.type_name == d.type_name
+    return cans and kind is Kind.CAN and k.type_name == d.type_name

@@ -38,6 +38,7 @@ from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
 from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost
+from hsgplan.perception.rules import SHIPPED, PerceptionRules
 from hsgplan.perception.settle import (
     OVERLAP_XY,
     fits_height,
@@ -78,6 +79,7 @@ class PoseEstimator:
     pruned: drop what a lone view found that the other views contradict.
     silhouette: check each box's yaw by its silhouette (`perception.silhouette`).
     vocabulary: the types the networks' channels name (`perception.vocabulary`).
+    rules: the estimator's and its tracker's rules (`perception.rules`; the shipped ones).
 
     What it knows of the scene it looks at (its object types' sizes and kinds, its table and
     shelves) is that scene's `World`, given with each look.
@@ -91,8 +93,10 @@ class PoseEstimator:
         pruned: bool = True,
         vocabulary: Vocabulary = KITCHEN_VOCABULARY,
         silhouette: bool = True,
+        rules: PerceptionRules = SHIPPED,
     ) -> None:
         self.net = net
+        self.rules = rules
         self.silhouette = silhouette
         self.settled = settled
         self.colour = colour
@@ -102,7 +106,11 @@ class PoseEstimator:
 
     @staticmethod
     def load(
-        folder: Path, settled: bool = True, pruned: bool = True, silhouette: bool = True
+        folder: Path,
+        settled: bool = True,
+        pruned: bool = True,
+        silhouette: bool = True,
+        rules: PerceptionRules = SHIPPED,
     ) -> PoseEstimator:
         """The estimator of a checkpoint folder (the keypoint network, and the colour network
         in its `colour/`), naming its vocabulary's types; one whose networks have another
@@ -115,7 +123,7 @@ class PoseEstimator:
                 f"f_p '{folder}': its networks name {config.types} and {colour.objects} "
                 f"types, its vocabulary {len(vocabulary.types)}"
             )
-        return PoseEstimator(net, settled, colour, pruned, vocabulary, silhouette)
+        return PoseEstimator(net, settled, colour, pruned, vocabulary, silhouette, rules)
 
     def _typed(self, world: World, images: np.ndarray, members: list[Seen]) -> tuple[str, float]:
         """The type of an object its members saw, and its probability: by the colour network
@@ -267,13 +275,14 @@ class PoseEstimator:
                 if single is not None:
                     found.append(Seen(inst.type_index, inst.score, v, seen, single.pose))
         typed = partial(self._typed, world, images)
-        fused = apart(fuse(found, typed, world), world)
-        if self.colour is not None:
-            fused = apart(self._retyped(world, images, cameras, fused), world)
+        cans = self.rules.found_again_can
+        fused = apart(fuse(found, typed, world, self.rules), world, cans)
+        if self.colour is not None and self.rules.pixel_vote:
+            fused = apart(self._retyped(world, images, cameras, fused), world, cans)
         if not self.settled:
             return fused
         fused = self._unstacked(world, images, cameras, fused)
-        rested = self.rest(world, [replace(d, measured=d.pose) for d in fused])
+        rested = self.rest(world, [replace(d, measured=d.pose) for d in fused], rules=self.rules)
         if self.silhouette and self.colour is not None:
             rested = yaw_checked(self.colour, self.types, world, images, cameras, rested, arm)
         if not self.pruned:
@@ -286,12 +295,17 @@ class PoseEstimator:
         found: list[Detection],
         fixed: Sequence[tuple[str, Pose]] = (),
         near: Mapping[int, Pose] | None = None,
+        rules: PerceptionRules = SHIPPED,
     ) -> list[Detection]:
         """Detections (as `detect` found them) made to rest from their measured poses
         (`perception.settle`), `fixed` objects (type and pose: believed there, unseen) carrying
         them too; one left with its centre inside the table is dropped (a lone view's phantom
         that nothing could hold: no object can be there). `near` (by index in `found`): where
-        the object a lone view's detection is was believed before (`along_ray_near`)."""
+        the object a lone view's detection is was believed before (`along_ray_near`). With the
+        `rules`' `rest` off, no unseen object carries and none is dropped; `near_ray` bounds the
+        move along a ray."""
+        rule = rules
+        fixed = fixed if rule.rest else ()
         # a split stack's keypoints are its blob's: they say nothing of either box's height
         costs = [
             None if d.stacked or not d.keypoints else partial(_cost_at, d, world) for d in found
@@ -299,11 +313,11 @@ class PoseEstimator:
         measured = [d.measured or d.pose for d in found]
         for k, before in (near or {}).items():
             if len(found[k].rays) == 1:
-                measured[k] = along_ray_near(found[k].rays[0], measured[k], before)
+                measured[k] = along_ray_near(found[k].rays[0], measured[k], before, rule.near_ray)
         types, rays = [d.type_name for d in found], [d.rays for d in found]
         poses = settle(world, types, measured, rays, costs, fixed)
         out = [replace(d, pose=p) for d, p in zip(found, poses, strict=True)]
-        return [d for d in out if not _inside_table(d.pose, world)]
+        return [d for d in out if not (rule.rest and _inside_table(d.pose, world))]
 
 
 def _inside_table(pose: Pose, world: World) -> bool:

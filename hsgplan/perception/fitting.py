@@ -11,6 +11,7 @@ from hsgplan.domain.world import ObjectType, World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen, grouped, line_of_sight
 from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost, upright_fit
+from hsgplan.perception.rules import SHIPPED, PerceptionRules
 from hsgplan.perception.settle import Ray, meeting_point
 from hsgplan.scene_graph.geometry import Pose
 
@@ -25,12 +26,16 @@ TOPPLED_COST = 0.5
 
 
 def fuse(
-    found: list[Seen], typed: Callable[[list[Seen]], tuple[str, float]], world: World
+    found: list[Seen],
+    typed: Callable[[list[Seen]], tuple[str, float]],
+    world: World,
+    rules: PerceptionRules = SHIPPED,
 ) -> list[Detection]:
-    """One detection per object that the views' lines of sight group (`fusion.grouped`),
-    named by `typed` and fitted to every member's keypoints (its type's cuboid in `world`)."""
+    """One detection per object that the views' lines of sight group (`fusion.grouped`, by
+    `rules`' gap and cliques), named by `typed` and fitted to every member's keypoints (its
+    type's cuboid in `world`)."""
     out = []
-    for members in grouped(found, world.table):
+    for members in grouped(found, world.table, rules.ray_gap, rules.cliques):
         name, confidence = typed(members)
         rays = [line_of_sight(s) for s in members]
         views = [s.keypoints for s in members]

@@ -77,11 +77,14 @@ def ray_gap(a: Seen, b: Seen, table: Rect) -> float:
     return float(np.linalg.norm(qa - qb))
 
 
-def grouped(found: list[Seen], table: Rect) -> list[list[Seen]]:
+def grouped(
+    found: list[Seen], table: Rect, gap: float = RAY_GAP, cliques: bool = True
+) -> list[list[Seen]]:
     """The instances as objects (over the `table`, `ray_gap`): groups of instances of one type, at
-    most one per view, every two of them within `RAY_GAP`; groups seen by more views first, and
-    among groups of one size the one whose farthest pair is closest first. Each group lists its
-    members strongest first; the groups come in the order of their strongest members."""
+    most one per view, every two of them within `gap`; groups seen by more views first, and
+    among groups of one size the one whose farthest pair is closest first (`cliques`; else
+    `_closest_pairs_first`). Each group lists its members strongest first; the groups come in
+    the order of their strongest members."""
     order = sorted(found, key=lambda s: -s.score)
     gaps = {
         (a, b): g
@@ -89,8 +92,10 @@ def grouped(found: list[Seen], table: Rect) -> list[list[Seen]]:
         for b in range(a + 1, len(order))
         if order[a].view != order[b].view
         and order[a].type_index == order[b].type_index
-        and (g := ray_gap(order[a], order[b], table)) < RAY_GAP
+        and (g := ray_gap(order[a], order[b], table)) < gap
     }
+    if not cliques:
+        return _closest_pairs_first(order, gaps)
     near: dict[int, set[int]] = {k: set() for k in range(len(order))}
     for a, b in gaps:
         near[a].add(b)
@@ -119,9 +124,24 @@ def grouped(found: list[Seen], table: Rect) -> list[list[Seen]]:
     return [[order[k] for k in g] for g in sorted(groups, key=min)]
 
 
-def along_ray_near(ray: Ray, measured: Pose, before: Pose) -> Pose:
+def _closest_pairs_first(order: list[Seen], gaps: dict[tuple[int, int], float]) -> list[list[Seen]]:
+    """The groups the closest pairs make, joined closest first while no view is in a group
+    twice (the rule the cliques replaced, kept to measure them against)."""
+    group = {k: {k} for k in range(len(order))}
+    for a, b in sorted(gaps, key=lambda pair: (gaps[pair], pair)):
+        ga, gb = group[a], group[b]
+        if ga is gb or {order[k].view for k in ga} & {order[k].view for k in gb}:
+            continue
+        ga |= gb
+        for k in gb:
+            group[k] = ga
+    groups = {id(g): sorted(g) for g in group.values()}.values()
+    return [[order[k] for k in g] for g in sorted(groups, key=min)]
+
+
+def along_ray_near(ray: Ray, measured: Pose, before: Pose, near: float = NEAR_RAY) -> Pose:
     """A lone view's estimate moved along its line of sight to the point nearest where its
-    object was believed before, if the line passes within `NEAR_RAY` of it; else as measured.
+    object was believed before, if the line passes within `near` of it; else as measured.
     Its depth is what PnP from one view gets worst: a butter under a soup on a shelf's top, a
     strip of it seen by one view, was put on the table along that view's ray 13 cm off, the soup
     was seen sunk onto the shelf, and the agent tried to pick the butter under it until the step
@@ -130,6 +150,6 @@ def along_ray_near(ray: Ray, measured: Pose, before: Pose) -> Pose:
     origin, direction = ray
     depth = float((np.asarray(before.position) - origin) @ direction)
     point = origin + depth * direction
-    if depth <= 0 or np.linalg.norm(point - np.asarray(before.position)) >= NEAR_RAY:
+    if depth <= 0 or np.linalg.norm(point - np.asarray(before.position)) >= near:
         return measured
     return Pose(tuple(map(float, point)), measured.orientation)

@@ -41,15 +41,13 @@ from scipy.optimize import linear_sum_assignment
 from hsgplan.domain.world import World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
+from hsgplan.perception.rules import SHIPPED, PerceptionRules
 from hsgplan.perception.vocabulary import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sensing import Look, Seen
 
-# A detection f_p named another type is only an object's if it is within this of where the
-# object was last seen (within `STILL` if a single view saw it).
-TRACK_DISTANCE = 0.3  # m
 # The cost, in metres of distance, of a detection f_p named another type. Small: within a
 # couple of centimetres where an object was is a surer sign of which it is than the colour at
 # its centroid, which a look-alike stacked on it lends it (at 3 cm, a box put down on its
@@ -100,12 +98,16 @@ class RgbObserver:
 
     @staticmethod
     def load(
-        folder: Path, name: str = "rgb", steady: bool = True, silhouette: bool = True
+        folder: Path,
+        name: str = "rgb",
+        steady: bool = True,
+        silhouette: bool = True,
+        rules: PerceptionRules = SHIPPED,
     ) -> RgbObserver:
         """The observer of an f_p checkpoint folder, through the cameras it was trained with
         (`silhouette`: its estimator checks boxes' yaws by their silhouettes,
-        `perception.silhouette`)."""
-        estimator = PoseEstimator.load(folder, silhouette=silhouette)
+        `perception.silhouette`; `rules`: its estimator's and tracker's, `perception.rules`)."""
+        estimator = PoseEstimator.load(folder, silhouette=silhouette, rules=rules)
         return RgbObserver(estimator, estimator.vocabulary.views, steady, name)
 
     def start(self, objects: tuple[str, ...], world: World) -> None:
@@ -132,8 +134,9 @@ class RgbObserver:
             detections = away_from_hand(detections, look.held_pose)
         self.detections = tuple(detections)
         known = {o: p for o, p in self._last.items() if o != held}
-        rest = partial(self.estimator.rest, world) if self.estimator.settled else None
-        tracks = tracked(detections, known, world, rest)
+        rules = self.estimator.rules
+        rest = partial(self.estimator.rest, world, rules=rules) if self.estimator.settled else None
+        tracks = tracked(detections, known, world, rest, rules)
         never = [o for o in self._objects if o not in self._last and o != held]
         first = first_sight(tracks.left, never, self._objects, world)
         poses = tracks.poses | {o: d.pose for o, d in first.items()}
@@ -211,20 +214,21 @@ def tracked(
     world: World,
     rest: Callable[[list[Detection], list[tuple[str, Pose]], dict[int, Pose]], list[Detection]]
     | None = None,
+    rules: PerceptionRules = SHIPPED,
 ) -> Tracks:
     """Every object's pose (by its last pose `last`; their types are `world`'s) and those no
     detection was given (`assigned`), which keep their last poses; with `rest`
     (`PoseEstimator.rest`), the detections are made to rest again with the unseen objects as
     supports, a lone view's at the place on its line of sight nearest where its object was
     (`along_ray_near`), and given again."""
-    found = assigned(detections, last, world)
+    found = assigned(detections, last, world, rules)
     unseen = tuple(o for o in last if o not in found)
     index = {id(d): k for k, d in enumerate(detections)}
     near = {index[id(d)]: last[o] for o, d in found.items() if len(d.rays) == 1}
     if (unseen or near) and rest is not None:
         fixed = [(world.type_of(o), last[o]) for o in unseen]
         detections = rest(detections, fixed, near)
-        found = assigned(detections, last, world)
+        found = assigned(detections, last, world, rules)
         unseen = tuple(o for o in last if o not in found)
     poses = {o: d.pose for o, d in found.items()}
     taken = {id(d) for d in found.values()}
@@ -272,7 +276,10 @@ def assign(detections: list[Detection], last: dict[str, Pose], world: World) -> 
 
 
 def assigned(
-    detections: list[Detection], last: dict[str, Pose], world: World
+    detections: list[Detection],
+    last: dict[str, Pose],
+    world: World,
+    rules: PerceptionRules = SHIPPED,
 ) -> dict[str, Detection]:
     """Each object (by its last pose) and the detection it gets, kind by kind (cans,
     boxes): the assignment of least total cost, a detection's cost for an object being its
@@ -282,7 +289,8 @@ def assigned(
     distance to break ties. A detection of another type further than `TRACK_DISTANCE` from an
     object's last pose is never that object, nor is one of another type that a single view saw
     further than `STILL`: two weak signs, where a look-alike phantom is likelier than a moved
-    object."""
+    object. (`rules` may set the first distance and switch the second off: `lone_still`.)"""
+    lone = STILL if rules.lone_still else rules.track_distance
     out: dict[str, Detection] = {}
     for kind in sorted({world.object_type(o).kind for o in last}):
         objects = [o for o in last if world.object_type(o).kind is kind]
@@ -295,7 +303,7 @@ def assigned(
             for j, d in enumerate(found):
                 far = float(np.linalg.norm(np.subtract(d.pose.position, last[o].position)))
                 same = d.type_name == world.type_of(o)
-                allowed[i, j] = same or far < (TRACK_DISTANCE if d.views > 1 else STILL)
+                allowed[i, j] = same or far < (rules.track_distance if d.views > 1 else lone)
                 cost[i, j] = min(far, STILL) + (0.0 if same else MISMATCH)
                 cost[i, j] += 1e-3 * far - 1e-2 * d.score
         cost[~allowed] = FORBIDDEN

@@ -82,6 +82,16 @@ def test_a_run_folder_names_its_protocol_unless_it_is_the_default():
     assert paper["protocol"] == "paper" and paper["rules_off"] == []
 
 
+def test_a_run_folder_records_f_ps_rules_where_they_differ_from_the_shipped():
+    plain = run_config(EvalConfig("oracle", (2,), 1, 0))
+    assert "perception_rules" not in plain  # as runs were claimed before
+    set_ = run_config(EvalConfig("oracle", (2,), 1, 0, perception_rules=["pixel_vote=off"]))
+    assert set_["perception_rules"] == ["pixel_vote=off"]
+    assert set_["fingerprint"] == plain["fingerprint"]  # the same checkpoints
+    with pytest.raises(InvalidInputError, match="perception rule"):
+        EvalConfig("oracle", (2,), 1, 0, perception_rules=("pixel_vote=maybe",))
+
+
 def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
     from hsgplan.evaluation.ablation import ablation_table, variants
     from hsgplan.evaluation.summary import summarize
