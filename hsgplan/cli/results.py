@@ -46,8 +46,9 @@ def results(
         bool,
         typer.Option(
             "--ship",
-            help="Once every step has finished: copy the data and each configuration's own "
-            "training into data/ and checkpoints/ (the plan's [[ship]] entries).",
+            help="Copy the data and each configuration's own training into data/ and "
+            "checkpoints/ (the plan's [[ship]] entries), each once every step that writes it "
+            "has finished.",
             metavar="",
         ),
     ] = False,
@@ -103,10 +104,17 @@ def _ship(plan: Path) -> None:
     from hsgplan.runner.ship import ship as copy_over
 
     steps = pipeline.read_plan(plan)
-    if waiting := [s.name for s in steps if pipeline.finished(pipeline.OUT, s) is None]:
-        raise InvalidInputError(
-            f"{len(waiting)} step(s) of {plan} have not finished (the first: {waiting[0]}); "
-            "nothing shipped"
-        )
-    for destination in copy_over(read_shipments(plan)):
+    entries = read_shipments(plan)
+    ready, waiting = [], []
+    for entry in entries:
+        makers = pipeline.writers(steps, entry.source)
+        if not makers:
+            raise InvalidInputError(f"'{plan}': no step writes '{entry.source}'")
+        unfinished = [s.name for s in makers if pipeline.finished(pipeline.OUT, s) is None]
+        (waiting if unfinished else ready).append((entry, unfinished))
+    for destination in copy_over([e for e, _ in ready], renames=entries):
         out.print(f"shipped {destination}", highlight=False)
+    for entry, unfinished in waiting:
+        out.print(f"not yet {entry.destination}: {', '.join(unfinished)} to run", highlight=False)
+    if not ready:
+        raise InvalidInputError(f"no step of {plan} that makes a shipment has finished")

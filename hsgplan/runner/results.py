@@ -71,6 +71,17 @@ def read_plan(path: Path = PLAN) -> list[Step]:
     return steps
 
 
+def writers(steps: list[Step], path: str) -> list[Step]:
+    """The steps whose `--out` is `path` or a folder above it: those that make what is there."""
+    made = []
+    for s in steps:
+        args = shlex.split(s.command)
+        outs = [b for a, b in zip(args, args[1:], strict=False) if a == "--out"]
+        if any(path == o or path.startswith(o.rstrip("/") + "/") for o in outs):
+            made.append(s)
+    return made
+
+
 def chosen(steps: list[Step], only: Iterable[str] = (), skip: Iterable[str] = ()) -> list[Step]:
     """The steps named by `only` (all if none), less those with a tag or name in `skip`."""
     only, skip = set(only), set(skip)

@@ -66,12 +66,17 @@ def _copy(source: Path, into: Path) -> None:
     shutil.copytree(source, into, ignore=ignore)
 
 
-def ship(shipments: list[Shipment], root: Path = Path(".")) -> list[str]:
-    """Copy every source over its destination under `root`; the destinations written."""
+def ship(
+    shipments: list[Shipment], root: Path = Path("."), renames: list[Shipment] | None = None
+) -> list[str]:
+    """Copy every source over its destination under `root`; the destinations written. Paths
+    inside the copies are renamed by `renames` (default: the `shipments`; a partial shipment
+    renames by every entry of its plan, so that what it ships names where the rest will
+    live)."""
     missing = [s.source for s in shipments if not (root / s.source).is_dir()]
     if missing:
         raise InvalidInputError(f"'{missing[0]}' is not there: finish the pass first")
-    moves = sorted(shipments, key=lambda s: len(s.source), reverse=True)
+    moves = sorted(renames or shipments, key=lambda s: len(s.source), reverse=True)
     written = []
     for s in shipments:
         target = root / s.destination

@@ -119,6 +119,22 @@ def test_ship_copies_the_made_files_and_renames_the_paths_inside_them(tmp_path):
     assert shipped == {"data": "data/motion", "loop_trials": "checkpoints/task-staged/x", "seed": 0}
     assert json.loads((net / "manifest.json").read_text()) == {"data": "runs/r/motion"}  # as is
     assert not list(tmp_path.rglob("*.shipping")) and not list(tmp_path.rglob("*.old"))
+    # a partial shipment names where the rest will live
+    _folder(tmp_path / "runs/r/nets/seed-0/place-gnn", {"train_config.json": json.dumps(config)})
+    assert ship(moves[1:2], tmp_path, renames=moves) == ["checkpoints/motion/place-gnn"]
+    assert json.loads((net / "train_config.json").read_text())["data"] == "data/motion"
+
+
+def test_a_shipment_waits_for_every_step_that_writes_into_it():
+    steps = [
+        results.Step("a", "collect place --out runs/r/motion"),
+        results.Step("b", "collect push --out runs/r/motion"),
+        results.Step("c", "train motion --name p --out runs/r/nets"),
+        results.Step("d", "train task --out runs/r/nets-other"),
+    ]
+    assert [s.name for s in results.writers(steps, "runs/r/motion")] == ["a", "b"]
+    assert [s.name for s in results.writers(steps, "runs/r/nets/seed-0/p")] == ["c"]
+    assert results.writers(steps, "runs/r/net") == []
 
 
 def test_the_shipped_plan_ships_what_its_steps_make():
@@ -133,4 +149,5 @@ def test_the_shipped_plan_ships_what_its_steps_make():
     ]
     for m in read_shipments(ROOT / results.PLAN):
         assert any(m.source == o or m.source.startswith(o + "/") for o in outs), m.source
+        assert results.writers(steps, m.source)  # a shipment waits for the steps that make it
         assert m.destination.split("/")[0] in ("data", "checkpoints")
