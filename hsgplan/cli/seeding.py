@@ -48,11 +48,29 @@ PerceptionRulesOption = Annotated[
 ]
 
 
+PlanRulesOption = Annotated[
+    str,
+    typer.Option(
+        "--plan-rules",
+        help="The motion planner's rules set otherwise, comma-separated NAME=VALUE: "
+        "descent_points (3), descent_branch (on) (docs/decisions.md).",
+        metavar="RULES",
+    ),
+]
+
+
 def rule_settings(text: str) -> tuple[str, ...]:
     """The `--perception-rules` settings, each checked (a bad one refused in one line)."""
     from hsgplan.perception.rules import PerceptionRules
 
     return PerceptionRules.parse(text).changed()
+
+
+def plan_rule_settings(text: str) -> tuple[str, ...]:
+    """The `--plan-rules` settings, each checked."""
+    from hsgplan.sim.plan_rules import PlanRules
+
+    return PlanRules.parse(text).changed()
 
 
 def split_seed(seed: int | None, split) -> int:

@@ -41,8 +41,10 @@ from hsgplan.cli.common import (
 )
 from hsgplan.cli.seeding import (
     PerceptionRulesOption,
+    PlanRulesOption,
     SeedOrSplitStart,
     SplitOption,
+    plan_rule_settings,
     rule_settings,
     split_seed,
 )
@@ -241,6 +243,7 @@ def evaluate(
         ),
     ] = "",
     perception_rules: PerceptionRulesOption = "",
+    plan_rules: PlanRulesOption = "",
     ablate_rules: Annotated[
         bool,
         typer.Option(
@@ -310,6 +313,7 @@ def evaluate(
         protocol=protocol.value,
         rules_off=names_of(rules_off, "--rules-off", "rule", none=True),
         perception_rules=rule_settings(perception_rules),
+        plan_rules=plan_rule_settings(plan_rules),
         scene=str(scene) if scene else None,
         split=split and split.value,
     )
@@ -363,7 +367,7 @@ def _run_name(methods, config) -> str:
     )
     protocol = "" if config.protocol == DEFAULT_PROTOCOL.value else f"-{config.protocol}"
     protocol += "".join(f"-no_{rule}" for rule in config.rules_off)
-    protocol += "".join(f"-{rule}" for rule in config.perception_rules)
+    protocol += "".join(f"-{rule}" for rule in (*config.perception_rules, *config.plan_rules))
     where = f"-{Path(config.scene).stem}" if config.scene else ""
     seed = config.split or f"seed{config.seed}"
     return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-{seed}{where}"

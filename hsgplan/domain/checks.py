@@ -197,3 +197,50 @@ def check_output(path: Path, kind: str = "folder") -> None:
         raise InvalidInputError(f"'{text}' is under '{nearest}', which is a file")
     if not os.access(nearest, os.W_OK):  # the path itself when it exists, else its folder
         raise InvalidInputError(f"'{text}': no permission to write in '{nearest}'")
+
+
+ON, OFF = ("on", "true", "yes", "1"), ("off", "false", "no", "0")
+
+
+def with_settings(rules, items, what: str):
+    """The frozen dataclass `rules` with `NAME=VALUE` settings applied (`items`: a
+    comma-separated text or a sequence): a bool field takes on or off, an int one a count, a
+    float one a non-negative number. An unknown name or a bad value is refused in one line
+    naming `what` (`perception rule`, `motion plan rule`)."""
+    names = [f.name for f in dataclasses.fields(rules)]
+    for item in (i.strip() for i in (items.split(",") if isinstance(items, str) else items)):
+        if not item:
+            continue
+        name, sep, text = item.partition("=")
+        name, text = name.strip(), text.strip().lower()
+        if name not in names or not sep:
+            raise InvalidInputError(
+                f"{what} '{item}': write NAME=VALUE, NAME one of {', '.join(names)}"
+            )
+        kind = type(getattr(rules, name))
+        if kind is bool:
+            if text not in ON + OFF:
+                raise InvalidInputError(f"{what} '{item}': {name} is on or off")
+            value: Any = text in ON
+        else:
+            try:
+                value = kind(text)
+            except ValueError:
+                value = math.nan
+            if not math.isfinite(value) or value < 0:
+                raise InvalidInputError(f"{what} '{item}': {name} is a number >= 0")
+        rules = dataclasses.replace(rules, **{name: value})
+    return rules
+
+
+def changed_settings(rules) -> tuple[str, ...]:
+    """The `NAME=VALUE` settings where the frozen dataclass `rules` differs from its defaults
+    (what a run records of them)."""
+    default = type(rules)()
+    out = []
+    for f in dataclasses.fields(rules):
+        value = getattr(rules, f.name)
+        if value != getattr(default, f.name):
+            text = ("on" if value else "off") if isinstance(value, bool) else f"{value:g}"
+            out.append(f"{f.name}={text}")
+    return tuple(out)

@@ -32,6 +32,7 @@ LIKE_FOR_LIKE = (
     "protocol",
     "rules_off",
     "perception_rules",
+    "plan_rules",
     "goals",
     "goals_file",
     "repeats",
@@ -45,7 +46,7 @@ LIKE_FOR_LIKE = (
 # size has as many episodes in each run
 ACROSS_SCENES = ("scene", "goals")
 # what a ladder of rules changes from row to row (`across_rules`)
-RULES = ("rules_off", "perception_rules")
+RULES = ("rules_off", "perception_rules", "plan_rules")
 
 
 def compare(

@@ -82,6 +82,8 @@ class EvalConfig:
     rules_off: tuple[str, ...] = ()
     # f_p's and its tracker's rules set otherwise than shipped, NAME=VALUE (`perception.rules`)
     perception_rules: tuple[str, ...] = ()
+    # the motion planner's rules set otherwise than shipped, NAME=VALUE (`sim.plan_rules`)
+    plan_rules: tuple[str, ...] = ()
     scene: str | None = None  # a scene file or a folder of them (None: the kitchen)
     # the split its goals and start scenes are drawn from (`evaluation.splits`; None: a bare
     # seed, exploration, its goals drawn from the whole goal space)
@@ -105,6 +107,11 @@ class EvalConfig:
             from hsgplan.perception.rules import PerceptionRules
 
             PerceptionRules.parse(self.perception_rules)  # a bad setting refused here
+        object.__setattr__(self, "plan_rules", tuple(self.plan_rules))
+        if self.plan_rules:
+            from hsgplan.sim.plan_rules import PlanRules
+
+            PlanRules.parse(self.plan_rules)
         if self.protocol == PAPER and (kept := set(self.rules_off) - set(NO_FAILURE_RULES)):
             raise InvalidInputError(
                 f"the paper protocol has no recovery rule to switch off ({', '.join(sorted(kept))}"

@@ -144,10 +144,11 @@ def run_config(config: EvalConfig) -> dict:
         settings["rules_off"] = list(config.rules_off)
     if config.scene is None:  # as runs were claimed before scenes were files
         del settings["scene"]
-    if not config.perception_rules:  # as runs were claimed before f_p's rules could be set
-        del settings["perception_rules"]
-    else:
-        settings["perception_rules"] = list(config.perception_rules)
+    for rules in ("perception_rules", "plan_rules"):  # as runs were claimed before rules were set
+        if not getattr(config, rules):
+            del settings[rules]
+        else:
+            settings[rules] = list(getattr(config, rules))
     if config.split is None:  # as runs were claimed before splits
         del settings["split"]
     files = [Path(p) for p in (config.goals_file, *config.worlds()) if p]
@@ -168,6 +169,7 @@ def read_eval_config(run_dir: Path) -> EvalConfig:
             sizes=tuple(config.sizes),
             rules_off=tuple(config.rules_off),
             perception_rules=tuple(config.perception_rules),
+            plan_rules=tuple(config.plan_rules),
         )
     except TypeError:
         raise InvalidInputError(
@@ -224,8 +226,14 @@ def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
 
     agent = _worker_agent(config)
     world = world_of_file(spec.scene) if spec.scene else KITCHEN
+    from hsgplan.sim.plan_rules import PlanRules
+
     env = KitchenStorageEnv(
-        observer=_worker_observer(config), rules=config.rules(), visuals=False, world=world
+        observer=_worker_observer(config),
+        rules=config.rules(),
+        visuals=False,
+        plan_rules=PlanRules.parse(config.plan_rules),
+        world=world,
     )
     goal = parse_goal(spec.goal, world=world)
     record = run_episode(env, agent, goal, spec.seed, end_at_failure=config.protocol == PAPER)

@@ -90,10 +90,11 @@ def table_settings(config: EvalConfig) -> dict:
         del table["protocol"], table["rules_off"]
     if config.split is None:  # as tables were claimed before splits
         del table["split"]
-    if not config.perception_rules:  # as tables were claimed before f_p's rules could be set
-        del table["perception_rules"]
-    else:
-        table["perception_rules"] = list(config.perception_rules)
+    for rules in ("perception_rules", "plan_rules"):  # as tables were claimed before rules were set
+        if not getattr(config, rules):
+            del table[rules]
+        else:
+            table[rules] = list(getattr(config, rules))
     return table
 
 

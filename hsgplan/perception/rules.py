@@ -11,17 +11,14 @@ reads a comma-separated list of them, and refuses an unknown name or a bad value
 
 from __future__ import annotations
 
-import math
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import dataclass, fields
 
-from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.checks import changed_settings, with_settings
 from hsgplan.perception.fusion import NEAR_RAY, RAY_GAP
 
 # A detection f_p named another type is only an object's if it is within this of where the
 # object was last seen (within `observer.STILL` if a single view saw it).
 TRACK_DISTANCE = 0.3  # m
-
-ON, OFF = ("on", "true", "yes", "1"), ("off", "false", "no", "0")
 
 
 @dataclass(frozen=True)
@@ -61,44 +58,12 @@ class PerceptionRules:
     @staticmethod
     def parse(settings: str | tuple[str, ...] | list[str]) -> PerceptionRules:
         """The shipped rules with `settings` (`NAME=VALUE`, comma-separated or as a list)."""
-        items = settings.split(",") if isinstance(settings, str) else list(settings)
-        rules = PerceptionRules()
-        for item in (i.strip() for i in items):
-            if item:
-                rules = rules.set(item)
-        return rules
-
-    def set(self, item: str) -> PerceptionRules:
-        """These rules with one `NAME=VALUE` setting changed."""
-        name, sep, text = item.partition("=")
-        name, text = name.strip(), text.strip().lower()
-        if name not in self.names() or not sep:
-            raise InvalidInputError(
-                f"perception rule '{item}': write NAME=VALUE, NAME one of {', '.join(self.names())}"
-            )
-        if isinstance(getattr(PerceptionRules(), name), bool):
-            if text not in ON + OFF:
-                raise InvalidInputError(f"perception rule '{item}': {name} is on or off")
-            return replace(self, **{name: text in ON})
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not math.isfinite(value) or value < 0:
-            raise InvalidInputError(f"perception rule '{item}': {name} is a distance in m, >= 0")
-        return replace(self, **{name: value})
+        return with_settings(PerceptionRules(), settings, "perception rule")
 
     def changed(self) -> tuple[str, ...]:
         """The settings that differ from the shipped rules, as `NAME=VALUE` (what a run
         records)."""
-        shipped = asdict(PerceptionRules())
-        return tuple(f"{k}={_text(v)}" for k, v in asdict(self).items() if v != shipped[k])
-
-
-def _text(value: bool | float) -> str:
-    if isinstance(value, bool):
-        return "on" if value else "off"
-    return f"{value:g}"
+        return changed_settings(self)
 
 
 SHIPPED = PerceptionRules()

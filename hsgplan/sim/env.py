@@ -50,6 +50,8 @@ from hsgplan.sim.outcome import (
     judge,
     largest_move,
 )
+from hsgplan.sim.plan_rules import SHIPPED as PLAN_RULES
+from hsgplan.sim.plan_rules import PlanRules
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sampler import sample_scene
@@ -96,10 +98,12 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         observer: SceneObserver | CameraObserver | None = None,
         rules: RecoveryRules = ALL_RULES,
         visuals: bool = True,
+        plan_rules: PlanRules = PLAN_RULES,
         *,
         world: World,
     ):
         self.scene_world = world
+        self.plan_rules = plan_rules  # the motion planner's, in the scene and in the model
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
         check_size(objects)  # refused here, not at the first reset
@@ -165,6 +169,7 @@ class KitchenStorageEnv(BelievedSteps, gymnasium.Env):
         # the robot's model, where it plans, dry-runs and tries: of its belief seeing through
         # cameras, of the truth under the ground truth (`_observe` puts it right)
         self.world = BeliefWorld(options.objects(), scene_seed, options.goal.world)
+        self.scene.plan_rules = self.world.scene.plan_rules = self.plan_rules
         if self.believing:
             self.observer.start(options.objects(), options.goal.world)
         else:

@@ -48,8 +48,6 @@ LINE_IK_EVERY = 8  # push waypoints (PUSH_STEP apart) per inverse kinematics alo
 # solved as with a tenth of a millimetre, in a third of the time.
 LINE_IK_TOL = 1e-3
 MAX_JOINT_JUMP = 0.3  # rad between IK solutions along a push line: more means a branch flip
-# Poses solved between the approach's ends: the hand then strays under 1 mm from the line.
-DESCENT_POINTS = 3
 
 
 @dataclass(frozen=True)
@@ -152,7 +150,8 @@ def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
         chain = [q_above, *descent, q_at]
         # q_at is solved from q_above and may land on another branch than the descent's last
         # point: the arm would swing between them through what a pick ignores, its object.
-        if np.max(np.abs(q_at - chain[-2])) <= MAX_JOINT_JUMP and all(
+        branch = not scene.plan_rules.descent_branch
+        if (branch or np.max(np.abs(q_at - chain[-2])) <= MAX_JOINT_JUMP) and all(
             near.segment_free(a, b) for a, b in zip(chain, chain[1:], strict=False)
         ):
             return q_above, q_at, descent
@@ -160,12 +159,14 @@ def _approach(scene: Scene, target: Pose, ignore: tuple[str, ...], seeds):
 
 
 def _descent(scene: Scene, above: Pose, target: Pose, q_above: np.ndarray):
-    """Joints at DESCENT_POINTS evenly spaced poses strictly between `above` and `target`,
-    each solved from the last, or None where one cannot be reached without a branch flip."""
+    """Joints at the scene's `descent_points` (`sim.plan_rules`) evenly spaced poses strictly
+    between `above` and `target`, each solved from the last, or None where one cannot be
+    reached without a branch flip."""
     robot, qs = scene.robot, [q_above]
     a, b = np.array(above.position), np.array(target.position)
-    for k in range(1, DESCENT_POINTS + 1):
-        f = k / (DESCENT_POINTS + 1)
+    points = scene.plan_rules.descent_points
+    for k in range(1, points + 1):
+        f = k / (points + 1)
         pose = Pose(tuple(a + (b - a) * f), target.orientation)
         q = robot.ik(
             pose, scene.rng, seeds=[qs[-1]], restarts=0, rest_fallback=False, threshold=LINE_IK_TOL

@@ -23,6 +23,7 @@ from hsgplan.sim.bodies import spawn_object
 from hsgplan.sim.collision import CollisionChecker
 from hsgplan.sim.hand_ghost import HandGhost
 from hsgplan.sim.motion import MotionPlanner
+from hsgplan.sim.plan_rules import SHIPPED as PLAN_RULES
 from hsgplan.sim.robot import Panda
 
 TIME_STEP = 1.0 / 240.0
@@ -68,6 +69,9 @@ class Scene:
         visuals: load the arm's visual meshes, for pictures of the scene (`Panda`); a scene
             nothing pictures builds faster without them and behaves the same.
         world: the table, shelves and object types it is built from.
+
+    Its `plan_rules` (`sim.plan_rules`, the shipped ones unless a run sets them) are the
+    motion planner's.
     """
 
     def __init__(
@@ -94,6 +98,7 @@ class Scene:
             self.bodies[name] = spawn_object(self.bc, world.object_type(name), pose)
         self.rng = np.random.default_rng(seed)
         self.seed = seed
+        self.plan_rules = PLAN_RULES
         self._closed_hand: HandGhost | None = None
 
     @property

@@ -13,6 +13,7 @@ from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.motion import MotionPlanner
 from hsgplan.sim.motion_plans import MotionPlan, plan_primitive
 from hsgplan.sim.outcome import Status
+from hsgplan.sim.plan_rules import PlanRules
 from hsgplan.sim.primitives import execute
 from hsgplan.sim.robot import ARM
 from hsgplan.sim.scene import Scene
@@ -179,6 +180,22 @@ def test_a_grasp_on_another_branch_than_its_descent_is_not_planned(scene, monkey
     monkeypatch.setattr(robot, "ik", flipped)
     refused = motion_plans.plan_primitive(scene, PickParams("cherries"))
     assert refused.status is Status.NO_IK
+    # the rule taken away (`--plan-rules descent_branch=off`): the flipped grasp is taken
+    robot.set_q(q0)
+    scene.plan_rules = PlanRules(descent_branch=False)
+    taken = motion_plans.plan_primitive(scene, PickParams("cherries"))
+    scene.plan_rules = PlanRules()
+    assert isinstance(taken, MotionPlan)
+
+
+def test_the_descent_has_as_many_poses_as_its_rule_says(scene):
+    q0 = scene.robot.q()
+    for points in (3, 0):
+        scene.plan_rules = PlanRules(descent_points=points)
+        scene.robot.set_q(q0)
+        plan = plan_primitive(scene, PickParams("cherries"))
+        assert isinstance(plan, MotionPlan) and len(plan.descent) == points
+    scene.plan_rules = PlanRules()
 
 
 def test_a_can_beside_the_base_is_grasped_with_the_hand_turned_half_round():
