@@ -32,8 +32,9 @@ from hsgplan.cli.common import (
     refuses_bad_input,
     shown,
 )
-from hsgplan.cli.seeding import TrainingSeeds
+from hsgplan.cli.seeding import SeedOrSplitStart, SplitOption, TrainingSeeds, split_seed
 from hsgplan.domain.checks import resolve
+from hsgplan.evaluation.seeds import marked, seed_words
 from hsgplan.paths import REACH_HELD_OUT, RUNS, TASK_CHECKPOINT
 
 train_app = typer.Typer(
@@ -138,7 +139,8 @@ def eval_task(
     planner: Annotated[SymbolicPlannerName, typer.Option(help="Task planner.")] = REGRESSION,
     sizes: Annotated[str, typer.Option(help="Problem sizes, e.g. 2-12.")] = "2-12",
     goals: Annotated[int, bounded_option("goals", "Random goals per size.")] = 100,
-    seed: Annotated[int, bounded_option("seed", "Seed of the goals and start states.")] = 0,
+    seed: SeedOrSplitStart = None,
+    split: SplitOption = None,
     goals_file: Annotated[
         Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
     ] = None,
@@ -170,6 +172,8 @@ def eval_task(
     from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
 
     planner = planner.value
+    seed = split_seed(seed, split)
+    split_name = split and split.value
     size_list = parse_sizes(sizes)
     total = goals * len(size_list) if goals_file is None else None
     source = goals_file.stem if goals_file else f"g{goals}"
@@ -177,7 +181,7 @@ def eval_task(
     paper = "-paper" if protocol.value == "paper" else ""
     where = f"-{scene.stem}" if scene else ""
     run_dir = run_dir or RUNS / (
-        f"eval-task-{planner}{tag}-{sizes}-{source}-seed{seed}{paper}{where}"
+        f"eval-task-{planner}{tag}-{sizes}-{source}-{split_name or f'seed{seed}'}{paper}{where}"
     )
     check_ray(ray)
     with Progress(console=err, transient=True) as progress:
@@ -195,10 +199,12 @@ def eval_task(
             ray,
             protocol.value,
             scene,
+            split_name,
         )
     report = summarize_task(episodes) | {
         "planner": planner,
         "seed": seed,
+        "split": split_name,
         "protocol": protocol.value,
         **({"scene": str(scene)} if scene else {}),
     }
@@ -219,9 +225,14 @@ def eval_task(
         for n, v in report["by_size"].items()
     ]
     print_table(
-        f"{planner} in the symbolic loop, {goals} goals per size, seed {seed}"
-        + (" (paper protocol)" if paper else "")
-        + (f", {_scenes_shown(scene)}" if scene else ""),
+        marked(
+            f"{planner} in the symbolic loop, {goals} goals per size, "
+            f"{seed_words(seed, split_name)}"
+            + (" (paper protocol)" if paper else "")
+            + (f", {_scenes_shown(scene)}" if scene else ""),
+            seed,
+            split=split_name,
+        ),
         (
             "objects",
             "success",

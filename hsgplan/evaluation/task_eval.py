@@ -146,11 +146,14 @@ def evaluate_task(
     ray: str | None = None,
     protocol: str = RECOVERING,
     scene: Path | None = None,
+    split: str | None = None,
 ) -> list[TaskEpisode]:
     """Every episode, `workers` at a time, under `protocol` (one of PROTOCOLS), in the world of
     the scene file `scene`, or of each scene file in the folder `scene`, with the same goal
-    seeds in each (default: the kitchen). With `run_dir`, finished episodes are appended to its
-    `episodes.jsonl` as they finish, and a run started again skips them."""
+    seeds in each (default: the kitchen), its goals drawn from the `split`'s share of the goal
+    space (`evaluation.splits`; None: the whole space, exploration). With `run_dir`, finished
+    episodes are appended to its `episodes.jsonl` as they finish, and a run started again
+    skips them."""
     if protocol not in PROTOCOLS:
         raise InvalidInputError(f"protocol '{protocol}': one of {', '.join(PROTOCOLS)}")
     worlds = scene_files(scene)
@@ -160,6 +163,13 @@ def evaluate_task(
     make_planner(planner, checkpoint)  # a bad name or checkpoint fails here, once
     if goals < 0:
         raise InvalidInputError(f"--goals {goals}: the number of goals cannot be negative")
+    from hsgplan.evaluation.splits import check_seed, split_goals, split_named
+
+    share = split_named(split) if split else None
+    if share is not None:
+        if goals_file:
+            raise InvalidInputError("--split draws its goals: give no --goals-file with it")
+        check_seed(share, seed)
     jobs = []
     for path, world in worlds.items():
         if goals_file:
@@ -169,7 +179,11 @@ def evaluate_task(
             drawn = [
                 (g, episode_seed(seed, n, i))
                 for n in sizes
-                for i, g in enumerate(random_goals(n, goals, seed, stacking=n > 2, world=world))
+                for i, g in enumerate(
+                    split_goals(share, n, goals, seed, stacking=n > 2, world=world)
+                    if share
+                    else random_goals(n, goals, seed, stacking=n > 2, world=world)
+                )
             ]
         where = str(path) if path else None
         jobs += [TaskJob(planner, str(checkpoint), str(g), s, protocol, where) for g, s in drawn]
@@ -192,6 +206,7 @@ def evaluate_task(
             "checkpoint": str(checkpoint),
             **({"protocol": protocol} if protocol != RECOVERING else {}),
             **({"scene": str(scene)} if scene else {}),
+            **({"split": split} if split else {}),
             "fingerprint": fingerprint(files),
         },
         workers=workers,

@@ -47,3 +47,25 @@ def test_the_protocol_is_part_of_a_runs_configuration_and_of_every_job(monkeypat
     assert all(j.protocol == "recovering" for j in recovering_jobs)
     with pytest.raises(InvalidInputError, match="protocol 'kind'"):
         evaluate_task("regression", TASK_CHECKPOINT, (2,), 2, 0, protocol="kind")
+
+
+def test_a_split_draws_its_goals_from_its_share_and_is_part_of_the_runs_configuration(
+    monkeypatch,
+):
+    from hsgplan.evaluation.splits import TEST, bucket
+
+    runs = []
+    monkeypatch.setattr(
+        task_eval, "run_items", lambda fn, jobs, config, **kw: runs.append((config, jobs)) or []
+    )
+    start = TEST.seeds.start
+    evaluate_task("fd", TASK_CHECKPOINT, (3,), 20, start, split="test")
+    evaluate_task("fd", TASK_CHECKPOINT, (3,), 20, start)
+    (split_config, jobs), (bare_config, bare_jobs) = runs
+    assert split_config["split"] == "test" and "split" not in bare_config
+    goals = [parse_goal(j.goal, world=KITCHEN) for j in jobs]
+    assert all(bucket(g) in TEST.goal_share for g in goals)
+    bare = [parse_goal(j.goal, world=KITCHEN) for j in bare_jobs]
+    assert not all(bucket(g) in TEST.goal_share for g in bare)  # the whole space
+    with pytest.raises(InvalidInputError, match="not a test seed"):
+        evaluate_task("fd", TASK_CHECKPOINT, (3,), 2, 0, split="test")
