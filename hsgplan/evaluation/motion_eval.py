@@ -148,6 +148,13 @@ def summarize(rows: list[dict]) -> dict:
         for r in mine:
             by_level[str(r["crowding"])].append(r)
         entry = _rate(mine) | {"by_crowding": {k: _rate(v) for k, v in sorted(by_level.items())}}
+        by_training = defaultdict(list)
+        for r in mine:
+            by_training[r.get("training")].append(r["ok"])
+        if len(by_training) > 1:  # how far one training's rate lies from another's
+            entry["success_by_training"] = {
+                str(s): sum(oks) / len(oks) for s, oks in sorted(by_training.items())
+            }
         crowded = [r for r in mine if r["shelf_top"] and r["crowding"] >= CROWDED]
         if crowded:
             entry["crowded_shelf_tops"] = _rate(crowded)
@@ -204,7 +211,7 @@ def evaluate_motion(
     for seed_of, folder in trainings.items():
         into = run_dir if run_dir is None or seed_of is None else run_dir / f"seed-{seed_of}"
         for kind, got in _rows(kinds, trials, seed, folder, workers, progress, into, ray, scene):
-            rows[kind] += got
+            rows[kind] += [r | {"training": seed_of} for r in got]
     report = {}
     first = next(iter(trainings.values()))  # the shipped seed's networks: what each learnt from
     for kind in kinds:

@@ -144,3 +144,5 @@ def test_trainings_are_tried_in_the_same_scenes_and_given_an_interval(checkpoint
     assert gnn["success_rate"] == one["success_rate"]  # two copies of one network
     assert gnn["success_ci"] == [one["success_rate"]] * 2
     assert {p.name for p in (tmp_path / "run").iterdir()} >= {"seed-0", "seed-1"}
+    assert gnn["success_by_training"] == {"0": one["success_rate"], "1": one["success_rate"]}
+    assert "success_by_training" not in one  # one training: nothing to set beside it
