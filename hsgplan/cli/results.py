@@ -94,7 +94,7 @@ def results(
     if paste:
         pages = [Path("README.md"), *sorted(Path("docs").glob("*.md"))]
         names = [s.block for s in steps if s.block]
-        pasted = pipeline.paste(pages, blocks=names)
+        pasted = pipeline.paste(pages, blocks=names) + pipeline.copy_pictures(steps)
         out.print(f"pasted {', '.join(pasted) or 'nothing'}", highlight=False)
 
 

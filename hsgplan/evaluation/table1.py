@@ -154,9 +154,7 @@ def run_table(
 
     plot_success_by_size(
         {
-            label(m): {
-                int(n): (v["success_rate"], v["success_std"]) for n, v in s["by_size"].items()
-            }
+            label(m): {int(n): (v["success_rate"], _spread(v)) for n, v in s["by_size"].items()}
             for m, s in report["methods"].items()
         },
         {
@@ -272,6 +270,16 @@ def _results(report: dict) -> TextTable:
         )
     title = marked(title, report["seed"], split=report.get("split"))
     return TextTable(title, tuple(header), tuple(rows))
+
+
+def _spread(v: dict) -> tuple[float, float] | None:
+    """What a size's error bar spans: its interval, else the rate ± its standard deviation
+    over repeats, else nothing."""
+    if v.get("success_ci"):
+        return (v["success_ci"][0], v["success_ci"][1])
+    if v.get("success_std") is not None:
+        return (v["success_rate"] - v["success_std"], v["success_rate"] + v["success_std"])
+    return None
 
 
 def runs_words(report: dict) -> str:

@@ -39,6 +39,8 @@ class Step:
     block: str | None = None  # the README / docs block its output becomes
     tags: tuple[str, ...] = ()
     ray: bool = False  # it takes --ray ADDRESS
+    # a picture the command draws, and the page's copy of it: (made, shown)
+    picture: tuple[str, str] | None = None
 
     def args(self, ray: str | None = None) -> list[str]:
         extra = ["--ray", ray] if ray and self.ray else []
@@ -61,6 +63,7 @@ def read_plan(path: Path = PLAN) -> list[Step]:
                     entry.get("block"),
                     tuple(entry.get("tags", ())),
                     bool(entry.get("ray", False)),
+                    _picture(entry.get("picture")),
                 )
             )
         except (KeyError, TypeError):
@@ -69,6 +72,25 @@ def read_plan(path: Path = PLAN) -> list[Step]:
     if len(set(names)) != len(names):
         raise InvalidInputError(f"'{path}': every step needs a name of its own")
     return steps
+
+
+def _picture(value) -> tuple[str, str] | None:
+    if value is None:
+        return None
+    if not isinstance(value, list) or len(value) != 2 or not all(isinstance(v, str) for v in value):
+        raise InvalidInputError(f"a step's picture {value!r}: write [made, shown]")
+    return (value[0], value[1])
+
+
+def copy_pictures(steps: list[Step], out: Path = OUT) -> list[str]:
+    """Each finished step's picture copied to where its page shows it; the copies made."""
+    copied = []
+    for s in steps:
+        if s.picture and finished(out, s) and Path(s.picture[0]).is_file():
+            Path(s.picture[1]).parent.mkdir(parents=True, exist_ok=True)
+            write_atomically(s.picture[1], Path(s.picture[0]).read_bytes())
+            copied.append(s.picture[1])
+    return copied
 
 
 def writers(steps: list[Step], path: str) -> list[Step]:
@@ -132,6 +154,7 @@ def run_step(
     """Run one step in a child process; its record. A failed step raises with its stderr's
     last line, and leaves no record."""
     start = time.perf_counter()
+    at = commit()  # the code the child runs: the tree as it starts, not as it ends
     args = [sys.executable, "-m", "hsgplan.cli", *step.args(ray)]
     echo(f"{step.name}: hsgplan {shlex.join(step.args(ray))}")
     # stderr passes through (progress bars); stdout is the block
@@ -140,7 +163,7 @@ def run_step(
         raise InvalidInputError(f"step '{step.name}' failed (exit code {result.returncode})")
     made = {
         "command": step.command,
-        "commit": commit(),
+        "commit": at,
         "date": str(datetime.date.today()),
         "machine": f"{platform.machine()}, {os.cpu_count()} cores",
         "wall_seconds": round(time.perf_counter() - start, 1),

@@ -23,15 +23,15 @@ def save_figure(fig, path: Path) -> None:
 
 
 def plot_success_by_size(
-    ours: dict[str, dict[int, tuple[float, float | None]]],
+    ours: dict[str, dict[int, tuple[float, tuple[float, float] | None]]],
     paper: dict[str, dict[int, float]],
     path: Path,
 ) -> None:
-    """Success rate by problem size, one colour per method: ours solid (with the standard
-    deviation over repeats as error bars), the paper's dashed.
+    """Success rate by problem size, one colour per method: ours solid (with its interval as
+    error bars), the paper's dashed.
 
     Args:
-        ours: method -> size -> (success rate, its standard deviation or None).
+        ours: method -> size -> (success rate, its interval (low, high) or None).
         paper: method -> size -> the paper's success rate.
         path: where the PNG goes.
     """
@@ -41,7 +41,11 @@ def plot_success_by_size(
         colour = colours[k % len(colours)]
         sizes = sorted(by_size)
         rates = [by_size[n][0] for n in sizes]
-        errors = [by_size[n][1] or 0.0 for n in sizes]
+        spans = [by_size[n][1] or (by_size[n][0], by_size[n][0]) for n in sizes]
+        errors = [
+            [r - lo for r, (lo, _) in zip(rates, spans, strict=True)],
+            [hi - r for r, (_, hi) in zip(rates, spans, strict=True)],
+        ]
         ax.errorbar(sizes, rates, yerr=errors, color=colour, marker="o", capsize=3, label=method)
         if method in paper:
             ps = sorted(paper[method])

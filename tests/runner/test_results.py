@@ -151,3 +151,23 @@ def test_the_shipped_plan_ships_what_its_steps_make():
         assert any(m.source == o or m.source.startswith(o + "/") for o in outs), m.source
         assert results.writers(steps, m.source)  # a shipment waits for the steps that make it
         assert m.destination.split("/")[0] in ("data", "checkpoints")
+
+
+def test_a_finished_steps_picture_is_copied_where_its_page_shows_it(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "runs/r").mkdir(parents=True)
+    (tmp_path / "runs/r/t.png").write_bytes(b"png")
+    plan = tmp_path / "plan.toml"
+    plan.write_text(
+        '[[step]]\nname = "t"\ncommand = "eval world"\npicture = ["runs/r/t.png", "docs/t.png"]\n'
+    )
+    (step,) = read_plan(plan)
+    out = tmp_path / "runs/results"
+    assert results.copy_pictures([step], out) == []  # not finished: nothing copied
+    (out / "steps").mkdir(parents=True)
+    (out / "steps/t.json").write_text(json.dumps({"command": "eval world"}))
+    assert results.copy_pictures([step], out) == ["docs/t.png"]
+    assert (tmp_path / "docs/t.png").read_bytes() == b"png"
+    plan.write_text('[[step]]\nname = "t"\ncommand = "x"\npicture = "one.png"\n')
+    with pytest.raises(InvalidInputError, match="picture"):
+        read_plan(plan)
