@@ -42,7 +42,8 @@ def test_a_reset_planner_decides_as_a_new_one():
     goal, before = parse_goal(GOALS[1], world=KITCHEN), parse_goal(GOALS[0], world=KITCHEN)
     start = random_state(goal.objects, random.Random(3), world=KITCHEN)
     used = RegressionPlanner(TASK_CHECKPOINT, seed=1)
-    _rollout(1, random_state(before.objects, random.Random(1), world=KITCHEN), before, used)
+    # a first episode only to use the planner: whether it succeeds is no part of this test
+    _rollout(1, random_state(before.objects, random.Random(1), world=KITCHEN), before, used, False)
     used.reset(goal, 5)
     assert _rollout(5, start, goal, used) == _rollout(5, start, goal)
 
@@ -61,7 +62,7 @@ def test_a_stack_is_taken_apart_and_rebuilt_in_the_shortest_way():
     assert len(actions) == 6  # butter off, cherries up, butter back on
 
 
-def _rollout(seed: int, state, goal, planner=None) -> list[str]:
+def _rollout(seed: int, state, goal, planner=None, reached: bool = True) -> list[str]:
     planner, actions = planner or RegressionPlanner(TASK_CHECKPOINT, seed=seed), []
     while not goal.satisfied_by(state) and len(actions) < 20:
         decision = planner.next_action(state, goal)
@@ -69,7 +70,7 @@ def _rollout(seed: int, state, goal, planner=None) -> list[str]:
         actions.append(str(decision.action))
         if why_not(state, decision.action) is None:  # else wasted: the state stays
             state = apply(state, decision.action)
-    assert goal.satisfied_by(state), actions
+    assert goal.satisfied_by(state) or not reached, actions
     return actions
 
 
