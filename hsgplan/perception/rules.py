@@ -11,7 +11,7 @@ reads a comma-separated list of them, and refuses an unknown name or a bad value
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from hsgplan.domain.checks import changed_settings, with_settings
 from hsgplan.perception.fusion import NEAR_RAY, RAY_GAP
@@ -50,10 +50,6 @@ class PerceptionRules:
     near_ray: float = NEAR_RAY
     track_distance: float = TRACK_DISTANCE
     lone_still: bool = True
-
-    @staticmethod
-    def names() -> tuple[str, ...]:
-        return tuple(f.name for f in fields(PerceptionRules))
 
     @staticmethod
     def parse(settings: str | tuple[str, ...] | list[str]) -> PerceptionRules:
