@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from hsgplan.cli import app
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.config import EvalConfig
-from hsgplan.evaluation.intervals import goal_interval, separate
+from hsgplan.evaluation.intervals import goal_interval, separate, training_goal_interval
 from hsgplan.evaluation.protocol import trained, training_dir
 from hsgplan.trainings import RECORD, paired, record, seed_folders
 
@@ -112,6 +112,57 @@ def test_an_interval_is_as_wide_as_goals_differ_and_each_goal_counts_once():
     assert low < 0.5 < high
     heavy = differ | {"0": [0.0] * 50}
     assert goal_interval(heavy) == (low, high)
+
+
+def _cells(rates, goals=40):
+    """Each training's episodes of each goal: training t wins goal g when g falls under its
+    rate, so trainings of different rates disagree on the same goals."""
+    return {(t, g): [float(g < rate * goals)] for t, rate in enumerate(rates) for g in range(goals)}
+
+
+def _width(interval):
+    return interval[1] - interval[0]
+
+
+def test_an_interval_over_trainings_is_as_wide_as_trainings_differ():
+    # the same episodes, pooled per goal as if one training ran them, give the interval over
+    # goals alone; trainings that disagree must widen it, trainings that agree must not
+    differ = _cells([0.9, 0.3, 0.9])
+    pooled = {g: [v[0] for (_, h), v in differ.items() if h == g] for g in range(40)}
+    assert _width(training_goal_interval(differ)) > 1.5 * _width(goal_interval(pooled))
+    agree = _cells([0.7, 0.7, 0.7])
+    alone = {g: v for (t, g), v in agree.items() if t == 0}
+    assert _width(training_goal_interval(agree)) == pytest.approx(
+        _width(goal_interval(alone)), abs=0.05
+    )
+    mean = sum(v[0] for v in differ.values()) / len(differ)
+    low, high = training_goal_interval(differ)
+    assert low <= mean <= high
+
+
+def test_an_interval_over_one_training_is_over_goals():
+    cells = _cells([0.6])
+    alone = {g: v for (_, g), v in cells.items()}
+    assert training_goal_interval(cells) == goal_interval(alone)
+    assert training_goal_interval({(0, "a"): [1.0], (1, "a"): [0.0]}) is None
+
+
+def test_a_summary_of_trainings_draws_trainings_too():
+    from hsgplan.evaluation.episode import EpisodeRecord
+    from hsgplan.evaluation.summary import summarize_trainings
+
+    def episode(goal, won):
+        failure = None if won else "overstep"
+        return EpisodeRecord(goal, "learned", f"goal-{goal}", 2, won, 1.0, failure, (), 1.0)
+
+    def run(rate):
+        return [episode(g, g < rate * 40) for g in range(40)]
+
+    one = summarize_trainings({None: run(0.6)})["by_size"]["2"]["success_ci"]
+    three = summarize_trainings({0: run(0.9), 1: run(0.3), 2: run(0.6)})["by_size"]["2"]
+    assert three["success_by_training"] == [0.9, 0.3, 0.6]
+    assert three["success_rate"] == pytest.approx(0.6)
+    assert _width(three["success_ci"]) > 1.5 * _width(one)
 
 
 def test_a_gain_is_called_only_where_intervals_separate():

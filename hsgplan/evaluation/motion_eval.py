@@ -25,7 +25,7 @@ from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import read_worlds
 from hsgplan.evaluation.config import world_of_file
-from hsgplan.evaluation.intervals import goal_interval
+from hsgplan.evaluation.intervals import training_goal_interval
 from hsgplan.paths import shipped
 from hsgplan.runner.items import run_items
 from hsgplan.sim.scene import Scene
@@ -124,15 +124,15 @@ def run_eval_chunk(
 
 
 def _rate(rows: list[dict]) -> dict:
-    """The success rate, and its 95% interval over scenes (each scene's trials under every
-    training kept together: `evaluation.intervals`)."""
-    by_scene: dict[tuple, list[float]] = defaultdict(list)
+    """The success rate, and its 95% interval over trainings and scenes
+    (`evaluation.intervals`)."""
+    cells: dict[tuple, list[float]] = defaultdict(list)
     for r in rows:
-        by_scene[(r.get("scene"), r["task"])].append(float(r["ok"]))
-    ci = goal_interval(list(by_scene.values()))
+        cells[(r.get("training"), (r.get("scene"), r["task"]))].append(float(r["ok"]))
+    ci = training_goal_interval(cells)
     return {
         "success_rate": sum(r["ok"] for r in rows) / len(rows),
-        "trials": len(by_scene),
+        "trials": len({scene for _, scene in cells}),
         **({"success_ci": list(ci)} if ci is not None else {}),
     }
 

@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence
 
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.failures import Failure
-from hsgplan.evaluation.intervals import goal_interval
+from hsgplan.evaluation.intervals import goal_interval, training_goal_interval
 from hsgplan.sim.outcome import DISTURB_RECORD, DISTURB_TOL, SEEN_DISTURB_TOL, Status
 
 EXECUTION = "execution"
@@ -109,7 +109,8 @@ def size_summary(rs: Sequence[EpisodeRecord]) -> dict:
         "episodes": len(rs),
         "repeats": len(by_repeat),
         "success_std": _spread({k: [r.success for r in v] for k, v in by_repeat.items()}),
-        # a bootstrap over goals, each goal's episodes (trainings, repeats) kept together
+        # a bootstrap over goals, each goal's episodes kept together (with several trainings
+        # `summarize_trainings` draws trainings too)
         "success_ci": _as_list(goal_interval(_by_goal(rs))),  # as JSON gives it back
         "completion_std": _spread(
             {k: [r.subgoal_completion for r in v] for k, v in by_repeat.items()}
@@ -205,17 +206,25 @@ def misbelieved(rs: Sequence[EpisodeRecord]) -> dict:
 
 def summarize_trainings(runs: Mapping[int | None, Sequence[EpisodeRecord]]) -> dict:
     """`summarize` over every training's records (`{None: records}`: one training), each
-    size's success rate with its interval over goals, trainings and repeats (`intervals`),
+    size's success rate with its interval over trainings and goals, repeats kept together
+    (`intervals`),
     and with several trainings each one's rate."""
     summary = summarize([r for rs in runs.values() for r in rs])
     seeds = [s for s in runs if s is not None]
     summary["trainings"] = seeds
     for n, entry in summary["by_size"].items():
         if seeds:
-            entry["success_by_training"] = [
-                _rate([r for r in runs[s] if str(r.size) == n and r.failure != Failure.UNSAMPLED])
+            mine = {
+                s: [r for r in runs[s] if str(r.size) == n and r.failure != Failure.UNSAMPLED]
                 for s in seeds
-            ]
+            }
+            entry["success_by_training"] = [_rate(mine[s]) for s in seeds]
+            # the interval over trainings and goals, not over goals alone
+            cells: dict[tuple[int, str], list[float]] = {}
+            for s in seeds:
+                for r in mine[s]:
+                    cells.setdefault((s, r.goal), []).append(float(r.success))
+            entry["success_ci"] = _as_list(training_goal_interval(cells))
     return summary
 
 
