@@ -290,10 +290,15 @@ def runs_words(report: dict) -> str:
     words = f", each run {report['repeats']} times" if report["repeats"] > 1 else ", each run once"
     if trained:
         words += f" under each of {trained} trainings"
+    if with_ci and trained > 1:
+        return words + (
+            " (in brackets the 95% interval of a bootstrap that draws trainings and goals, "
+            "each goal's repeats kept together)"
+        )
     if with_ci:
         return words + (
-            " (in brackets the 95% interval of a bootstrap over goals, each goal's episodes "
-            "under every training and repeat kept together)"
+            " (in brackets the 95% interval of a bootstrap over goals, each goal's repeats "
+            "kept together)"
         )
     if report["repeats"] > 1:
         return words + " (± the standard deviation of the success rate over the repeats)"

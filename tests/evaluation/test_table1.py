@@ -294,3 +294,15 @@ def test_a_cell_gives_its_interval_where_the_summary_has_one():
     v = {"success_rate": 0.5, "subgoal_completion": 0.75, "success_std": 0.1}
     assert cell(v) == "0.50 ± 0.10 / 0.75"  # a summary from before intervals
     assert cell(v | {"success_ci": [0.25, 0.75]}) == "0.50 (0.25–0.75) / 0.75"
+
+
+def test_a_table_says_what_its_interval_draws():
+    from hsgplan.evaluation.table1 import runs_words
+
+    def report(trainings):
+        entry = {"success_rate": 0.5, "success_ci": [0.4, 0.6]}
+        method = {"trainings": trainings, "by_size": {"2": entry}}
+        return {"repeats": 1, "methods": {"gnn": method}}
+
+    assert "draws trainings and goals" in runs_words(report([0, 1, 2]))
+    assert "over goals" in runs_words(report([]))
