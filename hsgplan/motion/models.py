@@ -2,8 +2,12 @@
 
 Both embed the grounded scene graph and the subgoal separately (`embed`-d each, 32 in the
 paper), concatenate the two and score the primitive's bins with a two-layer head; every layer
-has `hidden` units (256 in the paper). Logits cover the bin pairs jointly (10 x 10 for place,
-21 x 21 for push), so that a choice of x never goes with an incompatible y.
+has `hidden` units (256 in the paper). The paper's sentence, "we discretize each dimension
+into 10 discrete bins … 21 discrete bins for each", has two readings, both kept: the head
+scores the bin pairs jointly (`mlp`: 10 x 10 for place, 21 x 21 for push, so that a choice of
+x never goes with an incompatible y), or one softmax per dimension (`per-dim`: 10 + 10 or
+21 + 21 outputs, a pair scored by the sum of its two log-probabilities; cross-entropy over
+those pairs is the sum of the two dimensions' cross-entropies).
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ from hsgplan.scene_graph.grounding import EDGE_DIM, QUERY_DIM, TYPES, dims
 
 MODELS = ("gnn", "mlp")
 REFERENCE_A = slice(-6, -3)  # a node's reference-A position: the last six features but three
-HEADS = ("mlp", "bins")
+HEADS = ("mlp", "per-dim", "bins")
 
 
 @dataclass(frozen=True)
@@ -40,9 +44,10 @@ class MotionNetConfig:
     edge_dim: int = EDGE_DIM
     subgoal_dim: int = dims("names")[1]
     slots: int = len(TYPES)  # the MLP's fixed input: one node slot per object type
-    # The head: "mlp", the paper's (the embeddings, concatenated, through an MLP onto every
-    # bin), or "bins" (beyond the paper): each bin is scored from where it would put the
-    # object (the GNN: `BinQueryHead`; the MLP: `FlatBinHead`, the same inputs in slots).
+    # The head: "mlp", the paper's joint reading (the embeddings, concatenated, through an MLP
+    # onto every bin pair), "per-dim", its per-dimension reading (the same MLP onto each
+    # dimension's bins, a softmax each), or "bins" (beyond the paper): each bin is scored from
+    # where it would put the object (the GNN: `BinQueryHead`; the MLP: `FlatBinHead`).
     head: str = "mlp"
     query_dim: int = QUERY_DIM
     # what a node is (`domain.scene.FEATURES`): "names", the paper's one-hots over the kitchen's
@@ -96,7 +101,7 @@ class GraphMotionNet(nn.Module):
         if c.head == "bins":
             self.head = BinQueryHead(c.hidden, c.embed, c.query_dim, c.embed)
         else:
-            self.head = mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
+            self.head = _pair_head(c)
 
     def forward(self, batch, only: torch.Tensor | None = None) -> torch.Tensor:
         h = batch.x
@@ -128,7 +133,7 @@ class FlatMotionNet(nn.Module):
             self.head = FlatBinHead(c.hidden, c.embed, c.query_dim, c.slots, c.hidden)
         else:
             self.graph_embed = mlp([flat, c.hidden, c.hidden, c.embed])
-            self.head = mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
+            self.head = _pair_head(c)
 
     def _slot_positions(self, batch) -> tuple[torch.Tensor, torch.Tensor]:
         """Each slot's reference-A position [B, slots, 3] and whether its type is present
@@ -161,6 +166,31 @@ class FlatMotionNet(nn.Module):
             subgoal = self.subgoal_embed(batch.u)
             return self.head(torch.relu(graph), positions, present, batch, subgoal, only)
         return _pick(self.head(torch.cat([graph, self.subgoal_embed(batch.u)], dim=-1)), only)
+
+
+def _pair_head(c: MotionNetConfig) -> nn.Module:
+    """The paper's head onto every bin pair (`mlp`) or onto each dimension's bins (`per-dim`)."""
+    if c.head == "per-dim":
+        return PerDimensionHead(
+            mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] + c.bins[1]]), c.bins
+        )
+    return mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
+
+
+class PerDimensionHead(nn.Module):
+    """One softmax per dimension, given as the log-probability of every bin pair [B, x * y]:
+    the sum of its x bin's and its y bin's, so a pair's score ranks as the joint head's."""
+
+    def __init__(self, net: nn.Module, bins: tuple[int, int]) -> None:
+        super().__init__()
+        self.net = net
+        self.bins = bins
+
+    def forward(self, h: torch.Tensor) -> torch.Tensor:
+        out = self.net(h)
+        x = torch.log_softmax(out[:, : self.bins[0]], dim=-1)
+        y = torch.log_softmax(out[:, self.bins[0] :], dim=-1)
+        return (x.unsqueeze(2) + y.unsqueeze(1)).flatten(1)
 
 
 def _pick(logits: torch.Tensor, only: torch.Tensor | None) -> torch.Tensor:

@@ -63,7 +63,9 @@ class MotionTrainConfig:
     # than 1 (they fight the simulation workers for the cores).
     threads: int = setting(1, **BOUNDS["workers"])
     loss: str = "ce"  # "ce" (successes, the paper's) or "bce" (every trial)
-    head: str = "mlp"  # "mlp" (the paper's) or "bins" (`models.BinQueryHead`, `FlatBinHead`)
+    # "mlp" or "per-dim" (the paper's, read jointly or per dimension: `models`) or "bins"
+    # (`models.BinQueryHead`, `FlatBinHead`)
+    head: str = "mlp"
     # The share of the training scenes held out to choose the epoch: the weights kept are
     # those of the epoch with the lowest loss on them (0: train on all, keep the last epoch).
     validation: float = setting(0.0, lo=0, hi=0.5)
@@ -76,6 +78,9 @@ class MotionTrainConfig:
             raise InvalidInputError(f"primitive '{self.primitive}': place or push")
         if self.loss not in ("ce", "bce"):
             raise InvalidInputError(f"loss '{self.loss}': ce or bce")
+        if self.head == "per-dim" and self.loss != "ce":
+            # its scores are log-probabilities: no logit of a pair's own success to teach
+            raise InvalidInputError("head 'per-dim' learns with loss 'ce' only")
         self.net_config()  # refuses a bad model name or width
 
     def net_config(self) -> MotionNetConfig:

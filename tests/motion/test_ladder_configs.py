@@ -10,6 +10,7 @@ from hsgplan.paths import MOTION_CHECKPOINTS, home
 LADDER = home() / "configs" / "ladder"
 ROWS = {
     "paper-head-ce": {"head": "mlp", "loss": "ce"},
+    "paper-per-dim-ce": {"head": "per-dim", "loss": "ce"},
     "bin-inputs-ce": {"head": "bins", "loss": "ce"},
 }
 
