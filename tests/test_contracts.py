@@ -49,6 +49,12 @@ def _lint_with(tmp_path: Path, module: str, line: str) -> subprocess.CompletedPr
             "from hsgplan.sim.sampler import sample_scene",
             "hsgplan.sim.sampler",
         ),
+        # the kitchen is the commands' to name: not even an evaluation may import it
+        (
+            "hsgplan.evaluation.protocol",
+            "from hsgplan.domain.kitchen import KITCHEN",
+            "hsgplan.domain.kitchen",
+        ),
     ],
 )
 def test_touching_the_simulator_from_the_decision_path_breaks_the_lint(

@@ -247,9 +247,9 @@ def _reads_names(folder: Path) -> bool:
 def check_reads(folders: list[Path], world: World, scene: str | Path | None) -> None:
     """Refuse, in one line, checkpoints whose networks know the kitchen's names in a scene
     that names others (networks of the "geometry" features read any scene)."""
-    from hsgplan.scene_graph.names import NAMES_WORLD
+    from hsgplan.scene_graph.names import unnamed
 
-    others = world.names_beyond(NAMES_WORLD)
+    others = unnamed(world)
     bound = [f for f in folders if _reads_names(f)] if others else []
     if bound:
         raise InvalidInputError(

@@ -19,7 +19,7 @@ from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import recorded_worlds
 from hsgplan.runner.run_folder import CONFIG
-from hsgplan.scene_graph.names import NAMES_WORLD
+from hsgplan.scene_graph.names import names_world
 
 # (task, attempt) -> (bins, status index)
 Trials = dict[tuple[int, int], tuple[tuple[int, int], int]]
@@ -58,7 +58,7 @@ def _world(path: Path) -> World:
         return dataset_world(path)
     config = path / CONFIG
     scene = read_json(config, "collection settings").get("scene") if config.exists() else None
-    return recorded_worlds(scene, NAMES_WORLD, path)[0]
+    return recorded_worlds(scene, names_world(), path)[0]
 
 
 def _rows(data: MotionData):

@@ -16,7 +16,6 @@ import numpy as np
 
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
 from hsgplan.sim import motion_plans
@@ -54,8 +53,8 @@ def summarize(every: int, lines: int, errors_m: Sequence[float]) -> LineError:
 def line_error(
     tasks: int,
     every: int,
+    worlds: Sequence[World],
     on_task: Callable[[], None] | None = None,
-    worlds: Sequence[World] = (KITCHEN,),
 ) -> LineError:
     errors: list[float] = []
     lines = 0

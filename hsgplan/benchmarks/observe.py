@@ -25,8 +25,8 @@ import torch
 from hsgplan.domain.world import World
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.observer import tracked
-from hsgplan.perception.synthetic import VIEWS, render_sample
-from hsgplan.perception.vocabulary import TRAINING_WORLD
+from hsgplan.perception.synthetic import render_sample
+from hsgplan.perception.vocabulary import VIEW_COUNT
 from hsgplan.scene_graph.geometry import Pose
 
 # objects in a scene, grouped: what a row of the table covers
@@ -53,9 +53,9 @@ def bench_observe(
     checkpoint: Path,
     scenes: int,
     seed: int,
-    views: int = len(VIEWS),
+    world: World,
+    views: int = VIEW_COUNT,
     on_scene: Callable[[], None] | None = None,
-    world: World = TRAINING_WORLD,
 ) -> list[ObserveTiming]:
     """Time f_p on the scenes `(seed, 0 .. scenes - 1)` that could be staged (in `world`); a
     row per group of sizes that holds any, then one over all of them."""
@@ -65,7 +65,7 @@ def bench_observe(
     times: list[tuple[int, float, float, float]] = []
     for index in range(scenes):
         start = time.perf_counter()
-        sample = render_sample(seed, index, views=views, world=world)
+        sample = render_sample(seed, index, world, views=views)
         rendered = time.perf_counter() - start
         if sample is not None:
             known = {

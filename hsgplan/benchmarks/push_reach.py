@@ -17,7 +17,6 @@ from dataclasses import asdict, dataclass
 
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import PUSH_LEAD, MotionPrimitive, push_values
 from hsgplan.domain.scene import World
 from hsgplan.sim import motion_plans
@@ -63,8 +62,8 @@ def summarize(
 def push_reach(
     tasks: int,
     first: int,
+    worlds: Sequence[World],
     on_task: Callable[[], None] | None = None,
-    worlds: Sequence[World] = (KITCHEN,),
 ) -> PushReach:
     slack = motion_plans.PUSH_SLACK
     margins: list[tuple[float, bool]] = []

@@ -17,7 +17,6 @@ from dataclasses import asdict, dataclass
 from hsgplan.data import motion_trials
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
 from hsgplan.sim import primitives
@@ -84,8 +83,8 @@ def push_settings(
     scenes: int,
     trials: int,
     setting: PushSetting,
+    worlds: Sequence[World],
     on_task: Callable[[], None] | None = None,
-    worlds: Sequence[World] = (KITCHEN,),
 ) -> PushSettingRow:
     tasks = tasks_per_scene(trials, setting)
     saved = primitives.PUSH_SUBSTEPS, motion_trials.ATTEMPTS_PER_TASK[PUSH]

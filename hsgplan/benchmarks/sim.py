@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene_file import default_world
 from hsgplan.evaluation.config import EvalConfig, world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord, run_episode
 from hsgplan.evaluation.protocol import episode_specs
@@ -41,7 +41,7 @@ def bench_sim(
     specs = episode_specs(EvalConfig("oracle", tuple(sizes), episodes, seed, scene=scene))
     records = []
     for spec in specs:
-        world = KITCHEN if spec.scene is None else world_of_file(spec.scene)
+        world = default_world() if spec.scene is None else world_of_file(spec.scene)
         record = run_episode(
             KitchenStorageEnv(visuals=False, world=world),
             make_agent("oracle"),

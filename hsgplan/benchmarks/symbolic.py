@@ -12,7 +12,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.world import World
 from hsgplan.planning.fast_downward import FastDownwardPlanner, NoPlanError
 from hsgplan.symbolic.generator import random_goals, random_state
@@ -37,10 +36,10 @@ def bench_symbolic(
     sizes: Sequence[int],
     goals: int,
     seed: int,
+    world: World,
     optimal_max_size: int = 8,
     timeout_s: float = 30.0,
     on_problem: Callable[[], None] | None = None,
-    world: World = KITCHEN,
 ) -> list[SizeTiming]:
     """Time both Fast Downward configurations on `goals` problems per size, in `world`.
 

@@ -18,7 +18,6 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.world import World
 from hsgplan.evaluation.task_eval import run_task_episode
 from hsgplan.symbolic.generator import random_goals, random_state
@@ -56,8 +55,8 @@ def bench_task(
     sizes: Sequence[int],
     goals: int,
     seed: int,
+    world: World,
     on_episode: Callable[[], None] | None = None,
-    world: World = KITCHEN,
 ) -> list[TaskTiming]:
     """Time the three planners on `goals` problems per size, in `world`."""
     import torch

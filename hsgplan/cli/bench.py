@@ -104,9 +104,9 @@ def bench_symbolic(
             size_list,
             goals,
             seed,
+            world,
             optimal_max_size,
             on_problem=lambda: progress.advance(task),
-            world=world,
         )
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
@@ -151,7 +151,14 @@ def bench_task(
     check_reads([checkpoint], world, scene)
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("episodes", total=goals * len(size_list))
-        rows = run(checkpoint, size_list, goals, seed, lambda: progress.advance(task), world)
+        rows = run(
+            checkpoint,
+            size_list,
+            goals,
+            seed,
+            on_episode=lambda: progress.advance(task),
+            world=world,
+        )
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return

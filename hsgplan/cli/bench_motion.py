@@ -163,7 +163,9 @@ def push_settings(
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("push tasks", total=total)
         for s in chosen:
-            rows.append(run(scenes, trials, s, lambda: progress.advance(bar), worlds))
+            rows.append(
+                run(scenes, trials, s, on_task=lambda: progress.advance(bar), worlds=worlds)
+            )
     if as_json:
         print(json.dumps([r.to_json() for r in rows], indent=2))
         return

@@ -176,7 +176,14 @@ def eval_perception(
     with Progress(console=err, transient=True) as progress:
         task = progress.add_task("scenes", total=scenes)
         run = evaluate_loop if loop else evaluate
-        found = run(estimator, scenes, seed, lambda: progress.advance(task), shown, worlds)
+        found = run(
+            estimator,
+            scenes,
+            seed,
+            on_scene=lambda: progress.advance(task),
+            views=shown,
+            worlds=worlds,
+        )
         report = summary(found) | {"seed": seed, "split": split and split.value}
         report["perception_rules"] = list(settings)
     if as_json:

@@ -23,9 +23,8 @@ from hsgplan.data.demos import DEMOS, FORMAT, META, TASKS, VERSION, Demo, read_d
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world
+from hsgplan.domain.scene_file import default_world, read_world
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.files import write_atomically
 from hsgplan.runner.lock import hold_folder
@@ -44,7 +43,7 @@ def round_task(task: str, r: int) -> str:
 
 
 def record_demo(
-    task: str, goal_text: str, seed: int, full_scene: bool = False, world: World = KITCHEN
+    task: str, goal_text: str, seed: int, world: World, full_scene: bool = False
 ) -> Demo | None:
     """Run the oracle on one task in `world`; the demonstration, or None if the episode
     failed."""
@@ -116,7 +115,7 @@ def collect_demos(
     keeps (`data.demos.demos_world`)."""
     if rounds < 1:
         raise InvalidInputError(f"rounds {rounds}: need at least 1")
-    world, where = (KITCHEN, None) if scene is None else (read_world(scene), str(scene))
+    world, where = (default_world(), None) if scene is None else (read_world(scene), str(scene))
     if scene is not None:
         for _, goal in TASKS:
             try:
@@ -153,7 +152,7 @@ def collect_demos(
             continue
         base = seed * 1000 + r * ROUND_STRIDE + i * RETRIES
         for attempt in range(RETRIES):
-            demo = record_demo(task, goal, base + attempt, full_scene, world)
+            demo = record_demo(task, goal, base + attempt, world, full_scene)
             if demo is not None:
                 break
         else:

@@ -10,8 +10,8 @@ from hsgplan.domain.checks import BOUNDS, MAX_SAMPLES, bounded, check_fields, se
 from hsgplan.domain.scene_file import read_world
 from hsgplan.domain.world import World
 from hsgplan.perception.images import CHUNK, FORMAT, render_chunk, write_format
-from hsgplan.perception.synthetic import P_ELSEWHERE, VIEWS, first_views
-from hsgplan.perception.vocabulary import TRAINING_WORLD, Vocabulary
+from hsgplan.perception.synthetic import P_ELSEWHERE, first_views
+from hsgplan.perception.vocabulary import VIEW_COUNT, Vocabulary, training_world
 from hsgplan.runner.items import run_items
 from hsgplan.sim.render import Camera
 
@@ -25,7 +25,7 @@ class ImagesConfig:
     seed: int = setting(0, **BOUNDS["seed"])
     chunk: int = setting(CHUNK, lo=1, hi=MAX_SAMPLES)
     p_elsewhere: float = setting(P_ELSEWHERE, lo=0.0, hi=1.0)  # see `synthetic.P_ELSEWHERE`
-    views: int = len(VIEWS)  # the first this many fixed views (3: shoulders and front)
+    views: int = VIEW_COUNT  # the first this many fixed views (3: shoulders and front)
     # a scene file whose world the scenes are staged in (None: the kitchen, the shipped f_p's);
     # an f_p trained on the images learns its groceries' looks through its cameras
     scene: str | None = None
@@ -36,7 +36,7 @@ class ImagesConfig:
 
     def world(self) -> World:
         """The world the scenes are staged in."""
-        return TRAINING_WORLD if self.scene is None else read_world(self.scene)
+        return training_world() if self.scene is None else read_world(self.scene)
 
     def cameras(self) -> tuple[Camera, ...]:
         """The fixed views rendered: the first `views` of the world's."""
@@ -84,4 +84,4 @@ def collect_images(
 def _render(item: tuple[str, int, ImagesConfig]) -> dict:
     run_dir, chunk, c = item
     world = c.world()
-    return render_chunk(run_dir, c.seed, chunk, c.chunk, c.samples, c.p_elsewhere, c.views, world)
+    return render_chunk(run_dir, c.seed, chunk, c.chunk, c.samples, world, c.p_elsewhere, c.views)

@@ -38,7 +38,7 @@ from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import read_worlds, scene_file_names
 from hsgplan.runner.engines import engine
 from hsgplan.runner.run_folder import check_own, claim
-from hsgplan.scene_graph.names import NAMES_WORLD
+from hsgplan.scene_graph.names import names_world
 
 WORK = "work"
 REJECTED = "rejected"
@@ -64,7 +64,7 @@ class CollectConfig:
         """The scene files chunks are staged in, in turn, with their worlds (the kitchen's
         none); a bad scene file, or a folder of scenes of other types, refused in one line."""
         if self.scene is None:
-            return [(None, NAMES_WORLD)]
+            return [(None, names_world())]
         found = read_worlds(self.scene)
         store.one_set_of_types(list(found.values()), self.scene)
         return [(str(path), world) for path, world in found.items()]

@@ -50,12 +50,11 @@ import numpy as np
 from hsgplan.data.world_trials import NO_PARAMETERS, UNSTAGED, WorldTrial, state_row, trials_of
 from hsgplan.domain.actions import Action, Place
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
 from hsgplan.domain.room import Room
 from hsgplan.domain.scene import OPEN_SPACE, World
-from hsgplan.domain.scene_file import read_world, read_worlds
+from hsgplan.domain.scene_file import default_world, read_world, read_worlds
 from hsgplan.motion.sampler import candidates
 from hsgplan.planning.heuristic import action_for, candidate_literals
 from hsgplan.runner.items import run_items
@@ -90,7 +89,7 @@ class _Places:
         return _Places(tops, prepush, (*(("on", s) for s in tops + prepush), *inside_))
 
 
-def draw_reach_state(seed: int, index: int, world: World = KITCHEN) -> SymbolicSceneGraph:
+def draw_reach_state(seed: int, index: int, world: World) -> SymbolicSceneGraph:
     """A state to stage in `world` (the distribution is in the module docstring)."""
     rng = random.Random(f"reach-{seed}-{index}")
     places = _Places.of(world)
@@ -257,7 +256,7 @@ class ReachItem:
 
 @functools.cache
 def _process_scene(scene: str | None) -> Scene:
-    world = KITCHEN if scene is None else read_world(Path(scene))
+    world = default_world() if scene is None else read_world(Path(scene))
     return Scene((), visuals=False, world=world)
 
 
@@ -311,7 +310,7 @@ def collect_reach(
         "actions_per_state": actions_per_state,
         "max_params": max_params,
     }
-    worlds: dict[str | None, World] = {None: KITCHEN}
+    worlds: dict[str | None, World] = {None: default_world()}
     if scene is not None:  # a kitchen collection records no scene, as before scenes were given
         worlds = {str(p): w for p, w in read_worlds(scene).items()}
         config["scene"] = str(scene)

@@ -44,9 +44,8 @@ from hsgplan.collect.reach import (
 )
 from hsgplan.data.world_trials import WorldTrial, state_row, trials_of
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world, read_worlds
+from hsgplan.domain.scene_file import default_world, read_world, read_worlds
 from hsgplan.evaluation.seeds import GOAL_SEEDS, episode_seed
 from hsgplan.evaluation.splits import TRAIN, split_goals
 
@@ -87,7 +86,7 @@ def _agent(checkpoint: str | None = None, motion_checkpoints: str | None = None)
 
 @functools.cache
 def _world(scene: str | None) -> World:
-    return KITCHEN if scene is None else read_world(Path(scene))
+    return default_world() if scene is None else read_world(Path(scene))
 
 
 def _goal(item: VisitedItem):
@@ -190,7 +189,7 @@ def collect_visited(
     folder = None if checkpoint is None else str(checkpoint)
     motion = None if motion_checkpoints is None else str(motion_checkpoints)
     read = [Path(folder or TASK_CHECKPOINT), Path(motion or MOTION_CHECKPOINTS)]
-    worlds: dict[str | None, World] = {None: KITCHEN}
+    worlds: dict[str | None, World] = {None: default_world()}
     if scene is not None:  # a kitchen collection records no scene, as before scenes were given
         worlds = {str(p): w for p, w in read_worlds(scene).items()}
     # a missing or unreadable checkpoint, or one that cannot read a scene's names, is refused

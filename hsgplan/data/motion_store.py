@@ -42,7 +42,7 @@ from hsgplan.domain.scene_file import recorded_worlds, scene_file_names
 from hsgplan.files import atomic, write_atomically
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
-from hsgplan.scene_graph.names import NAMES_WORLD, TYPE_NAMES
+from hsgplan.scene_graph.names import TYPE_NAMES, names_world
 from hsgplan.sim.outcome import Status
 
 # 2: a place that leaves an object unpickable is labelled `blocks_pick`; 3: a push task may
@@ -68,7 +68,7 @@ class MotionData:
     target: np.ndarray
     bins: np.ndarray
     poses: np.ndarray
-    world: World = NAMES_WORLD  # whose object and entity types the indices name
+    world: World  # whose object and entity types the indices name
     # Collected round a folder of scene files: the world of each chunk of tasks, in turn (none:
     # every row is of `world`); see the module's schema.
     worlds: tuple[World, ...] = ()
@@ -116,9 +116,7 @@ class MotionData:
         return GeometricSceneGraph.from_poses(poses, held=held, world=self.world_of(i))
 
 
-def from_trials(
-    primitive: MotionPrimitive, trials: list[Trial], world: World = NAMES_WORLD
-) -> MotionData:
+def from_trials(primitive: MotionPrimitive, trials: list[Trial], world: World) -> MotionData:
     s = len(trials)
     types, entities = tuple(world.object_types), tuple(world.entity_types)
     poses = np.full((s, len(types), 7), np.nan, dtype=np.float32)
@@ -147,13 +145,13 @@ def save(path: Path, data: MotionData, **extra: np.ndarray) -> None:
         np.savez_compressed(f, primitive=np.array(data.primitive.value), **arrays, **extra)
 
 
-def load(path: Path, world: World = NAMES_WORLD) -> MotionData:
+def load(path: Path, world: World) -> MotionData:
     """Read a dataset or chunk file of `world`; a missing or damaged file is refused in one
     line."""
     return _read(path, world)[0]
 
 
-def _read(path: Path, world: World = NAMES_WORLD) -> tuple[MotionData, dict[str, int]]:
+def _read(path: Path, world: World) -> tuple[MotionData, dict[str, int]]:
     """The rows and the integer extras (a chunk's index, seed, unstaged count) of a file."""
     if not path.is_file():
         raise InvalidInputError(f"'{path}': no such motion data file")
@@ -232,7 +230,7 @@ def chunk_files(folder: Path) -> dict[int, Path]:
     return dict(sorted(found.items()))
 
 
-def save_chunk(folder: Path, result: ChunkResult, world: World = NAMES_WORLD) -> None:
+def save_chunk(folder: Path, result: ChunkResult, world: World) -> None:
     data = from_trials(result.primitive, list(result.trials), world)
     extras = {"unstaged": result.unstaged, "chunk": result.chunk, "seed": result.seed}
     save(chunk_path(folder, result.chunk), data, **{k: np.array(v) for k, v in extras.items()})
@@ -244,7 +242,7 @@ def load_chunk(
     seed: int,
     chunk: int,
     tasks_per_chunk: int,
-    world: World = NAMES_WORLD,
+    world: World,
 ) -> tuple[MotionData, int]:
     """A chunk's rows and unstaged count, checked to be the chunk its name says of this
     collection: a damaged chunk, or one copied from another place, is refused in one line."""
@@ -261,16 +259,14 @@ def load_chunk(
     return data, extras["unstaged"]
 
 
-def concat(
-    primitive: MotionPrimitive, parts: list[MotionData], world: World = NAMES_WORLD
-) -> MotionData:
+def concat(primitive: MotionPrimitive, parts: list[MotionData], world: World) -> MotionData:
     if not parts:
         return from_trials(primitive, [], world)
     joined = (np.concatenate([getattr(p, f) for p in parts]) for f in FIELDS)
     return MotionData(primitive, *joined, world=world)
 
 
-def write_schema(folder: Path, world: World = NAMES_WORLD) -> None:
+def write_schema(folder: Path, world: World) -> None:
     doc = (__doc__ or "").split("Schema", 1)[1]
     schema = {
         "version": SCHEMA_VERSION,
@@ -348,7 +344,7 @@ def dataset_worlds(path: Path, manifest: dict | None = None) -> list[World]:
     not found here, or a folder of scenes of other types, is refused in one line."""
     manifest = read_manifest(path) if manifest is None else manifest
     scene = (manifest or {}).get("scene")
-    return one_set_of_types(recorded_worlds(scene, NAMES_WORLD, path), scene)
+    return one_set_of_types(recorded_worlds(scene, names_world(), path), scene)
 
 
 def _round(path: Path, manifest: dict) -> int:

@@ -26,7 +26,7 @@ from hsgplan.domain.parameters import BINS, MotionPrimitive, params_for
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.scene_file import read_world
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.scene_graph.names import NAMES_WORLD
+from hsgplan.scene_graph.names import names_world
 from hsgplan.sim.motion_plans import can_pick
 from hsgplan.sim.outcome import Outcome, Status
 from hsgplan.sim.primitives import execute
@@ -88,7 +88,7 @@ def run_chunk(
     tasks are drawn and staged in the world of `scene_file`, else in the kitchen, whose names
     the shipped data's columns index (`data.motion_store`)."""
     kind = MotionPrimitive(primitive)
-    world = NAMES_WORLD if scene_file is None else read_world(scene_file)
+    world = names_world() if scene_file is None else read_world(scene_file)
     trials: list[Trial] = []
     unstaged = 0
     with Scene((), seed=seed, visuals=False, world=world) as scene:

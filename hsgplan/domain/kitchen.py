@@ -1,15 +1,15 @@
 """The default world: the kitchen of `scenes/kitchen.toml`, where every published number was
 measured.
 
-Library code takes the `World` it works in and never imports this module (an import contract
-in pyproject.toml holds this); the entry points (commands, evaluation configurations,
-collectors, benchmarks) resolve "no scene given" to it here, and tests build in it.
+It is read as this module is imported, so only the commands and the tests import it: library
+code takes the `World` it works in, or resolves "no scene given" when a run asks
+(`scene_file.default_world`), and never imports this module (an import contract in
+pyproject.toml holds this).
 """
 
 from __future__ import annotations
 
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world
-from hsgplan.paths import KITCHEN_SCENE
+from hsgplan.domain.scene_file import default_world
 
-KITCHEN: World = read_world(KITCHEN_SCENE)
+KITCHEN: World = default_world()

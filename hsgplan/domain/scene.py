@@ -343,11 +343,6 @@ class World:
         """Entity types in a fixed order: the object types, the shelves, the regions."""
         return tuple(self.object_types) + self.fixtures
 
-    def names_beyond(self, other: World) -> list[str]:
-        """Entity types of this world that `other` does not have (what a model trained in
-        `other`, encoding names, cannot read)."""
-        return [n for n in self.entity_types if n not in other.entity_types]
-
     def split_instance(self, name: str) -> tuple[str, int]:
         """(type, k) of an object instance name; raises UnknownNameError with the reason."""
         if name in self.object_types:

@@ -12,6 +12,7 @@ import json
 import re
 import tomllib
 from collections.abc import Callable
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,7 @@ from hsgplan.domain.scene import (
     World,
     make_shelf,
 )
+from hsgplan.paths import KITCHEN_SCENE
 
 MAX_SCENE_BYTES = 2**20
 MAX_SHELVES = 8
@@ -229,6 +231,19 @@ def _world(data: Any) -> World:
         raise _Bad(f"goals.interior {interior!r}: need a shelf with an interior")
     return World(name, table, tuple(shelves), tuple(regions), tuple(types), tuple(tops),
                  interior, friction, cameras)  # fmt: skip
+
+
+@cache
+def default_world() -> World:
+    """The kitchen of `scenes/kitchen.toml`: the world of whatever names no scene, read the
+    first time a run asks for it (never at import: a library module that reads a scene file
+    as it is imported fails every command when that file is bad)."""
+    return read_world(KITCHEN_SCENE)
+
+
+def scene_world(scene: Path | str | None) -> World:
+    """The world of a scene file, or the default world where none is given."""
+    return default_world() if scene is None else read_world(scene)
 
 
 def read_world(path: Path | str) -> World:

@@ -11,7 +11,6 @@ from pathlib import Path
 
 from hsgplan.domain.checks import BOUNDS, bounded, check_fields, read_text, setting
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.recovery import (
     NO_FAILURE_RULES,
     PAPER,
@@ -20,7 +19,7 @@ from hsgplan.domain.recovery import (
     RecoveryRules,
 )
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import MAX_SCENE_BYTES, read_world_text, read_worlds
+from hsgplan.domain.scene_file import MAX_SCENE_BYTES, default_world, read_world_text, read_worlds
 
 # What an agent sees the simulated world with (`evaluation.observers` makes them): gt, the
 # simulator's poses; rgb, f_p on the fixed cameras' images; rgb-latest, f_p with each look's
@@ -123,7 +122,7 @@ class EvalConfig:
     def worlds(self) -> dict[str | None, World]:
         """The worlds its episodes run in, by scene file ({None: the kitchen} without one)."""
         if self.scene is None:
-            return {None: KITCHEN}
+            return {None: default_world()}
         return {str(p): world_of_file(str(p)) for p in read_worlds(self.scene)}
 
     def rules(self) -> RecoveryRules:

@@ -20,7 +20,7 @@ from pathlib import Path
 from hsgplan.data.demos import load_demos
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene_file import default_world
 from hsgplan.evaluation.compare import task_summaries
 from hsgplan.evaluation.motion_eval import CROWDED, LABELS
 from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable
@@ -69,7 +69,7 @@ def demonstrations_of(checkpoint: Path) -> int:
     config = read_json(folder / TRAIN_CONFIG, "training configuration")
     if not isinstance(config.get("demos"), str):
         raise InvalidInputError(f"'{folder / TRAIN_CONFIG}' names no demonstration set")
-    held = len(load_demos(Path(config["demos"]), KITCHEN))
+    held = len(load_demos(Path(config["demos"]), default_world()))
     limit = config.get("demo_limit")
     return min(held, limit) if isinstance(limit, int) else held
 

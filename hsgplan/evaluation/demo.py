@@ -17,7 +17,6 @@ import numpy as np
 from hsgplan.agents.base import Agent, Decision
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.goals import Goal
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.scene import World
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.episode import EpisodeRecord, StepRecord, params_text, run_episode
@@ -34,7 +33,7 @@ FRAME_EVERY = 12  # arm waypoints between two GIF frames
 HOLD = 5  # frames a step's end state stays on screen
 
 
-def demo_goal(objects: int, seed: int, world: World = KITCHEN) -> Goal:
+def demo_goal(objects: int, seed: int, world: World) -> Goal:
     return random_goal(objects, random.Random(f"demo-{seed}"), stacking=objects > 2, world=world)
 
 

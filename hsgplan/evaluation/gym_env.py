@@ -3,9 +3,9 @@ a `world` is given. The sim layer takes its world; the default is resolved here,
 
 from __future__ import annotations
 
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene_file import default_world
 from hsgplan.sim.env import KitchenStorageEnv
 
 
 def kitchen_storage_env(**kwargs) -> KitchenStorageEnv:
-    return KitchenStorageEnv(**({"world": KITCHEN} | kwargs))
+    return KitchenStorageEnv(**({"world": default_world()} | kwargs))

@@ -21,7 +21,6 @@ import numpy as np
 
 from hsgplan.agents.registry import make_agent
 from hsgplan.domain.checks import MAX_SEED
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.world import World
 from hsgplan.evaluation.episode import run_episode
 from hsgplan.scene_graph.geometry import Pose
@@ -40,8 +39,8 @@ class LoopScene:
     held: Pose | None  # the object in the hand, if any
     images: np.ndarray  # [V, H, W, 3]
     step: int  # steps run before it was taken
+    world: World  # the scene's
     arm: tuple[Box, ...] = ()  # the arm's links (what the robot knows of where its arm is)
-    world: World = KITCHEN  # the scene's
 
 
 class _Taken(Exception):
@@ -49,7 +48,7 @@ class _Taken(Exception):
 
 
 def loop_scenes(
-    scenes: int, seed: int, cameras: tuple[Camera, ...], worlds: Sequence[World] = (KITCHEN,)
+    scenes: int, seed: int, cameras: tuple[Camera, ...], worlds: Sequence[World]
 ) -> Iterator[LoopScene]:
     """`scenes` scenes, each from an episode of its own, scene k in `worlds[k % len(worlds)]`."""
     envs = {id(w): KitchenStorageEnv(world=w) for w in worlds}
@@ -70,7 +69,7 @@ def loop_scenes(
             images = np.stack([c.capture(scene.bc) for c in cameras])
             truth = {o: p for o, p in poses.items() if o != held}
             arm = scene.robot.boxes()
-            yield LoopScene(truth, poses[held] if held else None, images, steps, arm, world)
+            yield LoopScene(truth, poses[held] if held else None, images, steps, world, arm)
     finally:
         for env in envs.values():
             env.close()

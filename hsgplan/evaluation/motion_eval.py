@@ -20,10 +20,9 @@ from hsgplan.checkpoint import fingerprint
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import stage_task, try_params
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.parameters import MotionPrimitive
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_worlds
+from hsgplan.domain.scene_file import default_world, read_worlds
 from hsgplan.evaluation.config import world_of_file
 from hsgplan.evaluation.intervals import training_goal_interval
 from hsgplan.paths import shipped
@@ -61,7 +60,7 @@ CROWDED = 2  # a shelf top with this many of its 4 cells taken counts as crowded
 
 
 def _learned(
-    kind: MotionPrimitive, checkpoints: Path, world: World = KITCHEN, scene: str | None = None
+    kind: MotionPrimitive, checkpoints: Path, world: World, scene: str | None = None
 ) -> dict:
     """The trained models for a primitive, loaded once (optional ones where they exist and
     read `world`'s names)."""
@@ -95,7 +94,7 @@ def run_eval_chunk(
     rows = []
     from hsgplan.motion.generator import RandomMotion
 
-    world = world_of_file(scene) if scene else KITCHEN
+    world = world_of_file(scene) if scene else default_world()
     learned = _learned(kind, Path(checkpoints), world, scene)
     for index in range(start, start + CHUNK):
         task = draw_task(kind, EVAL_STREAM + seed, index, world)
@@ -234,9 +233,9 @@ def _rows(
     scene: Path | None,
 ) -> list[tuple[str, list[dict]]]:
     """Every trial of one set of networks, by primitive, in the order of the tasks."""
-    worlds = {None: KITCHEN} if scene is None else read_worlds(scene)
+    worlds = {None: default_world()} if scene is None else read_worlds(scene)
     for kind in kinds:  # missing checkpoints, or a GNN that cannot read a scene: before work
-        _learned(kind, checkpoints)
+        _learned(kind, checkpoints, default_world())
         gnn = shipped(checkpoints) / f"{kind.value}-{FOLDERS['gnn']}"
         for path, world in worlds.items():
             check_reads([gnn], world, path and str(path))
@@ -293,5 +292,5 @@ def _trained_on(kind: MotionPrimitive, checkpoints: Path) -> dict:
     folders = shipped(checkpoints)
     return {
         name: TrainingRecord.of(folders / f"{kind.value}-{FOLDERS[name]}", gen.nets[kind])
-        for name, gen in _learned(kind, checkpoints).items()
+        for name, gen in _learned(kind, checkpoints, default_world()).items()
     }

@@ -26,13 +26,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.objects import EntityKind
 from hsgplan.domain.world import Kind, World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.observer import away_from_hand
-from hsgplan.perception.synthetic import VIEWS, ImageSample, render_sample
+from hsgplan.perception.synthetic import ImageSample, render_sample
+from hsgplan.perception.vocabulary import VIEW_COUNT
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose, rotation_apart
 from hsgplan.scene_graph.symbol_mapping import map_symbols
@@ -149,16 +149,16 @@ def evaluate(
     estimator: PoseEstimator,
     scenes: int,
     seed: int,
+    worlds: Sequence[World],
     on_scene: Callable[[], None] | None = None,
-    views: int = len(VIEWS),
-    worlds: Sequence[World] = (KITCHEN,),
+    views: int = VIEW_COUNT,
 ) -> list[SceneResult]:
     """The scenes `(seed, 0 .. scenes - 1)` that could be staged, each scored, seen from the
     first `views` fixed views; scene k staged in a scene of `worlds[k % len(worlds)]`."""
     out = []
     for index in range(scenes):
         world = worlds[index % len(worlds)]
-        sample = render_sample(seed, index, views=views, world=world)
+        sample = render_sample(seed, index, world, views=views)
         if sample is not None:
             found = estimator.detect(sample.images, sample.cameras, world)
             out.append(score_scene(sample, found, world))
@@ -171,9 +171,9 @@ def evaluate_loop(
     estimator: PoseEstimator,
     scenes: int,
     seed: int,
+    worlds: Sequence[World],
     on_scene: Callable[[], None] | None = None,
-    views: int = len(VIEWS),
-    worlds: Sequence[World] = (KITCHEN,),
+    views: int = VIEW_COUNT,
 ) -> list[SceneResult]:
     """f_p on scenes from inside the loop (`loop_scenes`; scene k in `worlds[k % len(worlds)]`),
     seen from the first `views` fixed views as the rgb observer sees them."""

@@ -30,9 +30,9 @@ from hsgplan.domain.checks import (
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.recovery import PAPER, RECOVERING
 from hsgplan.domain.scene import World
+from hsgplan.domain.scene_file import default_world
 from hsgplan.evaluation.config import EvalConfig, world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer, perception_folder
@@ -225,7 +225,7 @@ def run_spec(config: EvalConfig, spec: EpisodeSpec) -> dict:
     from hsgplan.sim.env import KitchenStorageEnv
 
     agent = _worker_agent(config)
-    world = world_of_file(spec.scene) if spec.scene else KITCHEN
+    world = world_of_file(spec.scene) if spec.scene else default_world()
     from hsgplan.sim.plan_rules import PlanRules
 
     env = KitchenStorageEnv(

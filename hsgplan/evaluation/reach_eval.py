@@ -19,7 +19,7 @@ import torch
 
 from hsgplan.data.world_trials import WorldTrial, collection_worlds, load_world_trials
 from hsgplan.domain.actions import Action, Place, Push
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene_file import default_world
 from hsgplan.planning.regression.examples import world_labels
 from hsgplan.planning.regression.planner import RegressionPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -102,8 +102,8 @@ def evaluate_reach(checkpoint: Path, trials: list[WorldTrial] | Path) -> dict:
     if isinstance(trials, Path):
         from hsgplan.agents.registry import check_reads
 
-        worlds = collection_worlds(trials, KITCHEN)
-        names = None if worlds == [KITCHEN] else sorted({w.name for w in worlds})
+        worlds = collection_worlds(trials, default_world())
+        names = None if worlds == [default_world()] else sorted({w.name for w in worlds})
         for world in worlds:
             check_reads([checkpoint], world, world.name)
         trials = load_world_trials(trials, worlds)

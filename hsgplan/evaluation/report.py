@@ -20,7 +20,7 @@ from pathlib import Path
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError, a
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene_file import default_world
 from hsgplan.evaluation.ablation import ABLATION_KIND
 from hsgplan.evaluation.config import world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord
@@ -140,7 +140,10 @@ def rollout(
         shutil.rmtree(partial, ignore_errors=True)
         run_demo(
             make_agent(agent, *checkpoints(config), config.rules()),
-            parse_goal(record.goal, world=world_of_file(record.scene) if record.scene else KITCHEN),
+            parse_goal(
+                record.goal,
+                world=world_of_file(record.scene) if record.scene else default_world(),
+            ),
             record.seed,
             partial,
             scale=GIF_SCALE,

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import parse_goal
-from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.domain.scene_file import default_world
 from hsgplan.evaluation.seeds import GOAL_SEEDS, episode_seed, is_tuning
 from hsgplan.evaluation.splits import SHARED_SIZES, TEST, TUNE, canonical, split_goals
 
@@ -62,7 +62,7 @@ def _canonical(text: str) -> tuple[str, int]:
     """A goal's canonical text and size; a goal in names the kitchen lacks (another world's),
     its literals sorted: it cannot be a kitchen goal."""
     try:
-        goal = parse_goal(text, validate=False, world=KITCHEN)
+        goal = parse_goal(text, validate=False, world=default_world())
         return canonical(goal), goal.size
     except InvalidInputError:
         literals = sorted(part.strip() for part in text.split("&"))
@@ -202,7 +202,7 @@ def drawn_by_test(sizes: Iterable[int] = TEST_SIZES) -> list[Draw]:
     seed = TEST.seeds.start
     draws = []
     for n in sizes:
-        goals = split_goals(TEST, n, TEST_GOALS, seed, stacking=n > 2, world=KITCHEN)
+        goals = split_goals(TEST, n, TEST_GOALS, seed, stacking=n > 2, world=default_world())
         for i, g in enumerate(goals):
             text = canonical(g)
             draws += [
@@ -216,7 +216,8 @@ def goal_space(n: int, draws: int = 3000) -> int:
     """How many distinct goals of n objects the generator draws (a shared size's whole
     space: the 2-object one is reached within a few hundred draws)."""
     rng_seed = random.Random(f"space-{n}").randrange(2**31)
-    return len({canonical(g) for g in split_goals(None, n, draws, rng_seed, n > 2, world=KITCHEN)})
+    drawn = split_goals(None, n, draws, rng_seed, n > 2, world=default_world())
+    return len({canonical(g) for g in drawn})
 
 
 def check(

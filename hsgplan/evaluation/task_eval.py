@@ -24,10 +24,9 @@ from hsgplan.agents.registry import LEARNED_PLANNERS, check_reads, make_planner
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.goals import Goal, parse_goal, read_goal_file
-from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.recovery import PAPER, PROTOCOLS, RECOVERING, RecoveryRules
 from hsgplan.domain.scene import World
-from hsgplan.domain.scene_file import read_world, read_worlds
+from hsgplan.domain.scene_file import default_world, read_world, read_worlds
 from hsgplan.domain.world import MAX_STEPS
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.seeds import episode_seed
@@ -123,7 +122,7 @@ def run_task_job(job: TaskJob) -> dict:
     import torch
 
     torch.set_num_threads(1)  # one core per worker: the pool already fills the machine
-    goal = parse_goal(job.goal, world=read_world(job.scene) if job.scene else KITCHEN)
+    goal = parse_goal(job.goal, world=read_world(job.scene) if job.scene else default_world())
     paper = job.protocol == PAPER
     rules = RecoveryRules.none() if paper else RecoveryRules()
     planner = make_planner(job.planner, Path(job.checkpoint), rules)
@@ -219,7 +218,7 @@ def evaluate_task(
 def scene_files(scene: Path | None) -> dict[Path | None, World]:
     """The worlds of a scene file, or of every `.toml` in a folder; {None: the kitchen}
     without one."""
-    return {None: KITCHEN} if scene is None else read_worlds(scene)
+    return {None: default_world()} if scene is None else read_worlds(scene)
 
 
 def _episode(row: dict) -> TaskEpisode:

@@ -40,7 +40,7 @@ from hsgplan.files import write_atomically
 from hsgplan.motion.models import MotionNetConfig, build
 from hsgplan.paths import MOTION_DATA, shipped
 from hsgplan.scene_graph.grounding import dims, ground
-from hsgplan.scene_graph.names import NAMES_WORLD
+from hsgplan.scene_graph.names import unnamed
 from hsgplan.training import TRAIN_CONFIG
 
 
@@ -118,7 +118,7 @@ def _training_rows(config: MotionTrainConfig) -> MotionData:
         data = data.take(slice(0, config.samples))
     if len(data) == 0:
         raise InvalidInputError(f"no successful {config.primitive} samples in '{folder}'")
-    others = data.world.names_beyond(NAMES_WORLD)
+    others = unnamed(data.world)
     if config.features == "names" and others:
         raise InvalidInputError(
             f"'{folder}' was collected in a scene that names others than the kitchen "

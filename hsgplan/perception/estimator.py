@@ -48,7 +48,7 @@ from hsgplan.perception.settle import (
 )
 from hsgplan.perception.silhouette import yaw_checked
 from hsgplan.perception.visible import painted, visible_masks
-from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY, Vocabulary, read_vocabulary
+from hsgplan.perception.vocabulary import Vocabulary, kitchen_vocabulary, read_vocabulary
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
 from hsgplan.sim.sensing import Box
@@ -78,7 +78,8 @@ class PoseEstimator:
         it, the keypoint network's type is kept.
     pruned: drop what a lone view found that the other views contradict.
     silhouette: check each box's yaw by its silhouette (`perception.silhouette`).
-    vocabulary: the types the networks' channels name (`perception.vocabulary`).
+    vocabulary: the types the networks' channels name (`perception.vocabulary`; None: the
+        shipped f_p's, the kitchen's).
     rules: the estimator's and its tracker's rules (`perception.rules`; the shipped ones).
 
     What it knows of the scene it looks at (its object types' sizes and kinds, its table and
@@ -91,7 +92,7 @@ class PoseEstimator:
         settled: bool = True,
         colour: ColourNet | None = None,
         pruned: bool = True,
-        vocabulary: Vocabulary = KITCHEN_VOCABULARY,
+        vocabulary: Vocabulary | None = None,
         silhouette: bool = True,
         rules: PerceptionRules = SHIPPED,
     ) -> None:
@@ -101,8 +102,8 @@ class PoseEstimator:
         self.settled = settled
         self.colour = colour
         self.pruned = pruned
-        self.vocabulary = vocabulary
-        self.types = vocabulary.types
+        self.vocabulary = kitchen_vocabulary() if vocabulary is None else vocabulary
+        self.types = self.vocabulary.types
 
     @staticmethod
     def load(

@@ -43,11 +43,10 @@ from hsgplan.perception.keypoints import KEYPOINTS
 from hsgplan.perception.synthetic import (
     MAX_OBJECTS,
     P_ELSEWHERE,
-    VIEWS,
     ImageSample,
     render_sample,
 )
-from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY, TRAINING_WORLD, Vocabulary
+from hsgplan.perception.vocabulary import VIEW_COUNT, Vocabulary, training_world
 from hsgplan.runner.run_folder import logged_rows
 
 FORMAT = 1
@@ -64,21 +63,21 @@ def render_chunk(
     chunk: int,
     size: int,
     count: int,
+    world: World,
     p_elsewhere: float = P_ELSEWHERE,
-    views: int = len(VIEWS),
-    world: World = TRAINING_WORLD,
+    views: int = VIEW_COUNT,
 ) -> dict:
     """Render a chunk's samples (of the first `count`, staged in scenes of `world`) into its
     file, written whole or not at all; the worker's entry point. Returns what the run log keeps
     of it."""
     indices = range(chunk * size, min((chunk + 1) * size, count))
-    samples = [render_sample(seed, i, p_elsewhere, views, world) for i in indices]
+    samples = [render_sample(seed, i, world, p_elsewhere, views) for i in indices]
     kept = [s for s in samples if s is not None]
     path = chunk_path(Path(run_dir), chunk)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic(path) as tmp:
-        sized = world is not TRAINING_WORLD  # the training world's chunks stay as they were
-        np.savez_compressed(tmp, **pack(kept, views, world, sized))
+        sized = world != training_world()  # the training world's chunks stay as they were
+        np.savez_compressed(tmp, **pack(kept, world, views, sized))
         digest = hashlib.sha256(tmp.read_bytes()).hexdigest()
     unstaged = len(indices) - len(kept)
     return {"chunk": chunk, "samples": len(kept), "unstaged": unstaged, "sha256": digest}
@@ -86,8 +85,8 @@ def render_chunk(
 
 def pack(
     samples: list[ImageSample],
-    views: int = len(VIEWS),
-    world: World = TRAINING_WORLD,
+    world: World,
+    views: int = VIEW_COUNT,
     sized: bool = False,
 ) -> dict[str, np.ndarray]:
     """The arrays of a chunk of samples staged in `world` (`views` each; a chunk whose draws
@@ -125,7 +124,7 @@ def pack(
 def collection_vocabulary(run_dir: Path) -> Vocabulary:
     """The types and cameras of the world a collection was staged in (its configuration's
     scene file, else the kitchen): what its `types` index."""
-    return Vocabulary(collection_worlds(run_dir, TRAINING_WORLD)[0])
+    return Vocabulary(collection_worlds(run_dir, training_world())[0])
 
 
 def load_chunks(run_dir: Path) -> dict[str, np.ndarray]:
@@ -167,7 +166,7 @@ def own_sizes(types: np.ndarray, vocabulary: Vocabulary) -> np.ndarray:
 
 
 def chunk_problem(
-    arrays: dict[str, np.ndarray], samples: int, vocabulary: Vocabulary = KITCHEN_VOCABULARY
+    arrays: dict[str, np.ndarray], samples: int, vocabulary: Vocabulary
 ) -> str | None:
     """What breaks the format in a chunk's arrays (`pack`'s), or None: every array present,
     one row per sample as logged, the views and objects alike in every array, every type an
@@ -199,7 +198,7 @@ def chunk_problem(
     return None
 
 
-def write_format(run_dir: Path, vocabulary: Vocabulary = KITCHEN_VOCABULARY) -> None:
+def write_format(run_dir: Path, vocabulary: Vocabulary) -> None:
     """The format above, beside the chunks, for whoever reads them without this package."""
     doc = (__doc__ or "").split("Format", 1)[1].split("The run folder", 1)[0]
     types = list(vocabulary.types)

@@ -42,7 +42,6 @@ from hsgplan.domain.world import World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.rules import SHIPPED, PerceptionRules
-from hsgplan.perception.vocabulary import VIEWS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -81,12 +80,13 @@ class RgbObserver:
     def __init__(
         self,
         estimator: PoseEstimator,
-        cameras: tuple[Camera, ...] = VIEWS,
+        cameras: tuple[Camera, ...] | None = None,
         steady: bool = True,
         name: str = "rgb",
     ) -> None:
         self.estimator = estimator
-        self.cameras = cameras
+        # None: the cameras its estimator's f_p was trained with
+        self.cameras = estimator.vocabulary.views if cameras is None else cameras
         self.steady = steady
         self.name = name
         self._views: dict[str, int] = {}  # the views behind each object's belief

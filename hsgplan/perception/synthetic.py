@@ -23,7 +23,7 @@ from hsgplan.domain.objects import draw_objects
 from hsgplan.domain.predicates import inside, on
 from hsgplan.domain.world import Kind, World
 from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, in_world
-from hsgplan.perception.vocabulary import TRAINING_WORLD, VIEWS, Vocabulary
+from hsgplan.perception.vocabulary import VIEW_COUNT, Vocabulary
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 from hsgplan.sim.render import Camera
 from hsgplan.sim.scene import Scene
@@ -70,9 +70,7 @@ class ImageSample:
     visible: np.ndarray
 
 
-def draw_state(
-    rng: random.Random, p_elsewhere: float = P_ELSEWHERE, world: World = TRAINING_WORLD
-) -> SymbolicSceneGraph:
+def draw_state(rng: random.Random, p_elsewhere: float, world: World) -> SymbolicSceneGraph:
     """A random arrangement of 2 to `MAX_OBJECTS` objects of `world`, some cans inside the
     shelves."""
     objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng, world)
@@ -96,9 +94,9 @@ def draw_state(
     return SymbolicSceneGraph.from_literals(objects, literals, world=world)
 
 
-def first_views(count: int, views: tuple[Camera, ...] = VIEWS) -> tuple[Camera, ...]:
-    """The first `count` fixed `views` (the kitchen's unless told); a count past them (or
-    under one) is refused in a line."""
+def first_views(count: int, views: tuple[Camera, ...]) -> tuple[Camera, ...]:
+    """The first `count` fixed `views`; a count past them (or under one) is refused in a
+    line."""
     if not 1 <= count <= len(views):
         raise InvalidInputError(f"views {count}: there are 1 to {len(views)} fixed views")
     return views[:count]
@@ -107,12 +105,12 @@ def first_views(count: int, views: tuple[Camera, ...] = VIEWS) -> tuple[Camera, 
 def render_sample(
     seed: int,
     index: int,
+    world: World,
     p_elsewhere: float = P_ELSEWHERE,
-    views: int = len(VIEWS),
-    world: World = TRAINING_WORLD,
+    views: int = VIEW_COUNT,
 ) -> ImageSample | None:
-    """The sample `(seed, index)` staged in a scene of `world` (the kitchen unless told),
-    from the first `views` of its fixed views; None when its arrangement could not be staged."""
+    """The sample `(seed, index)` staged in a scene of `world`, from the first `views` of its
+    fixed views; None when its arrangement could not be staged."""
     every = Vocabulary(world).views
     first_views(views, every)
     rng = random.Random(f"images-{seed}-{index}")

@@ -46,7 +46,7 @@ from hsgplan.perception.keypoints import KEYPOINTS, PinholeCamera, view_keypoint
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE, PerceptionNetConfig, build, load_perception_net
 from hsgplan.perception.vocabulary import (
-    KITCHEN_VOCABULARY,
+    TYPES,
     Vocabulary,
     read_vocabulary,
     write_vocabulary,
@@ -83,7 +83,7 @@ class PerceptionTrainConfig:
     def __post_init__(self) -> None:
         check_fields(self)
 
-    def net_config(self, types: int = len(KITCHEN_VOCABULARY.types)) -> PerceptionNetConfig:
+    def net_config(self, types: int = len(TYPES)) -> PerceptionNetConfig:
         """The network's sizes, for `types` type channels (its vocabulary's)."""
         return PerceptionNetConfig(
             types=types, width=self.width, stages=self.stages, stride=self.stride
@@ -124,7 +124,7 @@ class Examples:
         )
 
 
-def examples(data: dict[str, np.ndarray], vocabulary: Vocabulary = KITCHEN_VOCABULARY) -> Examples:
+def examples(data: dict[str, np.ndarray], vocabulary: Vocabulary) -> Examples:
     """Every (sample, view) of a loaded collection whose types index `vocabulary`'s, its
     keypoints named as that view names them (`perception.keypoints.view_keypoints`, from the
     stored poses, sizes and cameras)."""

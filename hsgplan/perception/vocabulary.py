@@ -8,7 +8,8 @@ when it looks, so that it sees in any scene whose objects have looks it learned,
 its cameras: a layout of its groceries, moved shelves, resized objects.
 
 A checkpoint folder trained in another world than the kitchen holds that world as a scene file
-(`TRAINING_SCENE`); one without it (the shipped f_p) learned the kitchen's (`KITCHEN_VOCABULARY`).
+(`TRAINING_SCENE`); one without it (the shipped f_p) learned the kitchen's
+(`kitchen_vocabulary`), read when first asked for, never at import.
 """
 
 from __future__ import annotations
@@ -17,10 +18,10 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.domain.scene_file import read_world, scene_data, to_toml
+from hsgplan.domain.scene_file import default_world, read_world, scene_data, to_toml
 from hsgplan.domain.world import ObjectType, World
 from hsgplan.files import write_atomically
+from hsgplan.scene_graph.names import TYPE_NAMES
 from hsgplan.sim.render import Camera
 
 # the world a checkpoint folder's networks were trained in, where it is not the kitchen
@@ -75,11 +76,19 @@ def _look(t: ObjectType) -> tuple:
     return t.name, t.kind, t.color
 
 
-KITCHEN_VOCABULARY = Vocabulary(KITCHEN)
-# The shipped f_p's: its images were staged in the kitchen (the default of every collection),
-# its type channels are the kitchen's six types in this order.
-TRAINING_WORLD = KITCHEN
-TYPES: tuple[str, ...] = KITCHEN_VOCABULARY.types
+def kitchen_vocabulary() -> Vocabulary:
+    """The shipped f_p's: its images were staged in the kitchen (the default of every
+    collection), its type channels are the kitchen's six types (`TYPES`), in that order."""
+    return Vocabulary(training_world())
+
+
+def training_world() -> World:
+    """The world the shipped f_p was trained in: the default world, the kitchen."""
+    return default_world()
+
+
+# its type channels, as written into its networks (a test holds them to the kitchen's types)
+TYPES: tuple[str, ...] = TYPE_NAMES
 
 # The fixed views (in the kitchen, five at 320 x 240: facing the robot over the table; from
 # behind the robot's shoulders on either side, low enough to look into the shelves and over the
@@ -87,8 +96,9 @@ TYPES: tuple[str, ...] = KITCHEN_VOCABULARY.types
 # table's far corners as low, which see the sides of the stacks on the open space and the shelf
 # tops that the first three see from one side only: a box under a can or another box was often
 # seen by one view alone). The keypoint network was first trained on the first three (see
-# `perception.synthetic.ORIGINAL_VIEWS`), then fine-tuned on all five.
-VIEWS: tuple[Camera, ...] = KITCHEN_VOCABULARY.views
+# `perception.synthetic.ORIGINAL_VIEWS`), then fine-tuned on all five. Their poses are the
+# scene file's (`kitchen_vocabulary().views`); how many there are, the networks' input.
+VIEW_COUNT = 5
 
 
 def read_vocabulary(folder: Path | str) -> Vocabulary:
@@ -96,7 +106,7 @@ def read_vocabulary(folder: Path | str) -> Vocabulary:
     training scene that does not read is refused in one line."""
     path = Path(folder) / TRAINING_SCENE
     if not path.exists():
-        return KITCHEN_VOCABULARY
+        return kitchen_vocabulary()
     world = read_world(path)
     if not world.object_types:
         raise InvalidInputError(f"'{path}' names no object types")
@@ -107,6 +117,6 @@ def write_vocabulary(folder: Path | str, vocabulary: Vocabulary) -> None:
     """Keep a vocabulary beside a checkpoint's networks (nothing for the kitchen's, which a
     folder without one reads as)."""
     path = Path(folder) / TRAINING_SCENE
-    if vocabulary.world == KITCHEN:
+    if vocabulary.world == training_world():
         return
     write_atomically(path, to_toml(scene_data(vocabulary.world)))

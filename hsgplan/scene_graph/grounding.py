@@ -45,15 +45,15 @@ from hsgplan.domain.predicates import Literal, Predicate
 from hsgplan.domain.scene import Kind, World, check_features
 from hsgplan.domain.world import PLACE_BINS, PUSH_ANGLE_BINS, PUSH_DIST_BINS
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
-from hsgplan.scene_graph.names import ENTITY_NAMES, NAMES_WORLD, TYPE_NAMES
+from hsgplan.scene_graph.names import ENTITY_NAMES, REGION_NAMES, SHELF_NAMES, TYPE_NAMES
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 
 TYPES = TYPE_NAMES
 REGION_CLASSES: tuple[str, ...] = (
-    *NAMES_WORLD.regions,
-    *(f"top:{s}" for s in NAMES_WORLD.shelves),
-    *(f"in:{s}" for s in NAMES_WORLD.shelves),
+    *REGION_NAMES,
+    *(f"top:{s}" for s in SHELF_NAMES),
+    *(f"in:{s}" for s in SHELF_NAMES),
     "held",
 )
 NODE_DIM = len(TYPES) + len(REGION_CLASSES) + 1 + 3 + 2 + 3 + 3

@@ -78,6 +78,7 @@ def _trials_file(path, statuses):
         np.full(n, KITCHEN.entity_types.index("shelf_a"), dtype=np.int8),
         np.ones((n, 2), dtype=np.int8),
         poses,
+        KITCHEN,
     )
     motion_store.save(path, data)
 

@@ -71,14 +71,14 @@ def test_killed_collection_resumes_to_exactly_n_samples(tmp_path):
     assert done.returncode == 0, done.stderr
     # what was saved before the kill was not run again
     assert all((chunks / name).stat().st_mtime_ns == mtimes[name] for name in kept)
-    resumed = store.load(tmp_path / "a" / "place.npz")
+    resumed = store.load(tmp_path / "a" / "place.npz", KITCHEN)
     assert len(resumed) == N and resumed.ok.all()
     assert len(set(_keys(resumed))) == N  # no duplicates
     assert _keys(resumed) == sorted(_keys(resumed))
     # the same samples as a run that was never interrupted, on two workers
     config = CollectConfig(PLACE, N, workers=2, tasks_per_chunk=CHUNK)
     collect(config, tmp_path / "b")
-    assert _same(resumed, store.load(tmp_path / "b" / "place.npz"))
+    assert _same(resumed, store.load(tmp_path / "b" / "place.npz", KITCHEN))
 
 
 @pytest.mark.slow
@@ -91,8 +91,8 @@ def test_the_ray_path_gives_the_same_samples(tmp_path):
     local = CollectConfig(PUSH, n, workers=1, tasks_per_chunk=CHUNK)
     collect(local, tmp_path / "pool")
     assert summary.samples == n
-    got = store.load(tmp_path / "ray" / "push.npz")
-    assert _same(got, store.load(tmp_path / "pool" / "push.npz"))
+    got = store.load(tmp_path / "ray" / "push.npz", KITCHEN)
+    assert _same(got, store.load(tmp_path / "pool" / "push.npz", KITCHEN))
 
 
 def test_bad_collection_settings_are_refused(tmp_path):
@@ -106,14 +106,14 @@ def test_bad_collection_settings_are_refused(tmp_path):
     damaged = tmp_path / "damaged.npz"
     damaged.write_bytes(b"not a zip")
     with pytest.raises(InvalidInputError, match="not a readable"):
-        store.load(damaged)
+        store.load(damaged, KITCHEN)
 
 
 @pytest.mark.slow
 def test_foreign_damaged_and_leftover_chunks_are_set_aside_and_redone(tmp_path):
     config = CollectConfig(PLACE, 4, workers=1, tasks_per_chunk=CHUNK)
     first = collect(config, tmp_path)
-    before = store.load(tmp_path / "place.npz")
+    before = store.load(tmp_path / "place.npz", KITCHEN)
     chunks = work_folder(tmp_path, PLACE, 0)
     names = sorted(p.name for p in chunks.glob("chunk-*.npz"))
     assert len(names) >= 2, names
@@ -126,7 +126,7 @@ def test_foreign_damaged_and_leftover_chunks_are_set_aside_and_redone(tmp_path):
     (tmp_path / "place.json").unlink()
     again = collect(config, tmp_path)
     assert again.set_aside == 2 and again.chunks_run >= 1
-    assert _same(store.load(tmp_path / "place.npz"), before)
+    assert _same(store.load(tmp_path / "place.npz", KITCHEN), before)
     assert len(list((chunks / "rejected").iterdir())) == 2  # kept for a look, not deleted
     assert not (chunks / ".chunk-000003.tmp.npz").exists()
     assert first.samples == again.samples == 4
@@ -154,7 +154,7 @@ def test_a_dataset_is_never_overwritten_by_other_settings(tmp_path):
 def test_a_replaced_dataset_is_refused_by_its_manifest(tmp_path):
     collect(CollectConfig(PLACE, 0, tasks_per_chunk=CHUNK), tmp_path)
     store.load_dataset(tmp_path / "place.npz")
-    replaced = store.from_trials(PLACE, [])
+    replaced = store.from_trials(PLACE, [], KITCHEN)
     store.save(tmp_path / "place.npz", replaced, extra=np.array(1))  # readable, but not it
     with pytest.raises(InvalidInputError, match="does not match its manifest"):
         store.load_dataset(tmp_path / "place.npz")

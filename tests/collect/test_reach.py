@@ -49,9 +49,9 @@ def _situations(s: SymbolicSceneGraph) -> set[str]:
 
 
 def test_drawn_states_are_reproducible_within_limits_and_often_hard():
-    states = [draw_reach_state(3, i) for i in range(200)]
-    assert states == [draw_reach_state(3, i) for i in range(200)]
-    assert states != [draw_reach_state(4, i) for i in range(200)]
+    states = [draw_reach_state(3, i, KITCHEN) for i in range(200)]
+    assert states == [draw_reach_state(3, i, KITCHEN) for i in range(200)]
+    assert states != [draw_reach_state(4, i, KITCHEN) for i in range(200)]
     for s in states:  # the world's limits (capacities, towers, fit) accept every one
         assert (
             SymbolicSceneGraph.from_literals(s.objects, s.literals, limits=True, world=KITCHEN) == s
@@ -72,7 +72,7 @@ def test_drawn_states_are_reproducible_within_limits_and_often_hard():
 def test_actions_are_the_heuristics_distinct_and_of_every_kind():
     kinds = set()
     for i in range(30):
-        state = draw_reach_state(0, i)
+        state = draw_reach_state(0, i, KITCHEN)
         named = {action_for(lit, state) for lit in candidate_literals(state)}
         chosen = choose_actions(state, random.Random(i))
         assert chosen == choose_actions(state, random.Random(i))

@@ -40,7 +40,7 @@ def _moved(state: SymbolicSceneGraph, obj: str) -> SymbolicSceneGraph:
 
 @st.composite
 def rows(draw):
-    state = draw_reach_state(draw(st.integers(0, 3)), draw(st.integers(0, 10_000)))
+    state = draw_reach_state(draw(st.integers(0, 3)), draw(st.integers(0, 10_000)), KITCHEN)
     actions = sorted({action_for(lit, state) for lit in candidate_literals(state)}, key=str)
     trials = []
     for _ in range(draw(st.integers(0, 4))):
@@ -67,7 +67,7 @@ def test_a_row_reads_back_as_it_was_written(row):
 
 
 def test_a_row_holds_the_trials_of_its_own_state_only():
-    a, b = draw_reach_state(0, 1), draw_reach_state(0, 2)
+    a, b = draw_reach_state(0, 1, KITCHEN), draw_reach_state(0, 2, KITCHEN)
     with pytest.raises(ValueError):
         state_row(a, [WorldTrial(b, parse_action("pick(cherries)", world=KITCHEN), "invalid", b)])
     trial = WorldTrial(a, parse_action("pick(cherries)", world=KITCHEN), "success", None)
@@ -87,7 +87,7 @@ def _write(folder, lines):
 
 
 def test_a_collection_reads_in_key_order_past_cut_lines_and_unstaged_states(tmp_path):
-    a, b, c = (draw_reach_state(0, i) for i in range(3))
+    a, b, c = (draw_reach_state(0, i, KITCHEN) for i in range(3))
     _write(
         tmp_path,
         [
@@ -138,6 +138,6 @@ def test_a_missing_or_unreadable_collection_is_refused(tmp_path):
 
 
 def test_state_json_lists_placements_only():
-    state = draw_reach_state(0, 5)
+    state = draw_reach_state(0, 5, KITCHEN)
     assert all(not x.startswith("Clear") for x in state_json(state))
     assert read_state(state.objects, state_json(state), world=KITCHEN) == state

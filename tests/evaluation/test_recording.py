@@ -17,13 +17,15 @@ from hsgplan.evaluation.recording import EpisodeRecording
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.keypoints import PinholeCamera, in_world
 from hsgplan.perception.pnp import ViewKeypoints
-from hsgplan.perception.vocabulary import VIEWS
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.sensing import Look, Seen
 
 rerun = pytest.importorskip("rerun")
 from rerun.chunk import RrdReader  # noqa: E402
+
+VIEWS = kitchen_vocabulary().views  # the shipped f_p's fixed cameras
 
 GOAL = "On(butter, shelf_a) & On(cherries, butter)"
 TIMES = ("seconds", "task_seconds", "motion_seconds", "execution_seconds")

@@ -44,7 +44,7 @@ def test_a_look_carries_images_calibration_joints_and_the_hands_own_record_only(
 
 
 def test_the_observer_is_given_looks_object_names_and_its_world_nothing_else():
-    assert isinstance(RgbObserver(estimator=None), CameraObserver)
+    assert isinstance(RgbObserver(estimator=None, cameras=()), CameraObserver)
     assert list(typing.get_type_hints(RgbObserver.look)) == ["look", "return"]
     assert typing.get_type_hints(RgbObserver.start) == {
         "objects": tuple[str, ...],

@@ -20,10 +20,12 @@ from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.maps import targets
 from hsgplan.perception.model import STRIDE
 from hsgplan.perception.pnp import ViewKeypoints
-from hsgplan.perception.synthetic import VIEWS, render_sample
+from hsgplan.perception.synthetic import render_sample
 from hsgplan.perception.train import MIN_VISIBLE
-from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometry import Pose, matrix_to_quat
+
+VIEWS = kitchen_vocabulary().views  # the shipped f_p's fixed cameras
 
 TYPES = list(KITCHEN.object_types)
 
@@ -66,7 +68,7 @@ class _TrueMaps(torch.nn.Module):
 
 
 def test_perfect_maps_give_the_scene_back_duplicates_and_all():
-    sample = render_sample(0, 1)  # twelve objects, five alphabet soups among them
+    sample = render_sample(0, 1, KITCHEN)  # twelve objects, five alphabet soups among them
     assert sample is not None and len(sample.objects) == 12
     detections = PoseEstimator(_TrueMaps(sample)).detect(sample.images, sample.cameras, KITCHEN)
     result = score_scene(sample, detections, KITCHEN)
@@ -177,7 +179,7 @@ def test_the_evaluation_sees_from_the_first_views_asked_for():
 
     for views in (3, len(VIEWS)):
         estimator = Counting()
-        results = evaluate(estimator, 2, 1, views=views)
+        results = evaluate(estimator, 2, 1, views=views, worlds=(KITCHEN,))
         assert estimator.views == [views] * len(results) and results
         assert all(r.found == 0 and not r.symbolic_match for r in results)
 
@@ -221,8 +223,8 @@ def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand()
     from hsgplan.evaluation.perception_eval import evaluate_loop
 
     cameras = VIEWS[:1]
-    first = list(loop_scenes(2, 3, cameras))
-    again = list(loop_scenes(2, 3, cameras))
+    first = list(loop_scenes(2, 3, cameras, (KITCHEN,)))
+    again = list(loop_scenes(2, 3, cameras, (KITCHEN,)))
     assert [s.truth for s in first] == [s.truth for s in again]  # the same seed, the same scenes
     assert all(s.step >= 1 and s.images.shape[0] == 1 for s in first)
     for s in first:
@@ -231,7 +233,7 @@ def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand()
     class Oracle:
         """Detects every object at its true pose, and the held one in the hand."""
 
-        vocabulary = KITCHEN_VOCABULARY
+        vocabulary = kitchen_vocabulary()
 
         def __init__(self, scenes):
             self.scenes = iter(scenes)
@@ -243,7 +245,7 @@ def test_scenes_from_inside_the_loop_are_scored_without_the_object_in_the_hand()
                 found.append(Detection("cherries", s.held, 1.0, 2, 0.0))
             return found
 
-    results = evaluate_loop(Oracle(first), 2, 3, views=1)
+    results = evaluate_loop(Oracle(first), 2, 3, views=1, worlds=(KITCHEN,))
     # every object found where it is, the hand's detection not counted against precision
     assert all(r.found == r.objects == r.detections and r.symbolic_match for r in results)
 

@@ -8,8 +8,10 @@ from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.fusion import RAY_GAP, Seen, grouped, line_of_sight, ray_gap
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.pnp import ViewKeypoints
-from hsgplan.perception.synthetic import VIEWS
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometry import Pose
+
+VIEWS = kitchen_vocabulary().views  # the shipped f_p's fixed cameras
 
 CAMERAS = [PinholeCamera.of(c) for c in VIEWS]
 

@@ -9,16 +9,20 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.images import chunk_path, load_chunks
 from hsgplan.perception.keypoints import PinholeCamera, in_world
-from hsgplan.perception.synthetic import VIEWS, render_sample
+from hsgplan.perception.synthetic import render_sample
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometry import Pose
+
+VOCABULARY = kitchen_vocabulary()  # the shipped f_p's
+VIEWS = VOCABULARY.views
 
 
 def test_a_sample_is_its_seed_and_index_alone_and_its_keypoints_are_its_poses_projected():
-    a, b = render_sample(0, 3), render_sample(0, 3)
+    a, b = render_sample(0, 3, KITCHEN), render_sample(0, 3, KITCHEN)
     assert a is not None and b is not None
     assert a.objects == b.objects and np.array_equal(a.images, b.images)
     assert a.images.shape == (len(VIEWS), VIEWS[0].height, VIEWS[0].width, 3)
-    assert not np.array_equal(a.images, render_sample(1, 3).images)
+    assert not np.array_equal(a.images, render_sample(1, 3, KITCHEN).images)
     for v, camera in enumerate(a.cameras):
         pinhole = PinholeCamera.of(camera)
         for j, name in enumerate(a.objects):
@@ -35,7 +39,7 @@ def test_a_sample_staged_in_another_layout_is_labelled_with_that_layouts_sizes()
     from hsgplan.domain.layouts import random_layout
 
     layout = random_layout(KITCHEN, 3, 0)
-    sample = next(s for i in range(5) if (s := render_sample(2, i, views=1, world=layout)))
+    sample = next(s for i in range(5) if (s := render_sample(2, i, layout, views=1)))
     assert any(layout.object_type(n).size != KITCHEN.object_type(n).size for n in sample.objects)
     pinhole = PinholeCamera.of(sample.cameras[0])
     for j, name in enumerate(sample.objects):
@@ -69,7 +73,7 @@ def test_a_collection_may_ask_for_more_stacks_and_refuses_a_chance_outside_0_to_
     from hsgplan.perception.synthetic import draw_state
 
     def stacked(p: float) -> int:
-        states = [draw_state(random.Random(f"stacks-{i}"), p) for i in range(40)]
+        states = [draw_state(random.Random(f"stacks-{i}"), p, KITCHEN) for i in range(40)]
         return sum(len(s.resting_on(o)) > 0 for s in states for o in s.objects)
 
     assert stacked(0.85) > stacked(0.5) > stacked(0.0) == 0
@@ -78,7 +82,7 @@ def test_a_collection_may_ask_for_more_stacks_and_refuses_a_chance_outside_0_to_
 
 
 def test_the_first_views_of_a_sample_do_not_change_when_views_are_added():
-    three, every = render_sample(0, 3, views=3), render_sample(0, 3)
+    three, every = render_sample(0, 3, KITCHEN, views=3), render_sample(0, 3, KITCHEN)
     assert three is not None and every is not None
     assert len(three.cameras) == 3 and len(every.cameras) == len(VIEWS) > 3
     assert np.array_equal(three.images, every.images[:3])
@@ -103,13 +107,13 @@ def test_a_collection_of_fewer_views_records_them_and_a_count_past_the_views_is_
 def test_a_chunk_whose_draws_were_all_unstaged_packs_empty_arrays_of_its_views():
     from hsgplan.perception.images import pack
 
-    empty = pack([], views=3)
+    empty = pack([], KITCHEN, views=3)
     assert empty["images"].shape == (0, 3, VIEWS[0].height, VIEWS[0].width, 3)
     assert empty["keypoints"].shape[:2] == (0, 3)
 
 
 def test_fewer_than_three_views_render_the_first_ones_as_three_do():
-    one, three = render_sample(0, 3, views=1), render_sample(0, 3, views=3)
+    one, three = render_sample(0, 3, KITCHEN, views=1), render_sample(0, 3, KITCHEN, views=3)
     assert one is not None and three is not None
     assert np.array_equal(one.images, three.images[:1]) and one.cameras == three.cameras[:1]
 
@@ -117,15 +121,17 @@ def test_fewer_than_three_views_render_the_first_ones_as_three_do():
 def test_a_chunk_whose_arrays_break_the_format_is_named_damaged():
     from hsgplan.perception.images import chunk_problem, pack
 
-    good = pack([render_sample(0, 0)])
-    assert chunk_problem(good, 1) is None
-    assert "samples" in chunk_problem(good, 2)
+    good = pack([render_sample(0, 0, KITCHEN)], KITCHEN)
+    assert chunk_problem(good, 1, VOCABULARY) is None
+    assert "samples" in chunk_problem(good, 2, VOCABULARY)
     bad_type = dict(good, types=good["types"].copy())
     bad_type["types"][0, 0] = 42
-    assert "object type" in chunk_problem(bad_type, 1)
+    assert "object type" in chunk_problem(bad_type, 1, VOCABULARY)
     swapped = dict(good, poses=good["keypoints"])
-    assert "poses of shape" in chunk_problem(swapped, 1)
-    assert "no cameras" in chunk_problem({k: v for k, v in good.items() if k != "cameras"}, 1)
+    assert "poses of shape" in chunk_problem(swapped, 1, VOCABULARY)
+    assert "no cameras" in chunk_problem(
+        {k: v for k, v in good.items() if k != "cameras"}, 1, VOCABULARY
+    )
 
 
 def test_a_collection_staged_in_a_layout_keeps_its_sizes_and_trains_on_them(tmp_path):
@@ -143,7 +149,7 @@ def test_a_collection_staged_in_a_layout_keeps_its_sizes_and_trains_on_them(tmp_
     for types, sizes in zip(data["types"], data["sizes"], strict=True):
         for t, size in zip(types[types >= 0], sizes[types >= 0], strict=True):
             assert np.allclose(size, layout.object_type(names[t]).size)
-    found = examples(data)
+    found = examples(data, VOCABULARY)
     checked = 0
     for k, every in enumerate(found.cuboids):  # labels: the stored keypoints, by the view's names
         present = data["types"][k][data["types"][k] >= 0]

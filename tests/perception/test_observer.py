@@ -31,12 +31,14 @@ from hsgplan.perception.observer import (
     first_sight,
     tracked,
 )
-from hsgplan.perception.vocabulary import VIEWS
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.env import KitchenStorageEnv
 from hsgplan.sim.outcome import Status
 from hsgplan.sim.sensing import Look, Seen
+
+VIEWS = kitchen_vocabulary().views  # the shipped f_p's fixed cameras
 
 TYPES = list(KITCHEN.object_types)
 

@@ -12,9 +12,11 @@ from hsgplan.perception.fusion import Seen
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.phantoms import SURE, overlap, pruned
 from hsgplan.perception.pnp import ViewKeypoints
-from hsgplan.perception.synthetic import VIEWS
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.sensing import Box
+
+VIEWS = kitchen_vocabulary().views  # the shipped f_p's fixed cameras
 
 TYPES = list(KITCHEN.object_types)
 OPEN = Pose.from_xyz_yaw(0.45, 0.0, 0.0415, 0.0)  # a soup on the open table, in every view

@@ -17,7 +17,7 @@ from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.silhouette import yaw_checked
 from hsgplan.perception.synthetic import render_sample
 from hsgplan.perception.train import MIN_VISIBLE
-from hsgplan.perception.vocabulary import KITCHEN_VOCABULARY
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometry import Pose, rotation_apart, yaw_quat
 from hsgplan.sim.outcome import BELIEF_TURNED
 
@@ -62,13 +62,13 @@ def _boxes(found):
 @pytest.mark.parametrize("index", [1, 2, 3])
 @pytest.mark.parametrize("turn", [90.0, 21.0])
 def test_true_poses_stay_and_a_box_turned_off_turns_back(colour, index, turn):
-    sample = render_sample(0, index)
+    sample = render_sample(0, index, KITCHEN)
     assert sample is not None
     found = _detections(sample)
     boxes = _boxes(found)
     if not boxes:
         pytest.skip("no upright box in sight of two views in this sample")
-    types = KITCHEN_VOCABULARY.types
+    types = kitchen_vocabulary().types
     checked = yaw_checked(colour, types, KITCHEN, sample.images, sample.cameras, found)
     for a, b in zip(checked, found, strict=True):
         assert a.pose.position == b.pose.position
@@ -81,11 +81,11 @@ def test_true_poses_stay_and_a_box_turned_off_turns_back(colour, index, turn):
 
 
 def test_cans_tilted_boxes_and_boxes_no_view_found_are_not_checked(colour):
-    sample = render_sample(0, 1)
+    sample = render_sample(0, 1, KITCHEN)
     found = _detections(sample)
     turned = [replace(d, pose=_turned(d.pose, 90.0)) for d in found]
     unseen = [replace(d, keypoints=()) for d in turned]
-    types = KITCHEN_VOCABULARY.types
+    types = kitchen_vocabulary().types
     # no view found any: nothing is read, nothing turns
     kept = yaw_checked(colour, types, KITCHEN, sample.images, sample.cameras, unseen)
     assert [d.pose for d in kept] == [d.pose for d in unseen]

@@ -9,9 +9,11 @@ from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.observer import STEADY, RgbObserver, steadied
-from hsgplan.perception.vocabulary import VIEWS
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.sensing import Look
+
+VIEWS = kitchen_vocabulary().views  # the shipped f_p's fixed cameras
 
 Z = KITCHEN.object_types["popcorn"].size[2] / 2
 

@@ -10,8 +10,10 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.model import PerceptionNetConfig, build, load_perception_net
-from hsgplan.perception.synthetic import VIEWS
 from hsgplan.perception.train import PerceptionTrainConfig, train_perception
+from hsgplan.perception.vocabulary import kitchen_vocabulary
+
+VIEWS = kitchen_vocabulary().views  # the shipped f_p's fixed cameras
 
 
 def test_a_tiny_training_makes_a_checkpoint_that_loads_and_is_not_redone(tmp_path):
@@ -149,7 +151,7 @@ def test_examples_keep_the_keypoints_of_objects_in_sight_and_the_cuboids_of_all(
         "visible": np.array([[[MIN_VISIBLE - 1, 0, MIN_VISIBLE]]], np.int32),
         "cameras": np.array([[[*c.eye, *c.target, c.fov]]], np.float32),
     }
-    found = examples(data)
+    found = examples(data, kitchen_vocabulary())
     names = list(KITCHEN.object_types)
     camera = PinholeCamera.of(c)
     assert [list(t) for t in found.types] == [[5]]  # the popcorn is barely in sight
@@ -171,7 +173,7 @@ def test_collections_of_different_view_counts_train_together(tmp_path):
     from hsgplan.perception.images import load_chunks
     from hsgplan.perception.train import examples, joined
 
-    parts = [examples(load_chunks(f)) for f in (three, every)]
+    parts = [examples(load_chunks(f), kitchen_vocabulary()) for f in (three, every)]
     both = joined(parts)
     assert len(both.images) == 3 + len(VIEWS) == len(both.keypoints) == len(both.cuboids)
     assert torch.equal(both.images[3:], parts[1].images)

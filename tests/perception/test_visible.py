@@ -15,9 +15,11 @@ from hsgplan.perception.detection import Detection
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
 from hsgplan.perception.pnp import ViewKeypoints
-from hsgplan.perception.synthetic import VIEWS
 from hsgplan.perception.visible import painted, visible_masks
+from hsgplan.perception.vocabulary import kitchen_vocabulary
 from hsgplan.scene_graph.geometry import Pose
+
+VIEWS = kitchen_vocabulary().views  # the shipped f_p's fixed cameras
 
 TYPES = list(KITCHEN.object_types)
 LOWER = Pose.from_xyz_yaw(0.45, 0.1, 0.012, 0.3)  # a thin box on the table

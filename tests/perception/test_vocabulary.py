@@ -21,9 +21,9 @@ from hsgplan.perception.images import collection_vocabulary, load_chunks
 from hsgplan.perception.model import load_perception_net
 from hsgplan.perception.train import PerceptionTrainConfig, train_perception
 from hsgplan.perception.vocabulary import (
-    KITCHEN_VOCABULARY,
     TRAINING_SCENE,
     Vocabulary,
+    kitchen_vocabulary,
     read_vocabulary,
     write_vocabulary,
 )
@@ -33,16 +33,16 @@ NEW = random_layout(KITCHEN, 3, 0, new_objects=True)
 
 
 def test_a_checkpoint_without_a_training_scene_learned_the_kitchens_types(tmp_path):
-    assert read_vocabulary(tmp_path) == KITCHEN_VOCABULARY
+    assert read_vocabulary(tmp_path) == kitchen_vocabulary()
     assert read_vocabulary(PERCEPTION_CHECKPOINT).types == tuple(KITCHEN.object_types)
-    write_vocabulary(tmp_path, KITCHEN_VOCABULARY)  # the kitchen's needs no file
+    write_vocabulary(tmp_path, kitchen_vocabulary())  # the kitchen's needs no file
     assert not (tmp_path / TRAINING_SCENE).exists()
 
 
 def test_a_vocabulary_kept_beside_a_checkpoint_reads_back_with_its_types_and_cameras(tmp_path):
     write_vocabulary(tmp_path, Vocabulary(NEW))
     back = read_vocabulary(tmp_path)
-    assert back.types == tuple(NEW.object_types) != KITCHEN_VOCABULARY.types
+    assert back.types == tuple(NEW.object_types) != kitchen_vocabulary().types
     assert back.views == Vocabulary(NEW).views and back.same_looks(Vocabulary(NEW))
     (tmp_path / TRAINING_SCENE).write_text("name = [")
     with pytest.raises(InvalidInputError, match="not valid TOML"):
@@ -50,7 +50,7 @@ def test_a_vocabulary_kept_beside_a_checkpoint_reads_back_with_its_types_and_cam
 
 
 def test_looks_are_names_kinds_and_colours_in_channel_order_seen_by_the_same_cameras():
-    kitchen = KITCHEN_VOCABULARY
+    kitchen = kitchen_vocabulary()
     assert kitchen.same_looks(Vocabulary(LAYOUT))  # resized groceries, moved shelves
     assert not kitchen.same_looks(Vocabulary(NEW))
     swapped = replace(KITCHEN, type_list=(*KITCHEN.type_list[1::-1], *KITCHEN.type_list[2:]))

@@ -19,7 +19,7 @@ import torch
 
 from hsgplan.domain.predicates import PREDICATES, Predicate
 from hsgplan.domain.scene import EntityKind, Kind, World, check_features
-from hsgplan.scene_graph.names import ENTITY_NAMES, NAMES_WORLD
+from hsgplan.scene_graph.names import ENTITY_NAMES, unnamed
 
 KINDS = tuple(EntityKind)
 OBJECT_KINDS = tuple(Kind)
@@ -46,7 +46,7 @@ def edge_dim(features: str) -> int:
 
 def reads(features: str, world: World) -> bool:
     """Whether a network of these features can read a scene of this world."""
-    return features == "geometry" or not world.names_beyond(NAMES_WORLD)
+    return features == "geometry" or not unnamed(world)
 
 
 def _valid(world: World, pred: Predicate, src: str, dst: str) -> bool:
