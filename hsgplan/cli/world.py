@@ -111,6 +111,7 @@ def demo(
 ) -> None:
     """One episode in the simulated kitchen (or the world of --scene): a GIF, a scene-graph
     drawing per step, a record; with --rerun, a 3D recording for rerun's viewer."""
+    from hsgplan.agents.goal_scope import check_goal
     from hsgplan.agents.registry import make_agent
     from hsgplan.domain.goals import parse_goal
     from hsgplan.evaluation.config import check_seen
@@ -134,6 +135,7 @@ def demo(
     if goal is None:
         check_size(objects)
     g = parse_goal(goal, world=world) if goal else demo_goal(objects, seed, world)
+    check_goal(agent, g)
     check_own(out_dir, "episode.json", "demo")
     if rerun is not None:
         check_recording(rerun)

@@ -59,9 +59,16 @@ class EpisodeSpec:
 
 def check_world(config: EvalConfig) -> None:
     """Refuse, in one line, an agent whose networks know nodes by name in a scene whose names
-    they were not trained on."""
+    they were not trained on, and a goal of the goals file that the agent is not for
+    (`agents.goal_scope`: random goals always are)."""
+    from hsgplan.agents.goal_scope import check_goal
+
     for scene, world in config.worlds().items():
         check_agent_world(config.agent, world, scene, *checkpoints(config))
+        if config.goals_file:
+            for goal in read_goal_file(Path(config.goals_file), world):
+                if goal.size in config.sizes:
+                    check_goal(config.agent, goal)
 
 
 def check_agent_world(

@@ -20,6 +20,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
+from hsgplan.agents.goal_scope import check_planner_goal
 from hsgplan.agents.registry import LEARNED_PLANNERS, check_reads, make_planner
 from hsgplan.checkpoint import fingerprint
 from hsgplan.domain.errors import InvalidInputError
@@ -173,6 +174,8 @@ def evaluate_task(
     for path, world in worlds.items():
         if goals_file:
             chosen = [g for g in read_goal_file(goals_file, world) if g.size in sizes]
+            for g in chosen:  # a goal the planner is not for: refused before any episode
+                check_planner_goal(planner, g)
             drawn = [(g, episode_seed(seed, g.size, i)) for i, g in enumerate(chosen)]
         else:
             drawn = [
