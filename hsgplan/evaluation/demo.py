@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import random
+import shutil
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -64,7 +65,9 @@ def run_demo(
     one_core()  # beside other busy processes, two threads make each planner call 20x slower
     out.mkdir(parents=True, exist_ok=True)
     graphs = out / "graphs"
-    graphs.mkdir(exist_ok=True)
+    # a demo folder holds one episode: an earlier one's step drawings would mix with these
+    shutil.rmtree(graphs, ignore_errors=True)
+    graphs.mkdir()
     rec = None
     if recording is not None:
         from hsgplan.evaluation.recording import EpisodeRecording, RecordedLooks

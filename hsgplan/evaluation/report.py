@@ -27,7 +27,7 @@ from hsgplan.evaluation.episode import EpisodeRecord
 from hsgplan.evaluation.observers import make_observer
 from hsgplan.evaluation.protocol import EVAL_KIND, PAPER, checkpoints, read_eval_config
 from hsgplan.evaluation.summary import FAILED_EXECUTION, failure_class
-from hsgplan.evaluation.table1 import TABLE_KIND, label, tables
+from hsgplan.evaluation.table1 import TABLE_KIND, goals_words, label, tables
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 from hsgplan.viz.html_page import heading, image, page, paragraph, table
@@ -67,11 +67,25 @@ class Rollout:
 def _not_a_world_run(run_dir: Path) -> str:
     """Why a folder without summary.json has no page: another command's run, or an eval world
     run not finished yet."""
+    page = "report makes a page of an 'eval world' run folder"
+    for marker, what in _OTHER_FOLDERS:
+        if (run_dir / marker).is_file():
+            return f"holds {what}; {page}"
     saved = run_dir / CONFIG
     kind = read_json(saved, "run configuration").get("kind") if saved.is_file() else None
     if isinstance(kind, str) and kind not in (EVAL_KIND, TABLE_KIND, ABLATION_KIND):
-        return f"holds {a(kind)} run; report makes a page of an 'eval world' run folder"
-    return "holds no summary.json: not a finished 'eval world' run (run it again to finish it)"
+        return f"holds {a(kind)} run; {page}"
+    if kind is None:
+        return f"holds no run of 'eval world'; {page}"
+    return "holds no summary.json: an 'eval world' run not finished (run it again to finish it)"
+
+
+# what other commands leave in a folder, by the file each always writes
+_OTHER_FOLDERS = (
+    ("episode.json", "one episode of 'hsgplan demo' (episode.json, episode.gif, graphs/)"),
+    ("trainings.json", "the trainings of 'hsgplan train … --seeds' (a folder per seed)"),
+    ("train_config.json", "a network of 'hsgplan train'"),
+)
 
 
 def read_summary(run_dir: Path) -> dict:
@@ -174,7 +188,7 @@ def build_report(
     methods = list(summary["methods"])
     parts = [
         paragraph(
-            f"Run folder {run_dir}: {summary.get('goals')} goals per size, "
+            f"Run folder {run_dir}: {goals_words(summary)}, "
             f"{summary.get('repeats')} repeat(s), seed {summary.get('seed')}; methods: "
             + ", ".join(f"{label(m)} ({summary['methods'][m]['agent']})" for m in methods),
             "caption",

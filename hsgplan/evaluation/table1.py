@@ -139,8 +139,10 @@ def run_table(
             | summarize_trainings(runs[m.name])
             for m in methods
         },
-        "goals": config.goals,
+        # with a goals file, the goals it held of each size asked for, not the `goals` setting
+        "goals": None if config.goals_file else config.goals,
         "goals_file": config.goals_file,
+        **({"goals_by_size": _goals_by_size(config)} if config.goals_file else {}),
         "repeats": config.repeats,
         "seed": config.seed,
         "split": config.split,
@@ -257,7 +259,7 @@ def _results(report: dict) -> TextTable:
                 paper = PAPER_TABLE1[m].get(n)
                 row.append(f"{paper[0]:.2f} / {paper[1]:.2f}" if paper else "—")
         rows.append(tuple(row))
-    source = report["goals_file"] or f"{report['goals']} random goals per size"
+    source = goals_words(report)
     repeats = runs_words(report)
     title = (
         f"Success rate / subgoal completion ({protocol_name(report)}): {source}{repeats}, "
@@ -280,6 +282,30 @@ def _spread(v: dict) -> tuple[float, float] | None:
     if v.get("success_std") is not None:
         return (v["success_rate"] - v["success_std"], v["success_rate"] + v["success_std"])
     return None
+
+
+def _goals_by_size(config: EvalConfig) -> dict[str, int]:
+    """How many goals of each size a goals file gave the run (in its first scene)."""
+    from hsgplan.evaluation.protocol import episode_specs
+
+    specs = [s for s in episode_specs(config) if s.repeat == 0 and s.scene == _first(config)]
+    return {str(n): sum(1 for s in specs if s.size == n) for n in sorted({s.size for s in specs})}
+
+
+def _first(config: EvalConfig) -> str | None:
+    return next(iter(config.worlds()))
+
+
+def goals_words(report: dict) -> str:
+    """Where a run's goals came from: the goals file and how many of each size it gave, or
+    the random goals per size."""
+    if not report.get("goals_file"):
+        return f"{report['goals']} random goals per size"
+    counts = report.get("goals_by_size")
+    if not counts:  # a summary from before the counts were kept
+        return str(report["goals_file"])
+    held = ", ".join(f"{c} of {n} objects" for n, c in counts.items())
+    return f"the goals of {report['goals_file']} ({held})"
 
 
 def runs_words(report: dict) -> str:

@@ -2,13 +2,15 @@
 a checkpoint, for as long as it runs.
 
 The lock is `fcntl.flock` on the folder's `.lock` file, which also names its holder (process id
-and command). The kernel drops the lock when its process ends, however it ends, so the `.lock`
-of a run that was killed is simply taken over by the next run. A second process that finds the
-lock held is refused in one line that names the holder, before it has written anything.
+and command). The `.lock` leaves with its run: it is removed when the holder gives the folder up
+or exits. The kernel drops the lock when its process ends, however it ends, so the `.lock` of a
+run that was killed is simply taken over by the next run. A second process that finds the lock
+held is refused in one line that names the holder, before it has written anything.
 """
 
 from __future__ import annotations
 
+import atexit
 import errno
 import fcntl
 import os
@@ -20,7 +22,9 @@ from hsgplan.domain.errors import InvalidInputError
 
 LOCK = ".lock"
 
-_held: dict[str, int] = {}  # resolved folder -> the open lock file's descriptor
+# resolved folder -> the open lock file's descriptor and the process that opened it (a forked
+# child inherits the table, never the lock's ownership)
+_held: dict[str, tuple[int, int]] = {}
 
 
 def hold_folder(folder: Path) -> None:
@@ -32,24 +36,7 @@ def hold_folder(folder: Path) -> None:
         return
     made = [p for p in (folder, *folder.parents) if not p.exists()]
     folder.mkdir(parents=True, exist_ok=True)
-    flags = os.O_RDWR | os.O_NOFOLLOW  # a link planted as the lock is never written through
-    try:
-        fd = os.open(folder / LOCK, flags | os.O_CREAT | os.O_EXCL, 0o644)
-        created = True
-    except FileExistsError:
-        fd, created = os.open(folder / LOCK, flags), False
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError as e:
-        if e.errno not in (errno.EWOULDBLOCK, errno.EAGAIN):  # no locks on this file system
-            os.close(fd)
-            raise OSError(e.errno, f"cannot lock the folder ({e.strerror})", str(folder)) from None
-        holder = os.pread(fd, 1000, 0).decode("utf-8", errors="replace").strip()
-        os.close(fd)
-        raise InvalidInputError(
-            f"'{folder}' is being written by another run ({holder or 'a process'}); "
-            "wait for it to end or use another --out"
-        ) from None
+    fd, created = _locked(folder)
     command = " ".join(["hsgplan", *sys.argv[1:]])[:200].replace("\n", " ")
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     try:
@@ -62,7 +49,46 @@ def hold_folder(folder: Path) -> None:
         for path in made:  # deepest first
             path.rmdir()
         raise OSError(e.errno, e.strerror, str(folder / LOCK)) from None
-    _held[str(folder.resolve())] = fd
+    _held[str(folder.resolve())] = (fd, os.getpid())
+
+
+def _locked(folder: Path) -> tuple[int, bool]:
+    """The folder's `.lock` opened (made if missing) and flocked; whether this call made it.
+    A lock its holder removed as this process took it is left for the one that stands."""
+    flags = os.O_RDWR | os.O_NOFOLLOW  # a link planted as the lock is never written through
+    while True:
+        try:
+            fd = os.open(folder / LOCK, flags | os.O_CREAT | os.O_EXCL, 0o644)
+            created = True
+        except FileExistsError:
+            try:
+                fd, created = os.open(folder / LOCK, flags), False
+            except FileNotFoundError:  # removed by its leaving holder in between: again
+                continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as e:
+            if e.errno not in (errno.EWOULDBLOCK, errno.EAGAIN):  # no locks on this file system
+                os.close(fd)
+                raise OSError(
+                    e.errno, f"cannot lock the folder ({e.strerror})", str(folder)
+                ) from None
+            holder = os.pread(fd, 1000, 0).decode("utf-8", errors="replace").strip()
+            os.close(fd)
+            raise InvalidInputError(
+                f"'{folder}' is being written by another run ({holder or 'a process'}); "
+                "wait for it to end or use another --out"
+            ) from None
+        if _same_file(fd, folder / LOCK):
+            return fd, created
+        os.close(fd)  # the file it locked was removed by its leaving holder: take the new one
+
+
+def _same_file(fd: int, path: Path) -> bool:
+    try:
+        return os.fstat(fd).st_ino == os.lstat(path).st_ino
+    except FileNotFoundError:
+        return False
 
 
 def holds(folder: Path) -> bool:
@@ -71,12 +97,26 @@ def holds(folder: Path) -> bool:
 
 
 def release(folder: Path) -> None:
-    """Give `folder` up (its `.lock` stays, unheld)."""
-    fd = _held.pop(str(Path(folder).resolve()), None)
-    if fd is not None:
-        os.close(fd)  # closing the only descriptor drops the flock
+    """Give `folder` up, its `.lock` removed."""
+    key = str(Path(folder).resolve())
+    held = _held.pop(key, None)
+    if held is not None:
+        _leave(key, *held)
 
 
 def release_all() -> None:
+    """Give every held folder up (also as the process exits)."""
     for key in list(_held):
-        os.close(_held.pop(key))
+        _leave(key, *_held.pop(key))
+
+
+def _leave(folder: str, fd: int, owner: int) -> None:
+    if owner != os.getpid():  # a forked child's copy: the lock is its parent's to remove
+        return
+    lock = Path(folder) / LOCK
+    if _same_file(fd, lock):  # removed while still held: no other process holds that file
+        lock.unlink(missing_ok=True)
+    os.close(fd)  # closing the only descriptor drops the flock
+
+
+atexit.register(release_all)

@@ -60,6 +60,9 @@ def plot_success_by_size(
             )
     ax.set_xlabel("objects in the goal")
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # no tick at 2.5 objects
+    shown = [n for by_size in ours.values() for n in by_size]
+    if shown:  # half an object either side: one size alone is not stretched across the axis
+        ax.set_xlim(min(shown) - 0.5, max(shown) + 0.5)
     ax.set_ylabel("success rate")
     ax.set_ylim(0, 1.02)
     ax.grid(alpha=0.3)

@@ -52,7 +52,15 @@ def test_commands_refuse_such_a_goal_before_writing(tmp_path):
     goals.write_text(f"{POSITIVE}\n{NEGATED}\n")
     cases = [
         ("demo", "--goal", HELD, "--out", str(tmp_path / "demo")),
-        ("demo", "--goal", "On(butter, shelf_b)", "--agent", "oracle", "--out", str(tmp_path / "d")),
+        (
+            "demo",
+            "--goal",
+            "On(butter, shelf_b)",
+            "--agent",
+            "oracle",
+            "--out",
+            str(tmp_path / "d"),
+        ),
         ("eval", "world", "--goals-file", str(goals), "--sizes", "2", "--out", str(tmp_path / "w")),
         ("eval", "task", "--goals-file", str(goals), "--sizes", "2", "--out", str(tmp_path / "t")),
     ]

@@ -67,7 +67,7 @@ def test_the_sample_takes_each_kind_of_failure_in_turn(tmp_path):
 def test_refuses_what_is_not_a_finished_eval_run(tmp_path):
     with pytest.raises(InvalidInputError, match="not a folder"):
         read_summary(tmp_path / "missing")
-    with pytest.raises(InvalidInputError, match="no summary.json"):
+    with pytest.raises(InvalidInputError, match="no run of 'eval world'"):
         read_summary(tmp_path)
     (tmp_path / "summary.json").write_bytes(b"\xff\xfe{")
     with pytest.raises(InvalidInputError, match="not UTF-8"):
@@ -84,13 +84,29 @@ def test_refuses_what_is_not_a_finished_eval_run(tmp_path):
     ("kind", "says"),
     [
         ("eval-task", "holds an eval-task run; report makes a page of an 'eval world' run"),
-        ("eval-table", "not a finished 'eval world' run (run it again to finish it)"),
+        ("eval-table", "an 'eval world' run not finished (run it again to finish it)"),
     ],
 )
 def test_a_folder_without_summary_is_told_apart_by_its_kind(tmp_path, kind, says):
     (tmp_path / "config.json").write_text(json.dumps({"kind": kind}))
     with pytest.raises(InvalidInputError, match=re.escape(says)):
         read_summary(tmp_path)
+
+
+@pytest.mark.parametrize(
+    ("marker", "says"),
+    [
+        ("episode.json", "holds one episode of 'hsgplan demo'"),
+        ("trainings.json", "holds the trainings of 'hsgplan train"),
+        (None, "holds no run of 'eval world'"),
+    ],
+)
+def test_a_folder_of_another_command_is_named_not_sent_to_finish(tmp_path, marker, says):
+    if marker:
+        (tmp_path / marker).write_text("{}")
+    with pytest.raises(InvalidInputError, match=re.escape(says)) as refused:
+        read_summary(tmp_path)
+    assert "run it again" not in str(refused.value)
 
 
 RERUN = importlib.util.find_spec("rerun") is not None

@@ -306,3 +306,32 @@ def test_a_table_says_what_its_interval_draws():
 
     assert "draws trainings and goals" in runs_words(report([0, 1, 2]))
     assert "over goals" in runs_words(report([]))
+
+
+def test_a_goals_file_run_says_what_it_ran():
+    from hsgplan.evaluation.table1 import goals_words
+
+    drawn = {"goals": 50, "goals_file": None}
+    assert goals_words(drawn) == "50 random goals per size"
+    told = {"goals": None, "goals_file": "mine.txt", "goals_by_size": {"2": 3, "4": 1}}
+    assert goals_words(told) == "the goals of mine.txt (3 of 2 objects, 1 of 4 objects)"
+
+
+@pytest.mark.slow
+def test_a_goals_file_run_records_its_goals_by_size_not_the_setting(tmp_path):
+    from typer.testing import CliRunner
+
+    from hsgplan.cli import app
+
+    goals = tmp_path / "goals.txt"
+    goals.write_text("On(butter, shelf_b) & On(cherries, shelf_a)\n")
+    out = tmp_path / "run"
+    r = CliRunner().invoke(
+        app,
+        ["eval", "world", "--agent", "oracle", "--goals-file", str(goals), "--out", str(out)]
+        + ["--workers", "1", "--tables", "success"],
+    )
+    assert r.exit_code == 0, r.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["goals_by_size"] == {"2": 1} and summary["goals"] is None
+    assert f"the goals of {goals} (1 of 2 objects)" in (out / "table1.md").read_text()

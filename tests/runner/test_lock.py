@@ -68,6 +68,26 @@ def test_holding_is_reentrant_and_released(tmp_path):
     assert holds(tmp_path)
     release(tmp_path)
     assert not holds(tmp_path)
+    assert not (tmp_path / LOCK).exists()  # the lock leaves with its holder
+
+
+def test_the_lock_leaves_when_its_process_ends(tmp_path):
+    run = tmp_path / "run"
+    child = _hold_in_another_process(run)
+    assert (run / LOCK).is_file()
+    child.stdin.close()
+    child.wait()
+    assert not (run / LOCK).exists()
+
+
+def test_a_lock_taken_over_is_not_removed_by_its_earlier_holder(tmp_path):
+    # the earlier holder's file is gone (another took the folder over after it had been
+    # removed): leaving must not remove the file the new holder locks
+    hold_folder(tmp_path)
+    (tmp_path / LOCK).unlink()
+    (tmp_path / LOCK).write_text("pid 1 since now: another run\n")
+    release(tmp_path)
+    assert (tmp_path / LOCK).read_text() == "pid 1 since now: another run\n"
 
 
 def test_an_unheld_lock_left_behind_is_not_other_files(tmp_path):
