@@ -228,8 +228,8 @@ def evaluate(
     protocol: Annotated[
         ProtocolName,
         typer.Option(
-            help="paper: the first failed primitive ends the episode; recovering: it costs "
-            "its step.",
+            help="paper (every headline table's): the first failed primitive ends the "
+            "episode; recovering: it costs its step.",
             metavar="PROTOCOL",
         ),
     ] = DEFAULT_PROTOCOL,

@@ -41,7 +41,7 @@ def variants(
     if config.protocol == PAPER or config.rules_off:
         raise InvalidInputError(
             "--ablate-rules switches each recovery rule off in turn under the recovering "
-            "protocol; give neither --protocol paper nor --rules-off"
+            "protocol; give --protocol recovering and no --rules-off"
         )
     out = {ALL_RULES_ON: config}
     rules = [

@@ -15,7 +15,6 @@ from hsgplan.domain.recovery import (
     NO_FAILURE_RULES,
     PAPER,
     PROTOCOLS,
-    RECOVERING,
     RecoveryRules,
 )
 from hsgplan.domain.scene import World
@@ -76,7 +75,8 @@ class EvalConfig:
     motion_checkpoints: str | None = None  # the folder of motion networks (None: shipped)
     perception: str = "gt"  # what the agent sees: one of OBSERVERS
     perception_checkpoint: str | None = None  # f_p's network (None: the shipped one)
-    protocol: str = RECOVERING  # PROTOCOLS: what a failed primitive does to the episode
+    # PROTOCOLS: what a failed primitive does to the episode (the paper's: every headline's)
+    protocol: str = PAPER
     # rules switched off (any under the recovering protocol, the perception rules under both)
     rules_off: tuple[str, ...] = ()
     # f_p's and its tracker's rules set otherwise than shipped, NAME=VALUE (`perception.rules`)

@@ -3,6 +3,8 @@ goes on; the recovery rules are named, refused when unknown, and none under the 
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from hsgplan.agents.base import Decision
@@ -64,21 +66,24 @@ def test_the_paper_protocol_runs_without_any_recovery_rule_but_those_of_no_failu
     assert set(PERCEPTION_RULES) < set(NO_FAILURE_RULES)
     blind = EvalConfig("learned", (2,), 1, 0, protocol="paper", rules_off=NO_FAILURE_RULES)
     assert blind.rules() == RecoveryRules.none()
-    assert EvalConfig("learned", (2,), 1, 0).rules() == RecoveryRules()
-    some = EvalConfig("learned", (2,), 1, 0, rules_off=("failed_bins", "least_taken"))
+    assert EvalConfig("learned", (2,), 1, 0).protocol == "paper"  # every headline's
+    recovering = EvalConfig("learned", (2,), 1, 0, protocol="recovering")
+    assert recovering.rules() == RecoveryRules()
+    some = replace(recovering, rules_off=("failed_bins", "least_taken"))
     assert some.rules().off() == ("failed_bins", "least_taken")
     with pytest.raises(InvalidInputError, match="unknown recovery rule"):
-        EvalConfig("learned", (2,), 1, 0, rules_off=("wizard",))
+        EvalConfig("learned", (2,), 1, 0, protocol="recovering", rules_off=("wizard",))
     with pytest.raises(InvalidInputError, match="no recovery rule"):
         EvalConfig("learned", (2,), 1, 0, protocol="paper", rules_off=("failed_bins",))
     with pytest.raises(InvalidInputError, match="protocol 'x'"):
         EvalConfig("learned", (2,), 1, 0, protocol="x")
 
 
-def test_a_run_folder_names_its_protocol_unless_it_is_the_default():
-    default = run_config(EvalConfig("oracle", (2,), 1, 0))
-    assert "protocol" not in default and "rules_off" not in default  # as older runs were claimed
-    paper = run_config(EvalConfig("oracle", (2,), 1, 0, protocol="paper"))
+def test_a_run_folder_names_its_protocol_unless_it_is_the_first_one():
+    # runs were claimed under the recovering protocol before protocols were named
+    first = run_config(EvalConfig("oracle", (2,), 1, 0, protocol="recovering"))
+    assert "protocol" not in first and "rules_off" not in first
+    paper = run_config(EvalConfig("oracle", (2,), 1, 0))
     assert paper["protocol"] == "paper" and paper["rules_off"] == []
 
 
@@ -97,7 +102,7 @@ def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
     from hsgplan.evaluation.summary import summarize
     from tests.evaluation.test_table1 import _record
 
-    config = EvalConfig("learned", (2,), 1, 0)
+    config = EvalConfig("learned", (2,), 1, 0, protocol="recovering")
     found = variants(config)
     assert list(found)[0] == "all-rules" and found["all-rules"].rules_off == ()
     acting = [r for r in RecoveryRules.names() if r not in PERCEPTION_RULES + CHECKING_RULES]
