@@ -218,7 +218,11 @@ def eval_motion(
     title = f"Single-shot motion success on fresh scenes, {seed_words(seed, split and split.value)}"
     if trainings:
         title += f", each network trained {len(trainings)} times"
-    title += " (in brackets the 95% interval of a bootstrap over scenes)"
+    title += (
+        " (in brackets the 95% interval of a bootstrap that draws trainings and scenes)"
+        if len(trainings or ()) > 1
+        else " (in brackets the 95% interval of a bootstrap over scenes)"
+    )
     title += f", in each scene of {scene}" if scene else ""
     print_table(
         marked(title, seed, split=split and split.value),
