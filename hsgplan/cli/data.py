@@ -115,10 +115,19 @@ def _collect_command(primitive: str, default_samples: int):
             int, config_option(CollectConfig, "tasks_per_chunk", "Tasks per unit of work.")
         ] = config_default(CollectConfig, "tasks_per_chunk"),
         scene: SceneOption = None,
+        fell_short: Annotated[
+            float,
+            config_option(
+                CollectConfig,
+                "fell_short",
+                "Pushes: the chance that a can starts where a short push left it.",
+            ),
+        ] = config_default(CollectConfig, "fell_short"),
     ) -> None:
         check_ray(ray)
         where = None if scene is None else str(scene)
-        _collect(primitive, samples, workers, seed, ray, out_dir, tasks_per_chunk, where)
+        settings = (samples, workers, seed, ray, out_dir, tasks_per_chunk, where, fell_short)
+        _collect(primitive, *settings)
 
     command.__doc__ = (
         f"Self-supervised {primitive} data: uniformly sampled bins tried in generated scenes."
@@ -140,11 +149,13 @@ def _collect(
     out_dir: Path,
     chunk: int,
     scene: str | None,
+    fell_short: float,
 ):
     from hsgplan.collect.motion import collect
     from hsgplan.domain.parameters import MotionPrimitive
 
-    config = CollectConfig(MotionPrimitive(primitive), samples, seed, workers, ray, chunk, scene)
+    kind = MotionPrimitive(primitive)
+    config = CollectConfig(kind, samples, seed, workers, ray, chunk, scene, fell_short)
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task(f"{primitive} samples", total=samples)
         summary = collect(config, out_dir, lambda n: progress.update(bar, completed=n))

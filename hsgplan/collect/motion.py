@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from hsgplan.data import motion_store as store
+from hsgplan.data.motion_tasks import P_FELL_SHORT
 from hsgplan.data.motion_trials import ATTEMPTS_PER_TASK, TASKS_PER_CHUNK, run_chunk
 from hsgplan.domain.checks import (
     BOUNDS,
@@ -56,9 +57,14 @@ class CollectConfig:
     # a scene file, or a folder of them, whose worlds the tasks are drawn and staged in (None:
     # the kitchen)
     scene: str | None = None
+    # pushes only: the chance that a task's can starts where a short push left it
+    # (`data.motion_tasks.P_FELL_SHORT`)
+    fell_short: float = setting(P_FELL_SHORT, lo=0.0, hi=1.0)
 
     def __post_init__(self) -> None:
         check_fields(self)
+        if self.primitive is MotionPrimitive.PLACE and self.fell_short != P_FELL_SHORT:
+            raise InvalidInputError("--fell-short sets where pushes start: collect push only")
 
     def places(self) -> list[tuple[str | None, World]]:
         """The scene files chunks are staged in, in turn, with their worlds (the kitchen's
@@ -89,8 +95,14 @@ class CollectConfig:
                 "schema_version": store.SCHEMA_VERSION,
             }
             | self.scene_setting()
+            | self.fell_short_setting()
             | per_chunk
         )
+
+    def fell_short_setting(self) -> dict:
+        """The share of short starts as the settings record it: none at the shipped share,
+        as before it could be set (so the shipped data's settings stay as they were)."""
+        return {} if self.fell_short == P_FELL_SHORT else {"fell_short": self.fell_short}
 
     def scene_setting(self) -> dict:
         """The scene as the settings record it: none for the kitchen, as before scenes could
@@ -185,6 +197,7 @@ def collect(
             "chunk_format": store.CHUNK_FORMAT,
         }
         | config.scene_setting()
+        | config.fell_short_setting()
         | {k: v for k, v in config.dataset_settings().items() if k == "scene_files"},
         f"'{folder}' holds chunks made with other collection settings; use another --out",
     )
@@ -218,7 +231,14 @@ def _run(
             while nxt in done or nxt in in_flight.values():
                 nxt += 1
             scene_file = _of(places, nxt)[0]
-            job = (config.primitive.value, config.seed, nxt, config.tasks_per_chunk, scene_file)
+            job = (
+                config.primitive.value,
+                config.seed,
+                nxt,
+                config.tasks_per_chunk,
+                scene_file,
+                config.fell_short,
+            )
             in_flight[runner.submit(run_chunk, *job)] = nxt
             expected += per_chunk
         handle, result = runner.next_done(set(in_flight))

@@ -74,14 +74,22 @@ class MotionTask:
         return inside(self.obj, self.target)
 
 
-def draw_task(primitive: MotionPrimitive, seed: int, index: int, world: World) -> MotionTask:
-    """The task at `index` of the stream for `(primitive, seed)`, in `world`."""
+def draw_task(
+    primitive: MotionPrimitive,
+    seed: int,
+    index: int,
+    world: World,
+    fell_short: float = P_FELL_SHORT,
+) -> MotionTask:
+    """The task at `index` of the stream for `(primitive, seed)`, in `world`; a push starts
+    where a short push left its can with chance `fell_short`. The draws are the same whatever
+    the chance, but for whether a push starts short."""
     if index < 0:
         raise InvalidInputError(f"task index {index} cannot be negative")
     rng = random.Random(f"motion-{primitive.value}-{seed}-{index}")
     if primitive is MotionPrimitive.PLACE:
         return _draw_place(rng, seed, index, world)
-    return _draw_push(rng, seed, index, world)
+    return _draw_push(rng, seed, index, world, fell_short)
 
 
 def _draw_place(rng: random.Random, seed: int, index: int, world: World) -> MotionTask:
@@ -97,7 +105,9 @@ def _draw_place(rng: random.Random, seed: int, index: int, world: World) -> Moti
     return MotionTask(MotionPrimitive.PLACE, seed, index, obj, target, crowding, state)
 
 
-def _draw_push(rng: random.Random, seed: int, index: int, world: World) -> MotionTask:
+def _draw_push(
+    rng: random.Random, seed: int, index: int, world: World, fell_short: float
+) -> MotionTask:
     shelf = world.goal_interior
     types = world.object_types
     cans = [t for t, k in types.items() if k.kind is Kind.CAN and world.fits_inside(t, shelf)]
@@ -115,7 +125,7 @@ def _draw_push(rng: random.Random, seed: int, index: int, world: World) -> Motio
     left = [o for o in others if o not in inside_now]
     literals += _arrange([], left, prepush, rng, world, taken={prepush: 1})
     state = SymbolicSceneGraph.from_literals(objects, literals, world=world)
-    gap = rng.uniform(*FRONT_GAPS) if rng.random() < P_FELL_SHORT else None
+    gap = rng.uniform(*FRONT_GAPS) if rng.random() < fell_short else None
     return MotionTask(MotionPrimitive.PUSH, seed, index, obj, shelf, crowding, state, gap)
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hsgplan.data.motion_tasks import MotionTask, draw_task
+from hsgplan.data.motion_tasks import P_FELL_SHORT, MotionTask, draw_task
 from hsgplan.domain.parameters import BINS, MotionPrimitive, params_for
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.scene_file import read_world
@@ -83,6 +83,7 @@ def run_chunk(
     chunk: int,
     tasks_per_chunk: int = TASKS_PER_CHUNK,
     scene_file: str | None = None,
+    fell_short: float = P_FELL_SHORT,
 ) -> ChunkResult:
     """Stage every task of a chunk and try it; the worker entry point (pool or Ray). The
     tasks are drawn and staged in the world of `scene_file`, else in the kitchen, whose names
@@ -93,7 +94,7 @@ def run_chunk(
     unstaged = 0
     with Scene((), seed=seed, visuals=False, world=world) as scene:
         for index in range(chunk * tasks_per_chunk, (chunk + 1) * tasks_per_chunk):
-            got = run_task(scene, draw_task(kind, seed, index, world))
+            got = run_task(scene, draw_task(kind, seed, index, world, fell_short))
             unstaged += got is None
             trials += got or []
     return ChunkResult(kind, seed, chunk, tuple(trials), unstaged)

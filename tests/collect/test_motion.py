@@ -324,3 +324,27 @@ def test_a_folder_of_scenes_of_other_groceries_is_refused_in_one_line(tmp_path):
     with pytest.raises(InvalidInputError, match="same types"):
         collect(CollectConfig(PUSH, 3, scene=str(NEW_OBJECTS)), tmp_path / "data")
     assert not (tmp_path / "data").exists()
+
+
+def test_pushes_start_short_with_the_chance_asked_and_are_otherwise_the_same_tasks():
+    from dataclasses import replace
+
+    from hsgplan.data.motion_tasks import P_FELL_SHORT
+
+    shipped = [draw_task(PUSH, 5, i, KITCHEN) for i in range(60)]
+    never = [draw_task(PUSH, 5, i, KITCHEN, fell_short=0.0) for i in range(60)]
+    always = [draw_task(PUSH, 5, i, KITCHEN, fell_short=1.0) for i in range(60)]
+    assert 0 < sum(t.front_gap is not None for t in shipped) < 60
+    assert all(t.front_gap is None for t in never) and all(t.front_gap for t in always)
+    assert [replace(t, front_gap=None) for t in shipped] == never
+    assert draw_task(PUSH, 5, 3, KITCHEN) == draw_task(PUSH, 5, 3, KITCHEN, P_FELL_SHORT)
+
+
+def test_a_push_collection_records_its_share_of_short_starts_only_when_not_the_shipped():
+    shipped = CollectConfig(PUSH, 10).dataset_settings()
+    assert "fell_short" not in shipped  # the shipped data's manifest stays as it was
+    assert CollectConfig(PUSH, 10, fell_short=0.0).dataset_settings() == shipped | {
+        "fell_short": 0.0
+    }
+    with pytest.raises(InvalidInputError, match="collect push only"):
+        CollectConfig(PLACE, 10, fell_short=0.0)
