@@ -209,6 +209,10 @@ MIN_SUPPORT_SIDE = 0.045
 # still needs room to approach and to withdraw.
 REACH_MAX_Z = 0.40
 
+# The robot's base on the table, around the origin: the collision box of the Panda's base link
+# (its URDF; a test holds this to it). No fixture may stand on it.
+ROBOT_BASE = Rect(-0.16, 0.08, -0.10, 0.10)
+
 # Objects enter an interior only through its open front, so it is filled as one row across,
 # a can's width plus a finger's gap apart (pushes measured to land within +-9 cm of the middle).
 INTERIOR_SPOT = 0.09

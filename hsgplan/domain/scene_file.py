@@ -21,6 +21,8 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import (
     GRIPPER_MAX_OPENING,
     OPEN_SPACE,
+    REACH_MAX_Z,
+    ROBOT_BASE,
     Kind,
     ObjectType,
     Rect,
@@ -191,11 +193,56 @@ def _check_names(types: list[ObjectType], fixtures: list[str]) -> None:
 
 def world_of(data: Any, source: str = "scene") -> World:
     """A `World` from a scene file's parsed TOML; the first bad field refused in one line
-    (`InvalidInputError`) that starts with `source`."""
+    (`InvalidInputError`) that starts with `source`; a scene whose fields read but that the
+    robot cannot work in refused with every reason why, one line each (`unworkable`)."""
     try:
-        return _world(data)
+        world = _world(data)
     except _Bad as e:
         raise InvalidInputError(f"{source}: {e}") from None
+    if problems := unworkable(world):
+        raise InvalidInputError("\n".join(f"{source}: {p}" for p in problems))
+    return world
+
+
+def unworkable(world: World) -> list[str]:
+    """Why the robot cannot work in a scene, every reason: a fixture on its base, a shelf top
+    too high to put anything on within reach, an object type that fits on no surface within
+    reach and inside no interior (`REACH_MAX_Z`: the highest a held object's top may rise)."""
+    problems = []
+    base = ROBOT_BASE
+    where = f"x {base.x_min} to {base.x_max}, y {base.y_min} to {base.y_max}"
+    fixtures = [(f"shelf {s.name!r}", s.outer) for s in world.shelves.values()] + [
+        (f"region {name!r}", rect) for name, rect in world.regions.items()
+    ]
+    for what, rect in fixtures:
+        if rect.overlaps(base):
+            problems.append(f"{what} stands on the robot's base ({where})")
+    lowest = min(t.height for t in world.type_list)
+    for s in world.shelves.values():
+        if s.top.z + lowest > REACH_MAX_Z:
+            problems.append(
+                f"shelf {s.name!r}: its top at {s.top.z:.3f} m leaves no object within reach "
+                f"(the lowest stands {lowest:.3f} m; a top may rise to {REACH_MAX_Z} m)"
+            )
+    for t in world.type_list:
+        if not _fits_somewhere(world, t):
+            size = " x ".join(f"{100 * v:.1f}" for v in t.size)
+            problems.append(
+                f"object {t.name!r} ({size} cm) fits on no surface within reach and inside no shelf"
+            )
+    return problems
+
+
+def _fits_somewhere(world: World, t: ObjectType) -> bool:
+    def fits(rect: Rect) -> bool:
+        return max(t.footprint) <= max(rect.width_x, rect.width_y) and min(t.footprint) <= min(
+            rect.width_x, rect.width_y
+        )
+
+    on_a_surface = any(
+        fits(r) and r.z + t.height <= REACH_MAX_Z for r in map(world.surface_rect, world.surfaces)
+    )
+    return on_a_surface or any(world.fits_inside(t.name, s) for s in world.shelves)
 
 
 def _world(data: Any) -> World:

@@ -149,3 +149,49 @@ def test_any_value_anywhere_is_read_or_refused_in_one_line(place, value):
         world_of(data)
     except InvalidInputError as e:
         assert str(e).startswith("scene: ") and "\n" not in str(e)
+
+
+def test_a_scene_the_robot_cannot_work_in_is_refused_with_every_reason():
+    # a shelf moved onto the robot's base, a shelf so tall that nothing on its top stays within
+    # reach, and a box too long for every surface (the open space made small) and too tall for
+    # every shelf: a line for each
+    data = copy.deepcopy(KITCHEN)
+    data["regions"][0]["x"], data["regions"][0]["y"] = [0.26, 0.4], [-0.1, 0.1]
+    data["shelves"][0]["x"], data["shelves"][0]["y"] = [-0.1, 0.12], [-0.3, 0.02]
+    del data["shelves"][0]["prepush"]
+    data["shelves"][1]["clearance"] = 0.36
+    data["objects"].append(
+        {"name": "crate", "kind": "box", "size": [0.07, 0.3, 0.28], "colour": [0.5, 0.5, 0.5, 1]}
+        | {"mass": 0.5, "friction": 0.8}
+    )
+    with pytest.raises(InvalidInputError) as refused:
+        world_of(data, "scene file 'mine.toml'")
+    lines = str(refused.value).splitlines()
+    assert all(line.startswith("scene file 'mine.toml': ") for line in lines)
+    said = [
+        "shelf 'shelf_a' stands on the robot's base",
+        "region 'prepush_a' stands on the robot's base",  # the prepush region derived before it
+        "shelf 'shelf_b': its top at 0.380 m leaves no object within reach",
+        "object 'crate' (7.0 x 30.0 x 28.0 cm) fits on no surface within reach",
+    ]
+    assert len(lines) == len(said) and all(w in line for w, line in zip(said, lines, strict=True))
+    assert world_of(KITCHEN) is not None  # the kitchen itself has nothing of the kind
+
+
+def test_the_robots_base_is_its_urdfs_base_link():
+    import pybullet as p
+
+    from hsgplan.domain.scene import ROBOT_BASE
+    from hsgplan.sim.robot import panda_urdf
+
+    client = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(panda_urdf(False), useFixedBase=True, physicsClientId=client)
+        (x0, y0, _), (x1, y1, _) = p.getAABB(body, -1, physicsClientId=client)
+    finally:
+        p.disconnect(client)
+    # the constant holds the box to the centimetre, never inside it
+    assert ROBOT_BASE.x_min <= x0 < ROBOT_BASE.x_min + 0.01
+    assert ROBOT_BASE.x_max - 0.01 < x1 <= ROBOT_BASE.x_max
+    assert ROBOT_BASE.y_min <= y0 < ROBOT_BASE.y_min + 0.01
+    assert ROBOT_BASE.y_max - 0.01 < y1 <= ROBOT_BASE.y_max
