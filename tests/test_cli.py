@@ -365,3 +365,28 @@ def test_a_kill_interrupts_as_ctrl_c_does_so_a_long_job_closes_what_it_opened():
         [sys.executable, "-c", script], capture_output=True, text=True, timeout=60
     )
     assert done.stdout.strip() == "interrupted", done.stderr
+
+
+def test_the_rules_page_lists_every_rule_a_run_may_set_with_what_it_does():
+    from dataclasses import fields
+
+    from hsgplan.domain.recovery import NO_FAILURE_RULES, RecoveryRules
+    from hsgplan.perception.rules import PerceptionRules
+    from hsgplan.sim.plan_rules import PlanRules
+
+    r = run("rules", "--markdown")
+    assert r.exit_code == 0, r.output
+    rows = {line.split("|")[2].strip(): line for line in r.output.splitlines()[4:] if "|" in line}
+    names = [
+        *RecoveryRules.names(),
+        *(f.name for f in fields(PerceptionRules)),
+        *(f.name for f in fields(PlanRules)),
+    ]
+    assert sorted(rows) == sorted(names)
+    for name, line in rows.items():
+        what = line.split("|")[5].strip()
+        assert len(what) > 20 and what.endswith("."), name
+    assert "| kept |" in rows["relook"] and "| off |" in rows["failed_bins"]
+    assert all("| kept |" in rows[n] for n in NO_FAILURE_RULES)
+    help_text = run("eval", "world", "--help").output
+    assert "hsgplan rules" in help_text and "likeliest_literal" not in help_text

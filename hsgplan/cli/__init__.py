@@ -26,6 +26,7 @@ from hsgplan.cli import (
     results,
     runs,
     scenes,
+    seeding,
     splits,
     symbolic,
     world,
@@ -62,6 +63,7 @@ app.add_typer(data.app, name="collect")
 app.add_typer(learn.train_app, name="train")
 app.add_typer(bench.app, name="bench")
 app.add_typer(splits.app, name="splits")
+app.command()(seeding.rules)
 app.command()(results.results)
 bench.app.command("push-reach")(bench_motion.push_reach)
 bench.app.command("line-error")(bench_motion.line_error)

@@ -1,4 +1,5 @@
-"""The options that say which seeds a command draws: a split, a bare seed, trainings."""
+"""The options that say which seeds a command draws (a split, a bare seed, trainings) and which
+rules it runs under, and `hsgplan rules`, which lists those rules."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from hsgplan.cli.common import bounded_option, choice
+from hsgplan.cli.common import bounded_option, choice, print_table, refuses_bad_input
 
 SplitName = choice("SplitName", ("tune", "test"))
 SplitOption = Annotated[
@@ -41,8 +42,7 @@ PerceptionRulesOption = Annotated[
     typer.Option(
         "--perception-rules",
         help="f_p's rules set otherwise, comma-separated NAME=VALUE (e.g. pixel_vote=off,"
-        "ray_gap=0.03): cliques, ray_gap, pixel_vote, found_again_can, rest, near_ray, "
-        "track_distance, lone_still (docs/perception.md, Rules).",
+        "ray_gap=0.03; the names: hsgplan rules).",
         metavar="RULES",
     ),
 ]
@@ -52,8 +52,8 @@ PlanRulesOption = Annotated[
     str,
     typer.Option(
         "--plan-rules",
-        help="The motion planner's rules set otherwise, comma-separated NAME=VALUE: "
-        "descent_points (3), descent_branch (on) (docs/decisions.md).",
+        help="The motion planner's rules set otherwise, comma-separated NAME=VALUE (e.g. "
+        "descent_points=0; the names: hsgplan rules).",
         metavar="RULES",
     ),
 ]
@@ -82,3 +82,26 @@ def split_seed(seed: int | None, split) -> int:
     from hsgplan.evaluation.splits import split_named
 
     return split_named(split.value).seeds.start
+
+
+@refuses_bad_input
+def rules(
+    markdown: Annotated[
+        bool, typer.Option("--markdown", help="Print Markdown.", metavar="")
+    ] = False,
+) -> None:
+    """Every rule a run may switch off or set: the recovery rules (--rules-off), f_p's
+    (--perception-rules) and the motion planner's (--plan-rules), each as shipped."""
+    from hsgplan.evaluation.rule_list import rules as every_rule
+
+    rows = [
+        (r.option, r.name, r.shipped, "kept" if r.paper else "off", r.what) for r in every_rule()
+    ]
+    print_table(
+        "The rules a run may switch off or set: as shipped, under the paper's protocol, and "
+        "what each does (documented in domain/recovery.py, perception/rules.py, "
+        "sim/plan_rules.py)",
+        ("option", "rule", "shipped", "paper protocol", "what it does"),
+        rows,
+        markdown,
+    )

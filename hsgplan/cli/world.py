@@ -49,7 +49,6 @@ from hsgplan.cli.seeding import (
     split_seed,
 )
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.recovery import NO_FAILURE_RULES, RecoveryRules
 from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
 from hsgplan.paths import MOTION_CHECKPOINTS, RUNS, TASK_CHECKPOINT, shipped
 from hsgplan.runner.run_folder import check_own
@@ -236,12 +235,9 @@ def evaluate(
     rules_off: Annotated[
         str,
         typer.Option(
-            help="Rules switched off, comma-separated (under the paper protocol only those "
-            "it keeps on, which recover from no failure: "
-            + ", ".join(NO_FAILURE_RULES)
-            + "): "
-            + ", ".join(RecoveryRules.names())
-            + "."
+            help="Recovery rules switched off, comma-separated (under the paper protocol only "
+            "those it keeps; the names, and which: hsgplan rules).",
+            metavar="RULES",
         ),
     ] = "",
     perception_rules: PerceptionRulesOption = "",
