@@ -34,10 +34,7 @@ def _overlapping(fig, labels) -> list[tuple[str, str]]:
     boxes = {n: t.get_window_extent(renderer) for n, t in labels.items()}
     names = sorted(boxes)
     return [
-        (a, b)
-        for i, a in enumerate(names)
-        for b in names[i + 1 :]
-        if boxes[a].overlaps(boxes[b])
+        (a, b) for i, a in enumerate(names) for b in names[i + 1 :] if boxes[a].overlaps(boxes[b])
     ]
 
 
@@ -67,17 +64,9 @@ def test_held_and_shelved_objects_keep_their_names_apart():
     from hsgplan.domain.predicates import in_grasp
     from hsgplan.viz.scene_graph_drawing import figure
 
-    state = SymbolicSceneGraph.from_literals(
-        ["cherries", "tomato_soup", "alphabet_soup", "butter", "popcorn"],
-        [
-            inside("cherries", "shelf_a"),
-            inside("tomato_soup", "shelf_a"),
-            inside("alphabet_soup", "shelf_a"),
-            on("butter", "shelf_a"),
-            in_grasp("popcorn"),
-        ],
-        world=KITCHEN,
-    )
+    cans = ["cherries", "tomato_soup", "alphabet_soup"]  # a row inside shelf A
+    literals = [inside(c, "shelf_a") for c in cans] + [on("butter", "shelf_a"), in_grasp("popcorn")]
+    state = SymbolicSceneGraph.from_literals([*cans, "butter", "popcorn"], literals, world=KITCHEN)
     fig, labels = figure(state)
     assert _overlapping(fig, labels) == []
     plt.close(fig)
