@@ -206,7 +206,10 @@ out_file = _output("file")
 RunFolder = Annotated[
     Path | None,
     typer.Option(
-        "--out", help="Run folder (resumed if it exists; default runs/NAME).", parser=out_folder
+        "--out",
+        help="Run folder (resumed if it exists; default: a folder under runs/ named after "
+        "the run's settings).",
+        parser=out_folder,
     ),
 ]
 
@@ -250,7 +253,10 @@ TaskCheckpoint = Annotated[
 MotionCheckpoints = Annotated[
     Path | None,
     typer.Option(
-        help="Folder of motion networks, KIND-MODEL each (default: shipped).", parser=input_path
+        help="Folder of motion networks, one folder each named PRIMITIVE-MODEL "
+        "(place-gnn, push-gnn, place-mlp, ...), or a trainings folder of seed-S folders "
+        "(default: the shipped checkpoints/motion).",
+        parser=input_path,
     ),
 ]
 

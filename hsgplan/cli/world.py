@@ -220,7 +220,8 @@ def evaluate(
             help="What the agent sees with, comma-separated: gt (the simulator's poses), rgb "
             "(f_p on the fixed cameras' images), rgb-latest (f_p, each look taken as it "
             "comes: no steady rule), rgb-keypoint-yaw (f_p, boxes' yaws as their keypoints "
-            "say: no silhouette check); one column each, rgb's named METHOD-rgb."
+            "say: no silhouette check); one column each, a method seen through f_p named "
+            "after its motion generator with -rgb appended (gnn-rgb)."
         ),
     ] = config_default(EvalConfig, "perception"),
     perception_checkpoint: PerceptionCheckpoint = None,
