@@ -175,16 +175,14 @@ NO_RERUN = "--rerun needs rerun-sdk: pip install -e '.[rerun]' (make installs it
 
 
 def _print_step(s) -> None:
+    """A step in three lines, each within 80 columns however long its parameters: the subgoal
+    and what became of it, the parameters, the time each level took."""
     times = (
         f"task {s.task_seconds * 1000:.1f} ms, motion {s.motion_seconds * 1000:.1f} ms, "
         f"execution {s.execution_seconds:.2f} s"
     )
-    out.print(
-        f"{s.step:>2}  {s.subgoal:<28} {s.params:<50} {s.status:<12} {times}",
-        highlight=False,
-        markup=False,
-        soft_wrap=True,
-    )
+    for line in (f"{s.step:>2}  {s.subgoal:<44} {s.status}", f"    {s.params}", f"    {times}"):
+        out.print(line, highlight=False, markup=False, soft_wrap=True)
 
 
 DEFAULT_PROTOCOL = ProtocolName(config_default(EvalConfig, "protocol"))
