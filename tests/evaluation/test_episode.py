@@ -99,10 +99,14 @@ def test_demo_writes_pictures_and_a_record(tmp_path):
     record = json.loads((out / "episode.json").read_text())
     assert record["seed"] == 1 and record["size"] == 2
     assert record["agent"] == "learned"  # regression planner, motion GNN
-    # every decision printed with its subgoal, parameters and outcome
+    # every decision printed with its subgoal and outcome, then its parameters on the next line
     lines = r.stdout.splitlines()
     for s in record["steps"]:
-        assert any(s["subgoal"] in x and s["params"] in x and s["status"] in x for x in lines)
+        assert any(
+            s["subgoal"] in x and s["status"] in x and lines[k + 1].strip() == s["params"]
+            for k, x in enumerate(lines[:-1])
+        )
+    assert max(len(x) for x in lines[1:]) <= 80  # the goal's line aside
     graphs = sorted((out / "graphs").glob("step_*.png"))
     assert len(graphs) == len(record["steps"]) + 1
 
