@@ -364,13 +364,16 @@ def print_table(title: str, header: tuple[str, ...], rows: list[tuple[str, ...]]
             print("| " + " | ".join(row) + " |")
         print()  # a table ends at a blank line: the next title is not one of its rows
         return
-    table = Table(title=title)
+    table = Table()
     for col in header:
         table.add_column(col, justify="right")
     for row in rows:
         table.add_row(*row)
     # piped into a file or a pager, a table keeps its headers whole rather than fit 80 columns
-    (out if out.is_terminal else Console(width=PIPED_WIDTH)).print(table)
+    console = out if out.is_terminal else Console(width=PIPED_WIDTH)
+    # the title above the table, as wide as the console: a narrow table would squeeze it
+    console.print(title, style="italic", highlight=False, markup=False)
+    console.print(table)
 
 
 # f_p's checkpoint, where a command can see with it (--perception rgb)
