@@ -280,18 +280,16 @@ def in_scene(scene: Path | None) -> str:
 def scene_worlds(scene: Path | None) -> list:
     """The worlds of a `--scene` file or folder (the kitchen without one), in file order, each
     read (and a bad one refused in one line) before anything runs."""
-    from hsgplan.domain.kitchen import KITCHEN
-    from hsgplan.domain.scene_file import read_worlds
+    from hsgplan.domain.scene_file import default_world, read_worlds
 
-    return list(read_worlds(scene).values()) if scene else [KITCHEN]
+    return list(read_worlds(scene).values()) if scene else [default_world()]
 
 
 def scene_world(scene: Path | None):
     """The world of a `--scene` file (the kitchen without one), refused in one line if bad."""
-    from hsgplan.domain.kitchen import KITCHEN
-    from hsgplan.domain.scene_file import read_world
+    from hsgplan.domain.scene_file import scene_world as world_of_scene
 
-    return read_world(scene) if scene else KITCHEN
+    return world_of_scene(scene)
 
 
 SceneOption = Annotated[
