@@ -69,3 +69,13 @@ def test_a_split_draws_its_goals_from_its_share_and_is_part_of_the_runs_configur
     assert not all(bucket(g) in TEST.goal_share for g in bare)  # the whole space
     with pytest.raises(InvalidInputError, match="not a test seed"):
         evaluate_task("fd", TASK_CHECKPOINT, (3,), 2, 0, split="test")
+
+
+def test_a_reference_search_out_of_time_scores_no_length_and_ends_nothing(monkeypatch):
+    from hsgplan.planning import fast_downward
+
+    def out_of_time(self, state, goal, banned=()):
+        raise fast_downward.NoPlanError("no plan found within 60 s")
+
+    monkeypatch.setattr(fast_downward.FastDownwardPlanner, "plan", out_of_time)
+    assert task_eval.fd_length(GOAL, 3) == 0
