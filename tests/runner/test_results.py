@@ -31,6 +31,19 @@ def test_the_shipped_plan_names_configs_that_exist_and_tables_a_page_holds():
     ]
 
 
+def test_the_tune_plan_names_configs_that_exist_and_draws_only_from_the_tune_split():
+    steps = read_plan(ROOT / "configs/tune/plan.toml")
+    published = {s.name for s in read_plan(ROOT / results.PLAN)}
+    for s in steps:
+        assert s.name not in published, s.name  # the stamps share runs/results/steps/
+        args = shlex.split(s.command)
+        for option, value in zip(args, args[1:], strict=False):
+            if option == "--config":
+                assert (ROOT / value).is_file(), (s.name, value)
+        if args[0] == "eval":
+            assert "--split tune" in s.command, s.name  # choosing never reads the test split
+
+
 def test_only_and_skip_choose_steps_and_refuse_unknown_names():
     steps = [Step("a", "x"), Step("b", "y", tags=("slow",)), Step("c", "z")]
     assert [s.name for s in chosen(steps, only=["a", "b"], skip=["slow"])] == ["a"]
