@@ -34,3 +34,30 @@ def test_the_readmes_prose_is_at_most_1500_words():
     text = re.sub(r"```.*?```", "", text, flags=re.S)
     prose = [line for line in text.splitlines() if not line.startswith(("|", "![", "<!--", "#"))]
     assert len(" ".join(prose).split()) <= 1500
+
+
+# a rate (0.83, 1.00) or a ratio (34×) in prose is a measurement: it must be one a command wrote
+MEASURED = re.compile(r"(?<![\w.])(?:[01]\.\d\d|\d+×)(?![\w.])")
+
+
+def unmeasured(prose: str, blocks: str) -> list[str]:
+    """The rates and ratios in `prose` that no pasted block holds."""
+    return [n for n in MEASURED.findall(prose) if n not in blocks]
+
+
+def test_a_rate_in_the_readmes_prose_is_one_a_block_holds():
+    blocks = "".join(BLOCK.findall("".join(p.read_text(encoding="utf-8") for p in PAGES)))
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert unmeasured(outside_blocks(readme), blocks) == []
+
+
+def test_a_typed_rate_is_caught_and_a_pasted_one_is_not():
+    blocks = "<!-- BEGIN t -->\n| 0.96 | 34× |\n<!-- END t -->"
+    assert unmeasured("reads 0.96, 34× faster", blocks) == []
+    assert unmeasured("reads 0.97 at 6 objects, 35× faster", blocks) == ["0.97", "35×"]
+
+
+def test_docs_stay_a_reference_one_sitting_long():
+    words = {p.name: len(p.read_text(encoding="utf-8").split()) for p in PAGES[1:]}
+    assert sum(words.values()) <= 15000, words
+    assert max(words.values()) <= 4000, words

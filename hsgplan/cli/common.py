@@ -292,6 +292,18 @@ def scene_world(scene: Path | None):
     return world_of_scene(scene)
 
 
+# a collection takes turns round a folder's scenes, so that a network learns round many
+SceneRound = Annotated[
+    Path | None,
+    typer.Option(
+        "--scene",
+        help="The world: a scene file, or a folder of them taken in turn "
+        "(default: scenes/kitchen.toml; docs/scenes.md).",
+        parser=input_path,
+    ),
+]
+
+
 SceneOption = Annotated[
     Path | None,
     typer.Option(

@@ -15,6 +15,7 @@ from hsgplan.cli.common import (
     RayAddress,
     SceneFiles,
     SceneOption,
+    SceneRound,
     Summaries,
     TaskCheckpoint,
     bounded_option,
@@ -114,7 +115,7 @@ def _collect_command(primitive: str, default_samples: int):
         tasks_per_chunk: Annotated[
             int, config_option(CollectConfig, "tasks_per_chunk", "Tasks per unit of work.")
         ] = config_default(CollectConfig, "tasks_per_chunk"),
-        scene: SceneOption = None,
+        scene: SceneRound = None,
         fell_short: Annotated[
             float,
             config_option(
@@ -222,7 +223,7 @@ def reach(
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     out_dir: CollectionFolder = RUNS / "collect-reach",
-    scene: SceneOption = None,
+    scene: SceneRound = None,
 ) -> None:
     """Self-supervised reachability: primitives executed in the simulated world from staged
     symbolic states, and what the world showed after each (f_reach's labels)."""
