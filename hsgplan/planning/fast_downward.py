@@ -15,6 +15,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections import Counter
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -199,6 +200,11 @@ def _run_group(cmd: list[str], cwd: Path, timeout_s: float) -> tuple[int | None,
     return proc.returncode, " | ".join((out or "").strip().splitlines()[-3:])
 
 
+# Times the oracle names one action from one state before it gives it up there: a budget, as
+# the motion generator's retries are, not tuned.
+TAKEN_LIMIT = 3
+
+
 class FastDownwardTaskPlanner:
     """Fast Downward behind the task-planner interface: the next action of its plan, serving
     the literal that action makes true.
@@ -207,6 +213,13 @@ class FastDownwardTaskPlanner:
     predicted and goes on with the rest of the plan while they agree (a suffix of a shortest
     plan is a shortest plan from there, so Fast Downward would answer the same), planning
     again only when the world departs from it; without, it plans from every state.
+
+    It remembers the actions it named from each state of the episode. Back in a state it named
+    an action from (the action failed and left the state as it was, or a later one led back),
+    it plans around the actions named there while a plan without them exists, and never names
+    one a `TAKEN_LIMIT`th time from the same state: a place whose every pose the arm refuses is
+    given up there for another plan, or the planner stops, rather than being tried to the step
+    limit. An action `refused` by the agent is planned around in the same way.
     """
 
     name = "fd"
@@ -215,28 +228,51 @@ class FastDownwardTaskPlanner:
         self.planner = planner or FastDownwardPlanner()
         self.follow_plan = follow_plan
         self.plan: Plan | None = None
+        # the actions named from each state this episode, and how often
+        self.taken: dict[SymbolicSceneGraph, Counter[Action]] = {}
 
     def reset(self, goal: Goal | None, seed: int) -> None:
         self.plan = None
+        self.taken = {}
 
     def next_action(
         self, state: SymbolicSceneGraph, goal: Goal, refused: frozenset[Action] = frozenset()
     ) -> TaskDecision:
         start = time.perf_counter()
+        taken = self.taken.setdefault(state, Counter())
         plan = self._remaining(state) if self.follow_plan else None
-        if plan is None:
+        if plan is None or (plan.actions and (plan.actions[0] in refused or taken)):
             try:
-                plan = self.plan = self.planner.plan(state, goal)
+                plan = self.plan = self._plan_around(state, goal, refused, taken)
             except NoPlanError as e:
                 return TaskDecision.none(f"no plan: {e}", start)
         if not plan.actions:
             return TaskDecision.none("the goal holds", start)
         action = plan.actions[0]
-        if action in refused:  # an optimal plan has no second choice to offer
-            return TaskDecision.none(f"the plan's next action {action} was refused", start)
+        taken[action] += 1
         following = plan.actions[1] if len(plan.actions) > 1 else None
         seconds = time.perf_counter() - start
         return TaskDecision(action, intended_literal(action), seconds, following=following)
+
+    def _plan_around(
+        self,
+        state: SymbolicSceneGraph,
+        goal: Goal,
+        refused: frozenset[Action],
+        taken: Counter[Action],
+    ) -> Plan:
+        """A plan whose first action is neither refused nor named here before, else one whose
+        first action is not refused nor given up here (named `TAKEN_LIMIT` times)."""
+        given_up = {a for a, n in taken.items() if n >= TAKEN_LIMIT}
+        options = [set(refused) | set(taken)] if taken else []
+        options.append(set(refused) | given_up)
+        for i, banned in enumerate(options):
+            try:
+                return self.planner.plan(state, goal, banned=frozenset(banned))
+            except NoPlanError:
+                if i == len(options) - 1:
+                    raise
+        raise AssertionError("unreachable: the last option returns or raises")
 
     def _remaining(self, state: SymbolicSceneGraph) -> Plan | None:
         """The rest of the current plan, if the state is one the plan passes through."""

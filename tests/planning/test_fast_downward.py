@@ -119,3 +119,41 @@ def test_pddl_text_names_the_domain_actions():
     ):
         assert f"(:action {name}" in domain
     assert "(on butter cherries)" in problem
+
+
+def test_the_oracle_plans_around_an_action_that_left_its_state_and_gives_it_up_at_a_limit():
+    from collections import Counter
+
+    from hsgplan.planning.fast_downward import TAKEN_LIMIT, FastDownwardTaskPlanner
+
+    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)", world=KITCHEN)
+    start = SymbolicSceneGraph.initial(goal.objects, world=KITCHEN)
+    oracle = FastDownwardTaskPlanner()
+    oracle.reset(goal, 0)
+    named = []
+    for _ in range(20):  # every action named from `start` fails: the state never changes
+        decision = oracle.next_action(start, goal)
+        if decision.action is None:
+            break
+        named.append(decision.action)
+    assert decision.action is None and "no plan" in decision.note
+    assert max(Counter(named).values()) == TAKEN_LIMIT
+
+
+def test_back_in_a_state_the_oracle_takes_a_plan_without_what_it_named_there_first():
+    from hsgplan.domain.actions import Pick
+    from hsgplan.planning.fast_downward import FastDownwardTaskPlanner, Plan
+
+    goal = parse_goal("On(cherries, shelf_a) & On(butter, shelf_b)", world=KITCHEN)
+    start = SymbolicSceneGraph.initial(goal.objects, world=KITCHEN)
+    first, other = Pick("cherries"), Pick("butter")
+
+    class TwoPlans:  # a plan through `first` unless it is banned, else one through `other`
+        def plan(self, state, goal, banned=frozenset()):
+            action = other if first in banned else first
+            return Plan((action,), (state, apply(state, action)), 0.0, "stub")
+
+    oracle = FastDownwardTaskPlanner(planner=TwoPlans())
+    oracle.reset(goal, 0)
+    assert oracle.next_action(start, goal).action == first
+    assert oracle.next_action(start, goal).action == other  # `first` left the state as it was
