@@ -216,9 +216,9 @@ class FastDownwardTaskPlanner:
 
     It remembers the actions it named from each state of the episode. Back in a state it named
     an action from (the action failed and left the state as it was, or a later one led back),
-    it plans around the actions named there while a plan without them exists, and never names
-    one a `TAKEN_LIMIT`th time from the same state: a place whose every pose the arm refuses is
-    given up there for another plan, or the planner stops, rather than being tried to the step
+    it plans without the actions named there while such a plan exists, and names none more than
+    `TAKEN_LIMIT` times from the same state: a place whose every pose the arm refuses is given
+    up there for another plan, or the planner stops, rather than being tried to the step
     limit. An action `refused` by the agent is planned around in the same way.
     """
 
@@ -261,8 +261,8 @@ class FastDownwardTaskPlanner:
         refused: frozenset[Action],
         taken: Counter[Action],
     ) -> Plan:
-        """A plan whose first action is neither refused nor named here before, else one whose
-        first action is not refused nor given up here (named `TAKEN_LIMIT` times)."""
+        """A plan without the refused actions and those named here before, else one without
+        the refused actions and those given up here (named `TAKEN_LIMIT` times)."""
         given_up = {a for a, n in taken.items() if n >= TAKEN_LIMIT}
         options = [set(refused) | set(taken)] if taken else []
         options.append(set(refused) | given_up)
