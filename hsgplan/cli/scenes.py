@@ -1,4 +1,5 @@
-"""`hsgplan scenes`: random layouts of a scene, written as scene files."""
+"""`hsgplan scenes`: random layouts of a scene, written as scene files; `hsgplan scenes check
+FILE`: what a scene file's sizes allow."""
 
 from __future__ import annotations
 
@@ -8,10 +9,14 @@ from typing import Annotated
 import typer
 
 from hsgplan.cli.common import (
+    MarkdownFlag,
+    OneLineErrors,
     bounded_option,
     err,
     input_path,
+    out,
     out_folder,
+    print_table,
     refuses_bad_input,
     shown,
 )
@@ -19,12 +24,24 @@ from hsgplan.cli.seeding import SplitName
 from hsgplan.domain.errors import InvalidInputError
 
 
+app = typer.Typer(cls=OneLineErrors, invoke_without_command=True)
+
+
+@app.callback()
 @refuses_bad_input
 def scenes(
-    layouts: Annotated[int, bounded_option("layouts", "How many layouts.")],
-    out: Annotated[
-        Path, typer.Option("--out", help="Folder to write the scene files in.", parser=out_folder)
-    ],
+    ctx: typer.Context,
+    layouts: Annotated[
+        int | None, bounded_option("layouts", "How many layouts (needed to write them).")
+    ] = None,
+    folder: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            help="Folder to write the scene files in (needed to write them).",
+            parser=out_folder,
+        ),
+    ] = None,
     seed: Annotated[
         int | None,
         bounded_option(
@@ -52,7 +69,14 @@ def scenes(
     ] = None,
 ) -> None:
     """Write random layouts of a scene as scene files: its shelves moved and resized, its
-    objects resized (or new ones); the ranges are in docs/scenes.md."""
+    objects resized (or new ones); the ranges are in docs/scenes.md. `scenes check FILE`: what
+    a scene file's sizes allow."""
+    if ctx.invoked_subcommand is not None:
+        return
+    if layouts is None or folder is None:
+        raise InvalidInputError(
+            "name --layouts N and --out FOLDER to write layouts (or: hsgplan scenes check FILE)"
+        )
     from hsgplan.domain.layouts import write_layouts
     from hsgplan.domain.scene_file import read_world
     from hsgplan.evaluation.splits import split_named
@@ -73,5 +97,42 @@ def scenes(
     )
     if scene is not None:
         header += f" --scene {scene}"
-    written = write_layouts(base, layouts, seed, out, new_objects, header)
-    err.print(f"wrote {len(written)} scene files to {shown(out)}")
+    written = write_layouts(base, layouts, seed, folder, new_objects, header)
+    err.print(f"wrote {len(written)} scene files to {shown(folder)}")
+
+
+@app.command("check")
+@refuses_bad_input
+def check(
+    file: Annotated[
+        Path, typer.Argument(help="The scene file.", parser=input_path, metavar="FILE")
+    ],
+    markdown: MarkdownFlag = False,
+) -> None:
+    """What a scene file's sizes allow: each surface's and interior's capacity, how high a
+    tower may rise and which object sets it, where each object fits and whether it carries
+    another. A scene the robot cannot work in is refused with every reason (exit code 2)."""
+    from hsgplan.domain.scene_file import read_world
+    from hsgplan.domain.scene_limits import scene_limits
+
+    world = read_world(file)
+    limits = scene_limits(world)
+    print_table(
+        f"Surfaces of '{world.name}' ({file})",
+        ("surface", "kind", "height m", "objects it holds", "in goals"),
+        list(limits.surfaces),
+        markdown,
+    )
+    print_table(
+        "Shelf interiors (objects stand in one row, pushed in from the open side)",
+        ("shelf", "clearance m", "objects it holds", "types that fit"),
+        list(limits.interiors),
+        markdown,
+    )
+    print_table(
+        "Object types",
+        ("type", "size cm", "carries another", "fits inside"),
+        list(limits.objects),
+        markdown,
+    )
+    out.print(limits.tower, highlight=False)

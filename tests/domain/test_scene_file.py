@@ -195,3 +195,22 @@ def test_the_robots_base_is_its_urdfs_base_link():
     assert ROBOT_BASE.x_max - 0.01 < x1 <= ROBOT_BASE.x_max
     assert ROBOT_BASE.y_min <= y0 < ROBOT_BASE.y_min + 0.01
     assert ROBOT_BASE.y_max - 0.01 < y1 <= ROBOT_BASE.y_max
+
+
+def test_scenes_check_says_which_object_limits_a_tower_and_what_fits_where(tmp_path):
+    from typer.testing import CliRunner
+
+    from hsgplan.cli import app
+
+    data = copy.deepcopy(KITCHEN)
+    data["objects"][3]["size"] = [0.038, 0.085, 0.15]  # a popcorn box too tall for two levels
+    path = tmp_path / "tall.toml"
+    path.write_text(to_toml(data))
+    r = CliRunner().invoke(app, ["scenes", "check", str(path), "--markdown"])
+    assert r.exit_code == 0, r.output
+    assert "| shelf_a | shelf top | 0.140 | 4 | yes |" in r.output
+    assert "| popcorn | 3.8 x 8.5 x 15.0 | no | — |" in r.output
+    tower = " ".join(r.output.split())
+    assert "a tower holds at most 1 object: 1 of the tallest, popcorn (0.150 m)" in tower
+    kitchen = CliRunner().invoke(app, ["scenes", "check", str(KITCHEN_SCENE), "--markdown"])
+    assert "at most 2 objects" in " ".join(kitchen.output.split())

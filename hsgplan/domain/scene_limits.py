@@ -1,0 +1,63 @@
+"""What a scene's sizes allow, said plainly (`hsgplan scenes check FILE`): how many objects each
+surface and interior holds, how high a tower may rise and which object sets that, where each
+object type fits and whether it carries another. Read from the `World`, the same properties
+the transition model, the goal sampler and the PDDL count with, so the report cannot drift
+from what the planners are held to."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from hsgplan.domain.scene import REACH_MAX_Z, World
+
+
+@dataclass(frozen=True)
+class SceneLimits:
+    surfaces: tuple[tuple[str, ...], ...]  # name, kind, height (m), capacity, in goals
+    interiors: tuple[tuple[str, ...], ...]  # shelf, clearance (m), capacity, what fits
+    objects: tuple[tuple[str, ...], ...]  # type, size (cm), carries another, fits inside
+    tower: str  # how many objects a tower holds, and why
+
+
+def scene_limits(world: World) -> SceneLimits:
+    surfaces = tuple(
+        (
+            name,
+            "region" if name in world.regions else "shelf top",
+            f"{world.surface_rect(name).z:.3f}",
+            str(world.surface_capacity[name]),
+            "yes" if name in world.goal_shelf_tops else "—",
+        )
+        for name in world.surfaces
+    )
+    interiors = tuple(
+        (
+            shelf,
+            f"{world.shelves[shelf].clearance:.3f}",
+            str(n),
+            ", ".join(t.name for t in world.type_list if world.fits_inside(t.name, shelf)) or "—",
+        )
+        for shelf, n in world.interior_capacity.items()
+    )
+    objects = tuple(
+        (
+            t.name,
+            " x ".join(f"{100 * v:.1f}" for v in t.size),
+            "yes" if world.can_support(t.name) else "no",
+            ", ".join(s for s in world.interior_capacity if world.fits_inside(t.name, s)) or "—",
+        )
+        for t in world.type_list
+    )
+    return SceneLimits(surfaces, interiors, objects, _tower(world))
+
+
+def _tower(world: World) -> str:
+    tallest = max(world.type_list, key=lambda t: t.height)
+    highest = max(world.surfaces, key=lambda n: world.surface_rect(n).z)
+    levels = world.max_tower_levels
+    return (
+        f"a tower holds at most {levels} object{'s' if levels > 1 else ''}: {levels} of the "
+        f"tallest, {tallest.name} ({tallest.height:.3f} m), on the highest surface, {highest} "
+        f"({world.surface_rect(highest).z:.3f} m), stay within the {REACH_MAX_Z} m a held "
+        "object's top may rise to"
+    )
