@@ -23,7 +23,6 @@ from hsgplan.cli.common import (
 from hsgplan.cli.seeding import SplitName
 from hsgplan.domain.errors import InvalidInputError
 
-
 app = typer.Typer(cls=OneLineErrors, invoke_without_command=True)
 
 
