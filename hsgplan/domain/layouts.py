@@ -10,6 +10,8 @@ narrow side within what the gripper opens.
 from __future__ import annotations
 
 import random
+import re
+from collections import Counter
 from dataclasses import replace
 from pathlib import Path
 
@@ -44,17 +46,20 @@ def _span(rng: random.Random, bounds: tuple[float, float]) -> float:
 
 
 def _shelves(base: World, rng: random.Random) -> list[dict]:
+    """Each shelf moved and resized on the side of the robot it stands on; shelves sharing a
+    side keep their order outwards from the open space, each beyond the one before."""
     open_space = base.regions["open_space"]
-    out = []
-    for s in base.shelf_list:
-        near, depth = _span(rng, SHELF_NEAR), _span(rng, SHELF_DEPTH)
-        width, gap = _span(rng, SHELF_WIDTH), _span(rng, SHELF_SIDE_GAP)
-        left = s.outer.y_min >= 0  # the side of the robot it stands on stays
-        y = (open_space.y_max + gap, open_space.y_max + gap + width)
-        if not left:
-            y = (open_space.y_min - gap - width, open_space.y_min - gap)
-        out.append(
-            {
+    out: dict[str, dict] = {}
+    for left in (True, False):
+        side = [s for s in base.shelf_list if (s.outer.y_min >= 0) == left]
+        side.sort(key=lambda s: abs(s.outer.y_min + s.outer.y_max))  # nearest the middle first
+        edge = open_space.y_max if left else open_space.y_min
+        for s in side:
+            near, depth = _span(rng, SHELF_NEAR), _span(rng, SHELF_DEPTH)
+            width, gap = _span(rng, SHELF_WIDTH), _span(rng, SHELF_SIDE_GAP)
+            y = (edge + gap, edge + gap + width) if left else (edge - gap - width, edge - gap)
+            edge = y[1] if left else y[0]
+            out[s.name] = {
                 "name": s.name,
                 "x": [near, round(near + depth, 3)],
                 "y": [round(v, 3) for v in y],
@@ -62,8 +67,7 @@ def _shelves(base: World, rng: random.Random) -> list[dict]:
                 "wall": s.wall,
                 "interior": s.interior is not None,
             }  # fmt: skip
-        )
-    return out
+    return [out[s.name] for s in base.shelf_list]
 
 
 def _resized(t: ObjectType, rng: random.Random) -> ObjectType:
@@ -98,18 +102,30 @@ def random_layout(base: World, seed: int, index: int, new_objects: bool = False)
     types resized (or, with `new_objects`, replaced by as many new ones of each kind); the
     same arguments give the same world."""
     rng = random.Random(f"layout-{seed}-{index}-{int(new_objects)}")
+    why_not: Counter[str] = Counter()  # what refused the draws, said once the tries run out
+    example: dict[str, str] = {}  # a refusal, as first said, for each with its numbers left out
     for _ in range(TRIES):
         data = scene_data(base)
         data["name"] = f"{base.name}-layout-{seed}-{index}" + ("-new" if new_objects else "")
         data["shelves"] = _shelves(base, rng)
         data["objects"] = [object_data(t) for t in _objects(base, rng, new_objects)]
         try:
-            world = world_of(data)
-        except InvalidInputError:
-            continue  # a draw the scene file refuses (a shelf off the table): draw again
-        if world.goal_top_room >= GOAL_ROOM and world.max_tower_levels >= TOWER_LEVELS:
+            world = world_of(data, "the layout")
+        except InvalidInputError as e:  # a draw the scene file refuses: draw again
+            said = str(e).splitlines()[0]
+            why_not[example.setdefault(re.sub(r"-?\d+\.\d+", "#", said), said)] += 1
+            continue
+        if world.goal_top_room < GOAL_ROOM:
+            why_not[f"its goal shelf tops hold fewer than {GOAL_ROOM} objects"] += 1
+        elif world.max_tower_levels < TOWER_LEVELS:
+            why_not[f"its towers hold fewer than {TOWER_LEVELS} objects"] += 1
+        else:
             return world
-    raise InvalidInputError(f"no valid layout of '{base.name}' in {TRIES} draws (seed {seed})")
+    reason, n = why_not.most_common(1)[0]
+    raise InvalidInputError(
+        f"no valid layout of '{base.name}' in {TRIES} draws (seed {seed}); most often "
+        f"({n} of {TRIES}): {reason}"
+    )
 
 
 def write_layouts(

@@ -99,3 +99,38 @@ def test_a_scene_too_small_for_a_goal_is_refused_in_one_line():
     small = world_of(data)
     with pytest.raises(InvalidInputError, match="no room for a goal of 12 objects"):
         random_goals(12, 1, 0, world=small)
+
+
+def _three_shelves():
+    """The kitchen with a third shelf beyond shelf_a, on the same side of the robot."""
+    import tomllib
+
+    from hsgplan.domain.scene_file import scene_data, to_toml, world_of
+
+    data = tomllib.loads(to_toml(scene_data(KITCHEN)))
+    data["table"]["y"] = [-1.2, 1.2]  # room beyond shelf_a for shelves of the layouts' widths
+    third = dict(data["shelves"][0], name="shelf_c", y=[0.56, 0.80])
+    third.pop("prepush", None)
+    data["shelves"].append(third)
+    return data, world_of
+
+
+def test_shelves_sharing_a_side_keep_their_order_outwards_and_never_overlap():
+    data, world_of = _three_shelves()
+    base = world_of(data)
+    for index in range(5):
+        w = layouts.random_layout(base, 3, index)
+        a, c = w.shelves["shelf_a"].outer, w.shelves["shelf_c"].outer
+        assert a.y_max < c.y_min  # shelf_c stays beyond shelf_a, as in the base scene
+
+
+def test_a_scene_no_draw_can_vary_is_refused_with_what_refused_most_draws():
+    from hsgplan.domain.errors import InvalidInputError
+
+    data, world_of = _three_shelves()
+    data["objects"][3]["size"] = [0.038, 0.085, 0.25]  # no tower of two such boxes stays in reach
+    with pytest.raises(InvalidInputError) as e:
+        layouts.random_layout(world_of(data), 3, 0)
+    said = str(e.value)
+    assert "\n" not in said and said.endswith("): its towers hold fewer than 2 objects")
+    assert "most often (" in said
