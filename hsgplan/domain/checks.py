@@ -84,12 +84,21 @@ def _check_value(name: str, value: Any, allowed: tuple[type, ...], meta) -> Any:
         if isinstance(value, bool) or not isinstance(value, int):
             raise InvalidInputError(f"{name} {value!r}: need an integer")
     elif float in allowed:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise InvalidInputError(f"{name} {value!r}: need a number")
-        if not math.isfinite(value):
-            raise InvalidInputError(f"{name} {value!r}: need a finite number")
-        value = float(value)
-    lo, hi, above = meta.get("lo"), meta.get("hi"), meta.get("above")
+        value = check_number(name, value)
+    return _within(name, value, meta.get("lo"), meta.get("hi"), meta.get("above"))
+
+
+def check_number(name: str, value: Any, lo: float | None = None, hi: float | None = None) -> float:
+    """A finite number within `lo` and `hi`, as a float; refused in one line that names it (the
+    scene reader's numbers and a configuration's are refused in the same words)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise InvalidInputError(f"{name} {value!r}: need a number")
+    if not math.isfinite(value):
+        raise InvalidInputError(f"{name} {value!r}: need a finite number")
+    return _within(name, float(value), lo, hi)
+
+
+def _within(name: str, value: Any, lo=None, hi=None, above=None) -> Any:
     if lo is not None and value < lo:
         raise InvalidInputError(f"{name} {value!r}: must be at least {lo}")
     if hi is not None and value > hi:

@@ -16,7 +16,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from hsgplan.domain.checks import read_text
+from hsgplan.domain.checks import check_number, read_text
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import (
     GRIPPER_MAX_OPENING,
@@ -50,12 +50,31 @@ class _Bad(Exception):
     """A field refused: its place in the file and why (made one line by `read_world`)."""
 
 
+class _Faults:
+    """Every refusal of a file gathered, so that each bad field is named, not the first alone."""
+
+    def __init__(self) -> None:
+        self.said: list[str] = []
+
+    def read(self, read: Callable[..., Any], *args: Any) -> Any:
+        """`read(*args)`, or None with its refusal kept."""
+        try:
+            return read(*args)
+        except _Bad as e:
+            self.said.append(str(e))
+            return None
+
+    def check(self) -> None:
+        """Refuse the file with every refusal kept so far, one line each."""
+        if self.said:
+            raise _Bad("\n".join(self.said))
+
+
 def _number(v: Any, at: str, lo: float, hi: float) -> float:
-    if isinstance(v, bool) or not isinstance(v, int | float):
-        raise _Bad(f"{at} {v!r}: need a number")
-    if not lo <= v <= hi:
-        raise _Bad(f"{at} {v!r}: must be between {lo} and {hi}")
-    return float(v)
+    try:
+        return check_number(at, v, lo, hi)  # the project's one number check, its words
+    except InvalidInputError as e:
+        raise _Bad(str(e)) from None
 
 
 def _numbers(v: Any, at: str, count: int | tuple[int, ...], lo: float, hi: float) -> tuple:
@@ -164,41 +183,51 @@ def _camera(v: Any, at: str) -> View:
     return View(size[0], size[1], eye, target, _number(v["fov"], f"{at}.fov", 1.0, 170.0))
 
 
-def _each(v: Any, at: str, lo: int, hi: int, read: Callable[[Any, str], Any]) -> list:
-    return [read(item, f"{at}[{k}]") for k, item in enumerate(_tables(v, at, lo, hi), 1)]
+def _each(
+    v: Any, at: str, lo: int, hi: int, read: Callable[[Any, str], Any], faults: _Faults
+) -> list:
+    """Every table of an array read, the bad ones' refusals kept in `faults`."""
+    tables = faults.read(_tables, v, at, lo, hi) or []
+    read_ones = [faults.read(read, item, f"{at}[{k}]") for k, item in enumerate(tables, 1)]
+    return [r for r in read_ones if r is not None]
 
 
-def _check_places(table: Rect, shelves: list[Shelf], regions: list[tuple[str, Rect]]) -> None:
+def _places_problems(
+    table: Rect, shelves: list[Shelf], regions: list[tuple[str, Rect]]
+) -> list[str]:
     places = [(s.name, s.outer) for s in shelves] + regions
-    for name, rect in places:
-        if not (table.contains(rect.x_min, rect.y_min) and table.contains(rect.x_max, rect.y_max)):
-            raise _Bad(f"{name} is not wholly on the table")
+    problems = [
+        f"{name} is not wholly on the table"
+        for name, rect in places
+        if not (table.contains(rect.x_min, rect.y_min) and table.contains(rect.x_max, rect.y_max))
+    ]
     for k, (a, ra) in enumerate(places):
-        for b, rb in places[k + 1 :]:
-            if ra.overlaps(rb):
-                raise _Bad(f"{a} and {b} overlap")
+        problems += [f"{a} and {b} overlap" for b, rb in places[k + 1 :] if ra.overlaps(rb)]
+    return problems
 
 
-def _check_names(types: list[ObjectType], fixtures: list[str]) -> None:
-    seen: set[str] = set()
+def _names_problems(types: list[ObjectType], fixtures: list[str]) -> list[str]:
+    problems, seen = [], set()
     for name in [t.name for t in types] + fixtures:
         if name in seen:
-            raise _Bad(f"the name {name!r} is given twice")
+            problems.append(f"the name {name!r} is given twice")
         seen.add(name)
     for name in fixtures:
         head, _, tail = name.rpartition("_")
         if head in {t.name for t in types} and tail.isdigit():
-            raise _Bad(f"the name {name!r} reads as an instance of the object type {head!r}")
+            problems.append(f"the name {name!r} reads as an instance of the object type {head!r}")
+    return problems
 
 
 def world_of(data: Any, source: str = "scene") -> World:
-    """A `World` from a scene file's parsed TOML; the first bad field refused in one line
-    (`InvalidInputError`) that starts with `source`; a scene whose fields read but that the
+    """A `World` from a scene file's parsed TOML; every bad field refused, one line each
+    (`InvalidInputError`), each starting with `source`; a scene whose fields read but that the
     robot cannot work in refused with every reason why, one line each (`unworkable`)."""
     try:
         world = _world(data)
     except _Bad as e:
-        raise InvalidInputError(f"{source}: {e}") from None
+        lines = str(e).splitlines()
+        raise InvalidInputError("\n".join(f"{source}: {line}" for line in lines)) from None
     if problems := unworkable(world):
         raise InvalidInputError("\n".join(f"{source}: {p}" for p in problems))
     return world
@@ -245,37 +274,40 @@ def _fits_somewhere(world: World, t: ObjectType) -> bool:
     return on_a_surface or any(world.fits_inside(t.name, s) for s in world.shelves)
 
 
+def _region(v: Any, at: str) -> tuple[str, Rect]:
+    r = _table(v, at, {"name", "x", "y"})
+    return _name(r["name"], f"{at}.name", FIXTURE_NAME), _rect(r, at)
+
+
 def _world(data: Any) -> World:
     top = _table(data, "the file", {"name", "table", "regions", "shelves", "objects", "cameras"},
                  {"fixture_friction", "goals"})  # fmt: skip
-    name = _name(top["name"], "name", SCENE_NAME)
-    table = _rect(_table(top["table"], "table", {"x", "y"}), "table")
-    friction = _number(top.get("fixture_friction", 0.6), "fixture_friction", 0.05, 2.0)
-    regions = [
-        (_name(r["name"], f"{at}.name", FIXTURE_NAME), _rect(r, at))
-        for at, r in (
-            (f"regions[{k}]", _table(r, f"regions[{k}]", {"name", "x", "y"}))
-            for k, r in enumerate(_tables(top["regions"], "regions", 1, MAX_SHELVES + 1), 1)
-        )
-    ]
+    faults = _Faults()
+    name = faults.read(_name, top["name"], "name", SCENE_NAME)
+    table = faults.read(lambda: _rect(_table(top["table"], "table", {"x", "y"}), "table"))
+    friction = faults.read(_number, top.get("fixture_friction", 0.6), "fixture_friction", 0.05,
+                           2.0)  # fmt: skip
+    regions = _each(top["regions"], "regions", 1, MAX_SHELVES + 1, _region, faults)
+    read = _each(top["shelves"], "shelves", 1, MAX_SHELVES, _shelf, faults)
+    types = _each(top["objects"], "objects", 1, MAX_TYPES, _object, faults)
+    cameras = tuple(_each(top["cameras"], "cameras", 1, MAX_CAMERAS, _camera, faults))
+    goals = faults.read(_table, top.get("goals", {}), "goals", set(), {"shelf_tops", "interior"})
+    faults.check()  # what follows reads the fields together
     if OPEN_SPACE not in dict(regions):
-        raise _Bad(f"regions: need one named {OPEN_SPACE!r} (where objects are put aside)")
-    read = _each(top["shelves"], "shelves", 1, MAX_SHELVES, _shelf)
+        faults.said.append(f"regions: need one named {OPEN_SPACE!r} (where objects are put aside)")
     shelves = [s for s, _ in read]
     regions += [p for _, p in read if p is not None]
-    types = _each(top["objects"], "objects", 1, MAX_TYPES, _object)
-    cameras = tuple(_each(top["cameras"], "cameras", 1, MAX_CAMERAS, _camera))
-    _check_names(types, [s.name for s in shelves] + [r for r, _ in regions])
-    _check_places(table, shelves, regions)
+    faults.said += _names_problems(types, [s.name for s in shelves] + [r for r, _ in regions])
+    faults.said += _places_problems(table, shelves, regions)
     with_interior = [s.name for s in shelves if s.interior is not None]
-    goals = _table(top.get("goals", {}), "goals", set(), {"shelf_tops", "interior"})
     names = [s.name for s in shelves]
     tops = goals.get("shelf_tops", names)
     if not isinstance(tops, list) or not tops or any(t not in names for t in tops):
-        raise _Bad(f"goals.shelf_tops {tops!r}: need a list of the scene's shelves")
+        faults.said.append(f"goals.shelf_tops {tops!r}: need a list of the scene's shelves")
     interior = goals.get("interior", with_interior[0] if with_interior else None)
     if interior not in with_interior:
-        raise _Bad(f"goals.interior {interior!r}: need a shelf with an interior")
+        faults.said.append(f"goals.interior {interior!r}: need a shelf with an interior")
+    faults.check()
     return World(name, table, tuple(shelves), tuple(regions), tuple(types), tuple(tops),
                  interior, friction, cameras)  # fmt: skip
 
