@@ -326,7 +326,7 @@ def scene_world(scene: Path | str | None) -> World:
 
 
 def read_world(path: Path | str) -> World:
-    """The world a scene file describes; anything wrong with it refused in one line
+    """The world a scene file describes; everything wrong with it refused, one line each
     (`InvalidInputError`)."""
     return read_world_text(read_text(Path(path), "scene file", MAX_SCENE_BYTES), path)
 
