@@ -193,3 +193,15 @@ def test_a_table_runs_every_training_and_reports_over_them(tmp_path):
     assert {p.name for p in (tmp_path / "run" / "gnn").iterdir()} == {"seed-0", "seed-1"}
     title = tables(report, ("success",))[0].title
     assert "under each of 2 trainings" in title and "test split" in title
+
+
+def test_a_regularised_mlp_trains_and_its_network_reads_back_with_its_dropout(tmp_path):
+    from hsgplan.motion.models import load_motion_net
+    from hsgplan.motion.train import MotionTrainConfig, train_motion
+
+    settings = {**TINY_MOTION, "model": "mlp", "dropout": 0.3, "weight_decay": 0.01}
+    train_motion(MotionTrainConfig.from_json(settings), tmp_path / "mlp")
+    net = load_motion_net(tmp_path / "mlp", "place", "mlp")
+    assert net.config.dropout == 0.3 and not net.training
+    saved = json.loads((tmp_path / "mlp" / "train_config.json").read_text())
+    assert saved["weight_decay"] == 0.01

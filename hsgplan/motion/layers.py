@@ -7,12 +7,16 @@ from torch import nn
 from torch_geometric.nn import MessagePassing
 
 
-def mlp(sizes: list[int]) -> nn.Sequential:
-    """Linear layers with ReLU between them (none after the last)."""
+def mlp(sizes: list[int], dropout: float = 0.0) -> nn.Sequential:
+    """Linear layers with ReLU between them (none after the last), and with `dropout` a
+    dropout after each ReLU (none without, so that networks trained before keep their
+    layers' numbering)."""
     layers: list[nn.Module] = []
     for a, b in zip(sizes, sizes[1:], strict=False):
         layers += [nn.Linear(a, b), nn.ReLU()]
-    return nn.Sequential(*layers[:-1])
+        if dropout > 0:
+            layers.append(nn.Dropout(dropout))
+    return nn.Sequential(*layers[: -2 if dropout > 0 else -1])
 
 
 class GroundedConv(MessagePassing):

@@ -53,6 +53,8 @@ class MotionNetConfig:
     # what a node is (`domain.scene.FEATURES`): "names", the paper's one-hots over the kitchen's
     # names, or "geometry" (kind, size, the role of its region), which reads any scene
     features: str = "names"
+    # dropout after every hidden layer of the networks' MLPs (0: none, the paper's)
+    dropout: float = 0.0
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:
@@ -66,6 +68,8 @@ class MotionNetConfig:
             )
         if self.model == "mlp" and self.features != "names":
             raise InvalidInputError("the mlp keeps a slot per object type: features 'names' only")
+        if not 0 <= self.dropout < 1:
+            raise InvalidInputError(f"dropout {self.dropout!r}: from 0 up to (not) 1")
         for name in ("hidden", "embed", "rounds"):
             if not isinstance(getattr(self, name), int) or getattr(self, name) < 1:
                 raise InvalidInputError(f"{name} {getattr(self, name)!r}: need a positive integer")
@@ -97,9 +101,9 @@ class GraphMotionNet(nn.Module):
             GroundedConv(a, c.edge_dim, c.hidden, b) for a, b in zip(dims, dims[1:], strict=False)
         )
         self.graph_embed = nn.Linear(2 * c.hidden, c.embed)
-        self.subgoal_embed = mlp([c.subgoal_dim, c.hidden, c.embed])
+        self.subgoal_embed = mlp([c.subgoal_dim, c.hidden, c.embed], c.dropout)
         if c.head == "bins":
-            self.head = BinQueryHead(c.hidden, c.embed, c.query_dim, c.embed)
+            self.head = BinQueryHead(c.hidden, c.embed, c.query_dim, c.embed, c.dropout)
         else:
             self.head = _pair_head(c)
 
@@ -127,12 +131,12 @@ class FlatMotionNet(nn.Module):
         c = config
         self.slots = c.slots
         flat = c.slots * c.node_dim + c.slots * (c.slots - 1) * c.edge_dim
-        self.subgoal_embed = mlp([c.subgoal_dim, c.hidden, c.embed])
+        self.subgoal_embed = mlp([c.subgoal_dim, c.hidden, c.embed], c.dropout)
         if c.head == "bins":
-            self.graph_embed = mlp([flat, c.hidden, c.hidden])
-            self.head = FlatBinHead(c.hidden, c.embed, c.query_dim, c.slots, c.hidden)
+            self.graph_embed = mlp([flat, c.hidden, c.hidden], c.dropout)
+            self.head = FlatBinHead(c.hidden, c.embed, c.query_dim, c.slots, c.hidden, c.dropout)
         else:
-            self.graph_embed = mlp([flat, c.hidden, c.hidden, c.embed])
+            self.graph_embed = mlp([flat, c.hidden, c.hidden, c.embed], c.dropout)
             self.head = _pair_head(c)
 
     def _slot_positions(self, batch) -> tuple[torch.Tensor, torch.Tensor]:
@@ -172,9 +176,9 @@ def _pair_head(c: MotionNetConfig) -> nn.Module:
     """The paper's head onto every bin pair (`mlp`) or onto each dimension's bins (`per-dim`)."""
     if c.head == "per-dim":
         return PerDimensionHead(
-            mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] + c.bins[1]]), c.bins
+            mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] + c.bins[1]], c.dropout), c.bins
         )
-    return mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]])
+    return mlp([2 * c.embed, c.hidden, c.hidden, c.bins[0] * c.bins[1]], c.dropout)
 
 
 class PerDimensionHead(nn.Module):
@@ -215,10 +219,12 @@ class BinQueryHead(nn.Module):
         single trials need not score the other bins).
     """
 
-    def __init__(self, hidden: int, embed: int, query_dim: int, width: int = 64) -> None:
+    def __init__(
+        self, hidden: int, embed: int, query_dim: int, width: int = 64, dropout: float = 0.0
+    ) -> None:
         super().__init__()
-        self.read = mlp([hidden + 3, width, width])
-        self.score = mlp([width + query_dim + embed, width, 1])
+        self.read = mlp([hidden + 3, width, width], dropout)
+        self.score = mlp([width + query_dim + embed, width, 1], dropout)
 
     def forward(
         self, h: torch.Tensor, batch, subgoal: torch.Tensor, only: torch.Tensor | None = None
@@ -255,9 +261,11 @@ class FlatBinHead(nn.Module):
         with `only` [B] -> [B, 1].
     """
 
-    def __init__(self, hidden: int, embed: int, query_dim: int, slots: int, width: int) -> None:
+    def __init__(
+        self, hidden: int, embed: int, query_dim: int, slots: int, width: int, dropout: float = 0.0
+    ) -> None:
         super().__init__()
-        self.score = mlp([hidden + 3 * slots + query_dim + embed, width, width, 1])
+        self.score = mlp([hidden + 3 * slots + query_dim + embed, width, width, 1], dropout)
 
     def forward(
         self,

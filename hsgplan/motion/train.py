@@ -69,6 +69,10 @@ class MotionTrainConfig:
     # The share of the training scenes held out to choose the epoch: the weights kept are
     # those of the epoch with the lowest loss on them (0: train on all, keep the last epoch).
     validation: float = setting(0.0, lo=0, hi=0.5)
+    # regularisation, none by default (the paper's): dropout after every hidden layer of the
+    # networks' MLPs, and decoupled weight decay (AdamW in place of Adam)
+    dropout: float = setting(0.0, lo=0, hi=0.9)
+    weight_decay: float = setting(0.0, lo=0, hi=1)
     # what a node is (`domain.scene.FEATURES`): "names" (the paper's) or "geometry"
     features: str = "names"
 
@@ -97,6 +101,7 @@ class MotionTrainConfig:
             subgoal_dim=subgoal_dim,
             head=self.head,
             features=self.features,
+            dropout=self.dropout,
         )
 
     @staticmethod
@@ -170,10 +175,12 @@ def split_tasks(data: MotionData, share: float, seed: int) -> np.ndarray:
 
 def _mean_loss(kind: str, model: torch.nn.Module, examples: list[Data], size: int) -> float:
     total = 0.0
+    model.eval()  # no dropout while the held-out loss is read
     with torch.no_grad():
         for i in range(0, len(examples), size):
             batch = Batch.from_data_list(examples[i : i + size])
             total += _loss(kind, model, batch).item() * batch.num_graphs
+    model.train()
     return total / len(examples)
 
 
@@ -189,7 +196,9 @@ def train_motion(
     if config.loss == "bce":
         files.append(folder / f"{config.primitive}_trials.npz")
     data = fingerprint(files)
-    training.claim(out, asdict(config), defaults={"features": "names"}, data=data)
+    # settings a folder trained before they existed was trained with: their defaults
+    defaults = {"features": "names", "dropout": 0.0, "weight_decay": 0.0}
+    training.claim(out, asdict(config), defaults=defaults, data=data)
     if training.finished(out):
         return  # finished earlier
     held = split_tasks(rows, config.validation, config.seed)
@@ -199,7 +208,12 @@ def train_motion(
     torch.manual_seed(config.seed)
     net_config = config.net_config()
     model = build(net_config)
-    optim = torch.optim.Adam(model.parameters(), lr=config.lr)
+    if config.weight_decay > 0:
+        optim = torch.optim.AdamW(
+            model.parameters(), lr=config.lr, weight_decay=config.weight_decay
+        )
+    else:  # Adam, as every network trained before the setting was
+        optim = torch.optim.Adam(model.parameters(), lr=config.lr)
     start, kept = training.resume_with(out, model, optim, data)
     history: list[dict] = list(kept.get("history", []))
     for epoch in range(start, config.epochs):

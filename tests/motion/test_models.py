@@ -134,3 +134,28 @@ def test_bad_configurations_are_refused():
         MotionNetConfig("mlp", "place", (10, 10), head="query")
     with pytest.raises(InvalidInputError, match="hidden"):
         MotionNetConfig("gnn", "place", (10, 10), hidden=0)
+
+
+def test_without_dropout_a_network_keeps_the_layers_networks_were_saved_with():
+    from hsgplan.motion.layers import mlp
+
+    assert [type(m).__name__ for m in mlp([4, 8, 8, 2])] == [
+        "Linear", "ReLU", "Linear", "ReLU", "Linear",
+    ]  # fmt: skip
+    assert [type(m).__name__ for m in mlp([4, 8, 2], 0.5)] == [
+        "Linear", "ReLU", "Dropout", "Linear",
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize("model,head", MODELS)
+def test_dropout_draws_while_training_and_never_once_trained(model, head):
+    config = MotionNetConfig(model, "place", (10, 10), hidden=16, embed=8, head=head, dropout=0.5)
+    a, b = _permuted_pair()
+    batch = Batch.from_data_list([a, b])
+    net = build(config)
+    torch.manual_seed(0)
+    assert not torch.equal(net(batch), net(batch))
+    net.eval()
+    assert torch.equal(net(batch), net(batch))
+    with pytest.raises(InvalidInputError, match="dropout"):
+        MotionNetConfig(model, "place", (10, 10), dropout=1.0)
