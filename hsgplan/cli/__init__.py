@@ -70,6 +70,7 @@ bench.app.command("line-error")(bench_motion.line_error)
 bench.app.command("push-settings")(bench_motion.push_settings)
 bench.app.command("compare-trials")(bench_motion.compare_trials)
 learn.train_app.command("motion")(motion.train_motion)
+learn.train_app.command("motion-search")(motion.train_motion_search)
 
 
 def _print_version(given: bool) -> None:

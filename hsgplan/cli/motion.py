@@ -249,3 +249,53 @@ def eval_motion(
         trained,
         markdown,
     )
+
+
+@refuses_bad_input
+def train_motion_search(
+    config: Annotated[
+        Path, typer.Option(help="The base training configuration (JSON).", parser=input_path)
+    ],
+    grid: Annotated[
+        str,
+        typer.Option(help="Settings and values, e.g. 'lr=0.001,0.0003;dropout=0,0.2'."),
+    ],
+    out_dir: Annotated[
+        Path,
+        typer.Option("--out", help="Folder of the search's trainings.", parser=out_folder),
+    ],
+    workers: Annotated[int, bounded_option("workers", "Trainings side by side.")] = 1,
+    markdown: MarkdownFlag = False,
+) -> None:
+    """Every combination of a grid of training settings trained once, judged by the loss on
+    its held-out training scenes (the configuration's `validation`); writes search.json and
+    the chosen configuration, chosen.json, into the folder. Resumable."""
+    from hsgplan.motion.search import combinations, folder_of, parse_grid, summarize
+    from hsgplan.motion.train import MotionTrainConfig
+    from hsgplan.trainings import train_each
+
+    base = MotionTrainConfig.from_json(read_config(config))
+    values = parse_grid(grid)
+    configs = combinations(base, values)
+    jobs = [(c, folder_of(out_dir, k)) for k, c in enumerate(configs)]
+    train_each(_train_motion_once, jobs, workers)
+    report = summarize(out_dir, configs, values)
+    rows = [
+        (
+            str(r["combination"]),
+            ", ".join(f"{k}={v}" for k, v in r["settings"].items()),
+            f"{r['validation_loss']:.4f}",
+            str(r["chosen_epoch"]),
+            "chosen" if r["combination"] == report["chosen"] else "",
+        )
+        for r in report["rows"]
+    ]
+    print_table(
+        f"{base.model} {base.primitive}: held-out training loss of each combination "
+        f"({len(rows)} trainings, seed {base.seed})",
+        ("combination", "settings", "held-out loss", "epoch kept", ""),
+        rows,
+        markdown,
+    )
+    if not markdown:
+        out.print(f"wrote {shown(out_dir)}/search.json and chosen.json", highlight=False)
