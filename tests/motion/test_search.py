@@ -18,8 +18,9 @@ TINY = {"epochs": 2, "samples": 64, "hidden": 16, "embed": 8, "rounds": 1, "loss
 def test_the_search_trains_each_combination_and_chooses_the_lowest_held_out_loss(tmp_path):
     config = tmp_path / "base.json"
     config.write_text(json.dumps(TINY))
-    args = ["train", "motion-search", "--config", str(config), "--grid",
-            "dropout=0,0.3;weight_decay=0,0.01", "--out", str(tmp_path / "s"), "--markdown"]  # fmt: skip
+    grid = "dropout=0,0.3;weight_decay=0,0.01"
+    args = ["train", "motion-search", "--config", str(config), "--grid", grid,
+            "--out", str(tmp_path / "s"), "--markdown"]  # fmt: skip
     r = CliRunner().invoke(app, args)
     assert r.exit_code == 0, r.output
     report = json.loads((tmp_path / "s" / "search.json").read_text())
