@@ -22,6 +22,7 @@ from hsgplan.cli.common import (
     shown,
 )
 from hsgplan.cli.seeding import PerceptionRulesOption, SplitOption, rule_settings
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.seeds import marked, seed_words
 from hsgplan.paths import PERCEPTION_CHECKPOINT, RUNS
 
@@ -42,12 +43,32 @@ def train_perception(
         Path,
         typer.Option("--out", help="Checkpoint folder (resumed if it exists).", parser=out_folder),
     ] = RUNS / "train-perception",
+    scene: Annotated[
+        Path | None,
+        typer.Option(
+            help="Learn this scene file's looks: its images rendered into OUT-images first "
+            "(resumed), then trained on (docs/own-scene.md).",
+            parser=input_path,
+        ),
+    ] = None,
+    samples: Annotated[
+        int, bounded_option("samples", "With --scene, images to render (scenes x views).")
+    ] = 600,
+    image_seed: Annotated[
+        int, bounded_option("seed", "With --scene, the seed of the rendered scenes.")
+    ] = 30,
+    workers: Annotated[int, bounded_option("workers", "With --scene, rendering processes.")] = 2,
 ) -> None:
-    """Train the DOPE-style keypoint network on a synthetic image collection."""
+    """Train the DOPE-style keypoint network on a synthetic image collection, or on images of
+    a scene file rendered first (--scene)."""
     from hsgplan.perception.train import PerceptionTrainConfig
     from hsgplan.perception.train import train_perception as run
 
     settings = read_config(config)
+    if scene is not None and images:
+        raise InvalidInputError("--scene renders its own images: give it or --images")
+    if scene is not None:
+        settings["images"] = str(_render_scene(scene, samples, image_seed, workers, out_dir))
     if images:
         settings["images"] = ",".join(str(p) for p in images)
     cfg = PerceptionTrainConfig.from_json(settings)
@@ -64,6 +85,19 @@ def train_perception(
 
         run(cfg, out_dir, on_epoch, on_batch)
     out.print(f"trained the keypoint and colour networks into {shown(out_dir)}")
+
+
+def _render_scene(scene: Path, samples: int, seed: int, workers: int, out_dir: Path) -> Path:
+    """The scene's training images, rendered (or resumed) beside the checkpoint folder."""
+    from hsgplan.collect.images import ImagesConfig, collect_images
+
+    folder = out_dir.with_name(out_dir.name + "-images")
+    config = ImagesConfig(samples, seed, scene=str(scene))
+    with Progress(console=err, transient=True) as progress:
+        bar = progress.add_task(f"images of {scene.name}", total=config.chunks)
+        collect_images(config, folder, workers, None, lambda _: progress.advance(bar))
+    err.print(f"images of {scene} in {shown(folder)}", highlight=False)
+    return folder
 
 
 @refuses_bad_input

@@ -111,3 +111,20 @@ def test_networks_of_another_count_of_types_than_their_vocabulary_are_refused(tm
     write_vocabulary(folder, Vocabulary(fewer))
     with pytest.raises(InvalidInputError, match="name 6 and 6 types, its vocabulary 3"):
         PoseEstimator.load(folder)
+
+
+@pytest.mark.slow
+def test_one_command_renders_a_scenes_images_and_trains_an_f_p_of_its_groceries(tmp_path):
+    scene = tmp_path / "new.toml"
+    scene.write_text(to_toml(scene_data(NEW)))
+    config = tmp_path / "tiny.json"
+    config.write_text('{"epochs": 1, "width": 4, "stages": 1, "threads": 1}')
+    net = tmp_path / "net"
+    args = ["train", "perception", "--scene", str(scene), "--samples", "2", "--workers", "1",
+            "--config", str(config), "--out", str(net)]  # fmt: skip
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 0, r.output
+    assert collection_vocabulary(tmp_path / "net-images").types == tuple(NEW.object_types)
+    assert read_vocabulary(net).types == tuple(NEW.object_types)
+    both = CliRunner().invoke(app, [*args, "--images", str(tmp_path / "net-images")])
+    assert both.exit_code == 2 and "give it or --images" in both.output
