@@ -11,14 +11,15 @@ that view's look-alike of the pose being fitted.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
-from hsgplan.domain.world import ObjectType
-from hsgplan.perception.keypoints import PinholeCamera, canonical_rotation, cuboid
-from hsgplan.scene_graph.geometry import Pose
+from hsgplan.domain.world import Kind, ObjectType
+from hsgplan.perception.keypoints import PinholeCamera, cuboid
+from hsgplan.scene_graph.geometry import BOX_SYMMETRIES, Pose
 
 MIN_POINTS = 5  # solvePnP's iterative solver needs 4; one more guards against a bad peak
 # A keypoint further than this from where a pose projects it counts as this far: one wrong
@@ -85,18 +86,23 @@ def estimate_pose(t: ObjectType, views: list[ViewKeypoints]) -> PoseEstimate | N
 
 def robust_cost(t: ObjectType, views: list[ViewKeypoints], pose: Pose) -> float:
     """Squared reprojection error over every view's keypoints, each capped at `OUTLIER_PX`."""
-    r = _residuals(t, views, pose.matrix()).reshape(-1, 2)
-    return float(np.minimum((r**2).sum(axis=1), OUTLIER_PX**2).sum())
+    return float(_robust_costs(t, views, pose.matrix()[None])[0])
 
 
 def upright_fit(t: ObjectType, views: list[ViewKeypoints], position: tuple[float, ...]) -> Pose:
     """The upright pose at `position` whose yaw best explains every view's keypoints
-    (`robust_cost`), over `YAWS` yaws (a can's cuboid is named by the view: any yaw will do)."""
+    (`robust_cost`), over `YAWS` yaws (a can's cuboid is named by the view: any yaw will do).
+    The yaws are scored together, as one array per view."""
     yaws = np.linspace(0.0, np.pi, YAWS, endpoint=False)
-    return min(
-        (Pose.from_xyz_yaw(*position, float(y)) for y in yaws),
-        key=lambda p: robust_cost(t, views, p),
-    )
+    poses = [Pose.from_xyz_yaw(*position, float(y)) for y in yaws]
+    costs = _robust_costs(t, views, np.stack([p.matrix() for p in poses]))
+    return poses[int(np.argmin(costs))]  # the first of equals, as `min` takes
+
+
+def _robust_costs(t: ObjectType, views: list[ViewKeypoints], worlds: np.ndarray) -> np.ndarray:
+    r = _residuals_many(t, views, worlds)
+    squared = (r.reshape(len(worlds), -1, 2) ** 2).sum(axis=2)
+    return np.minimum(squared, OUTLIER_PX**2).sum(axis=1)
 
 
 def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
@@ -107,14 +113,40 @@ def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
 
 
 def _residuals(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
-    model, position = cuboid(t), world[:3, 3]
+    return _residuals_many(t, views, world[None])[0]
+
+
+def _residuals_many(t: ObjectType, views: list[ViewKeypoints], worlds: np.ndarray) -> np.ndarray:
+    """Each pose's reprojection residuals over every view's found keypoints, the cuboid named
+    by each view's look-alike of the pose (`keypoints.canonical_rotation`, here for many poses
+    at once): [N, 4, 4] -> [N, 2 * keypoints found]."""
+    model, positions = cuboid(t), worlds[:, :3, 3]
+    rotations = worlds[:, :3, :3].copy()
+    upside_down = rotations[:, 2, 2] < 0
+    rotations[upside_down] = rotations[upside_down] @ BOX_SYMMETRIES[1]
     out = []
     for view in views:
         found = ~np.isnan(view.pixels).any(axis=1)
-        rotation = canonical_rotation(t, world[:3, :3], position, view.camera.eye)
-        points = model[found] @ rotation.T + position
-        out.append((view.camera.project(points) - view.pixels[found]).ravel())
-    return np.concatenate(out) if out else np.zeros(0)
+        toward = view.camera.eye - positions  # [N, 3]
+        r = rotations
+        # the operations, and libm's trigonometry, of `canonical_rotation` for one pose, so
+        # that a pose scores here exactly as it scores alone
+        if t.kind is Kind.CAN:  # turned about its axis to face the view
+            local = (r.transpose(0, 2, 1) @ toward[:, :, None])[:, :, 0]
+            phi = [math.atan2(a, b) for a, b in local[:, 1::-1]]
+            spin = np.array([[[math.cos(f), -math.sin(f), 0.0], [math.sin(f), math.cos(f), 0.0],
+                              [0.0, 0.0, 1.0]] for f in phi])  # fmt: skip
+            r = r @ spin
+        else:  # its +x face towards the view
+            away = np.array([r[n, :, 0] @ toward[n] < 0 for n in range(len(r))], dtype=bool)
+            r = r.copy()
+            r[away] = r[away] @ BOX_SYMMETRIES[3]
+        points = model[found] @ r.transpose(0, 2, 1) + positions[:, None, :]
+        w = view.camera.world_to_camera
+        p = (points @ w[:3, :3].T + w[:3, 3]) @ view.camera.matrix.T
+        pixels = p[..., :2] / p[..., 2:3]
+        out.append((pixels - view.pixels[found]).reshape(len(worlds), -1))
+    return np.concatenate(out, axis=1) if out else np.zeros((len(worlds), 0))
 
 
 def _error(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> tuple[float, int]:
@@ -123,16 +155,16 @@ def _error(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> tupl
 
 
 def _refine(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
-    """Gauss-Newton on the pose (rotation vector, translation) over every view's keypoints."""
+    """Gauss-Newton on the pose (rotation vector, translation) over every view's keypoints;
+    the pose and its six nudged copies scored together for the forward differences."""
     rvec, tvec = cv2.Rodrigues(world[:3, :3])[0].ravel(), world[:3, 3].copy()
     x = np.concatenate([rvec, tvec])
+    nudges = np.vstack([np.zeros(6), np.eye(6) * 1e-6])
     for _ in range(10):
-        r = _residuals(t, views, _matrix(x[:3], x[3:]))
-        jac = np.empty((r.size, 6))
-        for i in range(6):
-            step = np.zeros(6)
-            step[i] = 1e-6
-            jac[:, i] = (_residuals(t, views, _matrix(*np.split(x + step, 2))) - r) / 1e-6
+        worlds = np.stack([_matrix(v[:3], v[3:]) for v in x + nudges])
+        r_all = _residuals_many(t, views, worlds)
+        r = r_all[0]
+        jac = ((r_all[1:] - r) / 1e-6).T
         dx = np.linalg.lstsq(jac, -r, rcond=None)[0]
         x = x + dx
         if np.linalg.norm(dx) < 1e-9:

@@ -1,0 +1,45 @@
+"""PnP's scoring of many poses at once: each pose scores exactly as the keypoints a camera
+names for it alone (`keypoints.view_keypoints`), so batching changes no estimate."""
+
+import numpy as np
+import pytest
+
+from hsgplan.domain.kitchen import KITCHEN
+from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
+from hsgplan.perception.pnp import ViewKeypoints, _residuals_many, robust_cost, upright_fit
+from hsgplan.perception.vocabulary import Vocabulary
+from hsgplan.scene_graph.geometry import Pose
+
+CAMERAS = [PinholeCamera.of(c) for c in Vocabulary(KITCHEN).views]
+POSES = [
+    Pose.from_xyz_yaw(0.45, 0.1, 0.05, 0.7),
+    Pose.from_xyz_yaw(0.30, -0.2, 0.15, -2.9),
+    Pose((0.5, 0.0, 0.1), (0.0, 1.0, 0.0, 0.0)),  # upside down
+    Pose((0.4, 0.3, 0.2), (0.3, -0.2, 0.5, 0.787)),
+]
+
+
+@pytest.mark.parametrize("type_name", ["cherries", "butter", "popcorn"])
+def test_many_poses_score_exactly_as_each_alone(type_name):
+    t = KITCHEN.object_type(type_name)
+    rng = np.random.default_rng(3)
+    views = []
+    for camera in CAMERAS[:3]:
+        pixels = rng.uniform(0, 240, size=(9, 2))
+        pixels[rng.random(9) < 0.3] = np.nan
+        views.append(ViewKeypoints(camera, pixels))
+    many = _residuals_many(t, views, np.stack([p.matrix() for p in POSES]))
+    for pose, row in zip(POSES, many, strict=True):
+        alone = [
+            (view_keypoints(t, pose, v.camera) - v.pixels)[~np.isnan(v.pixels).any(axis=1)]
+            for v in views
+        ]
+        assert np.array_equal(row, np.concatenate([a.ravel() for a in alone]))
+
+
+def test_the_upright_fit_finds_the_yaw_the_keypoints_were_made_at():
+    t = KITCHEN.object_type("butter")
+    truth = Pose.from_xyz_yaw(0.45, 0.1, 0.012, 0.7)
+    views = [ViewKeypoints(c, view_keypoints(t, truth, c)) for c in CAMERAS[:3]]
+    fit = upright_fit(t, views, truth.position)
+    assert robust_cost(t, views, fit) < 1.0
