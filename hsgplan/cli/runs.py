@@ -97,6 +97,14 @@ def compare(
             "differ, its name says which.",
         ),
     ] = False,
+    trainings: Annotated[
+        int,
+        typer.Option(
+            help="Eval task runs: each row is this many consecutive runs, one per training of "
+            "a configuration; its cells give an interval over trainings and goals.",
+            min=1,
+        ),
+    ] = 1,
     markdown: MarkdownFlag = False,
 ) -> None:
     """A method's success per size across eval world runs, one row each: a ladder from one
@@ -104,7 +112,7 @@ def compare(
     repeats, seed, sizes, scene, rules off); only their checkpoints, and the method when one is
     named per run, may differ (with --across-scenes the scene, with --across-rules the rules
     off). Eval task runs (the symbolic loop) are compared the same way, on the same episodes."""
-    from hsgplan.evaluation.compare import all_task_runs, compare_task
+    from hsgplan.evaluation.compare import all_task_runs, compare_task, compare_task_trainings
     from hsgplan.evaluation.compare import compare as compare_runs
 
     methods = [m.strip() for m in method.split(",")]
@@ -115,7 +123,18 @@ def compare(
             raise InvalidInputError(
                 "--across-scenes and --across-rules compare eval world runs only"
             )
-        t = compare_task(runs, row_names)
+        if trainings > 1:
+            given = names_of(names, "--names", "row") if names else None
+            rows = len(runs) // trainings
+            t = compare_task_trainings(
+                runs, given or [f"row {k + 1}" for k in range(rows)], trainings
+            )
+        else:
+            t = compare_task(runs, row_names)
     else:
+        if trainings > 1:
+            raise InvalidInputError(
+                "--trainings groups eval task runs; an eval world run holds its trainings"
+            )
         t = compare_runs(runs, row_names, methods, across_scenes, across_rules)
     print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

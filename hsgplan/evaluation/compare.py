@@ -161,6 +161,47 @@ def compare_task(runs: Sequence[Path], names: Sequence[str]) -> TextTable:
     return TextTable(title, ("run", *(f"{n} objects" for n in sizes)), tuple(rows))
 
 
+def compare_task_trainings(runs: Sequence[Path], names: Sequence[str], trainings: int) -> TextTable:
+    """One row per `trainings` consecutive `eval task` runs (a configuration trained that many
+    times, each training run on the same episodes): the success rate's mean over trainings
+    and goals with its 95% interval (a bootstrap drawing trainings and goals), and subgoal
+    completion's mean, per size."""
+    from hsgplan.evaluation.intervals import training_goal_interval
+    from hsgplan.evaluation.task_eval import _episode
+
+    if trainings < 1 or len(runs) % trainings:
+        raise InvalidInputError(
+            f"{len(runs)} runs in rows of {trainings} trainings: give each row all its runs"
+        )
+    rows_of = [runs[k : k + trainings] for k in range(0, len(runs), trainings)]
+    if len(names) != len(rows_of):
+        raise InvalidInputError(f"{len(rows_of)} rows and {len(names)} names: name each row once")
+    protocol, per_size, _ = task_summaries(runs)  # like for like, or refused
+    episodes = [[_episode(r["result"]) for r in logged_rows(run)] for run in runs]
+    sizes = sorted({e.size for e in episodes[0]})
+    table = []
+    for k, name in enumerate(names):
+        group = episodes[k * trainings : (k + 1) * trainings]
+        cells = []
+        for n in sizes:
+            won: dict = {}
+            done = []
+            for t, eps in enumerate(group):
+                for e in (e for e in eps if e.size == n):
+                    won.setdefault((t, (e.goal, e.seed)), []).append(float(e.success))
+                    done.append(e.subgoal_completion)
+            mean = sum(sum(v) / len(v) for v in won.values()) / len(won)
+            low, high = training_goal_interval(won) or (mean, mean)
+            cells.append(f"{mean:.2f} ({low:.2f}–{high:.2f}) / {sum(done) / len(done):.2f}")
+        table.append((name, *cells))
+    title = (
+        f"Success rate / subgoal completion in the symbolic loop by configuration ({protocol}): "
+        f"{per_size} goals per size, each run once under each of {trainings} trainings (in "
+        "brackets the 95% interval of a bootstrap that draws trainings and goals)"
+    )
+    return TextTable(title, ("configuration", *(f"{n} objects" for n in sizes)), tuple(table))
+
+
 def task_summaries(runs: Sequence[Path]) -> tuple[str, int, list[dict]]:
     """The protocol's name, the goals per size, and each `eval task` run's summary by size.
 

@@ -167,3 +167,24 @@ def test_a_ladder_of_recovery_rules_stands_side_by_side_when_told(tmp_path):
     seeded = _run(tmp_path / "seeded", {2: (True, True)}, seed=4)
     with pytest.raises(InvalidInputError, match="differ in seed"):  # the rest stays like for like
         compare([off, seeded], ["off", "seeded"], ["gnn"], across_rules=True)
+
+
+def test_task_runs_of_three_trainings_make_one_row_with_an_interval(tmp_path):
+    from hsgplan.evaluation.compare import compare_task_trainings
+
+    seeds = (1, 2, 3, 4)
+    ours = [_task_run(tmp_path / f"o{k}", (True, True, True, k > 0), seeds=seeds) for k in range(3)]
+    theirs = [
+        _task_run(tmp_path / f"t{k}", (True, False, False, False), seeds=seeds) for k in range(3)
+    ]
+    table = compare_task_trainings([*theirs, *ours], ["theirs", "ours"], 3)
+    cells = [row[1] for row in table.rows]
+    assert cells[0].startswith("0.25 (") and cells[1].startswith("0.92 (")
+    low, high = (float(v) for v in cells[1].split("(")[1].split(")")[0].split("–"))
+    assert low < 0.92 <= high <= 1.0  # a training that lost a goal widens the interval
+    assert "each run once under each of 3 trainings" in table.title
+    args = ["eval", "compare", *map(str, [*theirs, *ours]), "--trainings", "3"]
+    r = CliRunner().invoke(app, [*args, "--names", "theirs,ours", "--markdown"])
+    assert r.exit_code == 0 and "| ours | 0.92 (" in r.stdout
+    r = CliRunner().invoke(app, [*args[:-2], "--trainings", "4"])
+    assert r.exit_code == 2 and "rows of 4 trainings" in r.stderr
