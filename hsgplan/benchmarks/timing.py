@@ -168,6 +168,7 @@ def run_timing(
         "seed": seed,
         "split": split,
         "workers": workers,
+        "protocol": config.protocol,
         "run": str(out),
     } | ({} if scene is None else {"scene": scene})
     write_atomically(out / "summary.json", json.dumps(report, indent=2) + "\n")
@@ -237,6 +238,7 @@ def tables(report: dict) -> list[TextTable]:
         + (f"in {report['scene']}, " if "scene" in report else "")
         + f"{report['workers']} worker(s): the search baseline ({LABELS[name]}) against ours, "
         "beside the paper's Table 2; task medians (quartiles), their ratio, motion medians"
+        + (f"; success under the {report['protocol']} protocol" if "protocol" in report else "")
     )
     title = marked(title, report["seed"], split=report.get("split"))
     return [TextTable(title, header, tuple(rows))]

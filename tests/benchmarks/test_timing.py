@@ -46,3 +46,4 @@ def test_run_writes_both_agents_on_the_same_goals(tmp_path):
     assert f"{PAPER_TABLE2['pddlstream'][2][0]:g}" in text
     assert (tmp_path / "table2.png").stat().st_size > 5000
     assert tables(report)[0].rows[0][0] == "2"
+    assert "; success under the paper protocol" in tables(report)[0].title
