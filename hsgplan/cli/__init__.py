@@ -1,7 +1,7 @@
 """The `hsgplan` command. It parses, calls the package and prints; nothing else lives here.
 
 One module per group of commands: `symbolic` (plan, goals), `world` (demo, eval world, report),
-`scenes` (layouts), `data` (collect), `learn` (train task, eval task, eval reach), `motion`
+`scenes` (layouts), `data` (collect), `learn` (train task, eval task, eval reach, labels), `motion`
 (train motion, eval motion), `perception` (train perception, eval perception), `bench` and
 `bench_motion` (the measurements behind the motion constants); `renamed` refuses the older
 spellings.
@@ -64,7 +64,7 @@ app.add_typer(learn.train_app, name="train")
 app.add_typer(bench.app, name="bench")
 app.add_typer(splits.app, name="splits")
 app.command()(seeding.rules)
-app.command()(seeding.labels)
+app.command()(learn.labels)
 app.command()(results.results)
 bench.app.command("push-reach")(bench_motion.push_reach)
 bench.app.command("line-error")(bench_motion.line_error)

@@ -359,3 +359,30 @@ def _scenes_shown(scene: Path) -> str:
     if scene.is_dir():
         return f"each of the {len(list(scene.glob('*.toml')))} scenes in {scene}"
     return f"scene {scene}"
+
+
+@refuses_bad_input
+def labels(
+    checkpoints: Annotated[
+        list[Path] | None,
+        typer.Argument(
+            help="Task checkpoints or motion networks' folders (default: the shipped agent's).",
+            parser=input_path,
+            show_default=False,
+        ),
+    ] = None,
+    markdown: MarkdownFlag = False,
+) -> None:
+    """Where every training label of the networks comes from and who labelled it: each
+    source's examples and labels (by class), the hand-written rules among them named."""
+    from hsgplan.evaluation.labels import label_rows
+    from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
+
+    shipped = [TASK_CHECKPOINT, *(MOTION_CHECKPOINTS / n for n in ("place-gnn", "push-gnn"))]
+    rows = [r for c in checkpoints or shipped for r in label_rows(c)]
+    print_table(
+        "Where the networks' training labels come from (counts of the trained checkpoints)",
+        ("network", "source", "examples", "labels", "by class", "labelled by"),
+        [(r.network, r.source, str(r.examples), str(r.labels), r.by_class, r.who) for r in rows],
+        markdown,
+    )

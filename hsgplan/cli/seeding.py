@@ -3,18 +3,11 @@ rules it runs under, and `hsgplan rules`, which lists those rules."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from hsgplan.cli.common import (
-    bounded_option,
-    choice,
-    input_path,
-    print_table,
-    refuses_bad_input,
-)
+from hsgplan.cli.common import MarkdownFlag, bounded_option, choice, print_table, refuses_bad_input
 
 SplitName = choice("SplitName", ("tune", "test"))
 SplitOption = Annotated[
@@ -93,9 +86,7 @@ def split_seed(seed: int | None, split) -> int:
 
 @refuses_bad_input
 def rules(
-    markdown: Annotated[
-        bool, typer.Option("--markdown", help="Print Markdown.", metavar="")
-    ] = False,
+    markdown: MarkdownFlag = False,
 ) -> None:
     """Every rule a run may switch off or set: the recovery rules (--rules-off), f_p's
     (--perception-rules) and the motion planner's (--plan-rules), each as shipped."""
@@ -110,34 +101,5 @@ def rules(
         "sim/plan_rules.py)",
         ("option", "rule", "shipped", "paper protocol", "what it does"),
         rows,
-        markdown,
-    )
-
-
-@refuses_bad_input
-def labels(
-    checkpoints: Annotated[
-        list[Path] | None,
-        typer.Argument(
-            help="Task checkpoints or motion networks' folders (default: the shipped agent's).",
-            parser=input_path,
-            show_default=False,
-        ),
-    ] = None,
-    markdown: Annotated[
-        bool, typer.Option("--markdown", help="Print Markdown.", metavar="")
-    ] = False,
-) -> None:
-    """Where every training label of the networks comes from and who labelled it: each
-    source's examples and labels (by class), the hand-written rules among them named."""
-    from hsgplan.evaluation.labels import label_rows
-    from hsgplan.paths import MOTION_CHECKPOINTS, TASK_CHECKPOINT
-
-    shipped = [TASK_CHECKPOINT, *(MOTION_CHECKPOINTS / n for n in ("place-gnn", "push-gnn"))]
-    rows = [r for c in checkpoints or shipped for r in label_rows(c)]
-    print_table(
-        "Where the networks' training labels come from (counts of the trained checkpoints)",
-        ("network", "source", "examples", "labels", "by class", "labelled by"),
-        [(r.network, r.source, str(r.examples), str(r.labels), r.by_class, r.who) for r in rows],
         markdown,
     )

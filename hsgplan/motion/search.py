@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import itertools
 import json
-from dataclasses import asdict, fields, replace
+from dataclasses import asdict, fields
 from pathlib import Path
 
 from hsgplan.domain.checks import read_json
@@ -91,7 +91,7 @@ def summarize(root: Path, configs: list[MotionTrainConfig], grid: dict[str, list
             }
         )
     best = min(rows, key=lambda r: (r["validation_loss"], r["combination"]))
-    chosen = replace(configs[best["combination"]])
+    chosen = configs[best["combination"]]
     report = {"grid": grid, "rows": rows, "chosen": best["combination"]}
     write_atomically(root / SEARCH, json.dumps(report, indent=2) + "\n")
     write_atomically(root / CHOSEN, json.dumps(asdict(chosen), indent=2) + "\n")
