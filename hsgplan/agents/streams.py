@@ -26,7 +26,6 @@ from hsgplan.domain.world import (
     REACH_MAX_Z,
     Kind,
     World,
-    spot_cells,
 )
 from hsgplan.motion.sampler import (
     HAND_DROP,
@@ -108,7 +107,7 @@ def bin_order(
     (Measured on one 6-object goal: with every bin drawn uniformly, no plan was found within
     three levels, and the fourth held 3.8 million facts; cells first, the third had a plan.)"""
     grid = [(xb, yb) for xb in range(PLACE_BINS) for yb in range(PLACE_BINS)]
-    cells = spot_cells(world.surface_rect(surface))
+    cells = world.spot_cells(surface)
     first: list[tuple[int, int]] = []
     for i in rng.permutation(len(cells)):
         centre = cells[i]

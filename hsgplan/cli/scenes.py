@@ -108,9 +108,10 @@ def check(
     ],
     markdown: MarkdownFlag = False,
 ) -> None:
-    """What a scene file's sizes allow: each surface's and interior's capacity, how high a
-    tower may rise and which object sets it, where each object fits and whether it carries
-    another. A scene the robot cannot work in is refused with every reason (exit code 2)."""
+    """What a scene file's sizes allow: each surface's and interior's capacity and the places the
+    arm reaches, the cell objects are counted in, how high a tower may rise and which object sets
+    it, where each object fits and whether it carries another. A scene the robot cannot work in is
+    refused with every reason (exit code 2)."""
     from hsgplan.domain.scene_file import read_world
     from hsgplan.domain.scene_limits import scene_limits
 
@@ -118,7 +119,7 @@ def check(
     limits = scene_limits(world)
     print_table(
         f"Surfaces of '{world.name}' ({file})",
-        ("surface", "kind", "height m", "objects it holds", "in goals"),
+        ("surface", "kind", "height m", "objects it holds", "places reached", "in goals"),
         list(limits.surfaces),
         markdown,
     )
@@ -134,4 +135,5 @@ def check(
         list(limits.objects),
         markdown,
     )
+    out.print(limits.cell, highlight=False)
     out.print(limits.tower, highlight=False)

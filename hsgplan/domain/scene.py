@@ -195,12 +195,18 @@ def shelf_boards(shelf: Shelf) -> tuple[Board, ...]:
 
 GRIPPER_MAX_OPENING = 0.08
 
-# The cell each resting object is given when a surface is counted: the grid of SPOT cells that
+# The least cell each resting object is given when a surface is counted: the grid of cells that
 # fits on a surface, with objects resting long side along y (`PLACE_LONG_AXIS_YAW`), leaves
-# every object at least 1.5 cm of room for the open fingers. Measured: with 10 cm cells two
-# boxes (10.4 cm) cannot lie in a 22 cm deep shelf top with that room. Counting cells (not
-# areas) keeps capacities small integers that the PDDL domain can encode.
+# every kitchen object at least 1.5 cm of room for the open fingers. Measured: with 10 cm cells
+# two boxes (10.4 cm) cannot lie in a 22 cm deep shelf top with that room. Counting cells (not
+# areas) keeps capacities small integers that the PDDL domain can encode. A scene with larger
+# objects counts in larger cells (`World.cell`).
 SPOT = 0.11
+# A cell holds its scene's largest footprint with this room: across the grasp (x) the open
+# fingers' on either side; along the long side (y) the gap the kitchen's cells leave between its
+# two longest boxes (11 cm cells, 10.4 cm boxes).
+FINGER_ROOM = 0.015
+ALONG_GAP = 0.006
 
 # A top face narrower than this does not hold another object steadily (popcorn's 3.8 cm does not).
 MIN_SUPPORT_SIDE = 0.045
@@ -208,6 +214,12 @@ MIN_SUPPORT_SIDE = 0.045
 # Highest a tower's top may rise above the table: the hand holds the top object from above and
 # still needs room to approach and to withdraw.
 REACH_MAX_Z = 0.40
+
+# Farthest from the base's axis (horizontally) the hand reaches top-down at every height up to
+# `REACH_MAX_Z`: the arm's inverse kinematics reaches 0.74-0.81 m in directions 0-120 degrees
+# off +x (least at the top height), kept 2 cm inside the least (a test holds the arm to it). A
+# surface all of whose cells lie farther is out of reach.
+REACH_MAX_XY = 0.72
 
 # The robot's base on the table, around the origin: the collision box of the Panda's base link
 # (its URDF; a test holds this to it). No fixture may stand on it.
@@ -221,19 +233,16 @@ INTERIOR_SPOT = 0.09
 OPEN_SPACE = "open_space"
 
 
-def spot_cells(rect: Rect) -> list[tuple[float, float]]:
-    """Centres of the cells a surface is counted in (its capacity), spread evenly over it."""
-    nx, ny = math.floor(rect.width_x / SPOT + 1e-9), math.floor(rect.width_y / SPOT + 1e-9)
+def spot_cells(rect: Rect, cell: tuple[float, float] = (SPOT, SPOT)) -> list[tuple[float, float]]:
+    """Centres of the cells (at least `cell` wide along x and y) a surface is counted in (its
+    capacity), spread evenly over it."""
+    nx = math.floor(rect.width_x / cell[0] + 1e-9)
+    ny = math.floor(rect.width_y / cell[1] + 1e-9)
     return [
         (rect.x_min + rect.width_x * (i + 0.5) / nx, rect.y_min + rect.width_y * (j + 0.5) / ny)
         for i in range(nx)
         for j in range(ny)
     ]
-
-
-def capacity(rect: Rect) -> int:
-    """How many objects fit side by side on a rectangle: its SPOT cells."""
-    return len(spot_cells(rect))
 
 
 @dataclass(frozen=True)
@@ -284,8 +293,21 @@ class World:
         return self.shelves[name].top
 
     @cached_property
+    def cell(self) -> tuple[float, float]:
+        """The cell (along x, along y) each resting object is counted in: the scene's widest
+        and longest footprints with their room, never below the measured `SPOT`, so that any
+        mix of its objects fits the count (as towers are counted with the tallest)."""
+        widest = max(t.size[0] for t in self.type_list)
+        longest = max(t.size[1] for t in self.type_list)
+        return max(SPOT, widest + 2 * FINGER_ROOM), max(SPOT, longest + ALONG_GAP)
+
+    def spot_cells(self, surface: str) -> list[tuple[float, float]]:
+        """Centres of the cells a named surface is counted in."""
+        return spot_cells(self.surface_rect(surface), self.cell)
+
+    @cached_property
     def surface_capacity(self) -> dict[str, int]:
-        return {name: capacity(self.surface_rect(name)) for name in self.surfaces}
+        return {name: len(self.spot_cells(name)) for name in self.surfaces}
 
     @cached_property
     def goal_top_room(self) -> int:

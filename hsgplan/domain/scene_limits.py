@@ -1,22 +1,25 @@
 """What a scene's sizes allow, said plainly (`hsgplan scenes check FILE`): how many objects each
-surface and interior holds, how high a tower may rise and which object sets that, where each
-object type fits and whether it carries another. Read from the `World`, the same properties
-the transition model, the goal sampler and the PDDL count with, so the report cannot drift
-from what the planners are held to."""
+surface and interior holds and how many of those places the arm reaches, the cell each object is
+counted in and which object sets it, how high a tower may rise and which object sets that, where
+each object type fits and whether it carries another. Read from the `World`, the same properties the
+transition model, the goal sampler and the PDDL count with, so the report cannot drift from what the
+planners are held to."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-from hsgplan.domain.scene import REACH_MAX_Z, World
+from hsgplan.domain.scene import REACH_MAX_XY, REACH_MAX_Z, SPOT, World
 
 
 @dataclass(frozen=True)
 class SceneLimits:
-    surfaces: tuple[tuple[str, ...], ...]  # name, kind, height (m), capacity, in goals
+    surfaces: tuple[tuple[str, ...], ...]  # name, kind, height (m), capacity, reached, in goals
     interiors: tuple[tuple[str, ...], ...]  # shelf, clearance (m), capacity, what fits
     objects: tuple[tuple[str, ...], ...]  # type, size (cm), carries another, fits inside
     tower: str  # how many objects a tower holds, and why
+    cell: str  # the cell each object is counted in, and what sets it
 
 
 def scene_limits(world: World) -> SceneLimits:
@@ -26,6 +29,7 @@ def scene_limits(world: World) -> SceneLimits:
             "region" if name in world.regions else "shelf top",
             f"{world.surface_rect(name).z:.3f}",
             str(world.surface_capacity[name]),
+            str(sum(math.hypot(x, y) <= REACH_MAX_XY for x, y in world.spot_cells(name))),
             "yes" if name in world.goal_shelf_tops else "—",
         )
         for name in world.surfaces
@@ -48,7 +52,24 @@ def scene_limits(world: World) -> SceneLimits:
         )
         for t in world.type_list
     )
-    return SceneLimits(surfaces, interiors, objects, _tower(world))
+    return SceneLimits(surfaces, interiors, objects, _tower(world), _cell(world))
+
+
+def _cell(world: World) -> str:
+    cx, cy = world.cell
+    widest = max(world.type_list, key=lambda t: t.size[0])
+    longest = max(world.type_list, key=lambda t: t.size[1])
+    why = [
+        f"{along}: {'the least measured' if c <= SPOT else f'set by {t.name} ({100 * v:.1f} cm)'}"
+        for along, c, t, v in (
+            ("across", cx, widest, widest.size[0]),
+            ("along", cy, longest, longest.size[1]),
+        )
+    ]
+    return (
+        f"each object is counted in a cell of {100 * cx:.1f} x {100 * cy:.1f} cm ({'; '.join(why)}"
+        f"); a place counts as reached within {REACH_MAX_XY} m of the robot's base"
+    )
 
 
 def _tower(world: World) -> str:

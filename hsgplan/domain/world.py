@@ -17,22 +17,18 @@ from hsgplan.domain.scene import (
     MAX_OBJECTS,
     MIN_SUPPORT_SIDE,
     REACH_MAX_Z,
-    SPOT,
     Board,
     Kind,
     ObjectType,
     Rect,
     Shelf,
     World,
-    capacity,
     shelf_boards,
-    spot_cells,
 )
 
 __all__ = [
     "GRIPPER_MAX_OPENING", "INTERIOR_SPOT", "MAX_OBJECTS", "MIN_SUPPORT_SIDE", "REACH_MAX_Z",
-    "SPOT", "Board", "Kind", "ObjectType", "Rect", "Shelf", "World", "capacity", "shelf_boards",
-    "spot_cells",
+    "Board", "Kind", "ObjectType", "Rect", "Shelf", "World", "shelf_boards",
 ]  # fmt: skip
 
 # --- motion primitive parameters (the paper's discretisation) ---

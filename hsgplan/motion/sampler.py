@@ -25,11 +25,9 @@ from hsgplan.domain.parameters import (
 from hsgplan.domain.world import (
     PLACE_BINS,
     PLACE_LONG_AXIS_YAW,
-    SPOT,
     Kind,
     ObjectType,
     Rect,
-    spot_cells,
 )
 from hsgplan.motion.interface import DO_NOT_RETRY, DRY_RUNS, Feasibility, SingleShotMemory
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
@@ -123,10 +121,11 @@ def place_candidates(
     rect, t = world.surface_rect(target), world.object_type(obj)
     others, above = _on_rect(sg, rect, ignore=obj)
     hx, hy = _half_extents(t, PLACE_LONG_AXIS_YAW)
+    cx, cy = world.cell
     free = [
         c
-        for c in spot_cells(rect)
-        if all(abs(c[0] - o[0]) > SPOT / 2 or abs(c[1] - o[1]) > SPOT / 2 for o in others)
+        for c in world.spot_cells(target)
+        if all(abs(c[0] - o[0]) > cx / 2 or abs(c[1] - o[1]) > cy / 2 for o in others)
     ]
     slots = []
     if next_push:

@@ -17,7 +17,7 @@ from hsgplan.domain.errors import UnsampledSceneError
 from hsgplan.domain.parameters import place_inset
 from hsgplan.domain.predicates import Predicate
 from hsgplan.domain.scene import EntityKind
-from hsgplan.domain.world import Kind, World, spot_cells
+from hsgplan.domain.world import Kind, World
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.scene_graph.symbol_mapping import map_symbols
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
@@ -114,7 +114,7 @@ def free_spot(
     # Boxes lie long side along y, as they are placed (a cell is too short for them the other
     # way round); cans may stand any way.
     turns = [0.0, math.pi] if t.kind is Kind.BOX else [0.0, math.pi / 2]
-    cells = spot_cells(r)
+    cells = world.spot_cells(surface)
     rng.shuffle(cells)
     for cx, cy in cells:
         for k in range(TRIES_PER_CELL + 1):

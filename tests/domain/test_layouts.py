@@ -102,14 +102,16 @@ def test_a_scene_too_small_for_a_goal_is_refused_in_one_line():
 
 
 def _three_shelves():
-    """The kitchen with a third shelf beyond shelf_a, on the same side of the robot."""
+    """The kitchen with a third shelf beyond shelf_a, on the same side of the robot (the open
+    space narrowed, so that both shelves on that side stand within the arm's reach)."""
     import tomllib
 
     from hsgplan.domain.scene_file import scene_data, to_toml, world_of
 
     data = tomllib.loads(to_toml(scene_data(KITCHEN)))
     data["table"]["y"] = [-1.2, 1.2]  # room beyond shelf_a for shelves of the layouts' widths
-    third = dict(data["shelves"][0], name="shelf_c", y=[0.56, 0.80])
+    data["regions"][0]["y"] = [-0.07, 0.07]
+    third = dict(data["shelves"][0], name="shelf_c", x=[0.30, 0.52], y=[0.56, 0.80])
     third.pop("prepush", None)
     data["shelves"].append(third)
     return data, world_of
@@ -125,10 +127,14 @@ def test_shelves_sharing_a_side_keep_their_order_outwards_and_never_overlap():
 
 
 def test_a_scene_no_draw_can_vary_is_refused_with_what_refused_most_draws():
-    from hsgplan.domain.errors import InvalidInputError
+    import tomllib
 
-    data, world_of = _three_shelves()
-    data["objects"][3]["size"] = [0.038, 0.085, 0.25]  # no tower of two such boxes stays in reach
+    from hsgplan.domain.errors import InvalidInputError
+    from hsgplan.domain.scene_file import scene_data, to_toml, world_of
+
+    data = tomllib.loads(to_toml(scene_data(KITCHEN)))
+    # no tower of two such boxes (resized, 16 to 24 cm) stays in reach on any shelf top
+    data["objects"][3]["size"] = [0.038, 0.085, 0.20]
     with pytest.raises(InvalidInputError) as e:
         layouts.random_layout(world_of(data), 3, 0)
     said = str(e.value)

@@ -158,28 +158,33 @@ _places = [["name"], ["table"], ["table", "x"], ["regions", 0, "x"], ["shelves",
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(place=st.sampled_from(_places), value=_values)
-def test_any_value_anywhere_is_read_or_refused_in_one_line(place, value):
+def test_any_value_anywhere_is_read_or_refused_a_line_a_reason(place, value):
+    # one line for each thing refused (a table moved off every fixture refuses each of them)
     data = copy.deepcopy(KITCHEN)
     _set(place, value)(data)
     try:
         world_of(data)
     except InvalidInputError as e:
-        assert str(e).startswith("scene: ") and "\n" not in str(e)
+        lines = str(e).split("\n")
+        assert all(line.startswith("scene: ") and len(line) > 7 for line in lines)
+        assert len(set(lines)) == len(lines)
 
 
 def test_a_scene_the_robot_cannot_work_in_is_refused_with_every_reason():
-    # a shelf moved onto the robot's base, a shelf so tall that nothing on its top stays within
-    # reach, and a box too long for every surface (the open space made small) and too tall for
-    # every shelf: a line for each
+    # a shelf moved onto the robot's base, a region beyond the arm's reach, a shelf so tall that
+    # nothing on its top stays within reach, a box too long for every surface (the open space
+    # made small) and too tall for every shelf, whose length leaves two regions narrower than a
+    # cell, and a vase that stands on the floor but would rise past the reach on a shelf's top
     data = copy.deepcopy(KITCHEN)
     data["regions"][0]["x"], data["regions"][0]["y"] = [0.26, 0.4], [-0.1, 0.1]
     data["shelves"][0]["x"], data["shelves"][0]["y"] = [-0.1, 0.12], [-0.3, 0.02]
     del data["shelves"][0]["prepush"]
     data["shelves"][1]["clearance"] = 0.36
-    data["objects"].append(
-        {"name": "crate", "kind": "box", "size": [0.07, 0.3, 0.28], "colour": [0.5, 0.5, 0.5, 1]}
-        | {"mass": 0.5, "friction": 0.8}
-    )
+    data["regions"].append({"name": "far_side", "x": [0.64, 0.99], "y": [-0.79, -0.40]})
+    data["objects"] += [
+        {"name": "crate", "kind": "box", "size": [0.07, 0.30, 0.28], "colour": [0.5, 0.5, 0.5]},
+        {"name": "vase", "kind": "box", "size": [0.05, 0.06, 0.30], "colour": [0.2, 0.5, 0.5]},
+    ]
     with pytest.raises(InvalidInputError) as refused:
         world_of(data, "scene file 'mine.toml'")
     lines = str(refused.value).splitlines()
@@ -187,11 +192,36 @@ def test_a_scene_the_robot_cannot_work_in_is_refused_with_every_reason():
     said = [
         "shelf 'shelf_a' stands on the robot's base",
         "region 'prepush_a' stands on the robot's base",  # the prepush region derived before it
+        "region 'open_space' holds no object: it is smaller than a cell of 11.0 x 30.6 cm",
+        "region 'prepush_a' holds no object",
+        "region 'prepush_b' holds no object",
+        "region 'far_side': every place on it lies beyond the arm's reach (0.72 m",
         "shelf 'shelf_b': its top at 0.380 m leaves no object within reach",
         "object 'crate' (7.0 x 30.0 x 28.0 cm) fits on no surface within reach",
+        "object 'vase' (0.300 m high) would rise to 0.440 m on the top of shelf 'shelf_a'",
     ]
-    assert len(lines) == len(said) and all(w in line for w, line in zip(said, lines, strict=True))
+    assert len(lines) == len(said), lines
+    assert all(w in line for w, line in zip(said, lines, strict=True)), lines
     assert world_of(KITCHEN) is not None  # the kitchen itself has nothing of the kind
+
+
+def test_a_scene_counts_its_surfaces_in_cells_its_largest_footprint_fits():
+    # the kitchen's objects fit the measured 11 cm cells; a 13 cm box widens the cells along
+    # its long side (y), and the open space (40 cm across) holds two rows of them, not three
+    kitchen = world_of(KITCHEN)
+    assert kitchen.cell == (0.11, 0.11)
+    data = copy.deepcopy(KITCHEN)
+    data["objects"][4]["size"] = [0.053, 0.13, 0.024]
+    data["objects"][0]["size"] = [0.079, 0.079, 0.058]  # as wide as the gripper opens, with
+    wide = world_of(data)  # the fingers' room, fits 11 cm across
+    assert wide.cell == pytest.approx((0.11, 0.136))
+    assert kitchen.surface_capacity["open_space"] == 4 * 3
+    assert wide.surface_capacity["open_space"] == 4 * 2
+    for name in wide.surfaces:  # every cell holds the longest box with its gap
+        rect, cells = wide.surface_rect(name), wide.spot_cells(name)
+        assert len(cells) == wide.surface_capacity[name]
+        rows = len({round(y, 9) for _, y in cells})
+        assert rows == 0 or rect.width_y / rows >= 0.136
 
 
 def test_the_robots_base_is_its_urdfs_base_link():
@@ -224,9 +254,18 @@ def test_scenes_check_says_which_object_limits_a_tower_and_what_fits_where(tmp_p
     path.write_text(to_toml(data))
     r = CliRunner().invoke(app, ["scenes", "check", str(path), "--markdown"])
     assert r.exit_code == 0, r.output
-    assert "| shelf_a | shelf top | 0.140 | 4 | yes |" in r.output
+    assert "| shelf_a | shelf top | 0.140 | 4 | 4 | yes |" in r.output
     assert "| popcorn | 3.8 x 8.5 x 15.0 | no | — |" in r.output
     tower = " ".join(r.output.split())
     assert "a tower holds at most 1 object: 1 of the tallest, popcorn (0.150 m)" in tower
     kitchen = CliRunner().invoke(app, ["scenes", "check", str(KITCHEN_SCENE), "--markdown"])
-    assert "at most 2 objects" in " ".join(kitchen.output.split())
+    said = " ".join(kitchen.output.split())
+    assert "at most 2 objects" in said
+    assert "a cell of 11.0 x 11.0 cm (across: the least measured; along: the least" in said
+    data["objects"][4]["size"] = [0.053, 0.13, 0.024]  # a longer cream cheese sets the cells
+    path.write_text(to_toml(data))
+    long = CliRunner().invoke(app, ["scenes", "check", str(path), "--markdown"])
+    said = " ".join(long.output.split())
+    assert (
+        "a cell of 11.0 x 13.6 cm (across: the least measured; along: set by cream_cheese" in said
+    )

@@ -74,3 +74,36 @@ def test_the_objects_the_arm_stands_in_are_named_and_none_where_it_stands_free(s
     pose = scene.pose("cherries")
     scene.set_pose("cherries", type(pose)((x, y, z + 0.05), pose.orientation))  # in the hand
     assert overlapped(scene) == ("cherries",)
+
+
+def test_the_hands_horizontal_reach_is_the_arms():
+    # top-down at every height a held object may rise to, in directions 0-120 degrees: the
+    # arm reaches REACH_MAX_XY and does not reach 14 cm beyond it (a larger constant would
+    # accept scenes whose places the arm cannot reach)
+    import math
+
+    import pybullet as p
+    from pybullet_utils.bullet_client import BulletClient
+
+    from hsgplan.domain.scene import REACH_MAX_XY, REACH_MAX_Z
+    from hsgplan.scene_graph.geometry import Pose
+    from hsgplan.sim.robot import Panda, topdown
+
+    bc = BulletClient(p.DIRECT)
+    try:
+        robot, rng = Panda(bc, visuals=False), np.random.default_rng(0)
+
+        def reaches(r, z, direction):
+            at = (r * math.cos(direction), r * math.sin(direction), z)
+            return any(
+                robot.ik(Pose(at, topdown(direction + turn)), rng, restarts=6) is not None
+                for turn in (0.0, math.pi / 2)
+            )
+
+        for z in (0.02, REACH_MAX_Z / 2, REACH_MAX_Z):
+            for degrees in (0, 60, 120):
+                direction = math.radians(degrees)
+                assert reaches(REACH_MAX_XY, z, direction), (z, degrees)
+                assert not reaches(REACH_MAX_XY + 0.14, z, direction), (z, degrees)
+    finally:
+        bc.disconnect()
