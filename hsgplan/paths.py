@@ -23,6 +23,9 @@ TASK_CHECKPOINT = CHECKPOINTS / "task"
 PAPER_TASK_CHECKPOINT = CHECKPOINTS / "task-paper"  # the paper's recipe: 18 demonstrations alone
 MOTION_CHECKPOINTS = CHECKPOINTS / "motion"
 PERCEPTION_CHECKPOINT = CHECKPOINTS / "perception"  # f_p's keypoint network
+# The networks that read kind and size, not names: the default in a scene of other objects
+TASK_GEOMETRY_CHECKPOINT = CHECKPOINTS / "task-geometry"
+MOTION_GEOMETRY_CHECKPOINTS = CHECKPOINTS / "motion-geometry"
 DEMOS = DATA / "demos" / "v1"
 MOTION_DATA = DATA / "motion"
 REACH_DATA = DATA / "reach" / "v1"  # primitives executed in the simulated world: f_reach's labels

@@ -230,6 +230,41 @@ def agent_checkpoints(
     return folders
 
 
+def default_checkpoints(
+    name: str,
+    worlds: list[World],
+    checkpoint: Path | None = None,
+    motion_checkpoints: Path | None = None,
+) -> tuple[Path, Path, str | None]:
+    """The task and motion folders an agent runs with where a command names none: the shipped
+    networks, which know the kitchen's names, unless a world names others, where the shipped
+    networks that read kind and size take their place (where they hold the agent's parts and
+    no folder named by hand reads names). Returns the two folders and a line saying what was
+    swapped, or None (and the folders as they were)."""
+    from hsgplan.paths import MOTION_GEOMETRY_CHECKPOINTS, TASK_GEOMETRY_CHECKPOINT, shipped
+    from hsgplan.scene_graph.names import unnamed
+
+    task = checkpoint or TASK_CHECKPOINT
+    motion = motion_checkpoints or MOTION_CHECKPOINTS
+    others = sorted({n for w in worlds for n in unnamed(w)})
+    if not others:
+        return task, motion, None
+    geometry = (
+        task if checkpoint else TASK_GEOMETRY_CHECKPOINT,
+        motion if motion_checkpoints else MOTION_GEOMETRY_CHECKPOINTS,
+    )
+    before, after = agent_checkpoints(name, task, motion), agent_checkpoints(name, *geometry)
+    if before == after or not all(shipped(f).exists() for f in after):
+        return task, motion, None
+    if any(_reads_names(shipped(f)) for f in after):  # a folder named by hand binds it to names
+        return task, motion, None
+    said = (
+        f"the scene names what the shipped networks do not know by name ({', '.join(others)}): "
+        f"running the networks that read kind and size ({', '.join(map(str, geometry))})"
+    )
+    return *geometry, said
+
+
 def _reads_names(folder: Path) -> bool:
     """Whether a checkpoint folder's networks know nodes by name (`features` "names", what a
     configuration saved before the setting existed means); a folder that cannot be read is

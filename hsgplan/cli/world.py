@@ -50,7 +50,7 @@ from hsgplan.cli.seeding import (
 )
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.evaluation.config import OBSERVERS, TABLES, EvalConfig
-from hsgplan.paths import MOTION_CHECKPOINTS, RUNS, TASK_CHECKPOINT, shipped
+from hsgplan.paths import RUNS, shipped
 from hsgplan.runner.run_folder import check_own
 
 # what each agent is: docs/cli.md, "Agents" (a test holds the two to the same names)
@@ -111,7 +111,7 @@ def demo(
     """One episode in the simulated kitchen (or the world of --scene): a GIF, a scene-graph
     drawing per step, a record; with --rerun, a 3D recording for rerun's viewer."""
     from hsgplan.agents.goal_scope import check_goal
-    from hsgplan.agents.registry import make_agent
+    from hsgplan.agents.registry import default_checkpoints, make_agent
     from hsgplan.domain.goals import parse_goal
     from hsgplan.evaluation.config import check_seen
     from hsgplan.evaluation.demo import demo_goal, run_demo
@@ -121,10 +121,14 @@ def demo(
 
     agent = agent_name(agent.value, planner and planner.value, motion and motion.value)
     world = scene_world(scene)
-    folders = (
-        shipped(checkpoint) if checkpoint else TASK_CHECKPOINT,
-        shipped(motion_checkpoints) if motion_checkpoints else MOTION_CHECKPOINTS,
+    *folders, swapped = default_checkpoints(
+        agent,
+        [world],
+        checkpoint and shipped(checkpoint),
+        motion_checkpoints and shipped(motion_checkpoints),
     )
+    if swapped:
+        err.print(swapped, highlight=False)
     check_agent_world(agent, world, scene, *folders)
     check_seen(perception.value, [world], scene, perception_checkpoint)
     made = make_agent(agent, *folders)  # an unknown name or a missing checkpoint: before work
@@ -314,6 +318,7 @@ def evaluate(
         scene=str(scene) if scene else None,
         split=split and split.value,
     )
+    config = _default_networks(config, [m.agent for m in methods])
     if config.perception_rules and seeing == ("gt",):
         raise InvalidInputError("--perception-rules: f_p's rules act only where it sees (rgb)")
     for p in seeing:  # an unknown observer, or f_p's checkpoint missing: refused before work
@@ -368,3 +373,21 @@ def _run_name(methods, config) -> str:
     where = f"-{Path(config.scene).stem}" if config.scene else ""
     seed = config.split or f"seed{config.seed}"
     return f"eval-{agents}{protocol}-s{sizes}-{source}-r{config.repeats}-{seed}{where}"
+
+
+def _default_networks(config: EvalConfig, agents: list[str]) -> EvalConfig:
+    """The config with the networks that read kind and size where it names no checkpoint and
+    its scenes name what the shipped networks do not know (for every learned agent at once,
+    or for none: a run's agents share their folders)."""
+    from hsgplan.agents.registry import agent_checkpoints, default_checkpoints
+
+    worlds = list(config.worlds().values())
+    given = [config.checkpoint and Path(config.checkpoint)]
+    given.append(config.motion_checkpoints and Path(config.motion_checkpoints))
+    learned = [a for a in agents if agent_checkpoints(a)]
+    swaps = [default_checkpoints(a, worlds, *given) for a in learned]
+    if not learned or not all(said for *_, said in swaps):
+        return config
+    task, motion, said = swaps[0]
+    err.print(said, highlight=False)
+    return replace(config, checkpoint=str(task), motion_checkpoints=str(motion))

@@ -3,6 +3,7 @@ says, its objects have the scene's sizes, f_m reads the scene's surfaces, and an
 its goal's world."""
 
 import json
+import shutil
 from dataclasses import replace
 
 import numpy as np
@@ -75,17 +76,61 @@ runner = CliRunner()
 
 
 def test_an_agent_with_learned_parts_is_refused_a_world_of_other_names(tmp_path):
+    # networks named by hand that know the kitchen's names, or an MLP (which reads names
+    # alone): refused in one line before anything is written
     scene = tmp_path / "new.toml"
     scene.write_text(to_toml(scene_data(NEW)))
     evaluation = ["eval", "world", "--sizes", "2", "--goals", "1", "--workers", "1"]
     for args in (
-        ["demo", "--agent", "learned", "--out", str(tmp_path / "d")],
-        [*evaluation, "--out", str(tmp_path / "e")],
+        [
+            "demo",
+            "--agent",
+            "learned",
+            "--out",
+            str(tmp_path / "d"),
+            "--checkpoint",
+            "checkpoints/task",
+        ],
+        [*evaluation, "--out", str(tmp_path / "e"), "--motion", "mlp"],
     ):
         r = runner.invoke(app, [*args, "--scene", str(scene)])
         assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, r.output
         assert "know the kitchen's objects" in r.output
     assert not (tmp_path / "d").exists() and not (tmp_path / "e").exists()
+
+
+def test_a_scene_of_other_names_runs_the_networks_that_read_kind_and_size_by_default(tmp_path):
+    from hsgplan.agents.registry import default_checkpoints
+    from hsgplan.paths import (
+        MOTION_CHECKPOINTS,
+        MOTION_GEOMETRY_CHECKPOINTS,
+        TASK_CHECKPOINT,
+        TASK_GEOMETRY_CHECKPOINT,
+        shipped,
+    )
+
+    kitchen = default_checkpoints("regression+gnn", [KITCHEN])
+    assert kitchen == (TASK_CHECKPOINT, MOTION_CHECKPOINTS, None)
+    *folders, said = default_checkpoints("regression+gnn", [KITCHEN, NEW])
+    assert folders == [TASK_GEOMETRY_CHECKPOINT, MOTION_GEOMETRY_CHECKPOINTS]
+    assert "networks that read kind and size" in said
+    mine = tmp_path / "mine"
+    shutil.copytree(shipped(TASK_GEOMETRY_CHECKPOINT), mine)
+    *folders, _ = default_checkpoints("regression+gnn", [NEW], checkpoint=mine)
+    assert folders == [mine, MOTION_GEOMETRY_CHECKPOINTS]  # a folder named is kept
+    assert default_checkpoints("regression+mlp", [NEW])[2] is None  # no geometry MLP ships
+    names = default_checkpoints("regression+gnn", [NEW], checkpoint=shipped(TASK_CHECKPOINT))
+    assert names[2] is None  # a names planner named by hand: left to be refused
+    assert default_checkpoints("oracle", [NEW])[2] is None  # nothing learned to swap
+
+    scene, out = tmp_path / "new.toml", tmp_path / "e"
+    scene.write_text(to_toml(scene_data(NEW)))
+    args = ["eval", "world", "--sizes", "2", "--goals", "1", "--workers", "1", "--out", str(out)]
+    r = runner.invoke(app, [*args, "--scene", str(scene), "--tables", "success"])
+    assert r.exit_code == 0, r.output
+    assert "networks that read kind and size" in r.output
+    config = json.loads((out / "config.json").read_text())
+    assert config["checkpoint"] == str(TASK_GEOMETRY_CHECKPOINT)
 
 
 def test_the_stream_baselines_place_size_and_push_by_their_scenes_world():
