@@ -114,10 +114,10 @@ def _random(checkpoints: Path, rules: RecoveryRules) -> MotionGenerator:
 MOTION_GENERATORS: dict[str, Callable[[Path, RecoveryRules], MotionGenerator]] = {
     "sampler": _sampler,
     "gnn": _learned("gnn"),
-    # the same GNNs; a place before a push asks the push network where to put the object
-    "gnn-next": _learned("gnn", place_for_push=True),
-    # the same, each proposal planned before it is made (the sampler's budget of dry runs)
+    # the same GNNs, each proposal planned before it is made (the sampler's budget of dry runs)
     "gnn-checked": _learned("gnn", checked=True),
+    # ... and a place before a push asks the push network where to put the object (alone, the
+    # look ahead to the push showed no gain on the tune split: docs/decisions.md, `gnn-next`)
     "gnn-next-checked": _learned("gnn", place_for_push=True, checked=True),
     "mlp": _learned("mlp"),
     "random": _random,

@@ -39,7 +39,6 @@ PAPER_TABLE1: dict[str, dict[int, tuple[float, float]]] = {
 }
 LABELS = {
     "gnn": "GNN",
-    "gnn-next": "GNN (place for push)",
     "gnn-checked": "GNN (dry runs)",
     "gnn-next-checked": "GNN (place for push, dry runs)",
     "mlp": "MLP",

@@ -182,7 +182,7 @@ def test_checkpoints_that_know_names_are_refused_a_scene_of_other_names(tmp_path
         check_reads([task, motion], new, "new.toml")
 
 
-def test_gnn_next_reads_the_gnns_folders_and_refuses_networks_not_trained_on_every_trial(
+def test_the_place_for_push_reads_the_gnns_folders_and_refuses_networks_not_on_every_trial(
     tmp_path,
 ):
     import shutil
@@ -191,14 +191,17 @@ def test_gnn_next_reads_the_gnns_folders_and_refuses_networks_not_trained_on_eve
     from hsgplan.paths import MOTION_CHECKPOINTS, shipped
 
     motion = shipped(MOTION_CHECKPOINTS)
-    assert make_motion("gnn-next", motion).place_for_push
+    assert make_motion("gnn-next-checked", motion).place_for_push
     assert not make_motion("gnn", motion).place_for_push
+    assert not make_motion("gnn-checked", motion).place_for_push
     from hsgplan.motion.interface import DRY_RUNS
 
     assert make_motion("gnn-next-checked", motion).dry_runs == DRY_RUNS
     assert make_motion("gnn-checked", motion).dry_runs == DRY_RUNS
-    assert make_motion("gnn-next", motion).dry_runs == 0
-    reads = agent_checkpoints("regression+gnn-next", motion_checkpoints=motion)
+    assert make_motion("gnn", motion).dry_runs == 0
+    with pytest.raises(InvalidInputError, match="unknown motion generator 'gnn-next'"):
+        make_motion("gnn-next", motion)  # no gain alone on the tune split: not offered
+    reads = agent_checkpoints("regression+gnn-next-checked", motion_checkpoints=motion)
     assert reads[1:] == agent_checkpoints("regression+gnn", motion_checkpoints=motion)[1:]
     assert {p.name for p in reads[1:]} == {"place-gnn", "push-gnn"}
     # the paper's cross-entropy networks: scores are per-scene logits, no chances of success
@@ -207,5 +210,5 @@ def test_gnn_next_reads_the_gnns_folders_and_refuses_networks_not_trained_on_eve
     shutil.rmtree(tmp_path / "place-gnn")
     shutil.copytree(motion / "place-gnn-paper", tmp_path / "place-gnn")
     with pytest.raises(InvalidInputError, match="trained with ce"):
-        make_motion("gnn-next", tmp_path)
+        make_motion("gnn-next-checked", tmp_path)
     assert make_motion("gnn", tmp_path).name == "gnn"

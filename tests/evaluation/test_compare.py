@@ -79,16 +79,16 @@ def test_runs_that_are_not_like_for_like_are_refused(tmp_path, other, says):
 
 def test_each_run_may_name_its_own_method_and_then_no_paper_row_is_set_beside(tmp_path):
     a = _run(tmp_path / "a", {2: (True, False)})
-    b = _run(tmp_path / "b", {2: (True, True)}, method="gnn-next")
-    table = compare([a, b], ["gnn", "gnn-next"], ["gnn", "gnn-next"])
+    b = _run(tmp_path / "b", {2: (True, True)}, method="gnn-checked")
+    table = compare([a, b], ["gnn", "gnn-checked"], ["gnn", "gnn-checked"])
     assert [r[:2] for r in table.rows] == [
         ("gnn", "0.50 / 0.50"),  # one goal, run twice: no interval over goals
-        ("gnn-next", "1.00 / 0.50"),
+        ("gnn-checked", "1.00 / 0.50"),
     ]
     assert "each run's method" in table.title
     with pytest.raises(InvalidInputError, match="one, or one per run"):
         compare([a, b], ["a", "b"], ["gnn", "gnn", "gnn"])
-    r = CliRunner().invoke(app, ["eval", "compare", str(a), str(b), "--method", "gnn,gnn-next"])
+    r = CliRunner().invoke(app, ["eval", "compare", str(a), str(b), "--method", "gnn,gnn-checked"])
     assert r.exit_code == 0 and "1.00 / 0.50" in r.stdout
 
 
