@@ -259,7 +259,7 @@ def default_checkpoints(
     if any(_reads_names(shipped(f)) for f in after):  # a folder named by hand binds it to names
         return task, motion, None
     said = (
-        f"the scene names what the shipped networks do not know by name ({', '.join(others)}): "
+        f"a scene here names what the shipped networks do not know by name ({', '.join(others)}): "
         f"running the networks that read kind and size ({', '.join(map(str, geometry))})"
     )
     return *geometry, said
@@ -267,12 +267,15 @@ def default_checkpoints(
 
 def _reads_names(folder: Path) -> bool:
     """Whether a checkpoint folder's networks know nodes by name (`features` "names", what a
-    configuration saved before the setting existed means); a folder that cannot be read is
-    left to the loader to refuse."""
+    configuration saved before the setting existed means); a folder of trainings (`seed-S`) by
+    its first; a folder that cannot be read is left to the loader to refuse."""
     import json
 
     config = folder / "preimage" / "config.json"
     config = config if config.exists() else folder / "config.json"
+    trainings = sorted(folder.glob("seed-*")) if not config.exists() else []
+    if trainings:
+        return _reads_names(trainings[0])
     try:
         return json.loads(config.read_text()).get("features", "names") == "names"
     except (OSError, ValueError, AttributeError):

@@ -19,10 +19,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hsgplan.domain.parameters import PickParams, PushParams, extent_along, place_centre, place_xy
+from hsgplan.domain.parameters import (
+    PickParams,
+    PushParams,
+    extent_along,
+    place_centre,
+    place_xy,
+    place_yaw,
+)
 from hsgplan.domain.world import (
     PLACE_BINS,
-    PLACE_LONG_AXIS_YAW,
     REACH_MAX_Z,
     Kind,
     World,
@@ -118,9 +124,11 @@ def bin_order(
 
 
 def surface_pose(obj: str, surface: str, bins: tuple[int, int], world: World) -> PoseValue:
-    """The pose a place at these bins puts the object in (standing, long side along y)."""
+    """The pose a place at these bins puts the object in (standing, long side along the
+    surface's y)."""
     x, y, z = place_centre(obj, surface, *bins, world)
-    return PoseValue(obj, x, y, z, PLACE_LONG_AXIS_YAW, "supported", surface, bins, world=world)
+    yaw = place_yaw(surface, world)
+    return PoseValue(obj, x, y, z, yaw, "supported", surface, bins, world=world)
 
 
 def stack_pose(obj: str, below: PoseValue) -> PoseValue | None:
@@ -259,16 +267,17 @@ class StreamWorld:
         world = self.scene.world
         interior = world.shelves[shelf].interior
         sg = GeometricSceneGraph.from_poses({start.obj: start.pose}, world=world)
-        slots = sorted(world.interior_slots(shelf), key=lambda s: abs(s - start.y))
+        local_y = interior.to_local(start.x, start.y)[1]  # slots run along the shelf's y
+        slots = sorted(world.interior_slots(shelf), key=lambda s: abs(s - local_y))
         for slot, params in zip(slots, push_candidates(sg, start.obj, shelf), strict=True):
             self._show(start)
             plan = plan_primitive(self.scene, params)
             if isinstance(plan, PlanFailure):
                 continue
+            depth = extent_along(start.obj, start.yaw - interior.yaw, 0.0, world)
             end = PoseValue(
                 start.obj,
-                interior.x_min + PUSH_DEPTH + extent_along(start.obj, start.yaw, 0.0, world),
-                slot,
+                *interior.to_world(interior.x_min + PUSH_DEPTH + depth, slot),
                 start.z,
                 start.yaw,
                 "inside",

@@ -76,10 +76,10 @@ def push_reach(
                 for index in range(first + k, first + tasks, len(worlds)):
                     task = draw_task(MotionPrimitive.PUSH, SEED, index, world)
                     for trial in run_task(scene, task) or []:
+                        interior = world.shelves[trial.target].interior  # in its frame
                         angle, dist = push_values(*trial.bins)
-                        x = trial.before.pose(trial.obj).position[0]
-                        x_min = world.shelves[trial.target].interior.x_min
-                        margins.append((reach_margin(x, angle, dist, x_min), trial.ok))
+                        x = interior.to_local(*trial.before.pose(trial.obj).position[:2])[0]
+                        margins.append((reach_margin(x, angle, dist, interior.x_min), trial.ok))
                         statuses[trial.status.value] += 1
                     if on_task:
                         on_task()

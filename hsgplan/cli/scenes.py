@@ -66,10 +66,19 @@ def scenes(
         Path | None,
         typer.Option(help="The scene to vary (default: scenes/kitchen.toml).", parser=input_path),
     ] = None,
+    turn: Annotated[
+        float,
+        typer.Option(
+            help="Turn each shelf by a uniform draw within +-DEG degrees of its yaw (0: as it is).",
+            metavar="DEG",
+            min=0.0,
+            max=180.0,
+        ),
+    ] = 0.0,
 ) -> None:
-    """Write random layouts of a scene as scene files: its shelves moved and resized, its
-    objects resized (or new ones); the ranges are in docs/scenes.md. `scenes check FILE`: what
-    a scene file's sizes allow."""
+    """Write random layouts of a scene as scene files: its shelves moved and resized (and
+    turned), its objects resized (or new ones); the ranges are in docs/scenes.md. `scenes
+    check FILE`: what a scene file's sizes allow."""
     if ctx.invoked_subcommand is not None:
         return
     if layouts is None or folder is None:
@@ -96,7 +105,9 @@ def scenes(
     )
     if scene is not None:
         header += f" --scene {scene}"
-    written = write_layouts(base, layouts, seed, folder, new_objects, header)
+    if turn:
+        header += f" --turn {turn:g}"
+    written = write_layouts(base, layouts, seed, folder, new_objects, header, turn)
     err.print(f"wrote {len(written)} scene files to {shown(folder)}")
 
 

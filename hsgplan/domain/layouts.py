@@ -45,9 +45,11 @@ def _span(rng: random.Random, bounds: tuple[float, float]) -> float:
     return round(rng.uniform(*bounds), 3)
 
 
-def _shelves(base: World, rng: random.Random) -> list[dict]:
+def _shelves(base: World, rng: random.Random, turn: float = 0.0) -> list[dict]:
     """Each shelf moved and resized on the side of the robot it stands on; shelves sharing a
-    side keep their order outwards from the open space, each beyond the one before."""
+    side keep their order outwards from the open space, each beyond the one before. With a
+    `turn` (degrees), each shelf's yaw is its base's plus a uniform draw within +-`turn` (drawn
+    only then, so that layouts drawn without one stay as they were)."""
     open_space = base.regions["open_space"]
     out: dict[str, dict] = {}
     for left in (True, False):
@@ -67,6 +69,9 @@ def _shelves(base: World, rng: random.Random) -> list[dict]:
                 "wall": s.wall,
                 "interior": s.interior is not None,
             }  # fmt: skip
+            yaw = s.yaw_degrees + (round(rng.uniform(-turn, turn), 1) if turn else 0.0)
+            if yaw:
+                out[s.name]["yaw"] = yaw
     return [out[s.name] for s in base.shelf_list]
 
 
@@ -97,17 +102,19 @@ def _objects(base: World, rng: random.Random, new_objects: bool) -> list[ObjectT
     return [_new(t.kind, names[t.kind].pop(), rng) for t in base.type_list]
 
 
-def random_layout(base: World, seed: int, index: int, new_objects: bool = False) -> World:
-    """Layout `index` of `seed`: `base` with its shelves moved and resized and its object
-    types resized (or, with `new_objects`, replaced by as many new ones of each kind); the
-    same arguments give the same world."""
-    rng = random.Random(f"layout-{seed}-{index}-{int(new_objects)}")
+def random_layout(
+    base: World, seed: int, index: int, new_objects: bool = False, turn: float = 0.0
+) -> World:
+    """Layout `index` of `seed`: `base` with its shelves moved, resized (and, with `turn`,
+    turned) and its object types resized (or, with `new_objects`, replaced by as many new ones
+    of each kind); the same arguments give the same world."""
+    rng = random.Random(f"layout-{seed}-{index}-{int(new_objects)}" + (f"-{turn}" if turn else ""))
     why_not: Counter[str] = Counter()  # what refused the draws, said once the tries run out
     example: dict[str, str] = {}  # a refusal, as first said, for each with its numbers left out
     for _ in range(TRIES):
         data = scene_data(base)
         data["name"] = f"{base.name}-layout-{seed}-{index}" + ("-new" if new_objects else "")
-        data["shelves"] = _shelves(base, rng)
+        data["shelves"] = _shelves(base, rng, turn)
         data["objects"] = [object_data(t) for t in _objects(base, rng, new_objects)]
         try:
             world = world_of(data, "the layout")
@@ -129,7 +136,13 @@ def random_layout(base: World, seed: int, index: int, new_objects: bool = False)
 
 
 def write_layouts(
-    base: World, layouts: int, seed: int, folder: Path, new_objects: bool = False, header: str = ""
+    base: World,
+    layouts: int,
+    seed: int,
+    folder: Path,
+    new_objects: bool = False,
+    header: str = "",
+    turn: float = 0.0,
 ) -> list[Path]:
     """Layouts 0 .. `layouts` - 1 of `seed` as scene files `layout-NNN.toml` in `folder`, with
     `header` as their first comment. A file already there with the same content is kept (a
@@ -139,7 +152,7 @@ def write_layouts(
     planned = []
     for index in range(layouts):
         path = folder / f"{stem}-{index:03d}.toml"
-        world = random_layout(base, seed, index, new_objects)
+        world = random_layout(base, seed, index, new_objects, turn)
         text = f"# {header}\n" + to_toml(scene_data(world))
         if path.exists() and path.read_text() != text:
             raise InvalidInputError(f"'{path}' holds another scene; choose another --out")

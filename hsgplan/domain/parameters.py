@@ -18,6 +18,7 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import Kind, World
 from hsgplan.domain.world import (
     PLACE_BINS,
+    PLACE_LONG_AXIS_YAW,
     PUSH_ANGLE_BINS,
     PUSH_ANGLE_RANGE,
     PUSH_DIST_BINS,
@@ -87,7 +88,8 @@ def place_inset(obj: str, world: World) -> tuple[float, float]:
 
 
 def place_xy(obj: str, target: str, x_bin: int, y_bin: int, world: World) -> tuple[float, float]:
-    """The world (x, y) of a place bin's centre on a surface."""
+    """The world (x, y) of a place bin's centre on a surface (the bins run along the surface's
+    own axes, which turn with its shelf)."""
     if target not in world.surface_capacity:
         raise InvalidInputError(f"place bins are over surfaces, not '{target}'")
     _check_bin(x_bin, PLACE_BINS, "x_bin")
@@ -99,17 +101,23 @@ def place_xy(obj: str, target: str, x_bin: int, y_bin: int, world: World) -> tup
         x0 = x1 = (r.x_min + r.x_max) / 2
     if y1 < y0:
         y0 = y1 = (r.y_min + r.y_max) / 2
-    return (
+    return r.to_world(
         x0 + (x1 - x0) * (x_bin + 0.5) / PLACE_BINS,
         y0 + (y1 - y0) * (y_bin + 0.5) / PLACE_BINS,
     )
+
+
+def place_yaw(target: str, world: World) -> float:
+    """The yaw an object is placed at on a surface: long side along the surface's own y
+    (`PLACE_LONG_AXIS_YAW`, turned with its shelf)."""
+    return world.surface_rect(target).direction(PLACE_LONG_AXIS_YAW)
 
 
 def place_centre(
     obj: str, target: str, x_bin: int, y_bin: int, world: World
 ) -> tuple[float, float, float]:
     """Where a place at these bins stands the object's centre: over the bin's centre, resting
-    on the surface (long side along y, `PLACE_LONG_AXIS_YAW`)."""
+    on the surface (long side along its y, `place_yaw`)."""
     x, y = place_xy(obj, target, x_bin, y_bin, world)
     return x, y, world.surface_rect(target).z + world.object_type(obj).height / 2
 
@@ -120,14 +128,16 @@ def push_carry(dist: float) -> float:
     return dist - PUSH_LEAD
 
 
-def push_values(angle_bin: int, dist_bin: int) -> tuple[float, float]:
-    """(direction in radians from +x, distance in metres) of a push's bins."""
+def push_values(angle_bin: int, dist_bin: int, yaw: float = 0.0) -> tuple[float, float]:
+    """(direction in radians from +x, distance in metres) of a push's bins, into a shelf turned
+    by `yaw` radians (the bins run about the shelf's own inward x)."""
     _check_bin(angle_bin, PUSH_ANGLE_BINS, "angle_bin")
     _check_bin(dist_bin, PUSH_DIST_BINS, "dist_bin")
     a0, a1 = PUSH_ANGLE_RANGE
     d0, d1 = PUSH_DIST_RANGE
+    angle = a0 + (a1 - a0) * angle_bin / (PUSH_ANGLE_BINS - 1)
     return (
-        a0 + (a1 - a0) * angle_bin / (PUSH_ANGLE_BINS - 1),
+        angle + yaw if yaw else angle,
         d0 + (d1 - d0) * dist_bin / (PUSH_DIST_BINS - 1),
     )
 
@@ -141,8 +151,11 @@ def extent_along(obj: str, yaw: float, angle: float, world: World) -> float:
     return abs(math.cos(rel)) * t.size[0] / 2 + abs(math.sin(rel)) * t.size[1] / 2
 
 
-def nearest_push_bins(angle: float, dist: float) -> tuple[int, int]:
-    """The bins whose values are closest to a wanted direction and distance."""
+def nearest_push_bins(angle: float, dist: float, yaw: float = 0.0) -> tuple[int, int]:
+    """The bins whose values are closest to a wanted direction and distance, into a shelf
+    turned by `yaw` radians."""
+    if yaw:
+        angle = math.remainder(angle - yaw, 2 * math.pi)
     a0, a1 = PUSH_ANGLE_RANGE
     d0, d1 = PUSH_DIST_RANGE
     ab = round((angle - a0) / (a1 - a0) * (PUSH_ANGLE_BINS - 1))

@@ -20,6 +20,7 @@ from enum import StrEnum
 from functools import cached_property
 
 from hsgplan.domain.errors import InvalidInputError, UnknownNameError
+from hsgplan.domain.rect import Rect
 
 
 class Kind(StrEnum):
@@ -86,50 +87,14 @@ class ObjectType:
 
 
 @dataclass(frozen=True)
-class Rect:
-    """An axis-aligned rectangle on a horizontal plane at height `z`."""
-
-    x_min: float
-    x_max: float
-    y_min: float
-    y_max: float
-    z: float = 0.0
-
-    @property
-    def width_x(self) -> float:
-        return self.x_max - self.x_min
-
-    @property
-    def width_y(self) -> float:
-        return self.y_max - self.y_min
-
-    @property
-    def center(self) -> tuple[float, float]:
-        return (self.x_min + self.x_max) / 2, (self.y_min + self.y_max) / 2
-
-    def contains(self, x: float, y: float, margin: float = 0.0) -> bool:
-        return (
-            self.x_min - margin <= x <= self.x_max + margin
-            and self.y_min - margin <= y <= self.y_max + margin
-        )
-
-    def overlaps(self, other: Rect) -> bool:
-        """Whether the two share more than an edge."""
-        return (
-            self.x_min < other.x_max
-            and other.x_min < self.x_max
-            and self.y_min < other.y_max
-            and other.y_min < self.y_max
-        )
-
-
-@dataclass(frozen=True)
 class Shelf:
-    """An open-fronted cabinet facing the robot (open at its low-x side).
+    """An open-fronted cabinet, open at the low-x side of its own frame: turned by
+    `yaw_degrees` about its footprint's centre, it faces that way.
 
     `outer` is its footprint on the table; `interior` the floor of the space inside (the table
     itself, so objects can be pushed in), None for a closed cabinet; `top` the flat board
-    objects are placed on; `prepush` the region in front of it that pushes start from.
+    objects are placed on; `prepush` the region in front of it that pushes start from. Each
+    rectangle turns with the shelf (`Rect.yaw`, `Rect.pivot`).
     """
 
     name: str
@@ -139,6 +104,7 @@ class Shelf:
     top: Rect
     prepush: str | None
     wall: float = 0.02
+    yaw_degrees: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -170,24 +136,36 @@ def make_shelf(
     wall: float,
     interior: bool,
     prepush: str | None,
+    yaw_degrees: float = 0.0,
 ) -> Shelf:
-    """A shelf from its footprint: walls `wall` thick, its top board on walls `clearance` high."""
-    outer = Rect(x[0], x[1], y[0], y[1], 0.0)
-    inside = Rect(x[0], x[1] - wall, y[0] + wall, y[1] - wall, 0.0) if interior else None
-    top = Rect(x[0], x[1], y[0], y[1], clearance + wall)
-    return Shelf(name, outer, inside, clearance, top, prepush, wall)
+    """A shelf from its footprint (in its own frame): walls `wall` thick, its top board on walls
+    `clearance` high, turned by `yaw_degrees` about the footprint's centre."""
+    turn = shelf_turn(x, y, yaw_degrees)
+    outer = Rect(x[0], x[1], y[0], y[1], 0.0, **turn)
+    inside = Rect(x[0], x[1] - wall, y[0] + wall, y[1] - wall, 0.0, **turn) if interior else None
+    top = Rect(x[0], x[1], y[0], y[1], clearance + wall, **turn)
+    return Shelf(name, outer, inside, clearance, top, prepush, wall, yaw_degrees)
+
+
+def shelf_turn(x: tuple[float, float], y: tuple[float, float], yaw_degrees: float) -> dict:
+    """The `Rect` fields that turn a rectangle with a shelf of this footprint (none unturned,
+    so that an unturned shelf's rectangles are the plain ones they always were)."""
+    if yaw_degrees == 0.0:
+        return {}
+    return {"yaw": math.radians(yaw_degrees), "pivot": ((x[0] + x[1]) / 2, (y[0] + y[1]) / 2)}
 
 
 def shelf_boards(shelf: Shelf) -> tuple[Board, ...]:
     """A shelf's side walls, back wall and top board (and a front board when it has no
     interior); the floor is the table."""
     o, c, w = shelf.outer, shelf.clearance, shelf.wall
-    left = Rect(o.x_min, o.x_max, o.y_max - w, o.y_max)
-    right = Rect(o.x_min, o.x_max, o.y_min, o.y_min + w)
-    back = Rect(o.x_max - w, o.x_max, o.y_min + w, o.y_max - w)
+    turn = {"yaw": o.yaw, "pivot": o.pivot} if o.yaw else {}
+    left = Rect(o.x_min, o.x_max, o.y_max - w, o.y_max, **turn)
+    right = Rect(o.x_min, o.x_max, o.y_min, o.y_min + w, **turn)
+    back = Rect(o.x_max - w, o.x_max, o.y_min + w, o.y_max - w, **turn)
     walls = [left, right, back]
     if shelf.interior is None:
-        walls.append(Rect(o.x_min, o.x_min + w, o.y_min + w, o.y_max - w))
+        walls.append(Rect(o.x_min, o.x_min + w, o.y_min + w, o.y_max - w, **turn))
     return (*(Board(r, 0.0, c) for r in walls), Board(o, c, shelf.top.z))
 
 
@@ -234,12 +212,14 @@ OPEN_SPACE = "open_space"
 
 
 def spot_cells(rect: Rect, cell: tuple[float, float] = (SPOT, SPOT)) -> list[tuple[float, float]]:
-    """Centres of the cells (at least `cell` wide along x and y) a surface is counted in (its
-    capacity), spread evenly over it."""
+    """World centres of the cells (at least `cell` wide along the surface's own x and y) a
+    surface is counted in (its capacity), spread evenly over it."""
     nx = math.floor(rect.width_x / cell[0] + 1e-9)
     ny = math.floor(rect.width_y / cell[1] + 1e-9)
     return [
-        (rect.x_min + rect.width_x * (i + 0.5) / nx, rect.y_min + rect.width_y * (j + 0.5) / ny)
+        rect.to_world(
+            rect.x_min + rect.width_x * (i + 0.5) / nx, rect.y_min + rect.width_y * (j + 0.5) / ny
+        )
         for i in range(nx)
         for j in range(ny)
     ]
@@ -297,8 +277,9 @@ class World:
         """The cell (along x, along y) each resting object is counted in: the scene's widest
         and longest footprints with their room, never below the measured `SPOT`, so that any
         mix of its objects fits the count (as towers are counted with the tallest)."""
-        widest = max(t.size[0] for t in self.type_list)
-        longest = max(t.size[1] for t in self.type_list)
+        # as objects rest on a surface: narrow side across the grasp (x), long side along y
+        widest = max(min(t.footprint) for t in self.type_list)
+        longest = max(max(t.footprint) for t in self.type_list)
         return max(SPOT, widest + 2 * FINGER_ROOM), max(SPOT, longest + ALONG_GAP)
 
     def spot_cells(self, surface: str) -> list[tuple[float, float]]:
@@ -324,7 +305,8 @@ class World:
         }
 
     def interior_slots(self, shelf: str) -> list[float]:
-        """y of each spot in a shelf's interior row, evenly spread across its width."""
+        """y of each spot in a shelf's interior row, evenly spread across its width, in the
+        shelf's own frame (`Rect.to_world` with its interior's x gives the world point)."""
         r = self.shelves[shelf].interior
         assert r is not None, f"{shelf} has no interior"
         n = self.interior_capacity[shelf]
@@ -356,6 +338,13 @@ class World:
             and max(t.footprint) <= max(s.interior.width_x, s.interior.width_y)
             and min(t.footprint) <= min(s.interior.width_x, s.interior.width_y)
         )
+
+    def prepush_shelf(self, x: float, y: float) -> str | None:
+        """The shelf whose prepush region (within 1 cm) holds the point, if any."""
+        for s in self.shelf_list:
+            if s.prepush and self.regions[s.prepush].contains(x, y, margin=0.01):
+                return s.name
+        return None
 
     # --- names: object instances are named by their type (`cherries`, `cherries_2`, ...) ---
 

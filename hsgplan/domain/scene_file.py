@@ -9,10 +9,10 @@ default world.
 from __future__ import annotations
 
 import json
-import math
 import re
 import tomllib
 from collections.abc import Callable
+from dataclasses import replace
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -22,9 +22,6 @@ from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import (
     GRIPPER_MAX_OPENING,
     OPEN_SPACE,
-    REACH_MAX_XY,
-    REACH_MAX_Z,
-    ROBOT_BASE,
     Kind,
     ObjectType,
     Rect,
@@ -32,7 +29,9 @@ from hsgplan.domain.scene import (
     View,
     World,
     make_shelf,
+    shelf_turn,
 )
+from hsgplan.domain.workable import unworkable
 from hsgplan.paths import KITCHEN_SCENE
 
 MAX_SCENE_BYTES = 2**20
@@ -147,9 +146,11 @@ def _object(v: Any, at: str) -> ObjectType:
 
 
 def _shelf(v: Any, at: str) -> tuple[Shelf, tuple[str, Rect] | None]:
-    v = _table(v, at, {"name", "x", "y"}, {"clearance", "wall", "interior", "prepush"})
+    v = _table(v, at, {"name", "x", "y"}, {"clearance", "wall", "interior", "prepush", "yaw"})
     name = _name(v["name"], f"{at}.name", FIXTURE_NAME)
     x, y = _span(v["x"], f"{at}.x"), _span(v["y"], f"{at}.y")
+    yaw = _number(v.get("yaw", 0.0), f"{at}.yaw", -180.0, 180.0)
+    turn = shelf_turn(x, y, yaw)
     clearance = _number(v.get("clearance", 0.12), f"{at}.clearance", 0.05, 0.40)
     wall = _number(v.get("wall", 0.02), f"{at}.wall", 0.005, 0.05)
     interior = v.get("interior", True)
@@ -163,13 +164,14 @@ def _shelf(v: Any, at: str) -> tuple[Shelf, tuple[str, Rect] | None]:
         if not interior:
             raise _Bad(f"{at}.prepush: a shelf with no interior has nothing to push into")
         p = _table(v["prepush"], f"{at}.prepush", {"name", "x", "y"})
-        prepush = (_name(p["name"], f"{at}.prepush.name", FIXTURE_NAME), _rect(p, f"{at}.prepush"))
+        where = replace(_rect(p, f"{at}.prepush"), **turn)  # in the shelf's frame
+        prepush = (_name(p["name"], f"{at}.prepush.name", FIXTURE_NAME), where)
     elif interior:
         # rounded to a micrometre, so that a layout's file reads as it was drawn
         derived = Rect(round(x[0] - PREPUSH_GAP - PREPUSH_DEPTH, 6), round(x[0] - PREPUSH_GAP, 6),
-                       round(y[0] + wall, 6), round(y[1] - wall, 6))  # fmt: skip
+                       round(y[0] + wall, 6), round(y[1] - wall, 6), **turn)  # fmt: skip
         prepush = ("prepush_" + name.removeprefix("shelf_"), derived)
-    shelf = make_shelf(name, x, y, clearance, wall, interior, prepush[0] if prepush else None)
+    shelf = make_shelf(name, x, y, clearance, wall, interior, prepush[0] if prepush else None, yaw)
     return shelf, prepush
 
 
@@ -201,7 +203,7 @@ def _places_problems(
     problems = [
         f"{name} is not wholly on the table"
         for name, rect in places
-        if not (table.contains(rect.x_min, rect.y_min) and table.contains(rect.x_max, rect.y_max))
+        if not all(table.contains(x, y) for x, y in rect.corners())
     ]
     for k, (a, ra) in enumerate(places):
         problems += [f"{a} and {b} overlap" for b, rb in places[k + 1 :] if ra.overlaps(rb)]
@@ -233,102 +235,6 @@ def world_of(data: Any, source: str = "scene") -> World:
     if problems := unworkable(world):
         raise InvalidInputError("\n".join(f"{source}: {p}" for p in problems))
     return world
-
-
-def unworkable(world: World) -> list[str]:
-    """Why the robot cannot work in a scene, every reason: a fixture on its base, a surface that
-    holds nothing (smaller than a cell, or wholly beyond the arm's reach), a shelf top too high to
-    put anything on within reach, an object type that fits on no surface within reach and inside no
-    interior, or that would rise past the reach on a surface the planners may put it on
-    (`REACH_MAX_Z`: the highest a held object's top may rise; `REACH_MAX_XY`: the farthest the hand
-    reaches from the base)."""
-    return _on_base(world) + _out_of_reach(world) + _too_high(world)
-
-
-def _on_base(world: World) -> list[str]:
-    base = ROBOT_BASE
-    where = f"x {base.x_min} to {base.x_max}, y {base.y_min} to {base.y_max}"
-    fixtures = [(f"shelf {s.name!r}", s.outer) for s in world.shelves.values()] + [
-        (f"region {name!r}", rect) for name, rect in world.regions.items()
-    ]
-    return [
-        f"{what} stands on the robot's base ({where})" for what, r in fixtures if r.overlaps(base)
-    ]
-
-
-def _reachable(world: World) -> list[str]:
-    """Surfaces with a place (cell) within the hand's horizontal reach."""
-    return [
-        name
-        for name in world.surfaces
-        if any(math.hypot(x, y) <= REACH_MAX_XY for x, y in world.spot_cells(name))
-    ]
-
-
-def _out_of_reach(world: World) -> list[str]:
-    """Surfaces that hold nothing: narrower than a cell, or every cell beyond the hand's
-    horizontal reach."""
-    cx, cy = world.cell
-    problems = [
-        f"{_surface(world, name)} holds no object: it is smaller than a cell of "
-        f"{100 * cx:.1f} x {100 * cy:.1f} cm (the scene's largest footprint and its room)"
-        for name in world.surfaces
-        if not world.spot_cells(name)
-    ]
-    reachable = _reachable(world)
-    return problems + [
-        f"{_surface(world, name)}: every place on it lies beyond the arm's reach "
-        f"({REACH_MAX_XY} m from its base)"
-        for name in world.surfaces
-        if world.spot_cells(name) and name not in reachable
-    ]
-
-
-def _too_high(world: World) -> list[str]:
-    problems = []
-    lowest = min(t.height for t in world.type_list)
-    high = [s.name for s in world.shelf_list if s.top.z + lowest > REACH_MAX_Z]
-    problems += [
-        f"shelf {name!r}: its top at {world.shelves[name].top.z:.3f} m leaves no object within "
-        f"reach (the lowest stands {lowest:.3f} m; a top may rise to {REACH_MAX_Z} m)"
-        for name in high
-    ]
-    nowhere = [t for t in world.type_list if not _fits_somewhere(world, t)]
-    problems += [
-        f"object {t.name!r} ({' x '.join(f'{100 * v:.1f}' for v in t.size)} cm) fits on no "
-        "surface within reach and inside no shelf"
-        for t in nowhere
-    ]
-    # The symbolic domain lets any object go on any surface: one too tall for the highest
-    # surface left would be planned there and held past the reach.
-    usable = [n for n in world.surfaces if n not in high]
-    top = max(usable, key=lambda n: world.surface_rect(n).z, default=None)
-    z = world.surface_rect(top).z if top else 0.0
-    problems += [
-        f"object {t.name!r} ({t.height:.3f} m high) would rise to {z + t.height:.3f} m on "
-        f"{_surface(world, top)} ({z:.3f} m), past the {REACH_MAX_Z} m a held object's top "
-        "may rise to (the planners may put any object on any surface)"
-        for t in world.type_list
-        if top and t not in nowhere and z + t.height > REACH_MAX_Z
-    ]
-    return problems
-
-
-def _surface(world: World, name: str) -> str:
-    return f"region {name!r}" if name in world.regions else f"the top of shelf {name!r}"
-
-
-def _fits_somewhere(world: World, t: ObjectType) -> bool:
-    def fits(rect: Rect) -> bool:
-        return max(t.footprint) <= max(rect.width_x, rect.width_y) and min(t.footprint) <= min(
-            rect.width_x, rect.width_y
-        )
-
-    on_a_surface = any(
-        fits(r) and r.z + t.height <= REACH_MAX_Z
-        for r in map(world.surface_rect, _reachable(world))
-    )
-    return on_a_surface or any(world.fits_inside(t.name, s) for s in world.shelves)
 
 
 def _region(v: Any, at: str) -> tuple[str, Rect]:
@@ -446,6 +352,8 @@ def scene_data(world: World) -> dict:
     for s in world.shelf_list:
         entry = {"name": s.name, **_span_out(s.outer), "clearance": s.clearance, "wall": s.wall,
                  "interior": s.interior is not None}  # fmt: skip
+        if s.yaw_degrees:
+            entry["yaw"] = s.yaw_degrees
         if s.prepush is not None:
             entry["prepush"] = {"name": s.prepush, **_span_out(world.regions[s.prepush])}
         shelves.append(entry)

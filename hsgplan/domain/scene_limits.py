@@ -57,13 +57,13 @@ def scene_limits(world: World) -> SceneLimits:
 
 def _cell(world: World) -> str:
     cx, cy = world.cell
-    widest = max(world.type_list, key=lambda t: t.size[0])
-    longest = max(world.type_list, key=lambda t: t.size[1])
+    widest = max(world.type_list, key=lambda t: min(t.footprint))
+    longest = max(world.type_list, key=lambda t: max(t.footprint))
     why = [
         f"{along}: {'the least measured' if c <= SPOT else f'set by {t.name} ({100 * v:.1f} cm)'}"
         for along, c, t, v in (
-            ("across", cx, widest, widest.size[0]),
-            ("along", cy, longest, longest.size[1]),
+            ("across", cx, widest, min(widest.footprint)),
+            ("along", cy, longest, max(longest.footprint)),
         )
     ]
     return (

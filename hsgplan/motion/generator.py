@@ -45,10 +45,10 @@ from hsgplan.domain.parameters import (
     PushParams,
     params_for,
     place_centre,
+    place_yaw,
 )
 from hsgplan.domain.predicates import Literal
 from hsgplan.domain.recovery import ALL_RULES, RecoveryRules
-from hsgplan.domain.world import PLACE_LONG_AXIS_YAW
 from hsgplan.motion.interface import (
     DO_NOT_RETRY,
     PUSH_TRIES,
@@ -160,7 +160,7 @@ def placed_at(sg: GeometricSceneGraph, params: PlaceParams) -> GeometricSceneGra
     """The scene as it would be with the held object set down at a place bin's centre."""
     centre = place_centre(params.obj, params.target, params.x_bin, params.y_bin, sg.world)
     poses = {n.name: n.pose for n in sg.nodes}
-    poses[params.obj] = Pose.from_xyz_yaw(*centre, PLACE_LONG_AXIS_YAW)
+    poses[params.obj] = Pose.from_xyz_yaw(*centre, place_yaw(params.target, sg.world))
     return GeometricSceneGraph.from_poses(poses, None, world=sg.world)
 
 

@@ -76,9 +76,10 @@ def _standing(t: ObjectType, x: float, y: float, yaw: float, bottom: float):
 
 
 def free_slots(sg: GeometricSceneGraph, shelf: str, ignore: str = "") -> list[float]:
+    """The interior slots no object stands in (y in the shelf's own frame)."""
     r = sg.world.shelves[shelf].interior
     taken = [
-        n.pose.position[1]
+        r.to_local(*n.pose.position[:2])[1]
         for n in sg.nodes
         if n.name != ignore and r.contains(*n.pose.position[:2]) and n.pose.position[2] < r.z + 0.1
     ]
@@ -87,13 +88,14 @@ def free_slots(sg: GeometricSceneGraph, shelf: str, ignore: str = "") -> list[fl
 
 def _on_rect(sg: GeometricSceneGraph, rect: Rect, ignore: str) -> tuple[list, list]:
     """`_standing` tuples of the objects resting on a rectangle, and of all objects above it
-    (towers included, whose tops decide what the hand can sweep past)."""
+    (towers included, whose tops decide what the hand can sweep past), in the rectangle's own
+    frame."""
     resting, above = [], []
     for n in sg.nodes:
         x, y, _ = n.pose.position
         if n.name == ignore or not rect.contains(x, y, margin=0.05) or n.bottom_z < rect.z - 0.03:
             continue
-        item = _standing(n.type, x, y, n.pose.yaw, n.bottom_z)
+        item = _standing(n.type, *rect.to_local(x, y), n.pose.yaw - rect.yaw, n.bottom_z)
         above.append(item)
         if n.bottom_z < rect.z + 0.03:
             resting.append(item)
@@ -113,7 +115,8 @@ def place_candidates(
     Bins where the hand would sweep into a taller neighbour (or a tall object would block a
     box's later grasp) go last. Otherwise bins are ranked by how close they come to the centre
     of a free spot cell (so that the surface's whole capacity stays usable) or, on a prepush
-    region before a push, by how well they line up with a free slot inside the shelf.
+    region before a push, by how well they line up with a free slot inside the shelf. All of it
+    is reckoned in the surface's own frame (which turns with its shelf).
     """
     world = sg.world
     if target not in world.surface_capacity:
@@ -121,12 +124,13 @@ def place_candidates(
     rect, t = world.surface_rect(target), world.object_type(obj)
     others, above = _on_rect(sg, rect, ignore=obj)
     hx, hy = _half_extents(t, PLACE_LONG_AXIS_YAW)
-    cx, cy = world.cell
+    cell_x, cell_y = world.cell
     free = [
         c
-        for c in world.spot_cells(target)
-        if all(abs(c[0] - o[0]) > cx / 2 or abs(c[1] - o[1]) > cy / 2 for o in others)
+        for c in (rect.to_local(*w) for w in world.spot_cells(target))
+        if all(abs(c[0] - o[0]) > cell_x / 2 or abs(c[1] - o[1]) > cell_y / 2 for o in others)
     ]
+    avoid = tuple(rect.to_local(*a) for a in avoid)
     slots = []
     if next_push:
         shelf = next(s.name for s in world.shelf_list if s.prepush == target)
@@ -134,7 +138,7 @@ def place_candidates(
     ranked = []
     for xb in range(PLACE_BINS):
         for yb in range(PLACE_BINS):
-            x, y = place_xy(obj, target, xb, yb, world)
+            x, y = rect.to_local(*place_xy(obj, target, xb, yb, world))
             gap = min(
                 (max(abs(x - o[0]) - hx - o[2], abs(y - o[1]) - hy - o[3]) for o in others),
                 default=1.0,
@@ -148,7 +152,7 @@ def place_candidates(
                 for yaw in (PLACE_LONG_AXIS_YAW, PLACE_LONG_AXIS_YAW + math.pi / 2)
             )
             if slots:
-                cost = min(abs(y - s) for s in slots) + 0.3 * abs(x - rect.center[0])
+                cost = min(abs(y - s) for s in slots) + 0.3 * abs(x - (rect.x_min + rect.x_max) / 2)
             elif free:
                 cost = min(math.hypot(x - cx, y - cy) for cx, cy in free)
             else:
@@ -158,10 +162,10 @@ def place_candidates(
 
 
 def push_candidates(sg: GeometricSceneGraph, obj: str, shelf: str) -> list[PushParams]:
-    """Pushes aimed at the free interior slots, nearest slot first."""
-    x, y, _ = sg.pose(obj).position
+    """Pushes aimed at the free interior slots, nearest slot first (in the shelf's frame)."""
     r = sg.world.shelves[shelf].interior
-    yaw = sg.pose(obj).yaw
+    x, y = r.to_local(*sg.pose(obj).position[:2])
+    yaw = sg.pose(obj).yaw - r.yaw
     slots = sorted(free_slots(sg, shelf, ignore=obj), key=lambda s: abs(s - y))
     out = []
     for slot in slots:

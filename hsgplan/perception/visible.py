@@ -59,8 +59,13 @@ class Cuboid:
 
     @staticmethod
     def of_board(board: Board) -> Cuboid:
+        """A shelf's board, turned with its shelf."""
         r = board.rect
-        return Cuboid.of_box(Box((r.x_min, r.y_min, board.z_min), (r.x_max, r.y_max, board.z_max)))
+        box = Cuboid.of_box(Box((r.x_min, r.y_min, board.z_min), (r.x_max, r.y_max, board.z_max)))
+        if not r.yaw:
+            return box
+        centre = (*r.center, box.pose.position[2])
+        return Cuboid(Pose.from_xyz_yaw(*centre, r.yaw), box.half)
 
 
 OCCLUDED = -2  # a pixel an occluder shows (`painted`)

@@ -131,17 +131,19 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal, features: str = "names") -
     world = sg.world
     state = map_symbols(sg).state
     place = subgoal.predicate is Predicate.ON
+    # Positions and yaws are read in the target's frame (it turns with its shelf), so that a
+    # turned shelf reads as an unturned one.
     if place:
         rect = world.surface_rect(target)
-        cx, cy = rect.center
-        ref_a = (cx, cy, rect.z)
+        ref_a = ((rect.x_min + rect.x_max) / 2, (rect.y_min + rect.y_max) / 2, rect.z)
     else:
         rect = world.shelves[target].interior
-        ref_a = sg.pose(obj).position
+        ref_a = (*rect.to_local(*sg.pose(obj).position[:2]), sg.pose(obj).position[2])
         front = (rect.x_min, (rect.y_min + rect.y_max) / 2)
     rows = []
     for node in sg.nodes:
         x, y, z = node.pose.position
+        x, y = rect.to_local(x, y)
         t = node.type
         region = _region_class(state, node.name)
         if features == "names":
@@ -152,7 +154,7 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal, features: str = "names") -
             feat = [float(t.kind is k) for k in KINDS] + _described(world, region, target, place)
         k = len(feat)
         feat += [0.0] * (node_dim - k)
-        yaw = node.pose.yaw
+        yaw = node.pose.yaw - rect.yaw
         size = [SCALE * s for s in t.size]
         feat[k : k + 6] = [float(node.name == obj), *size, math.cos(2 * yaw), math.sin(2 * yaw)]
         feat[k + 6 : k + 9] = [
@@ -172,6 +174,10 @@ def ground(sg: GeometricSceneGraph, subgoal: Literal, features: str = "names") -
     src, dst = torch.meshgrid(torch.arange(n), torch.arange(n), indexing="ij")
     keep = src != dst
     edge_index = torch.stack([src[keep], dst[keep]])
+    if rect.yaw:  # into the target's frame, as the nodes' positions
+        c, s = math.cos(rect.yaw), math.sin(rect.yaw)
+        turn = torch.tensor([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], dtype=torch.float)
+        pos = pos @ turn
     offset = SCALE * (pos[edge_index[1]] - pos[edge_index[0]])
     edge_attr = torch.cat([offset, offset[:, :2].norm(dim=1, keepdim=True)], dim=1)
     u = torch.tensor([_subgoal(world, obj, target, place, features)])
@@ -212,10 +218,11 @@ def bin_queries(sg: GeometricSceneGraph, subgoal: Literal) -> torch.Tensor:
     obj, target = subgoal.args
     rows = []
     if subgoal.predicate is Predicate.ON:
-        cx, cy = sg.world.surface_rect(target).center
+        rect = sg.world.surface_rect(target)  # in its frame, as the nodes' features
+        cx, cy = (rect.x_min + rect.x_max) / 2, (rect.y_min + rect.y_max) / 2
         for i in range(PLACE_BINS):
             for j in range(PLACE_BINS):
-                x, y = place_xy(obj, target, i, j, sg.world)
+                x, y = rect.to_local(*place_xy(obj, target, i, j, sg.world))
                 rows.append(
                     [
                         SCALE * (x - cx),

@@ -252,6 +252,7 @@ def _reaches(below: dict[str, str], start: str, target: str) -> bool:
 
 def _rect_distance(rect: Rect, x: float, y: float) -> float:
     """Horizontal distance from (x, y) to a rectangle: 0 inside, inf for a NaN position."""
+    x, y = rect.to_local(x, y)
     dx = max(rect.x_min - x, 0.0, x - rect.x_max)
     dy = max(rect.y_min - y, 0.0, y - rect.y_max)
     d = math.hypot(dx, dy)

@@ -29,20 +29,21 @@ class Arena:
         return (self.table,) + tuple(b for parts in self.shelves.values() for b in parts)
 
 
-def _box(bc: BulletClient, center, half, color, friction: float | None) -> int:
-    """A fixed box; `friction` None: paint, with no collision shape."""
+def _box(bc: BulletClient, center, half, color, friction: float | None, yaw: float = 0.0) -> int:
+    """A fixed box turned by `yaw` about z; `friction` None: paint, with no collision shape."""
     col = bc.createCollisionShape(bc.GEOM_BOX, halfExtents=half) if friction is not None else -1
     vis = bc.createVisualShape(bc.GEOM_BOX, halfExtents=half, rgbaColor=color)
-    body = bc.createMultiBody(0, col, vis, basePosition=center)
+    turned = {"baseOrientation": bc.getQuaternionFromEuler((0.0, 0.0, yaw))} if yaw else {}
+    body = bc.createMultiBody(0, col, vis, basePosition=center, **turned)
     if friction is not None:
         bc.changeDynamics(body, -1, lateralFriction=friction)
     return body
 
 
 def _slab(bc: BulletClient, r: Rect, z0: float, z1: float, color, friction: float | None) -> int:
-    center = ((r.x_min + r.x_max) / 2, (r.y_min + r.y_max) / 2, (z0 + z1) / 2)
+    center = (*r.center, (z0 + z1) / 2)
     half = (r.width_x / 2, r.width_y / 2, (z1 - z0) / 2)
-    return _box(bc, center, half, color, friction)
+    return _box(bc, center, half, color, friction, r.yaw)
 
 
 def build_shelf(bc: BulletClient, shelf: Shelf, friction: float) -> tuple[int, ...]:

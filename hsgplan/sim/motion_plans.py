@@ -21,11 +21,12 @@ from hsgplan.domain.parameters import (
     PrimitiveParams,
     extent_along,
     place_xy,
+    place_yaw,
     push_carry,
     push_values,
 )
 from hsgplan.domain.predicates import Literal, in_grasp, inside, on
-from hsgplan.domain.world import GRIPPER_MAX_OPENING, PLACE_LONG_AXIS_YAW, Kind, World
+from hsgplan.domain.world import GRIPPER_MAX_OPENING, Kind, World
 from hsgplan.scene_graph.geometry import Pose, yaw_quat
 from hsgplan.sim.collision import SAFETY_MARGIN
 from hsgplan.sim.outcome import Status
@@ -253,7 +254,7 @@ def _plan_place(scene: Scene, p: PlaceParams, q0: np.ndarray) -> MotionPlan | Pl
         z = world.surface_rect(p.target).z
         # The convention first (long side along y), so the bins' insets hold; turned as needed.
         turns = (0, 2, 1, -1) if t.kind is Kind.BOX else (0, 1, 2, -1, 0.5, -0.5)
-        yaws = [PLACE_LONG_AXIS_YAW + k * math.pi / 2 for k in turns]
+        yaws = [place_yaw(p.target, world) + k * math.pi / 2 for k in turns]
     elif p.target in scene.bodies and p.target != p.obj:
         base = scene.pose(p.target)
         x, y = base.position[:2]
@@ -287,7 +288,8 @@ def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
     shelf = prepush_shelf(world, scene.pose(p.obj))
     if shelf is None:
         return PlanFailure(Status.INVALID, f"'{p.obj}' is not on a prepush region")
-    angle, dist = push_values(p.angle_bin, p.dist_bin)
+    interior = world.shelves[shelf].interior
+    angle, dist = push_values(p.angle_bin, p.dist_bin, interior.yaw)
     u = np.array([math.cos(angle), math.sin(angle), 0.0])
     pose, t = scene.pose(p.obj), world.object_type(p.obj)
     # The object goes at most as far as the fingertips push it, and measured about 4 cm less
@@ -295,8 +297,11 @@ def _plan_push(scene: Scene, p, q0: np.ndarray) -> MotionPlan | PlanFailure:
     # 1,600 more, every success had this bound at least 2.63 cm past the shelf's front, while
     # under 2.5 cm ~130 of the 1,600 were carried out in vain; one short of that front plus
     # PUSH_SLACK is refused before it is planned and run.
-    reach = pose.position[0] + push_carry(dist) * u[0]
-    if reach < world.shelves[shelf].interior.x_min + PUSH_SLACK:
+    # (along the shelf's own x: into it)
+    reach = interior.to_local(*pose.position[:2])[0] + push_carry(dist) * math.cos(
+        angle - interior.yaw
+    )
+    if reach < interior.x_min + PUSH_SLACK:
         return PlanFailure(Status.EFFECT_NOT_REACHED, f"too short to bring '{p.obj}' into {shelf}")
     orn = tilted(angle, PUSH_PITCH)
     axis = Pose((0, 0, 0), orn).rotation[:, 2]
@@ -378,7 +383,4 @@ def _line(scene: Scene, poses: list[Pose], q_start: np.ndarray) -> list[np.ndarr
 
 def prepush_shelf(world: World, pose: Pose) -> str | None:
     """The shelf whose prepush region an object stands on, if any."""
-    for s in world.shelf_list:
-        if s.prepush and world.regions[s.prepush].contains(*pose.position[:2], margin=0.01):
-            return s.name
-    return None
+    return world.prepush_shelf(*pose.position[:2])

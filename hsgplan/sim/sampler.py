@@ -114,7 +114,7 @@ def free_spot(
     # Boxes lie long side along y, as they are placed (a cell is too short for them the other
     # way round); cans may stand any way.
     turns = [0.0, math.pi] if t.kind is Kind.BOX else [0.0, math.pi / 2]
-    cells = world.spot_cells(surface)
+    cells = [r.to_local(*c) for c in world.spot_cells(surface)]  # drawn in the surface's frame
     rng.shuffle(cells)
     for cx, cy in cells:
         for k in range(TRIES_PER_CELL + 1):
@@ -122,7 +122,7 @@ def free_spot(
             yaw = rng.choice(turns) + rng.uniform(-YAW_JITTER, YAW_JITTER) * (jitter > 0)
             x = min(max(cx + rng.uniform(-jitter, jitter), r.x_min + ix), r.x_max - ix)
             y = min(max(cy + rng.uniform(-jitter, jitter), r.y_min + iy), r.y_max - iy)
-            pose = Pose.from_xyz_yaw(x, y, z, yaw)
+            pose = Pose.from_xyz_yaw(*r.to_world(x, y), z, r.direction(yaw))
             scene.set_pose(obj, pose)
             if not any(
                 scene.bc.getClosestPoints(scene.bodies[obj], scene.bodies[o], GAP) for o in placed

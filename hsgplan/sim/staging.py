@@ -75,8 +75,9 @@ def _put_inside(
         for o, y in zip(inside, slots, strict=True):
             t = world.object_type(o)
             x = r.x_min + t.size[0] / 2 + rng.uniform(*INSIDE_DEPTH)
-            y += rng.uniform(-INSIDE_JITTER, INSIDE_JITTER)
-            scene.set_pose(o, Pose.from_xyz_yaw(x, y, t.height / 2 + 0.001, 0.0))
+            y += rng.uniform(-INSIDE_JITTER, INSIDE_JITTER)  # in the shelf's frame
+            at = (*r.to_world(x, y), t.height / 2 + 0.001)
+            scene.set_pose(o, Pose.from_xyz_yaw(*at, r.direction(0.0)))
             placed.append(o)
     return all(
         state.location(o).predicate is not Predicate.IN or o in placed for o in state.objects
@@ -86,14 +87,15 @@ def _put_inside(
 def move_short_of(
     scene: Scene, state: SymbolicSceneGraph, obj: str, shelf: str, gap: float
 ) -> bool:
-    """Set a staged object down again nearer a shelf, moved along x only, its centre `gap`
-    short of the interior: where a push that fell short leaves it. False when it would not
-    rest there as `state` says (it met a neighbour, or f_m reads it otherwise)."""
+    """Set a staged object down again nearer a shelf, moved along the shelf's x only, its
+    centre `gap` short of the interior: where a push that fell short leaves it. False when it
+    would not rest there as `state` says (it met a neighbour, or f_m reads it otherwise)."""
     before = scene.pose(obj)
-    x = scene.world.shelves[shelf].interior.x_min - gap
-    scene.set_pose(obj, Pose((x, *before.position[1:]), before.orientation))
+    r = scene.world.shelves[shelf].interior
+    at = r.to_world(r.x_min - gap, r.to_local(*before.position[:2])[1])
+    scene.set_pose(obj, Pose((*at, before.position[2]), before.orientation))
     scene.settle()
-    moved = np.subtract(scene.pose(obj).position[:2], (x, before.position[1]))
+    moved = np.subtract(scene.pose(obj).position[:2], at)
     mapping = map_symbols(scene.scene_graph())
     return (
         float(np.hypot(*moved)) < SHORT_OF_TOLERANCE

@@ -40,6 +40,19 @@ def test_a_layout_is_drawn_within_its_ranges_and_again_the_same(new_objects):
                 )
 
 
+def test_a_turn_draws_each_shelfs_yaw_within_it_and_no_turn_leaves_the_layout_as_it_was():
+    yaws = []
+    for index in range(8):
+        w = layouts.random_layout(KITCHEN, 3, index, turn=30.0)
+        assert w == layouts.random_layout(KITCHEN, 3, index, turn=30.0)
+        yaws += [s.yaw_degrees for s in w.shelf_list]
+        assert layouts.random_layout(KITCHEN, 3, index) == layouts.random_layout(
+            KITCHEN, 3, index, turn=0.0
+        )
+    assert all(-30.0 <= y <= 30.0 for y in yaws) and len(set(yaws)) > 8
+    assert any(y < -10 for y in yaws) and any(y > 10 for y in yaws)
+
+
 def test_layouts_of_other_seeds_differ():
     assert layouts.random_layout(KITCHEN, 1, 0) != layouts.random_layout(KITCHEN, 2, 0)
 
