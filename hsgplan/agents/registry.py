@@ -292,7 +292,8 @@ def check_reads(folders: list[Path], world: World, scene: str | Path | None) -> 
     if bound:
         raise InvalidInputError(
             f"the networks of '{bound[0]}' know the kitchen's objects, shelves and regions by "
-            f"name; scene '{scene}' names others ({', '.join(others)})"
+            f"name; scene '{scene}' names others ({', '.join(others)}): networks that read kind "
+            "and size are checkpoints/task-geometry and checkpoints/motion-geometry (GNNs only)"
         )
 
 
