@@ -112,3 +112,35 @@ def test_a_push_subgoal_reads_the_same_into_a_turned_shelf_as_into_an_unturned_o
         assert torch.allclose(a.x, b.x, atol=1e-5), (a.x, b.x)
         assert torch.allclose(a.query, b.query, atol=1e-5)
     assert on("cherries", "prepush_a")  # the literal the staged can stands under
+
+
+def test_the_samplers_draw_in_the_cells_a_scene_of_long_boxes_counts():
+    # a 13 cm box widens the cells along y: the stream baselines' first place bins (one per
+    # cell) and the scene sampler's spots follow the world's cells, not fixed 11 cm ones
+    import random
+
+    import numpy as np
+
+    from hsgplan.agents.streams import bin_order
+    from hsgplan.scene_graph.geometry import Pose
+    from hsgplan.sim.sampler import free_spot
+    from hsgplan.sim.scene import Scene
+
+    data = copy.deepcopy(KITCHEN)
+    data["objects"][4]["size"] = [0.053, 0.13, 0.024]
+    w = world_of(data)
+    cells = w.spot_cells("open_space")
+    assert len(cells) == 8 and w.cell[1] > 0.11  # 4 x 2, where 11 cm cells make 4 x 3
+    first = bin_order("cherries", "open_space", np.random.default_rng(0), w)[: len(cells)]
+    nearest = [min(cells, key=lambda c: math.dist(place_xy("cherries", "open_space", *b, w), c))
+               for b in first]  # fmt: skip
+    assert sorted(nearest) == sorted(cells)  # one first bin in each of the 8 cells
+    names = ["cherries", *(f"cherries_{k}" for k in range(2, 10))]
+    with Scene(names, seed=0, poses={n: Pose.from_xyz_yaw(5.0 + k, 5.0, 0.1, 0.0)
+                                     for k, n in enumerate(names)}, world=w) as scene:  # fmt: skip
+        placed: list[str] = []
+        for name in names[:8]:
+            assert free_spot(scene, name, "open_space", placed, random.Random(1)) is not None
+            placed.append(name)
+        # every cell taken: a ninth has no spot (11 cm cells would have held four more)
+        assert free_spot(scene, names[8], "open_space", placed, random.Random(1)) is None
