@@ -109,6 +109,8 @@ def _draw_push(
     rng: random.Random, seed: int, index: int, world: World, fell_short: float
 ) -> MotionTask:
     shelf = world.goal_interior
+    if shelf is None:
+        raise InvalidInputError(f"scene '{world.name}' has no shelf to push into")
     types = world.object_types
     cans = [t for t, k in types.items() if k.kind is Kind.CAN and world.fits_inside(t, shelf)]
     obj = rng.choice(cans)

@@ -233,8 +233,10 @@ class World:
         regions: the regions on the table in the order the scene lists them (the open space
             first, then each shelf's prepush region); entity one-hots and PDDL objects follow
             this order, and that of `shelves` and `object_types`.
-        goal_shelf_tops: the shelf tops that goal literals put objects on.
-        goal_interior: the shelf whose interior `In` goals name (cans only, in evaluation goals).
+        goal_surfaces: the surfaces goal literals put objects on: shelf tops, then any regions
+            the scene names for goals (a scene of no shelves has only those).
+        goal_interior: the shelf whose interior `In` goals name (cans only, in evaluation
+            goals); None in a scene where no shelf has an interior.
         fixture_friction: the table's and the shelves' lateral friction.
         cameras: the fixed views f_p sees the scene with.
     """
@@ -244,8 +246,8 @@ class World:
     shelf_list: tuple[Shelf, ...]
     region_list: tuple[tuple[str, Rect], ...]
     type_list: tuple[ObjectType, ...]
-    goal_shelf_tops: tuple[str, ...]
-    goal_interior: str
+    goal_surfaces: tuple[str, ...]
+    goal_interior: str | None
     fixture_friction: float
     cameras: tuple[View, ...]
 
@@ -292,8 +294,8 @@ class World:
 
     @cached_property
     def goal_top_room(self) -> int:
-        """Objects the goal shelf tops hold side by side."""
-        return sum(self.surface_capacity[t] for t in self.goal_shelf_tops)
+        """Objects the goal surfaces hold side by side."""
+        return sum(self.surface_capacity[t] for t in self.goal_surfaces)
 
     @cached_property
     def interior_capacity(self) -> dict[str, int]:

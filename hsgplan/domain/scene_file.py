@@ -243,18 +243,20 @@ def _region(v: Any, at: str) -> tuple[str, Rect]:
 
 
 def _world(data: Any) -> World:
-    top = _table(data, "the file", {"name", "table", "regions", "shelves", "objects", "cameras"},
-                 {"fixture_friction", "goals"})  # fmt: skip
+    top = _table(data, "the file", {"name", "table", "regions", "objects", "cameras"},
+                 {"fixture_friction", "goals", "shelves"})  # fmt: skip
     faults = _Faults()
     name = faults.read(_name, top["name"], "name", SCENE_NAME)
     table = faults.read(lambda: _rect(_table(top["table"], "table", {"x", "y"}), "table"))
     friction = faults.read(_number, top.get("fixture_friction", 0.6), "fixture_friction", 0.05,
                            2.0)  # fmt: skip
     regions = _each(top["regions"], "regions", 1, MAX_SHELVES + 1, _region, faults)
-    read = _each(top["shelves"], "shelves", 1, MAX_SHELVES, _shelf, faults)
+    read = _each(top.get("shelves", []), "shelves", 0, MAX_SHELVES, _shelf, faults)
     types = _each(top["objects"], "objects", 1, MAX_TYPES, _object, faults)
     cameras = tuple(_each(top["cameras"], "cameras", 1, MAX_CAMERAS, _camera, faults))
-    goals = faults.read(_table, top.get("goals", {}), "goals", set(), {"shelf_tops", "interior"})
+    goals = faults.read(
+        _table, top.get("goals", {}), "goals", set(), {"shelf_tops", "regions", "interior"}
+    )
     faults.check()  # what follows reads the fields together
     if OPEN_SPACE not in dict(regions):
         faults.said.append(f"regions: need one named {OPEN_SPACE!r} (where objects are put aside)")
@@ -265,13 +267,25 @@ def _world(data: Any) -> World:
     with_interior = [s.name for s in shelves if s.interior is not None]
     names = [s.name for s in shelves]
     tops = goals.get("shelf_tops", names)
-    if not isinstance(tops, list) or not tops or any(t not in names for t in tops):
+    if not isinstance(tops, list) or any(t not in names for t in tops):
         faults.said.append(f"goals.shelf_tops {tops!r}: need a list of the scene's shelves")
+        tops = []
+    # regions goals may fill besides (or, in a scene of no shelves, instead of) shelf tops
+    free = [r for r, _ in regions if r != OPEN_SPACE and r not in {s.prepush for s in shelves}]
+    more = goals.get("regions", [])
+    if not isinstance(more, list) or any(r not in free for r in more):
+        faults.said.append(
+            f"goals.regions {more!r}: need a list of the scene's regions other than the open "
+            "space and prepush regions"
+        )
+        more = []
+    if not tops + more:
+        faults.said.append("goals: need a shelf top or a region for goals to fill")
     interior = goals.get("interior", with_interior[0] if with_interior else None)
-    if interior not in with_interior:
+    if interior is not None and interior not in with_interior:
         faults.said.append(f"goals.interior {interior!r}: need a shelf with an interior")
     faults.check()
-    return World(name, table, tuple(shelves), tuple(regions), tuple(types), tuple(tops),
+    return World(name, table, tuple(shelves), tuple(regions), tuple(types), (*tops, *more),
                  interior, friction, cameras)  # fmt: skip
 
 
@@ -374,7 +388,7 @@ def scene_data(world: World) -> dict:
             }  # fmt: skip
             for t in world.type_list
         ],
-        "goals": {"shelf_tops": list(world.goal_shelf_tops), "interior": world.goal_interior},
+        "goals": _goals_data(world),
         "cameras": [
             {
                 "width": c.width,
@@ -386,6 +400,16 @@ def scene_data(world: World) -> dict:
             for c in world.cameras
         ],
     }
+
+
+def _goals_data(world: World) -> dict:
+    tops = [s for s in world.goal_surfaces if s in world.shelves]
+    goals: dict[str, Any] = {"shelf_tops": tops}
+    if regions := [r for r in world.goal_surfaces if r in world.regions]:
+        goals["regions"] = regions
+    if world.goal_interior is not None:
+        goals["interior"] = world.goal_interior
+    return goals
 
 
 def _inline(v: Any) -> str:

@@ -30,7 +30,7 @@ def scene_limits(world: World) -> SceneLimits:
             f"{world.surface_rect(name).z:.3f}",
             str(world.surface_capacity[name]),
             str(sum(math.hypot(x, y) <= REACH_MAX_XY for x, y in world.spot_cells(name))),
-            "yes" if name in world.goal_shelf_tops else "—",
+            "yes" if name in world.goal_surfaces else "—",
         )
         for name in world.surfaces
     )

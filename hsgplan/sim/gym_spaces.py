@@ -48,7 +48,8 @@ def observation_space(world: World) -> spaces.Dict:
             # position (m) and quaternion xyzw per slot; zeros for an empty slot
             "poses": spaces.Box(-POSITION_BOUND, POSITION_BOUND, (MAX_OBJECTS, 7), np.float32),
             "on": spaces.MultiBinary([MAX_OBJECTS, _entities(world)]),  # On(slot i, entity j)
-            "inside": spaces.MultiBinary([MAX_OBJECTS, len(world.shelves)]),  # In(slot i, shelf j)
+            # In(slot i, shelf j); a scene of no shelves keeps one column, always 0
+            "inside": spaces.MultiBinary([MAX_OBJECTS, max(1, len(world.shelves))]),
             "in_grasp": spaces.MultiBinary(MAX_OBJECTS),
             "clear": spaces.MultiBinary(MAX_OBJECTS),
         }

@@ -51,7 +51,7 @@ def random_goal(n: int, rng: random.Random, stacking: bool = True, *, world: Wor
     objects = list(random_objects(n, rng, world))
     rng.shuffle(objects)
     interior = world.goal_interior
-    room = Room.left(world.goal_shelf_tops, (interior,), world=world)
+    room = Room.left(world.goal_surfaces, () if interior is None else (interior,), world=world)
     literals: list[Literal] = []
     for o in objects:
         kinds: list[str] = room.free_tops()
@@ -63,7 +63,7 @@ def random_goal(n: int, rng: random.Random, stacking: bool = True, *, world: Wor
         if not kinds:
             raise InvalidInputError(
                 f"scene '{world.name}' has no room for a goal of {n} objects as goals are drawn "
-                f"(its goal shelf tops hold {world.goal_top_room})"
+                f"(its goal surfaces hold {world.goal_top_room})"
             )
         kind = rng.choice(kinds)
         if kind == "inside":
@@ -108,7 +108,7 @@ def random_state(
     for o in order:
         options: list[str] = []
         if rng.random() < p_elsewhere:
-            options = room.free_tops(world.goal_shelf_tops) + room.bases()
+            options = room.free_tops(world.goal_surfaces) + room.bases()
         if not options:
             options = room.free_tops((OPEN_SPACE,)) or room.free_tops()
         target = rng.choice(options)

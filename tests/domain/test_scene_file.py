@@ -35,7 +35,7 @@ def test_the_kitchen_is_the_world_every_table_was_measured_in():
     }  # fmt: skip
     assert w.interior_capacity == {"shelf_a": 3, "shelf_b": 3}
     assert w.max_tower_levels == 2
-    assert w.goal_shelf_tops == ("shelf_a", "shelf_b") and w.goal_interior == "shelf_a"
+    assert w.goal_surfaces == ("shelf_a", "shelf_b") and w.goal_interior == "shelf_a"
     assert len(w.cameras) == 5 and w.cameras[0].eye == (1.15, 0.0, 1.0)
 
 
@@ -99,8 +99,10 @@ BAD = [
     (_set(["shelves", 0, "interior"], "yes"), "shelves[1].interior 'yes': true or false"),
     (_set(["shelves", 0, "interior"], False), "shelves[1].prepush: a shelf with no interior"),
     (_set(["goals", "interior"], "pantry"), "goals.interior 'pantry'"),
-    (_set(["goals", "shelf_tops"], []), "goals.shelf_tops []"),
-    (_set(["shelves"], []), "shelves: need between 1 and 8"),
+    (_set(["goals", "shelf_tops"], []), "goals: need a shelf top or a region for goals to fill"),
+    (_set(["goals", "regions"], ["prepush_a"]), "goals.regions ['prepush_a']: need a list"),
+    (_set(["shelves"], []), "goals.shelf_tops ['shelf_a', 'shelf_b']: need a list of the"),
+    (_set(["shelves"], [{"name": "s"}] * 9), "shelves: need between 0 and 8"),
     (_set(["cameras", 0, "width"], 0), "cameras[1] width and height [0, 240]"),
     (_set(["cameras", 0, "target"], [1.15, 0.0, 1.0]), "cameras[1]: the eye is where it looks"),
     (_set(["table"], "big"), "table: need a table of fields"),

@@ -77,14 +77,14 @@ def _places(objects: list[str], states, rng: random.Random) -> list[Literal]:
 
 def _extra_goals(objects: list[str], goal: frozenset[Literal], rng: random.Random, world: World):
     """Goal literals for some added objects, within the capacities the task goal leaves."""
-    tops, interior = world.goal_shelf_tops, world.goal_interior
+    tops, interior = world.goal_surfaces, world.goal_interior
     # An In literal on shelf A also takes a place of its top here (its last argument is the
     # shelf): stricter than needed, kept so that the copies stay as they were drawn.
     room = Room.left(
         tops,
-        (interior,),
+        () if interior is None else (interior,),
         on_top={s: sum(lit.args[-1] == s for lit in goal) for s in tops},
-        inside={interior: sum(lit.predicate is Predicate.IN for lit in goal)},
+        inside={interior: sum(lit.predicate is Predicate.IN for lit in goal)} if interior else {},
         world=world,
     )
     out = []
