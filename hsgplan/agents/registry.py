@@ -249,10 +249,13 @@ def default_checkpoints(
     others = sorted({n for w in worlds for n in unnamed(w)})
     if not others:
         return task, motion, None
+    # only the folders of the agent's learned parts are swapped (a run records what it read)
+    planner, generator = agent_parts(name) if name not in WHOLE_AGENTS else ("", "")
     geometry = (
-        task if checkpoint else TASK_GEOMETRY_CHECKPOINT,
-        motion if motion_checkpoints else MOTION_GEOMETRY_CHECKPOINTS,
-    )
+        task if checkpoint or planner not in LEARNED_PLANNERS else TASK_GEOMETRY_CHECKPOINT,
+        motion if motion_checkpoints or generator not in LEARNED_MOTION
+        else MOTION_GEOMETRY_CHECKPOINTS,
+    )  # fmt: skip
     before, after = agent_checkpoints(name, task, motion), agent_checkpoints(name, *geometry)
     if before == after or not all(shipped(f).exists() for f in after):
         return task, motion, None
@@ -260,7 +263,8 @@ def default_checkpoints(
         return task, motion, None
     said = (
         f"a scene here names what the shipped networks do not know by name ({', '.join(others)}): "
-        f"running the networks that read kind and size ({', '.join(map(str, geometry))})"
+        "running the networks that read kind and size "
+        f"({', '.join(str(f) for f in geometry if f not in (task, motion))})"
     )
     return *geometry, said
 

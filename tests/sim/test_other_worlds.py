@@ -122,6 +122,11 @@ def test_a_scene_of_other_names_runs_the_networks_that_read_kind_and_size_by_def
     names = default_checkpoints("regression+gnn", [NEW], checkpoint=shipped(TASK_CHECKPOINT))
     assert names[2] is None  # a names planner named by hand: left to be refused
     assert default_checkpoints("oracle", [NEW])[2] is None  # nothing learned to swap
+    # only a learned part's folder: Fast Downward reads no task networks
+    assert default_checkpoints("fd+gnn", [NEW])[:2] == (
+        TASK_CHECKPOINT,
+        MOTION_GEOMETRY_CHECKPOINTS,
+    )
 
     scene, out = tmp_path / "new.toml", tmp_path / "e"
     scene.write_text(to_toml(scene_data(NEW)))
