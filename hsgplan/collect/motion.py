@@ -73,6 +73,10 @@ class CollectConfig:
             return [(None, names_world())]
         found = read_worlds(self.scene)
         store.one_set_of_types(list(found.values()), self.scene)
+        if self.primitive is MotionPrimitive.PUSH:
+            for path, world in found.items():
+                if world.goal_interior is None:
+                    raise InvalidInputError(f"'{path}' has no shelf interior to push into")
         return [(str(path), world) for path, world in found.items()]
 
     def round_scenes(self) -> bool:

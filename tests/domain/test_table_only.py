@@ -59,3 +59,15 @@ def test_its_observations_keep_one_empty_inside_column():
         obs = encode(goal.objects, scene.scene_graph(), state)
     assert obs["inside"].shape == (12, 1) and not obs["inside"].any()
     assert observation_space(w).contains(obs)
+
+
+def test_pushes_are_not_collected_where_there_is_nothing_to_push_into(tmp_path):
+    from typer.testing import CliRunner
+
+    from hsgplan.cli import app
+
+    out = tmp_path / "push"
+    args = ["collect", "push", "--samples", "10", "--scene", str(TABLE), "--out", str(out)]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2 and "has no shelf interior to push into" in r.output, r.output
+    assert not out.exists()
