@@ -194,9 +194,9 @@ MIN_SUPPORT_SIDE = 0.045
 REACH_MAX_Z = 0.40
 
 # Farthest from the base's axis (horizontally) the hand reaches top-down at every height up to
-# `REACH_MAX_Z`: the arm's inverse kinematics reaches 0.74-0.81 m in directions 0-120 degrees
-# off +x (least at the top height), kept 2 cm inside the least (a test holds the arm to it). A
-# surface all of whose cells lie farther is out of reach.
+# `REACH_MAX_Z`: the arm's inverse kinematics reaches 0.73-0.81 m in every direction (least at
+# the top height), kept inside the least (a test holds the arm to it). A surface all of whose
+# cells lie farther is out of reach.
 REACH_MAX_XY = 0.72
 
 # The robot's base on the table, around the origin: the collision box of the Panda's base link
