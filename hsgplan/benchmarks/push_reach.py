@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass
 
 from hsgplan.data.motion_tasks import draw_task
 from hsgplan.data.motion_trials import run_task
+from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import PUSH_LEAD, MotionPrimitive, push_values
 from hsgplan.domain.scene import World
 from hsgplan.sim import motion_plans
@@ -65,6 +66,8 @@ def push_reach(
     worlds: Sequence[World],
     on_task: Callable[[], None] | None = None,
 ) -> PushReach:
+    if any(w.goal_interior is None for w in worlds):
+        raise InvalidInputError("push-reach: a scene has no shelf interior to push into")
     slack = motion_plans.PUSH_SLACK
     margins: list[tuple[float, bool]] = []
     statuses: Counter[str] = Counter()

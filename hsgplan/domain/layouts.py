@@ -70,6 +70,7 @@ def _shelves(base: World, rng: random.Random, turn: float = 0.0) -> list[dict]:
                 "interior": s.interior is not None,
             }  # fmt: skip
             yaw = s.yaw_degrees + (round(rng.uniform(-turn, turn), 1) if turn else 0.0)
+            yaw = (yaw + 180.0) % 360.0 - 180.0 if abs(yaw) > 180.0 else yaw
             if yaw:
                 out[s.name]["yaw"] = yaw
     return [out[s.name] for s in base.shelf_list]
@@ -123,7 +124,7 @@ def random_layout(
             why_not[example.setdefault(re.sub(r"-?\d+\.\d+", "#", said), said)] += 1
             continue
         if world.goal_top_room < GOAL_ROOM:
-            why_not[f"its goal shelf tops hold fewer than {GOAL_ROOM} objects"] += 1
+            why_not[f"its goal surfaces hold fewer than {GOAL_ROOM} objects"] += 1
         elif world.max_tower_levels < TOWER_LEVELS:
             why_not[f"its towers hold fewer than {TOWER_LEVELS} objects"] += 1
         else:

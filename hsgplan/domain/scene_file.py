@@ -281,6 +281,8 @@ def _world(data: Any) -> World:
         more = []
     if not tops + more:
         faults.said.append("goals: need a shelf top or a region for goals to fill")
+    elif len(set(tops + more)) < len(tops + more):
+        faults.said.append(f"goals: {tops + more!r} names a surface twice")
     interior = goals.get("interior", with_interior[0] if with_interior else None)
     if interior is not None and interior not in with_interior:
         faults.said.append(f"goals.interior {interior!r}: need a shelf with an interior")

@@ -239,6 +239,10 @@ def _rows(
         gnn = shipped(checkpoints) / f"{kind.value}-{FOLDERS['gnn']}"
         for path, world in worlds.items():
             check_reads([gnn], world, path and str(path))
+            if kind is MotionPrimitive.PUSH and world.goal_interior is None:
+                raise InvalidInputError(
+                    f"'{path}' has no shelf interior to push into: --primitives place"
+                )
     chunks = [
         MotionChunk(kind.value, seed, start, str(checkpoints), path and str(path))
         for path in worlds

@@ -75,6 +75,8 @@ def draw_state(rng: random.Random, p_elsewhere: float, world: World) -> Symbolic
     shelves."""
     objects = draw_objects(rng.randint(2, MAX_OBJECTS), rng, world)
     state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=world)
+    if not world.interior_capacity:  # no shelf to put a can inside
+        return state
     inside_count = dict.fromkeys(world.interior_capacity, 0)
     literals = []
     for o in state.objects:

@@ -6,7 +6,7 @@ The goal distribution, for n objects (2..12):
    replacement. Instances are named as in `objects.py`.
 2. Each object, in a uniformly shuffled order, gets one literal of the paper's goal kinds, the
    kind drawn uniformly among those still feasible for it:
-   - `On(o, top)` for each of the world's goal shelf tops (in the kitchen `shelf_a` and
+   - `On(o, top)` for each of the world's goal surfaces (in the kitchen `shelf_a` and
      `shelf_b`): on a shelf top, while the top has room;
    - `In(o, shelf)` for the world's goal interior (shelf A's in the kitchen): for cans, while
      the interior has room;

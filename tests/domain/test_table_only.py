@@ -71,3 +71,28 @@ def test_pushes_are_not_collected_where_there_is_nothing_to_push_into(tmp_path):
     r = CliRunner().invoke(app, args)
     assert r.exit_code == 2 and "has no shelf interior to push into" in r.output, r.output
     assert not out.exists()
+
+
+def test_its_images_draw_no_can_inside_and_its_motion_eval_runs_no_push(tmp_path):
+    import random
+
+    from typer.testing import CliRunner
+
+    from hsgplan.cli import app
+    from hsgplan.perception.synthetic import draw_state
+
+    w = read_world(TABLE)
+    for k in range(5):
+        state = draw_state(random.Random(k), 0.3, w)
+        assert all(lit.predicate is not Predicate.IN for lit in state.literals)
+    args = ["eval", "motion", "--scene", str(TABLE), "--trials", "2", "--out", str(tmp_path / "m")]
+    args += ["--motion-checkpoints", "checkpoints/motion-geometry"]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2 and "no shelf interior to push into" in r.output, r.output
+
+
+def test_a_surface_named_twice_in_the_goals_is_refused():
+    data = copy.deepcopy(DATA)
+    data["goals"]["regions"] = ["tray_a", "tray_a"]
+    with pytest.raises(InvalidInputError, match="names a surface twice"):
+        world_of(data)
