@@ -289,6 +289,14 @@ class World:
         return spot_cells(self.surface_rect(surface), self.cell)
 
     @cached_property
+    def reached_cells(self) -> dict[str, int]:
+        """How many of each surface's cells lie within the hand's reach (`REACH_MAX_XY`)."""
+        return {
+            name: sum(math.hypot(x, y) <= REACH_MAX_XY for x, y in self.spot_cells(name))
+            for name in self.surfaces
+        }
+
+    @cached_property
     def surface_capacity(self) -> dict[str, int]:
         return {name: len(self.spot_cells(name)) for name in self.surfaces}
 

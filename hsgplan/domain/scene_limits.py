@@ -7,7 +7,6 @@ planners are held to."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from hsgplan.domain.scene import REACH_MAX_XY, REACH_MAX_Z, SPOT, World
@@ -29,7 +28,7 @@ def scene_limits(world: World) -> SceneLimits:
             "region" if name in world.regions else "shelf top",
             f"{world.surface_rect(name).z:.3f}",
             str(world.surface_capacity[name]),
-            str(sum(math.hypot(x, y) <= REACH_MAX_XY for x, y in world.spot_cells(name))),
+            str(world.reached_cells[name]),
             "yes" if name in world.goal_surfaces else "—",
         )
         for name in world.surfaces

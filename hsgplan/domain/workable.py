@@ -3,8 +3,6 @@ line each, said before anything runs (`scene_file.world_of` refuses a scene with
 
 from __future__ import annotations
 
-import math
-
 from hsgplan.domain.scene import (
     REACH_MAX_XY,
     REACH_MAX_Z,
@@ -36,15 +34,6 @@ def _on_base(world: World) -> list[str]:
     ]
 
 
-def _reachable(world: World) -> list[str]:
-    """Surfaces with a place (cell) within the hand's horizontal reach."""
-    return [
-        name
-        for name in world.surfaces
-        if any(math.hypot(x, y) <= REACH_MAX_XY for x, y in world.spot_cells(name))
-    ]
-
-
 def _out_of_reach(world: World) -> list[str]:
     """Surfaces that hold nothing: narrower than a cell, or every cell beyond the hand's
     horizontal reach."""
@@ -55,14 +44,13 @@ def _out_of_reach(world: World) -> list[str]:
         f"{100 * cx:.1f} x {100 * cy:.1f} cm (the scene's largest footprint, {longest}'s, and "
         "its room)"
         for name in world.surfaces
-        if not world.spot_cells(name)
+        if not world.surface_capacity[name]
     ]
-    reachable = _reachable(world)
     return problems + [
         f"{_surface(world, name)}: every place on it lies beyond the arm's reach "
         f"({REACH_MAX_XY} m from its base)"
         for name in world.surfaces
-        if world.spot_cells(name) and name not in reachable
+        if world.surface_capacity[name] and not world.reached_cells[name]
     ]
 
 
@@ -108,6 +96,6 @@ def _fits_somewhere(world: World, t: ObjectType) -> bool:
 
     on_a_surface = any(
         fits(r) and r.z + t.height <= REACH_MAX_Z
-        for r in map(world.surface_rect, _reachable(world))
+        for r in (world.surface_rect(n) for n in world.surfaces if world.reached_cells[n])
     )
     return on_a_surface or any(world.fits_inside(t.name, s) for s in world.shelves)
