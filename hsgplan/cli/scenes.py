@@ -119,8 +119,8 @@ def check(
     ],
     markdown: MarkdownFlag = False,
 ) -> None:
-    """What a scene file's sizes allow: each surface's and interior's capacity and the places the
-    arm reaches, the cell objects are counted in, how high a tower may rise and which object sets
+    """What a scene file's sizes allow: each surface's cells and its capacity, the cells the arm
+    reaches, the cell objects are counted in, how high a tower may rise and which object sets
     it, where each object fits and whether it carries another. A scene the robot cannot work in is
     refused with every reason (exit code 2)."""
     from hsgplan.domain.scene_file import read_world
@@ -130,7 +130,7 @@ def check(
     limits = scene_limits(world)
     print_table(
         f"Surfaces of '{world.name}' ({file})",
-        ("surface", "kind", "height m", "objects it holds", "places reached", "in goals"),
+        ("surface", "kind", "height m", "cells", "objects it holds (cells reached)", "in goals"),
         list(limits.surfaces),
         markdown,
     )

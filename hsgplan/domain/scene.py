@@ -284,20 +284,19 @@ class World:
         longest = max(max(t.footprint) for t in self.type_list)
         return max(SPOT, widest + 2 * FINGER_ROOM), max(SPOT, longest + ALONG_GAP)
 
-    def spot_cells(self, surface: str) -> list[tuple[float, float]]:
-        """Centres of the cells a named surface is counted in."""
+    def grid_cells(self, surface: str) -> list[tuple[float, float]]:
+        """Centres of every cell a named surface's size makes room for, reached or not."""
         return spot_cells(self.surface_rect(surface), self.cell)
 
-    @cached_property
-    def reached_cells(self) -> dict[str, int]:
-        """How many of each surface's cells lie within the hand's reach (`REACH_MAX_XY`)."""
-        return {
-            name: sum(math.hypot(x, y) <= REACH_MAX_XY for x, y in self.spot_cells(name))
-            for name in self.surfaces
-        }
+    def spot_cells(self, surface: str) -> list[tuple[float, float]]:
+        """Centres of the cells a named surface is counted in: those of its grid within the
+        hand's reach (`REACH_MAX_XY`), since an object the arm cannot reach is neither put
+        there nor taken from there (a shelf of a drawn layout may stand half beyond it)."""
+        return [c for c in self.grid_cells(surface) if math.hypot(*c) <= REACH_MAX_XY]
 
     @cached_property
     def surface_capacity(self) -> dict[str, int]:
+        """Objects each surface holds side by side: its cells within reach."""
         return {name: len(self.spot_cells(name)) for name in self.surfaces}
 
     @cached_property

@@ -1,9 +1,9 @@
-"""What a scene's sizes allow, said plainly (`hsgplan scenes check FILE`): how many objects each
-surface and interior holds and how many of those places the arm reaches, the cell each object is
-counted in and which object sets it, how high a tower may rise and which object sets that, where
-each object type fits and whether it carries another. Read from the `World`, the same properties the
-transition model, the goal sampler and the PDDL count with, so the report cannot drift from what the
-planners are held to."""
+"""What a scene's sizes allow, said plainly (`hsgplan scenes check FILE`): how many cells each
+surface's size makes and how many of them, the cells the arm reaches, it holds; what each
+interior holds; the cell each object is counted in and which object sets it, how high a tower
+may rise and which object sets that, where each object type fits and whether it carries another.
+Read from the `World`, the same properties the transition model, the goal sampler and the PDDL
+count with, so the report cannot drift from what the planners are held to."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from hsgplan.domain.scene import REACH_MAX_XY, REACH_MAX_Z, SPOT, World
 
 @dataclass(frozen=True)
 class SceneLimits:
-    surfaces: tuple[tuple[str, ...], ...]  # name, kind, height (m), capacity, reached, in goals
+    surfaces: tuple[tuple[str, ...], ...]  # name, kind, height (m), cells, cells reached, in goals
     interiors: tuple[tuple[str, ...], ...]  # shelf, clearance (m), capacity, what fits
     objects: tuple[tuple[str, ...], ...]  # type, size (cm), carries another, fits inside
     tower: str  # how many objects a tower holds, and why
@@ -27,8 +27,8 @@ def scene_limits(world: World) -> SceneLimits:
             name,
             "region" if name in world.regions else "shelf top",
             f"{world.surface_rect(name).z:.3f}",
+            str(len(world.grid_cells(name))),
             str(world.surface_capacity[name]),
-            str(world.reached_cells[name]),
             "yes" if name in world.goal_surfaces else "—",
         )
         for name in world.surfaces
@@ -67,7 +67,7 @@ def _cell(world: World) -> str:
     ]
     return (
         f"each object is counted in a cell of {100 * cx:.1f} x {100 * cy:.1f} cm ({'; '.join(why)}"
-        f"); a place counts as reached within {REACH_MAX_XY} m of the robot's base"
+        f"); a surface holds its cells within {REACH_MAX_XY} m of the robot's base"
     )
 
 

@@ -44,13 +44,13 @@ def _out_of_reach(world: World) -> list[str]:
         f"{100 * cx:.1f} x {100 * cy:.1f} cm (the scene's largest footprint, {longest}'s, and "
         "its room)"
         for name in world.surfaces
-        if not world.surface_capacity[name]
+        if not world.grid_cells(name)
     ]
     return problems + [
         f"{_surface(world, name)}: every place on it lies beyond the arm's reach "
         f"({REACH_MAX_XY} m from its base)"
         for name in world.surfaces
-        if world.surface_capacity[name] and not world.reached_cells[name]
+        if world.grid_cells(name) and not world.surface_capacity[name]
     ]
 
 
@@ -96,6 +96,6 @@ def _fits_somewhere(world: World, t: ObjectType) -> bool:
 
     on_a_surface = any(
         fits(r) and r.z + t.height <= REACH_MAX_Z
-        for r in (world.surface_rect(n) for n in world.surfaces if world.reached_cells[n])
+        for r in (world.surface_rect(n) for n in world.surfaces if world.surface_capacity[n])
     )
     return on_a_surface or any(world.fits_inside(t.name, s) for s in world.shelves)

@@ -2,6 +2,7 @@
 reads back equal, and every bad field is refused in one line that names it."""
 
 import copy
+import math
 import tomllib
 
 import pytest
@@ -224,6 +225,23 @@ def test_a_scene_counts_its_surfaces_in_cells_its_largest_footprint_fits():
         assert len(cells) == wide.surface_capacity[name]
         rows = len({round(y, 9) for _, y in cells})
         assert rows == 0 or rect.width_y / rows >= 0.136
+
+
+def test_a_surface_holds_only_the_cells_the_arm_reaches():
+    # shelf A drawn half beyond the reach: its top still makes four cells, but only those
+    # within REACH_MAX_XY are counted, started in and placed on; the kitchen's are all reached
+    from hsgplan.domain.scene import REACH_MAX_XY
+
+    data = copy.deepcopy(KITCHEN)
+    data["shelves"][0] |= {"y": [0.40, 0.72]}
+    data["shelves"][0]["prepush"] |= {"y": [0.42, 0.70]}
+    far = world_of(data)
+    assert len(far.grid_cells("shelf_a")) == 4
+    assert 1 <= far.surface_capacity["shelf_a"] < 4
+    assert all(math.hypot(x, y) <= REACH_MAX_XY for x, y in far.spot_cells("shelf_a"))
+    assert far.surface_capacity["shelf_b"] == 4
+    kitchen = world_of(KITCHEN)
+    assert all(len(kitchen.grid_cells(n)) == kitchen.surface_capacity[n] for n in kitchen.surfaces)
 
 
 def test_the_robots_base_is_its_urdfs_base_link():

@@ -35,8 +35,9 @@ def _world(change):
 
 
 def _deep_shelf_a(data):
-    data["shelves"][0]["x"] = [0.38, 0.62]  # two cells deep, three wide: six places
-    data["shelves"][0]["y"] = [0.22, 0.56]
+    # two cells deep, three wide, every cell within the hand's reach: six places
+    data["shelves"][0] |= {"x": [0.36, 0.58], "y": [0.21, 0.54]}
+    data["shelves"][0]["prepush"]["x"] = [0.24, 0.35]
 
 
 def test_a_wider_shelf_top_holds_more_in_goals_and_in_the_transition_model():
