@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -18,12 +17,13 @@ from hsgplan.cli.common import (
     SceneFiles,
     SceneOption,
     Summaries,
+    TaskCheckpoint,
     bounded_option,
     check_ray,
     choice,
+    default_networks,
     err,
     in_scene,
-    input_path,
     out,
     parse_sizes,
     print_table,
@@ -133,9 +133,7 @@ def bench_task(
     sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "2-6",
     goals: Annotated[int, bounded_option("goals", "Goals per size.")] = 20,
     seed: Annotated[int, bounded_option("seed", "Random seed.")] = 0,
-    checkpoint: Annotated[
-        Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
-    ] = TASK_CHECKPOINT,
+    checkpoint: TaskCheckpoint = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
     markdown: MarkdownFlag = False,
     scene: SceneOption = None,
@@ -147,6 +145,8 @@ def bench_task(
 
     size_list = parse_sizes(sizes)
     world = scene_world(scene)
+    given, _ = default_networks("regression+sampler", [world], checkpoint, None)
+    checkpoint = given or TASK_CHECKPOINT
     load_network(checkpoint / "preimage")  # a missing checkpoint fails before any work
     check_reads([checkpoint], world, scene)
     with Progress(console=err, transient=True) as progress:

@@ -285,6 +285,24 @@ def scene_worlds(scene: Path | None) -> list:
     return list(read_worlds(scene).values()) if scene else [default_world()]
 
 
+def default_networks(
+    agent: str, worlds: list, checkpoint: Path | None, motion: Path | None
+) -> tuple[Path | None, Path | None]:
+    """The task and motion folders a command runs `agent` (or `PLANNER+MOTION`) with: those
+    given, or, where none is given and a world names what the shipped networks do not know,
+    the shipped networks that read kind and size (`registry.default_checkpoints`), said in
+    one line on stderr. A folder not swapped comes back as given (None: the shipped one)."""
+    from hsgplan.agents.registry import default_checkpoints
+    from hsgplan.paths import shipped
+
+    given = checkpoint and shipped(checkpoint), motion and shipped(motion)
+    task, motion_folder, said = default_checkpoints(agent, worlds, *given)
+    if not said:
+        return checkpoint, motion
+    err.print(said, highlight=False)
+    return task, motion_folder
+
+
 def scene_world(scene: Path | None):
     """The world of a `--scene` file (the kitchen without one), refused in one line if bad."""
     from hsgplan.domain.scene_file import scene_world as world_of_scene

@@ -22,11 +22,13 @@ from hsgplan.cli.common import (
     check_ray,
     config_default,
     config_option,
+    default_networks,
     err,
     out,
     out_folder,
     parse_sizes,
     refuses_bad_input,
+    scene_worlds,
     shown,
 )
 from hsgplan.collect.images import ImagesConfig
@@ -262,10 +264,14 @@ def visited(
 ) -> None:
     """f_reach's labels from the states the learned agent visits: in each, before it decides,
     primitives are executed as `collect reach` executes them from a staged state."""
+    from hsgplan.collect.visited import AGENT as VISITING_AGENT
     from hsgplan.collect.visited import collect_visited
 
     check_ray(ray)
     size_list = tuple(parse_sizes(sizes))
+    checkpoint, motion_checkpoints = default_networks(
+        VISITING_AGENT, scene_worlds(scene), checkpoint, motion_checkpoints
+    )
     with Progress(console=err, transient=True) as progress:
         bar = progress.add_task("episodes", total=episodes * len(set(size_list)))
         summary = collect_visited(

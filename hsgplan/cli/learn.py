@@ -18,9 +18,11 @@ from hsgplan.cli.common import (
     SceneFiles,
     Summaries,
     SymbolicPlannerName,
+    TaskCheckpoint,
     bounded_option,
     check_ray,
     dash,
+    default_networks,
     err,
     input_path,
     out,
@@ -30,6 +32,7 @@ from hsgplan.cli.common import (
     print_table,
     read_config,
     refuses_bad_input,
+    scene_worlds,
     shown,
 )
 from hsgplan.cli.seeding import SeedOrSplitStart, SplitOption, TrainingSeeds, split_seed
@@ -144,9 +147,7 @@ def eval_task(
     goals_file: Annotated[
         Path | None, typer.Option(help="Goals from a file instead.", parser=input_path)
     ] = None,
-    checkpoint: Annotated[
-        Path, typer.Option(help="Task planner checkpoint.", parser=input_path)
-    ] = TASK_CHECKPOINT,
+    checkpoint: TaskCheckpoint = None,
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     run_dir: RunFolder = None,
@@ -172,6 +173,8 @@ def eval_task(
     from hsgplan.evaluation.task_eval import evaluate_task, summarize_task
 
     planner = planner.value
+    given, _ = default_networks(f"{planner}+sampler", scene_worlds(scene), checkpoint, None)
+    checkpoint = given or TASK_CHECKPOINT
     seed = split_seed(seed, split)
     split_name = split and split.value
     size_list = parse_sizes(sizes)

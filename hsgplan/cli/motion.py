@@ -19,6 +19,7 @@ from hsgplan.cli.common import (
     SceneFiles,
     bounded_option,
     check_ray,
+    default_networks,
     err,
     input_path,
     out,
@@ -150,8 +151,12 @@ def eval_motion(
     split: SplitOption = None,
     primitives: Annotated[str, typer.Option(help="place, push or place,push.")] = "place,push",
     motion_checkpoints: Annotated[
-        Path, typer.Option(help="Folder of motion checkpoints.", parser=input_path)
-    ] = MOTION_CHECKPOINTS,
+        Path | None,
+        typer.Option(
+            help="Folder of motion checkpoints (default: the shipped checkpoints/motion).",
+            parser=input_path,
+        ),
+    ] = None,
     workers: CollectWorkers = 2,
     ray: RayAddress = None,
     run_dir: Annotated[
@@ -170,7 +175,7 @@ def eval_motion(
 ) -> None:
     """Single-shot success of the GNN, the MLP and Random on fresh random scenes (never the
     training scenes), per primitive and crowding level; every model sees the same scenes."""
-    from hsgplan.domain.scene_file import read_worlds
+    from hsgplan.domain.scene_file import default_world, read_worlds
     from hsgplan.evaluation.motion_eval import LABELS, MODELS, evaluate_motion
     from hsgplan.evaluation.seeds import marked, seed_words
     from hsgplan.evaluation.splits import check_seed, split_named
@@ -183,10 +188,13 @@ def eval_motion(
     seed = split_seed(seed, split)
     if split is not None:
         check_seed(split_named(split.value), seed)
+    worlds = list(read_worlds(scene).values()) if scene else [default_world()]
+    # the motion networks alone: fd reads no network, so only the motion folder may be swapped
+    _, given = default_networks("fd+gnn", worlds, None, motion_checkpoints)
+    motion_checkpoints = given or MOTION_CHECKPOINTS
     trainings = seed_folders(motion_checkpoints)
     with Progress(console=err, transient=True) as progress:
-        worlds = len(read_worlds(scene)) if scene else 1
-        bar = progress.add_task("scenes", total=trials * len(kinds) * worlds)
+        bar = progress.add_task("scenes", total=trials * len(kinds) * len(worlds))
         report = evaluate_motion(
             kinds,
             trials,

@@ -142,6 +142,27 @@ def test_a_scene_of_other_names_runs_the_networks_that_read_kind_and_size_by_def
     assert config["checkpoint"] == str(TASK_GEOMETRY_CHECKPOINT)
 
 
+def test_every_command_that_names_no_networks_runs_a_scene_of_other_names(tmp_path):
+    # the symbolic loop and the motion evaluation swap in the networks that read kind and size
+    # as eval world does, and say so; the kitchen keeps the shipped ones
+    from hsgplan.paths import TASK_GEOMETRY_CHECKPOINT
+
+    scene = tmp_path / "new.toml"
+    scene.write_text(to_toml(scene_data(NEW)))
+    task = ["eval", "task", "--sizes", "2", "--goals", "1", "--workers", "1"]
+    r = runner.invoke(app, [*task, "--scene", str(scene), "--out", str(tmp_path / "t")])
+    assert r.exit_code == 0, r.output
+    assert "networks that read kind and size" in r.output
+    config = json.loads((tmp_path / "t" / "config.json").read_text())
+    assert config["checkpoint"] == str(TASK_GEOMETRY_CHECKPOINT)
+    r = runner.invoke(app, [*task, "--out", str(tmp_path / "k")])
+    assert r.exit_code == 0 and "read kind and size" not in r.output, r.output
+    motion = ["eval", "motion", "--trials", "1", "--primitives", "place", "--workers", "1"]
+    r = runner.invoke(app, [*motion, "--scene", str(scene), "--json"])
+    assert r.exit_code == 0, r.output
+    assert "networks that read kind and size" in r.output
+
+
 def test_the_stream_baselines_place_size_and_push_by_their_scenes_world():
     from hsgplan.agents.streams import push_shelf, stack_pose, surface_pose
 
