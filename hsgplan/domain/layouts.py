@@ -16,8 +16,16 @@ from dataclasses import replace
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.scene import GRIPPER_MAX_OPENING, Kind, ObjectType, World
-from hsgplan.domain.scene_file import object_data, scene_data, to_toml, world_of
+from hsgplan.domain.scene import GRIPPER_MAX_OPENING, Kind, ObjectType, Shelf, World
+from hsgplan.domain.scene_file import (
+    PREPUSH_DEPTH,
+    PREPUSH_GAP,
+    derived_prepush_name,
+    object_data,
+    scene_data,
+    to_toml,
+    world_of,
+)
 from hsgplan.files import write_atomically
 
 SHELF_NEAR = (0.34, 0.44)  # x of a shelf's open front
@@ -26,6 +34,11 @@ SHELF_WIDTH = (0.28, 0.36)
 SHELF_SIDE_GAP = (0.02, 0.08)  # between the open space's side and the shelf beside it
 SHELF_CLEARANCE = (0.11, 0.14)
 OBJECT_SCALE = (0.8, 1.2)  # each dimension of each object type, drawn apart
+# A shelf that does not stand beside the open space facing the robot (turned, behind it, on
+# another side) keeps its place, moved within SHELF_SHIFT along each of its own axes, its
+# depth, width and clearance scaled within SHELF_SCALE of its own.
+SHELF_SHIFT = 0.04
+SHELF_SCALE = (0.9, 1.1)
 MAX_GRASP = GRIPPER_MAX_OPENING - 0.004  # a resized object's narrow side
 TRIES = 200
 # A layout's goal shelf tops hold at least this many objects, and its towers this many levels,
@@ -45,11 +58,24 @@ def _span(rng: random.Random, bounds: tuple[float, float]) -> float:
     return round(rng.uniform(*bounds), 3)
 
 
+def beside_open_space(base: World) -> bool:
+    """Whether every shelf faces the robot (yaw 0) beside the open space, on one side of it or
+    the other, as the kitchen's do: such a scene's shelves are drawn along its sides."""
+    space = base.regions.get("open_space")
+    return space is not None and all(
+        s.yaw_degrees == 0.0 and (s.outer.y_min >= space.y_max or s.outer.y_max <= space.y_min)
+        for s in base.shelf_list
+    )
+
+
 def _shelves(base: World, rng: random.Random, turn: float = 0.0) -> list[dict]:
     """Each shelf moved and resized on the side of the robot it stands on; shelves sharing a
     side keep their order outwards from the open space, each beyond the one before. With a
     `turn` (degrees), each shelf's yaw is its base's plus a uniform draw within +-`turn` (drawn
-    only then, so that layouts drawn without one stay as they were)."""
+    only then, so that layouts drawn without one stay as they were). A scene whose shelves do
+    not all stand so (`beside_open_space`) has each moved about its own place instead."""
+    if not beside_open_space(base):
+        return [_moved(s, base, rng, turn) for s in base.shelf_list]
     open_space = base.regions["open_space"]
     out: dict[str, dict] = {}
     for left in (True, False):
@@ -69,11 +95,52 @@ def _shelves(base: World, rng: random.Random, turn: float = 0.0) -> list[dict]:
                 "wall": s.wall,
                 "interior": s.interior is not None,
             }  # fmt: skip
-            yaw = s.yaw_degrees + (round(rng.uniform(-turn, turn), 1) if turn else 0.0)
-            yaw = (yaw + 180.0) % 360.0 - 180.0 if abs(yaw) > 180.0 else yaw
-            if yaw:
-                out[s.name]["yaw"] = yaw
+            _turned(out[s.name], s, rng, turn)
+            _named_prepush(out[s.name], s)
     return [out[s.name] for s in base.shelf_list]
+
+
+def _moved(s: Shelf, base: World, rng: random.Random, turn: float) -> dict:
+    """A shelf moved within `SHELF_SHIFT` and resized within `SHELF_SCALE` of its own place and
+    size, in the scene file's frame of it (before its yaw turns it)."""
+    x0, x1, y0, y1 = s.outer.x_min, s.outer.x_max, s.outer.y_min, s.outer.y_max  # unturned
+    cx, cy = (
+        (x0 + x1) / 2 + rng.uniform(-SHELF_SHIFT, SHELF_SHIFT),
+        (y0 + y1) / 2 + rng.uniform(-SHELF_SHIFT, SHELF_SHIFT),
+    )
+    depth, width = (x1 - x0) * rng.uniform(*SHELF_SCALE), (y1 - y0) * rng.uniform(*SHELF_SCALE)
+    entry = {
+        "name": s.name,
+        "x": [round(cx - depth / 2, 3), round(cx + depth / 2, 3)],
+        "y": [round(cy - width / 2, 3), round(cy + width / 2, 3)],
+        "clearance": round(s.clearance * rng.uniform(*SHELF_SCALE), 3),
+        "wall": s.wall,
+        "interior": s.interior is not None,
+    }
+    _turned(entry, s, rng, turn)
+    _named_prepush(entry, s)
+    return entry
+
+
+def _turned(entry: dict, s: Shelf, rng: random.Random, turn: float) -> None:
+    yaw = s.yaw_degrees + (round(rng.uniform(-turn, turn), 1) if turn else 0.0)
+    yaw = (yaw + 180.0) % 360.0 - 180.0 if abs(yaw) > 180.0 else yaw
+    if yaw:
+        entry["yaw"] = yaw
+
+
+def _named_prepush(entry: dict, s: Shelf) -> None:
+    """A prepush region the base names otherwise than the derived one keeps its name, drawn
+    where the derived one would stand (in front of the moved shelf)."""
+    if s.prepush is None or s.prepush == derived_prepush_name(s.name):
+        return
+    (x0, _), (y0, y1) = entry["x"], entry["y"]
+    x = [round(x0 - PREPUSH_GAP - PREPUSH_DEPTH, 6), round(x0 - PREPUSH_GAP, 6)]
+    entry["prepush"] = {
+        "name": s.prepush,
+        "x": x,
+        "y": [round(y0 + s.wall, 6), round(y1 - s.wall, 6)],
+    }
 
 
 def _resized(t: ObjectType, rng: random.Random) -> ObjectType:

@@ -170,9 +170,14 @@ def _shelf(v: Any, at: str) -> tuple[Shelf, tuple[str, Rect] | None]:
         # rounded to a micrometre, so that a layout's file reads as it was drawn
         derived = Rect(round(x[0] - PREPUSH_GAP - PREPUSH_DEPTH, 6), round(x[0] - PREPUSH_GAP, 6),
                        round(y[0] + wall, 6), round(y[1] - wall, 6), **turn)  # fmt: skip
-        prepush = ("prepush_" + name.removeprefix("shelf_"), derived)
+        prepush = (derived_prepush_name(name), derived)
     shelf = make_shelf(name, x, y, clearance, wall, interior, prepush[0] if prepush else None, yaw)
     return shelf, prepush
+
+
+def derived_prepush_name(shelf: str) -> str:
+    """The name of the prepush region a scene derives for a shelf it gives none."""
+    return "prepush_" + shelf.removeprefix("shelf_")
 
 
 def _camera(v: Any, at: str) -> View:

@@ -139,6 +139,34 @@ def test_shelves_sharing_a_side_keep_their_order_outwards_and_never_overlap():
         assert a.y_max < c.y_min  # shelf_c stays beyond shelf_a, as in the base scene
 
 
+def test_shelves_not_beside_the_open_space_move_about_their_own_place_and_keep_names():
+    # the example of three shelves (one turned 30 degrees, one 90, behind the robot's side):
+    # each drawn shelf stays within SHELF_SHIFT of its place, its yaw its own; a prepush region
+    # the scene names is kept under its name
+    import tomllib
+    from pathlib import Path
+
+    from hsgplan.domain.scene_file import world_of
+
+    example = Path(__file__).parents[2] / "scenes/examples/three-shelves.toml"
+    data = tomllib.loads(example.read_text())
+    data["shelves"][0]["prepush"] = {"name": "front_a", "x": [0.24, 0.37], "y": [-0.51, -0.25]}
+    base = world_of(data)
+    assert not layouts.beside_open_space(base) and layouts.beside_open_space(KITCHEN)
+    for index in range(4):
+        w = layouts.random_layout(base, 3, index)
+        assert w != base and w.shelves["shelf_a"].prepush == "front_a" and "front_a" in w.regions
+        for s in w.shelf_list:
+            old = base.shelves[s.name]
+            assert s.yaw_degrees == old.yaw_degrees
+            for axis in ("x", "y"):
+                centre = (getattr(s.outer, f"{axis}_min") + getattr(s.outer, f"{axis}_max")) / 2
+                before = (getattr(old.outer, f"{axis}_min") + getattr(old.outer, f"{axis}_max")) / 2
+                assert abs(centre - before) <= layouts.SHELF_SHIFT + 1e-3
+            lo, hi = layouts.SHELF_SCALE
+            assert lo * old.clearance - 1e-3 <= s.clearance <= hi * old.clearance + 1e-3
+
+
 def test_a_scene_no_draw_can_vary_is_refused_with_what_refused_most_draws():
     import tomllib
 

@@ -251,8 +251,11 @@ def test_the_benchmarks_run_in_a_scene_file_and_refuse_one_their_models_cannot_r
     args = ["bench", "symbolic", "--sizes", "2", "--goals", "1", "--markdown"]
     r = runner.invoke(app, [*args, "--scene", str(layout)])
     assert r.exit_code == 0 and f"in {layout})" in r.output, r.output
+    task = ["bench", "task", "--sizes", "2", "--goals", "1"]
+    r = runner.invoke(app, [*task, "--scene", str(new)])  # the networks that read kind and size
+    assert r.exit_code == 0 and "read kind and size" in r.output, r.output
     for args, why in (
-        (["bench", "task", "--sizes", "2", "--goals", "1"], "know the kitchen's objects"),
+        ([*task, "--checkpoint", "checkpoints/task"], "know the kitchen's objects"),
         (["bench", "observe", "--scenes", "1"], "f_p cannot see scene"),
     ):
         r = runner.invoke(app, [*args, "--scene", str(new)])
