@@ -9,6 +9,7 @@ default world.
 from __future__ import annotations
 
 import json
+import math
 import re
 import tomllib
 from collections.abc import Callable
@@ -35,7 +36,9 @@ from hsgplan.domain.workable import unworkable
 from hsgplan.paths import KITCHEN_SCENE
 
 MAX_SCENE_BYTES = 2**20
-MAX_SHELVES = 8
+# No cap on fixtures but the table's: each takes at least a square of a shelf's least span (two
+# of the thinnest walls and 5 cm between them), so a file asks for no more than its table holds.
+FIXTURE_LEAST = 2 * 0.005 + 0.05
 MAX_TYPES = 16
 MAX_CAMERAS = 8
 EXTENT = 3.0  # no table reaches further than this from the robot's base
@@ -247,6 +250,13 @@ def _region(v: Any, at: str) -> tuple[str, Rect]:
     return _name(r["name"], f"{at}.name", FIXTURE_NAME), _rect(r, at)
 
 
+def _fixture_room(table: Rect | None) -> int:
+    """How many fixtures (regions or shelves) a table holds apart, at most."""
+    side = 2 * EXTENT if table is None else None  # a table refused: the largest there may be
+    area = side * side if side else table.width_x * table.width_y
+    return max(1, math.floor(area / FIXTURE_LEAST**2))
+
+
 def _world(data: Any) -> World:
     top = _table(data, "the file", {"name", "table", "regions", "objects", "cameras"},
                  {"fixture_friction", "goals", "shelves"})  # fmt: skip
@@ -255,8 +265,9 @@ def _world(data: Any) -> World:
     table = faults.read(lambda: _rect(_table(top["table"], "table", {"x", "y"}), "table"))
     friction = faults.read(_number, top.get("fixture_friction", 0.6), "fixture_friction", 0.05,
                            2.0)  # fmt: skip
-    regions = _each(top["regions"], "regions", 1, MAX_SHELVES + 1, _region, faults)
-    read = _each(top.get("shelves", []), "shelves", 0, MAX_SHELVES, _shelf, faults)
+    room = _fixture_room(table)
+    regions = _each(top["regions"], "regions", 1, room, _region, faults)
+    read = _each(top.get("shelves", []), "shelves", 0, room, _shelf, faults)
     types = _each(top["objects"], "objects", 1, MAX_TYPES, _object, faults)
     cameras = tuple(_each(top["cameras"], "cameras", 1, MAX_CAMERAS, _camera, faults))
     goals = faults.read(
