@@ -6,7 +6,13 @@ from __future__ import annotations
 
 from hsgplan.evaluation.failures import Failure
 from hsgplan.evaluation.summary import class_of
-from hsgplan.sim.outcome import DISTURB_TOL, SEEN_DISTURB_TOL, Status
+from hsgplan.sim.outcome import (
+    BELIEF_OFF,
+    BELIEF_TURNED,
+    DISTURB_TOL,
+    SEEN_DISTURB_TOL,
+    Status,
+)
 
 STATUSES = {
     Status.SUCCESS: "the primitive did what it was for.",
@@ -53,8 +59,32 @@ ENDINGS = {
 }
 
 
+# The failure table's columns (`evaluation.table1.failure_table`), beyond method and objects
+COLUMNS = {
+    "episodes": "episodes run at that size.",
+    "failed": "episodes that failed, of every class.",
+    "execution": "episodes a primitive's execution ended, by the fatal anomaly or the "
+    "primitive's status.",
+    "overstep": "episodes the step limit ended, or nothing reachable to do next.",
+    "perception": "seeing through f_p: the goal seen reached where it was not, an object no "
+    "view found, or a stop on a primitive seen to fail that truly succeeded.",
+    "failed primitives": "primitives that truly failed, over all episodes (the recovering "
+    "protocol's continue past them).",
+    "overstep after failures": "overstep episodes that had failed primitives.",
+    "disturbing steps": "primitives that moved another object than their own.",
+    "relooks": "seeing through f_p: looks taken again before a primitive.",
+    "belief off": "seeing through f_p: failed primitives planned on a belief that had an object "
+    f"they acted on more than {BELIEF_OFF * 100:.0f} cm or {BELIEF_TURNED:.0f}° off its true "
+    "pose.",
+    "misread": "seeing through f_p: steps the robot read otherwise than the judge, seen to "
+    "succeed where they truly failed / seen to fail where they truly succeeded.",
+    "unsampled": "goals whose start scene could not be sampled, left out of every column "
+    "before it.",
+}
+
+
 def glossary() -> str:
-    """The two tables of `docs/failures.md`, in Markdown."""
+    """The three tables of `docs/failures.md`, in Markdown."""
     lines = [
         "A primitive's status (each step's `status` in `episodes.jsonl`, as the robot read it, "
         "and `truth`, the judge's verdict on the simulator's state):",
@@ -65,6 +95,9 @@ def glossary() -> str:
     lines += ["", "What ended a failed episode (its `failure`), and the class tables count it in:"]
     lines += ["", "| failure | class | meaning |", "|---|---|---|"]
     lines += [f"| `{f}` | {class_of(f)} | {ENDINGS[f]} |" for f in Failure]
+    lines += ["", "What each column of a failure table counts:", ""]
+    lines += ["| column | counts |", "|---|---|"]
+    lines += [f"| {c} | {meaning} |" for c, meaning in COLUMNS.items()]
     return "\n".join(lines) + "\n"
 
 

@@ -29,7 +29,6 @@ from hsgplan.evaluation.seeds import is_tuning, marked, seed_words
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, summarize_trainings
 from hsgplan.files import write_atomically
 from hsgplan.runner.run_folder import check_claim, claim, read_timing, sittings
-from hsgplan.sim.outcome import BELIEF_OFF, BELIEF_TURNED
 
 # Table 1 of the paper (success rate, subgoal completion), by motion generator and size.
 PAPER_TABLE1: dict[str, dict[int, tuple[float, float]]] = {
@@ -369,31 +368,16 @@ def _failures(report: dict) -> TextTable:
                     + ((_misread(v),) if seen else ())
                     + ((str(skipped),) if unsampled else ())
                 )
+    # the columns are said once, in docs/failures.md (`evaluation.glossary.COLUMNS`)
     title = (
-        f"Failures ({protocol_name(report)}), by what ended the episode: execution (a failed "
-        "primitive; by the fatal anomaly or its status) and overstep (the step limit, or "
-        "nothing reachable); failed primitives over all episodes, overstep episodes that "
-        "had some, and primitives that moved another object than their own (disturbing)"
+        f"Failures ({protocol_name(report)}), by what ended the episode; what each column counts: "
+        "docs/failures.md"
     )
-    if seen:
-        title += (
-            "; seeing through f_p, perception (the goal seen reached where it was not, an "
-            "object no view found, or a stop on a primitive seen to fail that truly succeeded), "
-            "the looks taken again before a primitive (relook), failed primitives planned on a "
-            "belief that had an object they acted on more than "
-            f"{BELIEF_OFF * 100:.0f} cm or {BELIEF_TURNED:.0f}° off its true pose (belief off), "
-            "and steps the robot read otherwise than the judge (misread: seen to succeed where "
-            "they truly failed / seen to fail where they truly succeeded)"
-        )
     header = ("method", "objects", "episodes", "failed", "execution", "overstep")
     header += (PERCEPTION,) if seen else ()
     header += ("failed primitives", "overstep after failures", "disturbing steps")
     header += ("relooks", "belief off", "misread") if seen else ()
     if unsampled:
-        title += (
-            "; unsampled: goals whose start scene could not be sampled (the world's limit, "
-            "not the agent's failure), left out of every column before it"
-        )
         header += ("unsampled",)
     return TextTable(title, header, tuple(rows))
 

@@ -3,16 +3,17 @@
 from pathlib import Path
 
 from hsgplan.evaluation.failures import Failure
-from hsgplan.evaluation.glossary import ENDINGS, STATUSES, glossary
+from hsgplan.evaluation.glossary import COLUMNS, ENDINGS, STATUSES, glossary
 from hsgplan.evaluation.summary import EXECUTION, OVERSTEP, PERCEPTION, class_of
 from hsgplan.sim.outcome import Status
 
 PAGE = Path(__file__).resolve().parents[2] / "docs" / "failures.md"
 
 
-def test_every_status_and_ending_has_a_meaning():
+def test_every_status_ending_and_column_has_a_meaning():
     assert set(STATUSES) == set(Status) and set(ENDINGS) == set(Failure)
-    assert all(text.endswith(".") for text in [*STATUSES.values(), *ENDINGS.values()])
+    said = [*STATUSES.values(), *ENDINGS.values(), *COLUMNS.values()]
+    assert all(text.endswith(".") for text in said)
 
 
 def test_the_classes_are_the_summarys():

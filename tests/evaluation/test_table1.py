@@ -111,6 +111,11 @@ def test_failed_primitives_planned_on_a_belief_off_are_counted():
     report = {"methods": {"gnn-rgb": method | summarize([record])}}
     (failures,) = tables(report, ("failures",))
     assert failures.header[-2] == "belief off" and failures.rows[0][-2] == "1"
+    # every column the table prints is said in docs/failures.md, where its title points
+    from hsgplan.evaluation.glossary import COLUMNS
+
+    assert set(failures.header) - {"method", "objects"} <= set(COLUMNS)
+    assert "docs/failures.md" in failures.title
     # a record from before the one judge holds no verdicts: nothing misread is counted
     assert failures.header[-1] == "misread" and failures.rows[0][-1] == "0 / 0"
     judged = replace(record, steps=(replace(steps[0], truth="disturbed"), *steps[1:]))
