@@ -87,12 +87,16 @@ def rows(decisions: list[Decision]) -> list[tuple[str, ...]]:
         (
             f"`{d.name}`",
             d.what,
-            f"{d.chosen_on} ({', '.join(map(str, d.seeds)) or 'no seed'})",
+            f"{d.chosen_on} ({', '.join(map(str, d.seeds)) or 'no seed'})" + _standing(d),
             d.measurement,
-            d.status,
         )
         for d in decisions
     ]
 
 
-HEADER = ("choice", "what", "chosen on (seeds)", "by", "status")
+def _standing(d: Decision) -> str:
+    """Where a choice stands, said only where its split does not say it already."""
+    return "" if d.status == f"chosen on {d.chosen_on}" else f"; {d.status}"
+
+
+HEADER = ("choice", "what", "chosen on (seeds); where it stands", "by")

@@ -61,25 +61,20 @@ ENDINGS = {
 
 # The failure table's columns (`evaluation.table1.failure_table`), beyond method and objects
 COLUMNS = {
-    "episodes": "episodes run at that size.",
-    "failed": "episodes that failed, of every class.",
-    "execution": "episodes a primitive's execution ended, by the fatal anomaly or the "
-    "primitive's status.",
-    "overstep": "episodes the step limit ended, or nothing reachable to do next.",
-    "perception": "seeing through f_p: the goal seen reached where it was not, an object no "
-    "view found, or a stop on a primitive seen to fail that truly succeeded.",
-    "failed primitives": "primitives that truly failed, over all episodes (the recovering "
-    "protocol's continue past them).",
+    "episodes": "run at that size.",
+    "failed": "failed episodes, every class.",
+    "execution": "ended by a primitive: the fatal anomaly or its status.",
+    "overstep": "ended by the step limit, or nothing reachable to do.",
+    "perception": "f_p: the goal seen reached where it was not, an object no view found, or a "
+    "stop on a success seen to fail.",
+    "failed primitives": "primitives that truly failed, in every episode.",
     "overstep after failures": "overstep episodes that had failed primitives.",
     "disturbing steps": "primitives that moved another object than their own.",
-    "relooks": "seeing through f_p: looks taken again before a primitive.",
-    "belief off": "seeing through f_p: failed primitives planned on a belief that had an object "
-    f"they acted on more than {BELIEF_OFF * 100:.0f} cm or {BELIEF_TURNED:.0f}° off its true "
-    "pose.",
-    "misread": "seeing through f_p: steps the robot read otherwise than the judge, seen to "
-    "succeed where they truly failed / seen to fail where they truly succeeded.",
-    "unsampled": "goals whose start scene could not be sampled, left out of every column "
-    "before it.",
+    "relooks": "f_p: looks taken again before a primitive.",
+    "belief off": "f_p: failed primitives planned on a belief more than "
+    f"{BELIEF_OFF * 100:.0f} cm or {BELIEF_TURNED:.0f}° off an object they acted on.",
+    "misread": "f_p: steps seen to succeed that truly failed / seen to fail that truly succeeded.",
+    "unsampled": "goals with no start scene, left out of the columns before.",
 }
 
 

@@ -72,3 +72,15 @@ def test_a_malformed_record_is_refused_in_one_line(tmp_path, text, why):
     record.write_text(text)
     with pytest.raises(InvalidInputError, match=why):
         read_decisions(record)
+
+
+def test_a_rows_standing_is_printed_where_its_split_does_not_say_it(tmp_path):
+    from hsgplan.evaluation.decisions import rows
+
+    record = tmp_path / "d.toml"
+    record.write_text(
+        _row("plain") + _row("old", "reporting", "[0, 900]", "kept on tune (seed 900)")
+    )
+    plain, old = rows(read_decisions(record))
+    assert plain[2] == "tune (900)"
+    assert old[2] == "reporting (0, 900); kept on tune (seed 900)"
