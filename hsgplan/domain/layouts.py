@@ -18,9 +18,8 @@ from pathlib import Path
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import GRIPPER_MAX_OPENING, Kind, ObjectType, Shelf, World
 from hsgplan.domain.scene_file import (
-    PREPUSH_DEPTH,
-    PREPUSH_GAP,
     derived_prepush_name,
+    derived_prepush_span,
     object_data,
     scene_data,
     to_toml,
@@ -75,7 +74,7 @@ def _shelves(base: World, rng: random.Random, turn: float = 0.0) -> list[dict]:
     only then, so that layouts drawn without one stay as they were). A scene whose shelves do
     not all stand so (`beside_open_space`) has each moved about its own place instead."""
     if not beside_open_space(base):
-        return [_moved(s, base, rng, turn) for s in base.shelf_list]
+        return [_moved(s, rng, turn) for s in base.shelf_list]
     open_space = base.regions["open_space"]
     out: dict[str, dict] = {}
     for left in (True, False):
@@ -100,7 +99,7 @@ def _shelves(base: World, rng: random.Random, turn: float = 0.0) -> list[dict]:
     return [out[s.name] for s in base.shelf_list]
 
 
-def _moved(s: Shelf, base: World, rng: random.Random, turn: float) -> dict:
+def _moved(s: Shelf, rng: random.Random, turn: float) -> dict:
     """A shelf moved within `SHELF_SHIFT` and resized within `SHELF_SCALE` of its own place and
     size, in the scene file's frame of it (before its yaw turns it)."""
     x0, x1, y0, y1 = s.outer.x_min, s.outer.x_max, s.outer.y_min, s.outer.y_max  # unturned
@@ -134,13 +133,8 @@ def _named_prepush(entry: dict, s: Shelf) -> None:
     where the derived one would stand (in front of the moved shelf)."""
     if s.prepush is None or s.prepush == derived_prepush_name(s.name):
         return
-    (x0, _), (y0, y1) = entry["x"], entry["y"]
-    x = [round(x0 - PREPUSH_GAP - PREPUSH_DEPTH, 6), round(x0 - PREPUSH_GAP, 6)]
-    entry["prepush"] = {
-        "name": s.prepush,
-        "x": x,
-        "y": [round(y0 + s.wall, 6), round(y1 - s.wall, 6)],
-    }
+    x, y = derived_prepush_span(entry["x"], entry["y"], s.wall)
+    entry["prepush"] = {"name": s.prepush, "x": x, "y": y}
 
 
 def _resized(t: ObjectType, rng: random.Random) -> ObjectType:

@@ -170,12 +170,23 @@ def _shelf(v: Any, at: str) -> tuple[Shelf, tuple[str, Rect] | None]:
         where = replace(_rect(p, f"{at}.prepush"), **turn)  # in the shelf's frame
         prepush = (_name(p["name"], f"{at}.prepush.name", FIXTURE_NAME), where)
     elif interior:
-        # rounded to a micrometre, so that a layout's file reads as it was drawn
-        derived = Rect(round(x[0] - PREPUSH_GAP - PREPUSH_DEPTH, 6), round(x[0] - PREPUSH_GAP, 6),
-                       round(y[0] + wall, 6), round(y[1] - wall, 6), **turn)  # fmt: skip
+        (px0, px1), (py0, py1) = derived_prepush_span(x, y, wall)
+        derived = Rect(px0, px1, py0, py1, **turn)
         prepush = (derived_prepush_name(name), derived)
     shelf = make_shelf(name, x, y, clearance, wall, interior, prepush[0] if prepush else None, yaw)
     return shelf, prepush
+
+
+def derived_prepush_span(
+    x: tuple[float, float], y: tuple[float, float], wall: float
+) -> tuple[list[float], list[float]]:
+    """The x and y spans of the prepush region derived for a shelf of these spans (in its
+    unturned frame): in front of its open side, inset from its walls; rounded to a micrometre,
+    so that a layout's file reads as it was drawn."""
+    return (
+        [round(x[0] - PREPUSH_GAP - PREPUSH_DEPTH, 6), round(x[0] - PREPUSH_GAP, 6)],
+        [round(y[0] + wall, 6), round(y[1] - wall, 6)],
+    )
 
 
 def derived_prepush_name(shelf: str) -> str:
