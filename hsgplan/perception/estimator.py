@@ -37,7 +37,7 @@ from hsgplan.perception.fusion import Seen, along_ray_near, line_of_sight
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.maps import decode
 from hsgplan.perception.model import KeypointNet, load_perception_net
-from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost
+from hsgplan.perception.pnp import ViewKeypoints, robust_cost, solvable
 from hsgplan.perception.rules import SHIPPED, PerceptionRules
 from hsgplan.perception.settle import (
     OVERLAP_XY,
@@ -272,9 +272,8 @@ class PoseEstimator:
                 if name not in world.object_types:
                     continue  # a type the scene holds none of
                 seen = ViewKeypoints(pinhole, inst.pixels)
-                single = estimate_pose(world.object_type(name), [seen])
-                if single is not None:
-                    found.append(Seen(inst.type_index, inst.score, v, seen, single.pose))
+                if solvable(world.object_type(name), seen):  # a pose from this view alone
+                    found.append(Seen(inst.type_index, inst.score, v, seen))
         typed = partial(self._typed, world, images)
         cans = self.rules.found_again_can
         fused = apart(fuse(found, typed, world, self.rules), world, cans)

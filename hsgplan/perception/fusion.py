@@ -23,6 +23,7 @@ seed 2, 0.89 to 0.90 on seed 3, 0.90 to 0.92 on the evaluation's seed 1).
 
 from __future__ import annotations
 
+import functools
 import itertools
 from dataclasses import dataclass
 
@@ -40,22 +41,26 @@ NEAR_RAY = 0.05  # m from a lone view's line of sight to a prior pose, for `alon
 
 @dataclass(frozen=True)
 class Seen:
-    """One instance in one view, with its single-view pose."""
+    """One instance in one view (one PnP can fit: `pnp.solvable`)."""
 
     type_index: int
     score: float
     view: int
     keypoints: ViewKeypoints
-    pose: Pose
+
+    # kept once per instance: grouping compares every two instances' rays
+    @functools.cached_property
+    def ray(self) -> Ray:
+        camera = self.keypoints.camera
+        u, v = self.keypoints.pixels[-1]
+        local = np.linalg.solve(camera.matrix, np.array([u, v, 1.0]))
+        direction = camera.world_to_camera[:3, :3].T @ local
+        return camera.eye, direction / np.linalg.norm(direction)
 
 
 def line_of_sight(s: Seen) -> Ray:
     """The ray through the instance's centroid: origin and unit direction (world)."""
-    camera = s.keypoints.camera
-    u, v = s.keypoints.pixels[-1]
-    local = np.linalg.solve(camera.matrix, np.array([u, v, 1.0]))
-    direction = camera.world_to_camera[:3, :3].T @ local
-    return camera.eye, direction / np.linalg.norm(direction)
+    return s.ray
 
 
 def ray_gap(a: Seen, b: Seen, table: Rect) -> float:

@@ -18,6 +18,7 @@ in the horizontal plane). The centroid is the same point in every look-alike.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -35,9 +36,17 @@ CORNER_SIGNS = np.array(
 
 
 def cuboid(t: ObjectType) -> np.ndarray:
-    """An object of type `t`: its 9 keypoints in its own frame, metres: [9, 3]."""
-    half = np.asarray(t.size, dtype=np.float64) / 2
-    return np.vstack([CORNER_SIGNS * half, np.zeros((1, 3))])
+    """An object of type `t`: its 9 keypoints in its own frame, metres: [9, 3] (read-only)."""
+    return _cuboid(tuple(t.size))
+
+
+@functools.lru_cache(maxsize=256)
+def _cuboid(size: tuple[float, ...]) -> np.ndarray:
+    # kept once per size: a look asks for it thousands of times (PnP's residuals)
+    half = np.asarray(size, dtype=np.float64) / 2
+    out = np.vstack([CORNER_SIGNS * half, np.zeros((1, 3))])
+    out.setflags(write=False)
+    return out
 
 
 def in_world(t: ObjectType, pose: Pose) -> np.ndarray:
@@ -117,11 +126,21 @@ class PinholeCamera:
         return p[:, :2] / p[:, 2:3]
 
     def camera_to_world(self) -> np.ndarray:
-        """The inverse extrinsic transform: [4, 4]."""
-        return np.linalg.inv(self.world_to_camera)
+        """The inverse extrinsic transform: [4, 4] (read-only)."""
+        return self._camera_to_world
 
-    @property
+    # Both kept once per camera (the extrinsics never change): PnP's residuals ask for the eye
+    # for every pose they score.
+    @functools.cached_property
+    def _camera_to_world(self) -> np.ndarray:
+        out = np.linalg.inv(self.world_to_camera)
+        out.setflags(write=False)
+        return out
+
+    @functools.cached_property
     def eye(self) -> np.ndarray:
-        """The camera's position in the world: [3]."""
+        """The camera's position in the world: [3] (read-only)."""
         r, t = self.world_to_camera[:3, :3], self.world_to_camera[:3, 3]
-        return -r.T @ t
+        out = -r.T @ t
+        out.setflags(write=False)
+        return out

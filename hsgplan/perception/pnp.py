@@ -51,29 +51,10 @@ class PoseEstimate:
 def estimate_pose(t: ObjectType, views: list[ViewKeypoints]) -> PoseEstimate | None:
     """An object of type `t`: its pose in the world from its keypoints in the given views;
     None when no view has `MIN_POINTS` keypoints."""
-    model = cuboid(t)
     fits = []
     for view in views:
-        found = ~np.isnan(view.pixels).any(axis=1)
-        if found.sum() < MIN_POINTS:
-            continue
-        ok, rvec, tvec = cv2.solvePnP(
-            model[found], view.pixels[found], view.camera.matrix, None, flags=cv2.SOLVEPNP_EPNP
-        )
-        if not ok:
-            continue
-        ok, rvec, tvec = cv2.solvePnP(
-            model[found],
-            view.pixels[found],
-            view.camera.matrix,
-            None,
-            rvec,
-            tvec,
-            useExtrinsicGuess=True,
-            flags=cv2.SOLVEPNP_ITERATIVE,
-        )
-        if ok:
-            world = view.camera.camera_to_world() @ _matrix(rvec, tvec)
+        if (camera_pose := _view_fit(t, view)) is not None:
+            world = view.camera.camera_to_world() @ camera_pose
             fits.append((_error(t, views, world), world))
     if not fits:
         return None
@@ -82,6 +63,38 @@ def estimate_pose(t: ObjectType, views: list[ViewKeypoints]) -> PoseEstimate | N
     world = min((best, fused), key=lambda m: _error(t, views, m)[0])
     rms, used = _error(t, views, world)
     return PoseEstimate(Pose.from_matrix(world), rms, used)
+
+
+def solvable(t: ObjectType, view: ViewKeypoints) -> bool:
+    """Whether PnP finds a pose of an object of type `t` from this view's keypoints alone
+    (`estimate_pose` of the one view is then not None), without refining it: a look asks this
+    of every instance every view finds."""
+    return _view_fit(t, view) is not None
+
+
+def _view_fit(t: ObjectType, view: ViewKeypoints) -> np.ndarray | None:
+    """The object's pose in the camera's frame from one view's keypoints (EPnP, then refined
+    by OpenCV's iterative solver), [4, 4]; None with under `MIN_POINTS` keypoints or no fit."""
+    model = cuboid(t)
+    found = ~np.isnan(view.pixels).any(axis=1)
+    if found.sum() < MIN_POINTS:
+        return None
+    ok, rvec, tvec = cv2.solvePnP(
+        model[found], view.pixels[found], view.camera.matrix, None, flags=cv2.SOLVEPNP_EPNP
+    )
+    if not ok:
+        return None
+    ok, rvec, tvec = cv2.solvePnP(
+        model[found],
+        view.pixels[found],
+        view.camera.matrix,
+        None,
+        rvec,
+        tvec,
+        useExtrinsicGuess=True,
+        flags=cv2.SOLVEPNP_ITERATIVE,
+    )
+    return _matrix(rvec, tvec) if ok else None
 
 
 def robust_cost(t: ObjectType, views: list[ViewKeypoints], pose: Pose) -> float:
@@ -134,11 +147,13 @@ def _residuals_many(t: ObjectType, views: list[ViewKeypoints], worlds: np.ndarra
         if t.kind is Kind.CAN:  # turned about its axis to face the view
             local = (r.transpose(0, 2, 1) @ toward[:, :, None])[:, :, 0]
             phi = [math.atan2(a, b) for a, b in local[:, 1::-1]]
-            spin = np.array([[[math.cos(f), -math.sin(f), 0.0], [math.sin(f), math.cos(f), 0.0],
-                              [0.0, 0.0, 1.0]] for f in phi])  # fmt: skip
+            cos, sin = np.array([math.cos(f) for f in phi]), np.array([math.sin(f) for f in phi])
+            spin = np.zeros((len(phi), 3, 3))
+            spin[:, 0, 0], spin[:, 0, 1], spin[:, 1, 0], spin[:, 1, 1] = cos, -sin, sin, cos
+            spin[:, 2, 2] = 1.0
             r = r @ spin
         else:  # its +x face towards the view
-            away = np.array([r[n, :, 0] @ toward[n] < 0 for n in range(len(r))], dtype=bool)
+            away = (r[:, :, 0] * toward).sum(axis=1) < 0
             r = r.copy()
             r[away] = r[away] @ BOX_SYMMETRIES[3]
         points = model[found] @ r.transpose(0, 2, 1) + positions[:, None, :]

@@ -36,7 +36,7 @@ def _detection(name: str, pose: Pose, views: tuple[int, ...], confidence: float 
 
 def _instances(name: str, pose: Pose, views: tuple[int, ...]) -> list[Seen]:
     """What those views found: the object's instance in each."""
-    return [Seen(TYPES.index(name), 0.8, v, _keypoints(name, pose, v), pose) for v in views]
+    return [Seen(TYPES.index(name), 0.8, v, _keypoints(name, pose, v)) for v in views]
 
 
 def test_a_lone_view_no_other_view_backs_where_every_view_would_show_it_is_dropped():

@@ -5,8 +5,16 @@ import numpy as np
 import pytest
 
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.perception.keypoints import PinholeCamera, view_keypoints
-from hsgplan.perception.pnp import ViewKeypoints, _residuals_many, robust_cost, upright_fit
+from hsgplan.perception.keypoints import PinholeCamera, cuboid, view_keypoints
+from hsgplan.perception.pnp import (
+    MIN_POINTS,
+    ViewKeypoints,
+    _residuals_many,
+    estimate_pose,
+    robust_cost,
+    solvable,
+    upright_fit,
+)
 from hsgplan.perception.vocabulary import Vocabulary
 from hsgplan.scene_graph.geometry import Pose
 
@@ -43,3 +51,17 @@ def test_the_upright_fit_finds_the_yaw_the_keypoints_were_made_at():
     views = [ViewKeypoints(c, view_keypoints(t, truth, c)) for c in CAMERAS[:3]]
     fit = upright_fit(t, views, truth.position)
     assert robust_cost(t, views, fit) < 1.0
+
+
+@pytest.mark.parametrize("found", [MIN_POINTS - 1, MIN_POINTS, 9])
+def test_a_view_is_solvable_exactly_where_its_estimate_is_found(found):
+    t = KITCHEN.object_type("popcorn")
+    pixels = view_keypoints(t, POSES[0], CAMERAS[0])
+    pixels[found:] = np.nan
+    view = ViewKeypoints(CAMERAS[0], pixels)
+    assert solvable(t, view) == (estimate_pose(t, [view]) is not None) == (found >= MIN_POINTS)
+
+
+def test_the_kept_cuboid_cannot_be_changed_by_a_caller():
+    with pytest.raises(ValueError):
+        cuboid(KITCHEN.object_type("butter"))[0, 0] = 1.0
