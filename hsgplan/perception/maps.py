@@ -96,14 +96,31 @@ def peaks(
     within `MIN_APART` cells of a stronger one (a keypoint half-way between cells makes two
     equal maxima), each refined by a parabola through the log beliefs of its neighbours along
     x and along y (exact for a Gaussian): (x, y, belief) in cells."""
-    h, w = belief.shape
-    padded = np.pad(belief, 1, constant_values=-1.0)
+    return _refined(belief, _maxima(belief[None], threshold)[0])
+
+
+def _maxima(beliefs: np.ndarray, threshold: float) -> np.ndarray:
+    """Where maps [C, H, W] peak above `threshold` (no neighbour higher), all maps at once:
+    [C, H, W] bool."""
+    h, w = beliefs.shape[1:]
+    padded = np.pad(beliefs, ((0, 0), (1, 1), (1, 1)), constant_values=-1.0)
     neighbours = np.stack(
-        [padded[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+        [
+            padded[:, 1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
+            for dy in (-1, 0, 1)
+            for dx in (-1, 0, 1)
+        ]
     )
-    ys, xs = np.nonzero((belief >= neighbours.max(axis=0)) & (belief > threshold))
+    return (beliefs >= neighbours.max(axis=0)) & (beliefs > threshold)
+
+
+def _refined(belief: np.ndarray, maxima: np.ndarray) -> list[tuple[float, float, float]]:
+    """`peaks` of one map from where it peaks (`_maxima`)."""
+    ys, xs = np.nonzero(maxima)
+    if not len(ys):
+        return []
     order = np.argsort(-belief[ys, xs], kind="stable")[: 8 * MAX_PEAKS]
-    log = np.log(np.maximum(padded, 1e-6))
+    log = np.log(np.maximum(np.pad(belief, 1, constant_values=-1.0), 1e-6))
     out: list[tuple[float, float, float]] = []
     for y, x in zip(ys[order], xs[order], strict=True):
         if len(out) == MAX_PEAKS:
@@ -137,9 +154,11 @@ def decode(beliefs: np.ndarray, fields: np.ndarray, stride: int = STRIDE) -> lis
         beliefs: [types * 9, H, W]; fields: [8 * 2, H, W]; stride: input pixels per cell.
     """
     max_distance = MAX_DISTANCE_PX / stride
+    maxima = _maxima(beliefs, PEAK_THRESHOLD)  # every map at once: a look has dozens
     found = []
     for t in range(beliefs.shape[0] // KEYPOINTS):
-        centroids = peaks(beliefs[t * KEYPOINTS + CENTROID])
+        centroid = t * KEYPOINTS + CENTROID
+        centroids = _refined(beliefs[centroid], maxima[centroid])
         if not centroids:
             continue
         cells = np.full((len(centroids), KEYPOINTS, 2), np.nan)
@@ -148,7 +167,7 @@ def decode(beliefs: np.ndarray, fields: np.ndarray, stride: int = STRIDE) -> lis
             cells[i, CENTROID] = (x, y)
         for k in range(CORNERS):
             base = k * 2
-            for x, y, _ in peaks(beliefs[t * KEYPOINTS + k]):
+            for x, y, _ in _refined(beliefs[t * KEYPOINTS + k], maxima[t * KEYPOINTS + k]):
                 iy, ix = int(round(y)), int(round(x))
                 target = np.array([x + fields[base, iy, ix], y + fields[base + 1, iy, ix]])
                 d = [np.hypot(*(target - (cx, cy))) for cx, cy, _ in centroids]

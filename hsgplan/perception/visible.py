@@ -98,22 +98,29 @@ def painted(
 
 def paint(cuboids: list[Cuboid], camera: PinholeCamera) -> np.ndarray:
     """Which cuboid (its index; -1 for none) each pixel shows, the far faces painted first:
-    [H, W] int32."""
+    [H, W] int32. The faces of every cuboid are found and projected together (a look paints
+    the shelves' boards and the objects many times over)."""
     label = np.full((camera.height, camera.width), -1, dtype=np.int32)
-    faces = []
-    for i, cuboid in enumerate(cuboids):
-        corners, middle = cuboid.corners(), np.asarray(cuboid.pose.position)
-        for axis, sign in itertools.product(range(3), (-1, 1)):
-            quad = corners[CORNER_SIGNS[:, axis] * sign > 0]
-            centre = quad.mean(axis=0)
-            if (centre - middle) @ (camera.eye - centre) <= 0:
-                continue  # faces away from the camera
-            faces.append((float(np.linalg.norm(camera.eye - centre)), i, quad))
-    for _, i, quad in sorted(faces, key=lambda f: -f[0]):
-        if (camera.to_camera(quad)[:, 2] <= 0).any():
-            continue  # behind the camera
-        hull = cv2.convexHull(np.round(camera.project(quad)).astype(np.int32))
-        cv2.fillConvexPoly(label, hull, i)
+    if not cuboids:
+        return label
+    corners = np.stack([c.corners() for c in cuboids])  # [N, 8, 3]
+    middles = np.array([c.pose.position for c in cuboids], dtype=np.float64)
+    quads = np.stack(
+        [corners[:, CORNER_SIGNS[:, a] * s > 0] for a, s in itertools.product(range(3), (-1, 1))],
+        axis=1,
+    )  # [N, 6, 4, 3]: each cuboid's faces
+    centres = quads.mean(axis=2)
+    toward = camera.eye - centres
+    facing = ((centres - middles[:, None]) * toward).sum(axis=2) > 0  # away: never seen
+    distance = np.sqrt((toward**2).sum(axis=2))
+    index, face = np.nonzero(facing)
+    order = np.argsort(-distance[index, face], kind="stable")  # far first; ties as listed
+    quads = quads[index[order], face[order]]  # [M, 4, 3]
+    depth = camera.to_camera(quads.reshape(-1, 3))[:, 2].reshape(-1, 4)
+    pixels = np.round(camera.project(quads.reshape(-1, 3))).reshape(-1, 4, 2)
+    for i, quad, behind in zip(index[order], pixels, (depth <= 0).any(axis=1), strict=True):
+        if not behind:
+            cv2.fillConvexPoly(label, cv2.convexHull(quad.astype(np.int32)), int(i))
     return label
 
 

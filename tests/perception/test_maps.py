@@ -5,7 +5,7 @@ import numpy as np
 
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.keypoints import PinholeCamera, in_world
-from hsgplan.perception.maps import decode, targets
+from hsgplan.perception.maps import PEAK_THRESHOLD, _maxima, _refined, decode, peaks, targets
 from hsgplan.perception.model import STRIDE
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -53,3 +53,12 @@ def test_two_thin_boxes_stacked_are_two_peaks_at_stride_2_and_one_blob_at_stride
             centroids = sorted(f.pixels[8][1] for f in found)
             assert np.allclose(centroids, sorted([low[8][1], high[8][1]]), atol=0.5)
     assert counts == {4: 1, 2: 2}
+
+
+def test_a_looks_maps_peak_together_where_each_peaks_alone():
+    rng = np.random.default_rng(5)
+    beliefs = rng.random((6, 20, 30)).astype(np.float32) ** 4  # sparse, uneven peaks
+    together = _maxima(beliefs, PEAK_THRESHOLD)
+    for belief, maxima in zip(beliefs, together, strict=True):
+        assert _refined(belief, maxima) == peaks(belief)
+    assert together.any() and not together.all()

@@ -232,3 +232,16 @@ def test_a_box_whose_pixels_all_lie_near_another_ones_edge_is_named_by_them(monk
     found = [_detection("butter", LOWER), _detection("butter", UPPER)]  # as the centroids say
     named = estimator._retyped(KITCHEN, images, VIEWS, found)
     assert [d.type_name for d in named] == types
+
+
+def test_what_is_painted_does_not_depend_on_the_order_the_cuboids_are_listed_in():
+    # the faces are sorted far to near, whatever order the cuboids come in
+    camera = PinholeCamera.of(VIEWS[0])
+    butter, soup = KITCHEN.object_type("butter"), KITCHEN.object_type("tomato_soup")
+    near = Pose.from_xyz_yaw(0.55, 0.05, soup.height / 2, 0.0)  # nearer the front camera
+    far = Pose.from_xyz_yaw(0.40, 0.05, butter.height / 2, 0.4)
+    one = painted([butter, soup], [far, near], camera)
+    other = painted([soup, butter], [near, far], camera)
+    swapped = np.where(other == 0, 1, np.where(other == 1, 0, other))
+    assert np.array_equal(one, swapped)
+    assert (one == 0).any() and (one == 1).any()
