@@ -14,6 +14,7 @@ from pathlib import Path
 
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
+from hsgplan.domain.recovery import RECOVERING
 from hsgplan.evaluation.report import read_summary
 from hsgplan.evaluation.seeds import marked, seed_words
 from hsgplan.evaluation.table1 import (
@@ -128,7 +129,9 @@ def _check_episodes(runs: Sequence[Path], by_run: list[dict]) -> None:
 
 
 def _settings(run: Path) -> dict:
-    return read_json(run / CONFIG, "run configuration")
+    # a recovering run with every rule on records neither (`table1.table_settings`)
+    defaults = {"protocol": RECOVERING, "rules_off": []}
+    return defaults | read_json(run / CONFIG, "run configuration")
 
 
 def all_task_runs(runs: Sequence[Path]) -> bool:

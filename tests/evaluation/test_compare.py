@@ -169,6 +169,21 @@ def test_a_ladder_of_recovery_rules_stands_side_by_side_when_told(tmp_path):
         compare([off, seeded], ["off", "seeded"], ["gnn"], across_rules=True)
 
 
+def test_every_rule_on_under_the_recovering_protocol_stands_beside_one_off(tmp_path):
+    # a recovering run with every rule on writes no protocol (as runs did before protocols
+    # were named); it is still the recovering protocol, not another
+    on = _run(tmp_path / "on", {2: (True, True)}, protocol="recovering")
+    config = json.loads((on / CONFIG).read_text())
+    del config["protocol"], config["rules_off"]
+    (on / CONFIG).write_text(json.dumps(config))
+    off = _run(tmp_path / "off", {2: (True, False)}, protocol="recovering", rules_off=("x",))
+    table = compare([on, off], ["on", "off"], ["gnn"], across_rules=True)
+    assert table.rows[1][1].startswith("0.50")
+    paper = _run(tmp_path / "paper", {2: (True, True)})
+    with pytest.raises(InvalidInputError, match="differ in protocol"):
+        compare([on, paper], ["on", "paper"], ["gnn"], across_rules=True)
+
+
 def test_task_runs_of_three_trainings_make_one_row_with_an_interval(tmp_path):
     from hsgplan.evaluation.compare import compare_task_trainings
 
