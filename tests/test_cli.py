@@ -386,7 +386,7 @@ def test_the_rules_page_lists_every_rule_a_run_may_set_with_what_it_does():
     for name, line in rows.items():
         what = line.split("|")[5].strip()
         assert len(what) > 20 and what.endswith("."), name
-    assert "| kept |" in rows["relook"] and "| off |" in rows["failed_bins"]
+    assert "| kept |" in rows["relook"] and "| off |" in rows["least_taken"]
     assert all("| kept |" in rows[n] for n in NO_FAILURE_RULES)
     help_text = run("eval", "world", "--help").output
-    assert "hsgplan rules" in help_text and "likeliest_literal" not in help_text
+    assert "hsgplan rules" in help_text and "push_give_up" not in help_text

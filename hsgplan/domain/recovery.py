@@ -4,27 +4,24 @@ The paper's agent has none: a primitive that fails ends its episode (the `paper`
 `hsgplan.evaluation.protocol`, which keeps only the perception rules below). Our loop lets a
 failed primitive cost one step and goes on (the `recovering` protocol), and these hand-written
 rules decide how it goes on. Each is named here, documented once, and switched off by name
-(`hsgplan eval world --rules-off NAME,...`), so that what each buys is measured (README,
-"Recovery rules"). None of them consults the domain's rules (transition model, feasibility):
-they read only what the agent saw and did.
+(`hsgplan eval world --rules-off NAME,...`), so that what each buys is measured
+(`--ablate-rules`; a rule that showed no gain on the tune split left, docs/decisions.md). None
+of them consults the domain's rules (transition model, feasibility): they read only what the
+agent saw and did.
 
 Motion level (`hsgplan.motion.generator`):
 - `failed_bins`: parameters that failed for good are remembered with the scene they failed in;
   in that unchanged scene the generator draws its next proposal from its own distribution over
-  the bins not yet failed there, instead of proposing its best again.
+  the bins not yet failed there, instead of proposing its best again (an agent does not repeat
+  a refused action; the geometric sampler remembers its failures so too).
 - `push_give_up`: after three failed pushes of an object from where it was put down, the
   generator gives up the spot: the agent takes the object up instead, and the place that put
   it there counts as failed, so that the next place draws another spot.
 
 Task level (`hsgplan.planning.regression.planner`):
-- `avoid_taken`: an action already taken from the very state observed now (with this goal) is
-  avoided while the regression finds another.
-- `least_taken`: once every action found from a state has been taken there, the least often
-  taken goes again rather than the search giving up.
-- `likeliest_literal`: when the regression reaches nothing, the literal f_reach finds likeliest
-  is taken rather than the planner stopping ("regression stuck").
-- `failed_goal_waits`: a goal literal whose action came back to the same state (it failed)
-  waits while another goal literal can go on.
+- `least_taken`: an action already taken from the very state observed now (with this goal)
+  goes again only once every other action found there has been taken as often, rather than
+  the search giving up.
 
 Agents that check their actions (`hsgplan.agents.hierarchical`; the paper's does not):
 - `refuse_repeats`: an action that succeeded from the very state observed now (with this goal)
@@ -81,10 +78,7 @@ class RecoveryRules:
 
     failed_bins: bool = True
     push_give_up: bool = True
-    avoid_taken: bool = True
     least_taken: bool = True
-    likeliest_literal: bool = True
-    failed_goal_waits: bool = True
     refuse_repeats: bool = True
     stuck_goal_literals: bool = True
     relook: bool = True

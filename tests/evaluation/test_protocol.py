@@ -69,12 +69,12 @@ def test_the_paper_protocol_runs_without_any_recovery_rule_but_those_of_no_failu
     assert EvalConfig("learned", (2,), 1, 0).protocol == "paper"  # every headline's
     recovering = EvalConfig("learned", (2,), 1, 0, protocol="recovering")
     assert recovering.rules() == RecoveryRules()
-    some = replace(recovering, rules_off=("failed_bins", "least_taken"))
-    assert some.rules().off() == ("failed_bins", "least_taken")
+    some = replace(recovering, rules_off=("push_give_up", "least_taken"))
+    assert some.rules().off() == ("push_give_up", "least_taken")
     with pytest.raises(InvalidInputError, match="unknown recovery rule"):
         EvalConfig("learned", (2,), 1, 0, protocol="recovering", rules_off=("wizard",))
     with pytest.raises(InvalidInputError, match="no recovery rule"):
-        EvalConfig("learned", (2,), 1, 0, protocol="paper", rules_off=("failed_bins",))
+        EvalConfig("learned", (2,), 1, 0, protocol="paper", rules_off=("push_give_up",))
     with pytest.raises(InvalidInputError, match="protocol 'x'"):
         EvalConfig("learned", (2,), 1, 0, protocol="x")
 
@@ -120,12 +120,12 @@ def test_an_ablation_switches_each_rule_off_in_turn_and_tables_them():
     report = {
         "variants": {
             "all-rules": run | {"methods": {"gnn": ok}},
-            "no-failed_bins": run | {"methods": {"gnn": failed}},
+            "no-push_give_up": run | {"methods": {"gnn": failed}},
         }
     }
     table = ablation_table(report)
     assert table.header == ("recovery rules", "GNN 2", "GNN failed primitives / episode")
-    assert table.rows == (("all on", "1.00", "0.00"), ("failed_bins off", "0.00", "1.00"))
+    assert table.rows == (("all on", "1.00", "0.00"), ("push_give_up off", "0.00", "1.00"))
 
 
 @pytest.mark.parametrize("protocol", ["paper", "recovering"])

@@ -313,8 +313,8 @@ bench compare-trials | bench compare-trials missing.npz missing.npz
 bench compare-trials | bench compare-trials . .
 eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --ray ''
 eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --rules-off wizard
-eval           | eval world --sizes 2 --goals 1 --out run --rules-off failed_bins,,least_taken
-eval           | eval world --sizes 2 --goals 1 --out run --protocol paper --rules-off failed_bins
+eval           | eval world --sizes 2 --goals 1 --out run --rules-off push_give_up,,least_taken
+eval           | eval world --sizes 2 --goals 1 --out run --protocol paper --rules-off push_give_up
 eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --protocol ''
 eval           | eval world --sizes 2 --goals 1 --out run --ablate-rules --protocol paper
 eval           | eval world --sizes 2 --goals 1 --workers 1 --out run --ray 127.0.0.1:1

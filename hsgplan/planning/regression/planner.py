@@ -94,10 +94,9 @@ class RegressionPlanner:
     asking the networks again; otherwise (a primitive failed, the world moved) the chain is
     dropped and the planner regresses from the goal.
 
-    What it does after a failure is the recovery rules' (`hsgplan.domain.recovery`:
-    `avoid_taken`, `least_taken`, `likeliest_literal`, `failed_goal_waits`); with all of them
-    off it is the paper's planner: the shallowest reachable literal, drawn uniformly, or
-    "regression stuck".
+    What it does after a failure is the recovery rule `least_taken`'s
+    (`hsgplan.domain.recovery`); with it off it is the paper's planner: the shallowest reachable
+    literal, drawn uniformly, or "regression stuck".
 
     With `look_ahead` (beyond the paper, `lookahead.py`) a subgoal is passed over while another
     is found when f_reach finds a literal up its chain out of reach once those below it are
@@ -135,10 +134,6 @@ class RegressionPlanner:
         self.rng = random.Random(seed)
         self._taken: dict[tuple[Goal, SymbolicSceneGraph], Counter[Action]] = {}
         self._plan: tuple[Goal, list[tuple[Literal, frozenset[Literal]]], Literal] | None = None
-        # what the world said: an action after which the very same state was observed again
-        # failed there; the goal literal it served is tried after the others from then on
-        self._last: tuple[SymbolicSceneGraph, Action, Literal] | None = None
-        self._failed_roots: set[Literal] = set()
         self._pending: list[str] = []
         self._asked: dict[tuple[SymbolicSceneGraph, Literal], float] = {}
 
@@ -190,14 +185,9 @@ class RegressionPlanner:
         start = time.perf_counter()
         if not (unsatisfied := unsatisfied_literals(state, goal)):
             return TaskDecision.none("the goal holds", start)
-        rules = self.rules
-        if rules.failed_goal_waits and self._last is not None and self._last[0] == state:
-            self._failed_roots.add(self._last[2])
         taken = self._taken.setdefault((goal, state), Counter())
-        kept = (refused | set(taken)) if rules.avoid_taken else refused
-        if (step := self._follow(state, goal, kept)) is not None:
+        if (step := self._follow(state, goal, refused)) is not None:
             taken[step[1]] += 1
-            self._last = (state, step[1], step[2])
             return TaskDecision.taken(step[1], step[0], start, state.world)
         context = frozenset(goal.literals)
         # objects other goal literals still have to move, whose picks the look-ahead keeps
@@ -208,48 +198,30 @@ class RegressionPlanner:
         # A goal literal waits while its preimage names another unsatisfied goal literal; if
         # nothing is reached from the free ones (a dependency the network got wrong, or a
         # goal literal stuck behind a full shelf), the waiting ones are tried as well.
-        # An action already taken from this very state (with this goal) failed or came back
-        # to it: it is avoided while any other is found. This breaks loops such as picking an
-        # object whose shelf is full and putting it back. Once every action found here has
-        # been taken here, the least often taken goes again (uniformly among equals), rather
-        # than stopping: in the world a primitive may pass on another try (the motion level
-        # draws other parameters), and a failed action is tried as often as the detours that
-        # only came back here (put the object down, take it up again), never the detour for
-        # ever. A loop that never passes ends at the step limit, the paper's overstep.
+        # `least_taken`: an action already taken from this very state (with this goal) failed
+        # or came back to it, so of the actions found the least often taken here goes
+        # (uniformly among equals). This breaks loops such as picking an object whose shelf is
+        # full and putting it back, and a failed action is tried again as often as the detours
+        # that only came back here, never the detour for ever: in the world a primitive may
+        # pass on another try. A loop that never passes ends at the step limit, the paper's
+        # overstep.
         pairs = list(zip(roots, preimages, strict=True))
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
-        seen: dict[Literal, tuple[float, Node]] = {}
-        passes = [(set(taken) | refused, None)] if rules.avoid_taken else []
-        if rules.least_taken:
-            passes.append((set(refused), taken))
-        for avoid, counts in passes or [(set(refused), None)]:
-            vetoed: list[Node] = []
-            for frontier in (free, [x for x in pairs if x not in free]):
-                found = self._search(state, frontier, avoid, seen, counts, vetoed)
-                if found is not None:
-                    return self._take(state, goal, *found, taken, start)
-            # every subgoal found serves a literal out of reach once it is achieved: the first
-            # ones found, as the planner takes them without looking ahead
-            if (found := self._choose(state, vetoed, avoid, counts)) is not None:
+        counts = taken if self.rules.least_taken else None
+        vetoed: list[Node] = []
+        for frontier in (free, [x for x in pairs if x not in free]):
+            found = self._search(state, frontier, set(refused), counts, vetoed)
+            if found is not None:
                 return self._take(state, goal, *found, taken, start)
-            if not rules.likeliest_literal:
-                continue
-            # Nothing reached: the literal f_reach finds likeliest (it learned the physical
-            # world, which refuses more than some other world would), before repeating
-            likely = [
-                (counts[a] if counts else 0, -p, literal_key(n.lit), n, a)
-                for p, n in seen.values()
-                if (a := action_for(n.lit, state)) is not None and a not in avoid
-            ]
-            if likely:
-                *_, node, action = min(likely, key=lambda x: x[:3])
-                return self._take(state, goal, node, action, taken, start)
+        # every subgoal found serves a literal out of reach once it is achieved: the first
+        # ones found, as the planner takes them without looking ahead
+        if (found := self._choose(state, vetoed, set(refused), counts)) is not None:
+            return self._take(state, goal, *found, taken, start)
         return TaskDecision.none("regression stuck", start)
 
     def _take(self, state, goal, node: Node, action: Action, taken, start) -> TaskDecision:
         taken[action] += 1
         self._plan = (goal, list(reversed(node.chain)), node.path[0])
-        self._last = (state, action, node.path[0])
         decision = TaskDecision.taken(action, node.lit, start, state.world)
         if isinstance(action, Pick) and node.chain:
             # what the pick is for: the action of the literal next up the chain, in the state
@@ -303,13 +275,12 @@ class RegressionPlanner:
             asked.update(((state, lit), p) for lit, p in zip(new, scores, strict=True))
         return [asked[state, lit] for lit in lits]
 
-    def _search(self, state, frontier, avoid, seen, counts, vetoed):
+    def _search(self, state, frontier, avoid, counts, vetoed):
         """Breadth first from the frontier: a (node, action) one primitive reaches, or None.
 
         A node is reached when f_reach says so, or when its whole preimage already holds
         (then, by what a preimage means, one primitive achieves it). Where a level's
-        preimages are known, f_reach is asked about it and the next level in one call. `seen`
-        collects every literal met with f_reach's probability."""
+        preimages are known, f_reach is asked about it and the next level in one call."""
         reach: dict[Literal, float] = {}
         for _ in range(self.max_depth):
             if not frontier:
@@ -320,8 +291,6 @@ class RegressionPlanner:
             ask = list(dict.fromkeys(ask))
             if ask:
                 reach.update(zip(ask, self.reach_scores(state, ask), strict=True))
-            for n, _ in frontier:
-                seen.setdefault(n.lit, (reach[n.lit], n))
             hits = self._ahead(state, [n for n, _ in frontier if reach[n.lit] > 0.5], vetoed)
             if found := self._choose(state, hits, avoid, counts):
                 return found
@@ -339,10 +308,7 @@ class RegressionPlanner:
         hits = [
             (n, a) for n in nodes if (a := action_for(n.lit, state)) is not None and a not in avoid
         ]
-        if counts is None:
-            # a goal literal whose action failed this episode waits while another one can go on
-            hits = [h for h in hits if h[0].path[0] not in self._failed_roots] or hits
-        elif hits:
+        if counts is not None and hits:
             least = min(counts[a] for _, a in hits)
             hits = [h for h in hits if counts[h[1]] == least]
         return self.rng.choice(hits) if hits else None  # the paper's uniform serialisation
