@@ -38,12 +38,6 @@ def _regression_ahead(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     return RegressionPlanner(checkpoint, rules=rules, look_ahead=True)
 
 
-def _regression_ahead_chain(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
-    from hsgplan.planning.regression.planner import RegressionPlanner
-
-    return RegressionPlanner(checkpoint, rules=rules, look_ahead=True, sideways=False)
-
-
 def _regression_paper(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     from hsgplan.planning.regression.paper_loop import PaperRegressionPlanner
 
@@ -69,7 +63,6 @@ TASK_PLANNERS: dict[str, Callable[[Path, RecoveryRules], TaskPlanner]] = {
     # the same networks; a subgoal is taken only if what it serves stays reachable (f_reach)
     # and the picks other goal literals still need stay likely
     "regression-ahead": _regression_ahead,
-    "regression-ahead-chain": _regression_ahead_chain,  # the look up the chain alone
     # the same planner; the agent tries each action in its model first and refuses those
     # that do not plan (`agents/hierarchical.py`)
     "regression-ahead-checked": _regression_ahead,
@@ -204,7 +197,6 @@ LEARNED_PLANNERS = (
     "regression-ahead",
     "regression-ahead-checked",
     "regression-ahead-clearing",
-    "regression-ahead-chain",
     "regression-paper",
     "forward",
 )
