@@ -78,9 +78,12 @@ def compare(
         typer.Option(help="The rows' names, comma-separated (default: the folders' names)."),
     ] = None,
     method: Annotated[
-        str,
-        typer.Option(help="The column compared (gnn, mlp, ...), or one per run, comma-separated."),
-    ] = "gnn",
+        str | None,
+        typer.Option(
+            help="The column compared (gnn, mlp, ...), or one per run, comma-separated "
+            "(default: the one method every run holds, else gnn)."
+        ),
+    ] = None,
     across_scenes: Annotated[
         bool,
         typer.Option(
@@ -112,10 +115,15 @@ def compare(
     repeats, seed, sizes, scene, rules off); only their checkpoints, and the method when one is
     named per run, may differ (with --across-scenes the scene, with --across-rules the rules
     off). Eval task runs (the symbolic loop) are compared the same way, on the same episodes."""
-    from hsgplan.evaluation.compare import all_task_runs, compare_task, compare_task_trainings
+    from hsgplan.evaluation.compare import (
+        all_task_runs,
+        compare_task,
+        compare_task_trainings,
+        only_method,
+    )
     from hsgplan.evaluation.compare import compare as compare_runs
 
-    methods = [m.strip() for m in method.split(",")]
+    methods = [m.strip() for m in method.split(",")] if method else []
     default = methods if len(set(methods)) == len(runs) > 1 else [r.name for r in runs]
     row_names = names_of(names, "--names", "run") if names else tuple(default)
     if all_task_runs(runs):
@@ -136,5 +144,6 @@ def compare(
             raise InvalidInputError(
                 "--trainings groups eval task runs; an eval world run holds its trainings"
             )
+        methods = methods or [only_method(runs)]
         t = compare_runs(runs, row_names, methods, across_scenes, across_rules)
     print_table(t.title, t.header, [list(r) for r in t.rows], markdown)

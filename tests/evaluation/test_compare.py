@@ -203,3 +203,17 @@ def test_task_runs_of_three_trainings_make_one_row_with_an_interval(tmp_path):
     assert r.exit_code == 0 and "| ours | 0.92 (" in r.stdout
     r = CliRunner().invoke(app, [*args[:-2], "--trainings", "4"])
     assert r.exit_code == 2 and "rows of 4 trainings" in r.stderr
+
+
+def test_the_method_compared_is_the_one_every_run_holds_else_gnn(tmp_path):
+    from hsgplan.evaluation.compare import only_method
+
+    agent = [_run(tmp_path / f"a{k}", {2: (True, k > 0)}, method="learned") for k in range(2)]
+    assert only_method(agent) == "learned"
+    table = compare(agent, ["a0", "a1"], [only_method(agent)])
+    assert table.rows[0][1].startswith("0.50") and table.rows[1][1].startswith("1.00")
+    mixed = [agent[0], _run(tmp_path / "g", {2: (True, True)})]
+    assert only_method(mixed) == "gnn"  # runs of different methods: Table 1's column
+    assert only_method([tmp_path / "nothing"]) == "gnn"  # refused where it is read
+    r = CliRunner().invoke(app, ["eval", "compare", str(agent[0]), str(agent[1])])
+    assert r.exit_code == 0 and "learned" in r.output, r.output
