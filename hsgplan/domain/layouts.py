@@ -20,11 +20,9 @@ from hsgplan.domain.scene import GRIPPER_MAX_OPENING, Kind, ObjectType, Shelf, W
 from hsgplan.domain.scene_file import (
     derived_prepush_name,
     derived_prepush_span,
-    object_data,
-    scene_data,
-    to_toml,
     world_of,
 )
+from hsgplan.domain.scene_write import object_data, scene_data, to_toml
 from hsgplan.files import write_atomically
 
 SHELF_NEAR = (0.34, 0.44)  # x of a shelf's open front

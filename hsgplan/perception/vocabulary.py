@@ -18,7 +18,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
-from hsgplan.domain.scene_file import default_world, read_world, scene_data, to_toml
+from hsgplan.domain.scene_file import default_world, read_world
+from hsgplan.domain.scene_write import scene_data, to_toml
 from hsgplan.domain.world import ObjectType, World
 from hsgplan.files import write_atomically
 from hsgplan.scene_graph.names import TYPE_NAMES

@@ -119,7 +119,8 @@ def _three_shelves():
     space narrowed, so that both shelves on that side stand within the arm's reach)."""
     import tomllib
 
-    from hsgplan.domain.scene_file import scene_data, to_toml, world_of
+    from hsgplan.domain.scene_file import world_of
+    from hsgplan.domain.scene_write import scene_data, to_toml
 
     data = tomllib.loads(to_toml(scene_data(KITCHEN)))
     data["table"]["y"] = [-1.2, 1.2]  # room beyond shelf_a for shelves of the layouts' widths
@@ -171,7 +172,8 @@ def test_a_scene_no_draw_can_vary_is_refused_with_what_refused_most_draws():
     import tomllib
 
     from hsgplan.domain.errors import InvalidInputError
-    from hsgplan.domain.scene_file import scene_data, to_toml, world_of
+    from hsgplan.domain.scene_file import world_of
+    from hsgplan.domain.scene_write import scene_data, to_toml
 
     data = tomllib.loads(to_toml(scene_data(KITCHEN)))
     # no tower of two such boxes (resized, 16 to 24 cm) stays in reach on any shelf top

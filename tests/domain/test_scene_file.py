@@ -11,7 +11,8 @@ from hypothesis import strategies as st
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene import Kind, Rect, shelf_boards
-from hsgplan.domain.scene_file import read_world, scene_data, to_toml, world_of
+from hsgplan.domain.scene_file import read_world, world_of
+from hsgplan.domain.scene_write import scene_data, to_toml
 from hsgplan.paths import KITCHEN_SCENE
 
 KITCHEN = tomllib.loads(KITCHEN_SCENE.read_text())

@@ -9,7 +9,8 @@ import pytest
 
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.predicates import Predicate
-from hsgplan.domain.scene_file import read_world, scene_data, to_toml, world_of
+from hsgplan.domain.scene_file import read_world, world_of
+from hsgplan.domain.scene_write import scene_data, to_toml
 from hsgplan.paths import SCENES, home
 from hsgplan.symbolic.generator import random_goals
 

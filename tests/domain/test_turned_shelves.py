@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.parameters import place_xy, place_yaw, push_values
 from hsgplan.domain.scene import Rect
-from hsgplan.domain.scene_file import read_world, scene_data, to_toml, world_of
+from hsgplan.domain.scene_file import read_world, world_of
+from hsgplan.domain.scene_write import scene_data, to_toml
 from hsgplan.domain.world import PLACE_BINS, PLACE_LONG_AXIS_YAW
 from hsgplan.paths import KITCHEN_SCENE, SCENES, home
 

@@ -208,7 +208,7 @@ def test_a_scene_of_objects_f_p_never_saw_is_refused_in_one_line(tmp_path):
 
     from hsgplan.cli import app
     from hsgplan.domain.layouts import random_layout
-    from hsgplan.domain.scene_file import scene_data, to_toml
+    from hsgplan.domain.scene_write import scene_data, to_toml
 
     scene = tmp_path / "new.toml"
     scene.write_text(to_toml(scene_data(random_layout(KITCHEN, 3, 0, new_objects=True))))

@@ -136,7 +136,7 @@ def test_a_chunk_whose_arrays_break_the_format_is_named_damaged():
 
 def test_a_collection_staged_in_a_layout_keeps_its_sizes_and_trains_on_them(tmp_path):
     from hsgplan.domain.layouts import random_layout
-    from hsgplan.domain.scene_file import scene_data, to_toml
+    from hsgplan.domain.scene_write import scene_data, to_toml
     from hsgplan.perception.train import examples
 
     layout = random_layout(KITCHEN, 3, 0)

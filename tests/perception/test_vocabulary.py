@@ -13,7 +13,7 @@ from hsgplan.collect.images import ImagesConfig, collect_images
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.layouts import random_layout
-from hsgplan.domain.scene_file import scene_data, to_toml
+from hsgplan.domain.scene_write import scene_data, to_toml
 from hsgplan.evaluation.config import unseeable
 from hsgplan.paths import PERCEPTION_CHECKPOINT
 from hsgplan.perception.estimator import PoseEstimator

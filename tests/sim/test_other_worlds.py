@@ -15,7 +15,7 @@ from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.layouts import random_layout
 from hsgplan.domain.predicates import on
-from hsgplan.domain.scene_file import scene_data, to_toml
+from hsgplan.domain.scene_write import scene_data, to_toml
 from hsgplan.paths import KITCHEN_SCENE
 from hsgplan.scene_graph.geometric import GeometricSceneGraph
 from hsgplan.scene_graph.geometry import Pose

@@ -16,7 +16,8 @@ from hsgplan.domain.goals import parse_goal
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.domain.layouts import random_layout
 from hsgplan.domain.predicates import on
-from hsgplan.domain.scene_file import scene_data, to_toml, world_of
+from hsgplan.domain.scene_file import world_of
+from hsgplan.domain.scene_write import scene_data, to_toml
 from hsgplan.paths import KITCHEN_SCENE
 from hsgplan.planning.fast_downward import FastDownwardPlanner
 from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
