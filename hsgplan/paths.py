@@ -53,3 +53,8 @@ def shipped(path: Path | str) -> Path:
     if path.is_absolute() or os.path.lexists(path):  # a link here, even a broken one, is meant
         return path
     return home() / path
+
+
+def perception_folder(checkpoint: str | Path | None) -> Path:
+    """f_p's checkpoint folder: `checkpoint`, or the shipped one."""
+    return Path(checkpoint or PERCEPTION_CHECKPOINT)

@@ -321,7 +321,7 @@ def bench_observe(
     network, PnP, fusion, naming and resting, and the tracker; medians over the scenes."""
     from hsgplan.benchmarks.observe import bench_observe as run
     from hsgplan.evaluation.config import unseeable
-    from hsgplan.evaluation.observers import perception_folder
+    from hsgplan.paths import perception_folder
 
     world = scene_world(scene)
     if why := unseeable([world], scene, perception_checkpoint):

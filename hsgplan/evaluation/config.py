@@ -50,8 +50,7 @@ def unseeable(
     """Why f_p (`checkpoint`'s, else the shipped one) cannot see the scenes of `worlds` (read
     from `scene`), or None: one has objects whose look it has not learned, or other cameras
     (`perception.vocabulary`)."""
-    from hsgplan.evaluation.observers import perception_folder
-    from hsgplan.paths import shipped
+    from hsgplan.paths import perception_folder, shipped
     from hsgplan.perception.vocabulary import read_vocabulary
 
     vocabulary = read_vocabulary(shipped(perception_folder(checkpoint)))

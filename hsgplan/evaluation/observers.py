@@ -8,14 +8,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from hsgplan.evaluation.config import check_observer
+from hsgplan.paths import perception_folder
 from hsgplan.sim.observer import GroundTruth, SceneObserver
-
-
-def perception_folder(checkpoint: str | Path | None) -> Path:
-    """f_p's checkpoint folder: `checkpoint`, or the shipped one."""
-    from hsgplan.paths import PERCEPTION_CHECKPOINT
-
-    return Path(checkpoint or PERCEPTION_CHECKPOINT)
 
 
 def make_observer(

@@ -35,9 +35,10 @@ from hsgplan.domain.scene import World
 from hsgplan.domain.scene_file import default_world
 from hsgplan.evaluation.config import EvalConfig, world_of_file
 from hsgplan.evaluation.episode import EpisodeRecord
-from hsgplan.evaluation.observers import make_observer, perception_folder
+from hsgplan.evaluation.observers import make_observer
 from hsgplan.evaluation.seeds import episode_seed
 from hsgplan.evaluation.splits import split_goals, split_named
+from hsgplan.paths import perception_folder
 from hsgplan.runner.items import run_items
 from hsgplan.runner.run_folder import CONFIG, add_wall_seconds, check_claim
 
