@@ -131,12 +131,11 @@ def _check_episodes(runs: Sequence[Path], by_run: list[dict]) -> None:
 def only_method(runs: Sequence[Path]) -> str:
     """The one method every eval world run holds (an agent's run holds `learned`, an ablation's
     variants theirs), else `gnn`, Table 1's column."""
-    held = set()
-    for run in runs:
-        if not (run / "summary.json").is_file():
-            return "gnn"  # refused with its reason where it is read
-        held.add(tuple(read_summary(run)["methods"]))
-    return held.pop()[0] if len(held) == 1 and len(next(iter(held))) == 1 else "gnn"
+    if not all((run / "summary.json").is_file() for run in runs):
+        return "gnn"  # a folder that is no run is refused with its reason where it is read
+    held = {tuple(read_summary(run)["methods"]) for run in runs}
+    only = held.pop() if len(held) == 1 else ()
+    return only[0] if len(only) == 1 else "gnn"
 
 
 def _settings(run: Path) -> dict:
