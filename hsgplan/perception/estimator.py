@@ -167,7 +167,7 @@ class PoseEstimator:
                 out.append(replace(d, type_confidence=confidence))
                 continue
             t = world.object_type(best)
-            pose, error = fitted(t, list(d.keypoints), list(d.rays))
+            pose, error = fitted(t, list(d.keypoints), list(d.rays), self.rules.refine_rounds)
             if pose is not None:
                 d = replace(d, type_name=best, pose=pose, reprojection_px=error)
             out.append(replace(d, type_confidence=confidence))
@@ -196,7 +196,7 @@ class PoseEstimator:
             masks = visible_masks(label, len(found), APART_PX)
             near: list[np.ndarray] | None = None  # the masks with every pixel in sight
             for i, (d, mask) in enumerate(zip(found, masks, strict=True)):
-                if not any(np.allclose(k.camera.eye, pinhole.eye) for k in d.keypoints):
+                if not any(k.camera.at_eye_of(pinhole) for k in d.keypoints):
                     continue  # a view that did not find it: a phantom's pixels there are not its
                 u, v = np.round(pinhole.project(np.array([d.pose.position]))[0]).astype(int)
                 own = 0 <= v < label.shape[0] and 0 <= u < label.shape[1] and label[v, u] == i

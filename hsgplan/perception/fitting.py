@@ -5,12 +5,16 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-import numpy as np
-
 from hsgplan.domain.world import ObjectType, World
 from hsgplan.perception.detection import Detection
 from hsgplan.perception.fusion import Seen, grouped, line_of_sight
-from hsgplan.perception.pnp import ViewKeypoints, estimate_pose, robust_cost, upright_fit
+from hsgplan.perception.pnp import (
+    REFINE_ROUNDS,
+    ViewKeypoints,
+    estimate_pose,
+    robust_cost,
+    upright_fit,
+)
 from hsgplan.perception.rules import SHIPPED, PerceptionRules
 from hsgplan.perception.settle import Ray, meeting_point
 from hsgplan.scene_graph.geometry import Pose
@@ -39,7 +43,7 @@ def fuse(
         name, confidence = typed(members)
         rays = [line_of_sight(s) for s in members]
         views = [s.keypoints for s in members]
-        pose, error = fitted(world.object_type(name), views, rays)
+        pose, error = fitted(world.object_type(name), views, rays, rules.refine_rounds)
         if pose is None:
             continue
         score = members[0].score
@@ -49,10 +53,13 @@ def fuse(
     return out
 
 
-def fitted(t: ObjectType, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[Pose | None, float]:
-    """The pose of an object of type `t` from the keypoints of the views that saw it, and
-    its RMS reprojection error (pixels); None if PnP finds none."""
-    fused = estimate_pose(t, views)
+def fitted(
+    t: ObjectType, views: list[ViewKeypoints], rays: list[Ray], rounds: int = REFINE_ROUNDS
+) -> tuple[Pose | None, float]:
+    """The pose of an object of type `t` from the keypoints of the views that saw it (PnP's
+    fit refined by `rounds` rounds over them all), and its RMS reprojection error (pixels);
+    None if PnP finds none."""
+    fused = estimate_pose(t, views, rounds)
     if fused is None:
         return None, math.inf
     pose = fused.pose
@@ -66,5 +73,5 @@ def fitted(t: ObjectType, views: list[ViewKeypoints], rays: list[Ray]) -> tuple[
         cost = free
     else:
         pose = level
-    points = sum(int((~np.isnan(v.pixels).any(axis=1)).sum()) for v in views)
+    points = sum(int(v.found.sum()) for v in views)
     return pose, math.sqrt(cost / max(points, 1))

@@ -82,6 +82,36 @@ def ray_gap(a: Seen, b: Seen, table: Rect) -> float:
     return float(np.linalg.norm(qa - qb))
 
 
+def _gaps_within(order: list[Seen], table: Rect, gap: float) -> dict[tuple[int, int], float]:
+    """`ray_gap` of every two instances of one type in two views (indices a < b in `order`)
+    where it is under `gap`: every pair at once, as arrays (a look has hundreds of pairs)."""
+    views = np.array([s.view for s in order])
+    types = np.array([s.type_index for s in order])
+    a, b = np.triu_indices(len(order), 1)
+    keep = (views[a] != views[b]) & (types[a] == types[b])
+    a, b = a[keep], b[keep]
+    if not len(a):
+        return {}
+    origins = np.array([s.ray[0] for s in order])
+    directions = np.array([s.ray[1] for s in order])
+    pa, da, pb, db = origins[a], directions[a], origins[b], directions[b]
+    w = pa - pb
+    cross = (da * db).sum(axis=1)
+    denom = 1.0 - cross**2
+    apart = denom >= 1e-9  # not parallel
+    denom = np.where(apart, denom, 1.0)
+    dw, bw = (da * w).sum(axis=1), (db * w).sum(axis=1)
+    ta, tb = (cross * bw - dw) / denom, (bw - cross * dw) / denom
+    qa, qb = pa + ta[:, None] * da, pb + tb[:, None] * db
+    meet, g = (qa + qb) / 2, np.linalg.norm(qa - qb, axis=1)
+    ahead = apart & (ta > 0) & (tb > 0) & (g < gap) & (table.z - 0.05 < meet[:, 2])
+    return {
+        (int(a[k]), int(b[k])): float(g[k])
+        for k in np.flatnonzero(ahead & (meet[:, 2] < TOP_Z))
+        if table.contains(meet[k, 0], meet[k, 1])
+    }
+
+
 def grouped(
     found: list[Seen], table: Rect, gap: float = RAY_GAP, cliques: bool = True
 ) -> list[list[Seen]]:
@@ -91,14 +121,7 @@ def grouped(
     `_closest_pairs_first`). Each group lists its members strongest first; the groups come in
     the order of their strongest members."""
     order = sorted(found, key=lambda s: -s.score)
-    gaps = {
-        (a, b): g
-        for a in range(len(order))
-        for b in range(a + 1, len(order))
-        if order[a].view != order[b].view
-        and order[a].type_index == order[b].type_index
-        and (g := ray_gap(order[a], order[b], table)) < gap
-    }
+    gaps = _gaps_within(order, table, gap)
     if not cliques:
         return _closest_pairs_first(order, gaps)
     near: dict[int, set[int]] = {k: set() for k in range(len(order))}

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from hsgplan.perception.keypoints import KEYPOINTS
@@ -96,31 +97,40 @@ def peaks(
     within `MIN_APART` cells of a stronger one (a keypoint half-way between cells makes two
     equal maxima), each refined by a parabola through the log beliefs of its neighbours along
     x and along y (exact for a Gaussian): (x, y, belief) in cells."""
-    return _refined(belief, _maxima(belief[None], threshold)[0])
+    return _refined(belief, _maxima(belief[None], threshold)[0], _log_padded(belief[None])[0])
 
 
 def _maxima(beliefs: np.ndarray, threshold: float) -> np.ndarray:
     """Where maps [C, H, W] peak above `threshold` (no neighbour higher), all maps at once:
-    [C, H, W] bool."""
-    h, w = beliefs.shape[1:]
-    padded = np.pad(beliefs, ((0, 0), (1, 1), (1, 1)), constant_values=-1.0)
-    neighbours = np.stack(
-        [
-            padded[:, 1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
-            for dy in (-1, 0, 1)
-            for dx in (-1, 0, 1)
-        ]
+    [C, H, W] bool. The neighbours' maximum is a 3 x 3 dilation of the maps as the channels of
+    one image (outside the map counts as no neighbour)."""
+    highest = np.concatenate(
+        [_dilated(beliefs[c : c + MAX_CHANNELS]) for c in range(0, len(beliefs), MAX_CHANNELS)]
     )
-    return (beliefs >= neighbours.max(axis=0)) & (beliefs > threshold)
+    return (beliefs >= highest) & (beliefs > threshold)
 
 
-def _refined(belief: np.ndarray, maxima: np.ndarray) -> list[tuple[float, float, float]]:
-    """`peaks` of one map from where it peaks (`_maxima`)."""
+MAX_CHANNELS = 128  # the most channels OpenCV takes in one image
+
+
+def _dilated(maps: np.ndarray) -> np.ndarray:
+    out = cv2.dilate(np.ascontiguousarray(maps.transpose(1, 2, 0)), np.ones((3, 3), np.uint8))
+    return out.reshape(*out.shape[:2], -1).transpose(2, 0, 1)  # OpenCV drops a lone channel
+
+
+def _log_padded(beliefs: np.ndarray) -> np.ndarray:
+    """The log of maps [C, H, W], floored, with a border of the floor: [C, H + 2, W + 2]."""
+    return np.log(np.maximum(np.pad(beliefs, ((0, 0), (1, 1), (1, 1)), constant_values=-1.0), 1e-6))
+
+
+def _refined(
+    belief: np.ndarray, maxima: np.ndarray, log: np.ndarray
+) -> list[tuple[float, float, float]]:
+    """`peaks` of one map from where it peaks (`_maxima`) and its `_log_padded`."""
     ys, xs = np.nonzero(maxima)
     if not len(ys):
         return []
     order = np.argsort(-belief[ys, xs], kind="stable")[: 8 * MAX_PEAKS]
-    log = np.log(np.maximum(np.pad(belief, 1, constant_values=-1.0), 1e-6))
     out: list[tuple[float, float, float]] = []
     for y, x in zip(ys[order], xs[order], strict=True):
         if len(out) == MAX_PEAKS:
@@ -143,7 +153,7 @@ def _vertex(before: float, centre: float, after: float) -> float:
     curvature = before - 2 * centre + after
     if curvature >= 0:  # flat or not a maximum: stay on the cell
         return 0.0
-    return float(np.clip(0.5 * (before - after) / curvature, -0.5, 0.5))
+    return float(min(max(0.5 * (before - after) / curvature, -0.5), 0.5))
 
 
 def decode(beliefs: np.ndarray, fields: np.ndarray, stride: int = STRIDE) -> list[Instance]:
@@ -155,22 +165,25 @@ def decode(beliefs: np.ndarray, fields: np.ndarray, stride: int = STRIDE) -> lis
     """
     max_distance = MAX_DISTANCE_PX / stride
     maxima = _maxima(beliefs, PEAK_THRESHOLD)  # every map at once: a look has dozens
+    log = _log_padded(beliefs)
     found = []
     for t in range(beliefs.shape[0] // KEYPOINTS):
         centroid = t * KEYPOINTS + CENTROID
-        centroids = _refined(beliefs[centroid], maxima[centroid])
+        centroids = _refined(beliefs[centroid], maxima[centroid], log[centroid])
         if not centroids:
             continue
+        xs, ys = np.array([c[0] for c in centroids]), np.array([c[1] for c in centroids])
         cells = np.full((len(centroids), KEYPOINTS, 2), np.nan)
         best = np.full((len(centroids), CORNERS), np.inf)
         for i, (x, y, _) in enumerate(centroids):
             cells[i, CENTROID] = (x, y)
         for k in range(CORNERS):
             base = k * 2
-            for x, y, _ in _refined(beliefs[t * KEYPOINTS + k], maxima[t * KEYPOINTS + k]):
+            m = t * KEYPOINTS + k
+            for x, y, _ in _refined(beliefs[m], maxima[m], log[m]):
                 iy, ix = int(round(y)), int(round(x))
                 target = np.array([x + fields[base, iy, ix], y + fields[base + 1, iy, ix]])
-                d = [np.hypot(*(target - (cx, cy))) for cx, cy, _ in centroids]
+                d = np.hypot(target[0] - xs, target[1] - ys)
                 i = int(np.argmin(d))
                 if d[i] <= max_distance and d[i] < best[i, k]:
                     best[i, k], cells[i, k] = d[i], (x, y)

@@ -104,7 +104,7 @@ def _missed(
     there."""
     centre = np.array([d.pose.position])
     for view, (pinhole, label) in enumerate(zip(pinholes, labels, strict=True)):
-        if any(np.allclose(k.camera.eye, pinhole.eye) for k in d.keypoints):
+        if any(k.camera.at_eye_of(pinhole) for k in d.keypoints):
             continue  # a view that found it
         alone = paint([Cuboid.of_object(t, d.pose)], pinhole) == 0
         area = int(alone.sum())

@@ -2,15 +2,17 @@
 
 DOPE's last step: with the cuboid known (the object type's size), the pose that projects it
 onto the detected keypoints is the solution of a perspective-n-point problem. Views are fused
-as the paper fuses its real robot's viewpoints: each view's estimate is refined by minimising
-the reprojection error over the keypoints of every view at once, starting from the view whose
-own fit is best. Each view names the keypoints by its own canonical look-alike of the pose
-(`perception.keypoints.canonical_rotation`), so the refit projects, for each view, the cuboid of
-that view's look-alike of the pose being fitted.
+as the paper fuses its real robot's viewpoints: each view's own fit is scored on the keypoints
+of every view, and the best is the estimate; `rounds` of Levenberg-Marquardt then refine it
+over them all (`PerceptionRules.refine_rounds`; none shipped, as the tune split chose:
+configs/decisions.toml). Each view names the keypoints by its own canonical look-alike of the
+pose (`perception.keypoints.canonical_rotation`), so a fit projects, for each view, the cuboid
+of that view's look-alike of the pose being fitted.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -26,6 +28,14 @@ MIN_POINTS = 5  # solvePnP's iterative solver needs 4; one more guards against a
 # peak should not outweigh the keypoints that agree.
 OUTLIER_PX = 8.0
 YAWS = 90  # upright yaws tried, over the half turn a box looks the same after
+NUDGE = 1e-6  # rad and m: the forward differences' step
+DAMPING, MAX_DAMPING = 1e-3, 1e6  # Levenberg-Marquardt's, relative to the normal equations
+# rounds of the fit to every view's keypoints (`PerceptionRules.refine_rounds`)
+REFINE_ROUNDS = 0
+_TURNS = np.stack([cv2.Rodrigues(np.eye(3)[i] * NUDGE)[0] for i in range(3)])
+# the upright yaws' poses at the origin, as `Pose.matrix` makes them: a look fits one per object
+_UPRIGHT_YAWS = np.linspace(0.0, np.pi, YAWS, endpoint=False)
+_UPRIGHT = np.stack([Pose.from_xyz_yaw(0.0, 0.0, 0.0, float(y)).matrix() for y in _UPRIGHT_YAWS])
 
 
 @dataclass(frozen=True)
@@ -40,6 +50,23 @@ class ViewKeypoints:
     camera: PinholeCamera
     pixels: np.ndarray
 
+    # a look fits each view twice, to keep it (`solvable`) and to fuse it (`estimate_pose`):
+    # the fit of the view alone, [4, 4] in the camera's frame or None, kept by cuboid size
+    @functools.cached_property
+    def _fits(self) -> dict[tuple[float, ...], np.ndarray | None]:
+        return {}
+
+    # kept once per view: every pose a fit scores asks for them
+    @functools.cached_property
+    def found(self) -> np.ndarray:
+        """Which keypoints the view found: [9] bool."""
+        return ~np.isnan(self.pixels).any(axis=1)
+
+    @functools.cached_property
+    def found_pixels(self) -> np.ndarray:
+        """The found keypoints' pixels: [found, 2]."""
+        return self.pixels[self.found]
+
 
 @dataclass(frozen=True)
 class PoseEstimate:
@@ -48,21 +75,25 @@ class PoseEstimate:
     points: int  # keypoints used, all views
 
 
-def estimate_pose(t: ObjectType, views: list[ViewKeypoints]) -> PoseEstimate | None:
-    """An object of type `t`: its pose in the world from its keypoints in the given views;
-    None when no view has `MIN_POINTS` keypoints."""
-    fits = []
-    for view in views:
-        if (camera_pose := _view_fit(t, view)) is not None:
-            world = view.camera.camera_to_world() @ camera_pose
-            fits.append((_error(t, views, world), world))
+def estimate_pose(
+    t: ObjectType, views: list[ViewKeypoints], rounds: int = REFINE_ROUNDS
+) -> PoseEstimate | None:
+    """An object of type `t`: its pose in the world from its keypoints in the given views,
+    the best view's fit refined by `rounds` rounds over them all; None when no view has
+    `MIN_POINTS` keypoints."""
+    fits = [
+        view.camera.camera_to_world() @ fit
+        for view in views
+        if (fit := _view_fit(t, view)) is not None
+    ]
     if not fits:
         return None
-    best = min(fits, key=lambda f: f[0][0])[1]
-    fused = _refine(t, views, best)
-    world = min((best, fused), key=lambda m: _error(t, views, m)[0])
-    rms, used = _error(t, views, world)
-    return PoseEstimate(Pose.from_matrix(world), rms, used)
+    errors = _errors(t, views, np.stack(fits))  # each view's fit scored on every view at once
+    best = fits[int(np.argmin(errors))]  # the first of equals, as `min` takes
+    if rounds:  # a refined fit is never worse: a step is taken only where it lowers the cost
+        best = _refine(t, views, best, rounds)
+    rms, used = _error(t, views, best)
+    return PoseEstimate(Pose.from_matrix(best), rms, used)
 
 
 def solvable(t: ObjectType, view: ViewKeypoints) -> bool:
@@ -75,18 +106,24 @@ def solvable(t: ObjectType, view: ViewKeypoints) -> bool:
 def _view_fit(t: ObjectType, view: ViewKeypoints) -> np.ndarray | None:
     """The object's pose in the camera's frame from one view's keypoints (EPnP, then refined
     by OpenCV's iterative solver), [4, 4]; None with under `MIN_POINTS` keypoints or no fit."""
-    model = cuboid(t)
-    found = ~np.isnan(view.pixels).any(axis=1)
+    size = tuple(t.size)
+    if size not in view._fits:
+        view._fits[size] = _fit_alone(cuboid(t), view)
+    return view._fits[size]
+
+
+def _fit_alone(model: np.ndarray, view: ViewKeypoints) -> np.ndarray | None:
+    found = view.found
     if found.sum() < MIN_POINTS:
         return None
     ok, rvec, tvec = cv2.solvePnP(
-        model[found], view.pixels[found], view.camera.matrix, None, flags=cv2.SOLVEPNP_EPNP
+        model[found], view.found_pixels, view.camera.matrix, None, flags=cv2.SOLVEPNP_EPNP
     )
     if not ok:
         return None
     ok, rvec, tvec = cv2.solvePnP(
         model[found],
-        view.pixels[found],
+        view.found_pixels,
         view.camera.matrix,
         None,
         rvec,
@@ -94,7 +131,11 @@ def _view_fit(t: ObjectType, view: ViewKeypoints) -> np.ndarray | None:
         useExtrinsicGuess=True,
         flags=cv2.SOLVEPNP_ITERATIVE,
     )
-    return _matrix(rvec, tvec) if ok else None
+    if not ok:
+        return None
+    fit = _matrix(rvec, tvec)
+    fit.setflags(write=False)
+    return fit
 
 
 def robust_cost(t: ObjectType, views: list[ViewKeypoints], pose: Pose) -> float:
@@ -106,10 +147,11 @@ def upright_fit(t: ObjectType, views: list[ViewKeypoints], position: tuple[float
     """The upright pose at `position` whose yaw best explains every view's keypoints
     (`robust_cost`), over `YAWS` yaws (a can's cuboid is named by the view: any yaw will do).
     The yaws are scored together, as one array per view."""
-    yaws = np.linspace(0.0, np.pi, YAWS, endpoint=False)
-    poses = [Pose.from_xyz_yaw(*position, float(y)) for y in yaws]
-    costs = _robust_costs(t, views, np.stack([p.matrix() for p in poses]))
-    return poses[int(np.argmin(costs))]  # the first of equals, as `min` takes
+    worlds = _UPRIGHT.copy()
+    worlds[:, :3, 3] = position
+    costs = _robust_costs(t, views, worlds)
+    # the first of equals, as `min` takes
+    return Pose.from_xyz_yaw(*position, float(_UPRIGHT_YAWS[int(np.argmin(costs))]))
 
 
 def _robust_costs(t: ObjectType, views: list[ViewKeypoints], worlds: np.ndarray) -> np.ndarray:
@@ -139,7 +181,7 @@ def _residuals_many(t: ObjectType, views: list[ViewKeypoints], worlds: np.ndarra
     rotations[upside_down] = rotations[upside_down] @ BOX_SYMMETRIES[1]
     out = []
     for view in views:
-        found = ~np.isnan(view.pixels).any(axis=1)
+        found = view.found
         toward = view.camera.eye - positions  # [N, 3]
         r = rotations
         # the operations, and libm's trigonometry, of `canonical_rotation` for one pose, so
@@ -160,7 +202,7 @@ def _residuals_many(t: ObjectType, views: list[ViewKeypoints], worlds: np.ndarra
         w = view.camera.world_to_camera
         p = (points @ w[:3, :3].T + w[:3, 3]) @ view.camera.matrix.T
         pixels = p[..., :2] / p[..., 2:3]
-        out.append((pixels - view.pixels[found]).reshape(len(worlds), -1))
+        out.append((pixels - view.found_pixels).reshape(len(worlds), -1))
     return np.concatenate(out, axis=1) if out else np.zeros((len(worlds), 0))
 
 
@@ -169,19 +211,40 @@ def _error(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> tupl
     return (float(np.sqrt(np.mean(r**2))) if r.size else float("inf")), r.size // 2
 
 
-def _refine(t: ObjectType, views: list[ViewKeypoints], world: np.ndarray) -> np.ndarray:
-    """Gauss-Newton on the pose (rotation vector, translation) over every view's keypoints;
-    the pose and its six nudged copies scored together for the forward differences."""
-    rvec, tvec = cv2.Rodrigues(world[:3, :3])[0].ravel(), world[:3, 3].copy()
-    x = np.concatenate([rvec, tvec])
-    nudges = np.vstack([np.zeros(6), np.eye(6) * 1e-6])
-    for _ in range(10):
-        worlds = np.stack([_matrix(v[:3], v[3:]) for v in x + nudges])
-        r_all = _residuals_many(t, views, worlds)
-        r = r_all[0]
-        jac = ((r_all[1:] - r) / 1e-6).T
-        dx = np.linalg.lstsq(jac, -r, rcond=None)[0]
-        x = x + dx
-        if np.linalg.norm(dx) < 1e-9:
-            break
-    return _matrix(x[:3], x[3:])
+def _errors(t: ObjectType, views: list[ViewKeypoints], worlds: np.ndarray) -> np.ndarray:
+    """Each pose's root mean square reprojection error over every view's keypoints: [N]."""
+    r = _residuals_many(t, views, worlds)
+    return np.sqrt(np.mean(r**2, axis=1)) if r.shape[1] else np.full(len(worlds), np.inf)
+
+
+def _refine(
+    t: ObjectType, views: list[ViewKeypoints], world: np.ndarray, rounds: int
+) -> np.ndarray:
+    """Levenberg-Marquardt on the pose over every view's keypoints, for `rounds` rounds: the
+    rotation nudged about the world's axes (a rotation vector of the whole rotation made
+    Gauss-Newton step by radians, then diverge), the pose and its six nudged copies scored
+    together for the forward differences; a step is taken only where it lowers the cost."""
+    rotation, position = world[:3, :3], world[:3, 3]
+    r = _residuals_many(t, views, world[None])[0]
+    cost, damping = float(r @ r), DAMPING
+    for _ in range(rounds):
+        nudged = np.tile(world, (7, 1, 1))
+        nudged[1:4, :3, :3] = _TURNS @ rotation
+        nudged[4:7, :3, 3] += np.eye(3) * NUDGE
+        r_all = _residuals_many(t, views, nudged)
+        jac = ((r_all[1:] - r_all[0]) / NUDGE).T
+        normal, gradient = jac.T @ jac, jac.T @ r_all[0]
+        while damping <= MAX_DAMPING:
+            step = np.linalg.solve(normal + damping * np.diag(np.diag(normal) + 1e-12), -gradient)
+            tried = np.eye(4)
+            tried[:3, :3] = cv2.Rodrigues(step[:3])[0] @ rotation
+            tried[:3, 3] = position + step[3:]
+            r = _residuals_many(t, views, tried[None])[0]
+            if (c := float(r @ r)) < cost:
+                world, rotation, position, cost = tried, tried[:3, :3], tried[:3, 3], c
+                damping = max(damping / 10, 1e-9)
+                break
+            damping *= 10
+        else:
+            break  # no step lowers the cost: a minimum
+    return world

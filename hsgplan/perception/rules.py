@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from hsgplan.domain.checks import changed_settings, with_settings
 from hsgplan.perception.fusion import NEAR_RAY, RAY_GAP
+from hsgplan.perception.pnp import REFINE_ROUNDS
 
 # A detection f_p named another type is only an object's if it is within this of where the
 # object was last seen (within `observer.STILL` if a single view saw it).
@@ -40,6 +41,8 @@ class PerceptionRules:
         never that object (`observer.assigned`).
     lone_still: a detection of another type that one view saw is an object's only within
         `observer.STILL` of its last pose (off: within `track_distance`, as several views').
+    refine_rounds: rounds of the fit of the best view's pose to every view's keypoints
+        (`pnp.estimate_pose`); 0: the best view's own fit.
     """
 
     cliques: bool = True
@@ -50,6 +53,7 @@ class PerceptionRules:
     near_ray: float = NEAR_RAY
     track_distance: float = TRACK_DISTANCE
     lone_still: bool = True
+    refine_rounds: int = REFINE_ROUNDS
 
     @staticmethod
     def parse(settings: str | tuple[str, ...] | list[str]) -> PerceptionRules:

@@ -65,11 +65,14 @@ def yaw_checked(
         if not _checked(d, world):
             continue
         candidates = _candidates(d, world)
+        t = world.object_type(d.type_name)
+        # the candidates' corners, [candidates, 8, 3], once for every view that scores them
+        corners = np.stack([Cuboid.of_object(t, p, 1.0).corners() for p in candidates])
         scores = [
             s
             for image, pinhole in zip(images, pinholes, strict=True)
-            if any(np.allclose(k.camera.eye, pinhole.eye) for k in d.keypoints)
-            and (s := _scores(colour, types, world, image, pinhole, out, i, candidates, occluders))
+            if any(k.camera.at_eye_of(pinhole) for k in d.keypoints)
+            and (s := _scores(colour, types, world, image, pinhole, out, i, corners, occluders))
             is not None
         ]
         if not scores:
@@ -104,15 +107,13 @@ def _scores(
     camera: PinholeCamera,
     found: list[Detection],
     i: int,
-    candidates: list[Pose],
+    corners: np.ndarray,
     occluders: tuple[Cuboid, ...],
 ) -> list[float] | None:
-    """Each candidate's intersection over union with the pixels named the box's type in one
-    view; None where no candidate is drawn in it."""
-    t = world.object_type(found[i].type_name)
-    hulls = [_hull(Cuboid.of_object(t, p, 1.0), camera) for p in candidates]
-    hulls = [h for h in hulls if h is not None]
-    if len(hulls) < len(candidates):
+    """Each candidate's (its cuboid's `corners`) intersection over union with the pixels named
+    the box's type in one view; None where no candidate is drawn in it."""
+    hulls = _hulls(corners, camera)
+    if hulls is None:
         return None  # partly behind the camera
     points = np.concatenate(hulls)
     h, w = image.shape[:2]
@@ -141,10 +142,12 @@ def _scores(
     return out
 
 
-def _hull(cuboid: Cuboid, camera: PinholeCamera) -> np.ndarray | None:
-    """The cuboid's outline in the image: its corners' convex hull, [K, 2] int32 pixels; None
-    where a corner is behind the camera."""
-    corners = cuboid.corners()
-    if (camera.to_camera(corners)[:, 2] <= 0).any():
+def _hulls(corners: np.ndarray, camera: PinholeCamera) -> list[np.ndarray] | None:
+    """Cuboids' outlines in the image from their corners [N, 8, 3]: each one's convex hull,
+    [K, 2] int32 pixels; None where a corner is behind the camera."""
+    seen = camera.to_camera(corners.reshape(-1, 3))
+    if (seen[:, 2] <= 0).any():
         return None
-    return cv2.convexHull(np.round(camera.project(corners)).astype(np.int32)).reshape(-1, 2)
+    p = seen @ camera.matrix.T  # `camera.project`, from the points it has in its frame
+    pixels = np.round(p[:, :2] / p[:, 2:3]).astype(np.int32).reshape(len(corners), -1, 2)
+    return [cv2.convexHull(c).reshape(-1, 2) for c in pixels]

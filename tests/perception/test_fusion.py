@@ -5,7 +5,14 @@ does not take that object's instance from it."""
 import numpy as np
 
 from hsgplan.domain.kitchen import KITCHEN
-from hsgplan.perception.fusion import RAY_GAP, Seen, grouped, line_of_sight, ray_gap
+from hsgplan.perception.fusion import (
+    RAY_GAP,
+    Seen,
+    _gaps_within,
+    grouped,
+    line_of_sight,
+    ray_gap,
+)
 from hsgplan.perception.keypoints import PinholeCamera
 from hsgplan.perception.pnp import ViewKeypoints
 from hsgplan.perception.vocabulary import kitchen_vocabulary
@@ -84,3 +91,27 @@ def test_a_pair_of_rays_to_two_objects_does_not_break_up_an_object_every_view_sa
     )  # the closest pair is a ghost
     groups = grouped([t0, t1, t2, b1, b2], KITCHEN.table)
     assert [{id(s) for s in g} for g in groups] == [{id(t0), id(t1), id(t2)}, {id(b1), id(b2)}]
+
+
+def test_every_pair_gap_at_once_is_each_pairs_ray_gap():
+    # instances of two types at random points over and beside the table, in every view: the
+    # pairs of one type in two views, within a gap wide enough to keep many, as one by one
+    rng = np.random.default_rng(11)
+    found = [
+        _seen(rng.uniform((0.2, -0.5, 0.0), (0.8, 0.5, 0.4)), int(v), 0.5, int(k))
+        for k in range(2)
+        for v in rng.integers(0, len(CAMERAS), size=12)
+    ]
+    gap = 0.2
+    expected = {
+        (a, b): g
+        for a in range(len(found))
+        for b in range(a + 1, len(found))
+        if found[a].view != found[b].view
+        and found[a].type_index == found[b].type_index
+        and (g := ray_gap(found[a], found[b], KITCHEN.table)) < gap
+    }
+    together = _gaps_within(found, KITCHEN.table, gap)
+    assert len(expected) > 10
+    assert together.keys() == expected.keys()
+    assert all(abs(together[p] - g) < 1e-12 for p, g in expected.items())

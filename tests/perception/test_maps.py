@@ -2,10 +2,19 @@
 instance each, duplicates of a type apart."""
 
 import numpy as np
+import pytest
 
 from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.keypoints import PinholeCamera, in_world
-from hsgplan.perception.maps import PEAK_THRESHOLD, _maxima, _refined, decode, peaks, targets
+from hsgplan.perception.maps import (
+    PEAK_THRESHOLD,
+    _log_padded,
+    _maxima,
+    _refined,
+    decode,
+    peaks,
+    targets,
+)
 from hsgplan.perception.model import STRIDE
 from hsgplan.scene_graph.geometry import Pose
 from hsgplan.sim.render import Camera
@@ -58,7 +67,26 @@ def test_two_thin_boxes_stacked_are_two_peaks_at_stride_2_and_one_blob_at_stride
 def test_a_looks_maps_peak_together_where_each_peaks_alone():
     rng = np.random.default_rng(5)
     beliefs = rng.random((6, 20, 30)).astype(np.float32) ** 4  # sparse, uneven peaks
-    together = _maxima(beliefs, PEAK_THRESHOLD)
-    for belief, maxima in zip(beliefs, together, strict=True):
-        assert _refined(belief, maxima) == peaks(belief)
+    together, logs = _maxima(beliefs, PEAK_THRESHOLD), _log_padded(beliefs)
+    for belief, maxima, log in zip(beliefs, together, logs, strict=True):
+        assert _refined(belief, maxima, log) == peaks(belief)
     assert together.any() and not together.all()
+
+
+@pytest.mark.parametrize("maps", [1, 54, 200])  # 200: more than OpenCV dilates at once
+def test_maps_peak_where_no_neighbour_is_higher(maps):
+    rng = np.random.default_rng(maps)
+    beliefs = rng.random((maps, 12, 17)).astype(np.float32) ** 4
+    h, w = beliefs.shape[1:]
+    padded = np.pad(beliefs, ((0, 0), (1, 1), (1, 1)), constant_values=-1.0)
+    highest = np.max(
+        [
+            padded[:, 1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
+            for dy in (-1, 0, 1)
+            for dx in (-1, 0, 1)
+        ],
+        axis=0,
+    )
+    expected = (beliefs >= highest) & (beliefs > PEAK_THRESHOLD)
+    assert expected.any()
+    assert np.array_equal(_maxima(beliefs, PEAK_THRESHOLD), expected)

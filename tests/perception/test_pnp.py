@@ -65,3 +65,30 @@ def test_a_view_is_solvable_exactly_where_its_estimate_is_found(found):
 def test_the_kept_cuboid_cannot_be_changed_by_a_caller():
     with pytest.raises(ValueError):
         cuboid(KITCHEN.object_type("butter"))[0, 0] = 1.0
+
+
+def test_the_fit_to_every_view_lowers_the_error_of_the_best_views_own_fit():
+    t = KITCHEN.object_type("popcorn")
+    rng = np.random.default_rng(2)
+    views = [
+        ViewKeypoints(c, view_keypoints(t, POSES[0], c) + rng.normal(0, 2.0, (9, 2)))
+        for c in CAMERAS[:3]
+    ]
+    alone = estimate_pose(t, views, rounds=0)
+    refined = estimate_pose(t, views, rounds=3)
+    assert alone is not None and refined is not None
+    assert refined.points == alone.points == 27
+    assert refined.reprojection_px < alone.reprojection_px
+    # without rounds, the estimate is one view's own fit
+    assert any(
+        np.allclose(estimate_pose(t, [v], rounds=0).pose.matrix(), alone.pose.matrix())
+        for v in views
+    )
+
+
+def test_a_camera_is_at_anothers_eye_as_allclose_says():
+    a = CAMERAS[0]
+    for shift, same in ((0.0, True), (1e-9, True), (1e-3, False)):
+        moved = PinholeCamera(a.matrix, a.world_to_camera.copy(), a.width, a.height)
+        moved.world_to_camera[0, 3] += shift
+        assert moved.at_eye_of(a) == np.allclose(moved.eye, a.eye) == same
