@@ -263,7 +263,7 @@ class PoseEstimator:
         `world`, with the arm's links at `arm` (`sim.sensing.Box`; they may hide objects from a
         view)."""
         batch = torch.from_numpy(images).permute(0, 3, 1, 2).float() / 255.0
-        beliefs, fields = self.net(batch)[-1]
+        beliefs, fields = self.net.last(batch)
         found: list[Seen] = []
         for v, camera in enumerate(cameras):
             pinhole = PinholeCamera.of(camera)

@@ -97,7 +97,8 @@ def peaks(
     within `MIN_APART` cells of a stronger one (a keypoint half-way between cells makes two
     equal maxima), each refined by a parabola through the log beliefs of its neighbours along
     x and along y (exact for a Gaussian): (x, y, belief) in cells."""
-    return _refined(belief, _maxima(belief[None], threshold)[0], _log_padded(belief[None])[0])
+    (ys, xs), log = _cells(_maxima(belief[None], threshold))[0], _log_padded(belief[None])[0]
+    return _refined(belief, ys, xs, log)
 
 
 def _maxima(beliefs: np.ndarray, threshold: float) -> np.ndarray:
@@ -123,11 +124,18 @@ def _log_padded(beliefs: np.ndarray) -> np.ndarray:
     return np.log(np.maximum(np.pad(beliefs, ((0, 0), (1, 1), (1, 1)), constant_values=-1.0), 1e-6))
 
 
+def _cells(maxima: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Where each map of `maxima` [C, H, W] is set, as `np.nonzero` of each: (rows, columns)."""
+    maps, ys, xs = np.nonzero(maxima)
+    bounds = np.searchsorted(maps, np.arange(len(maxima) + 1))
+    return [(ys[a:b], xs[a:b]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
 def _refined(
-    belief: np.ndarray, maxima: np.ndarray, log: np.ndarray
+    belief: np.ndarray, ys: np.ndarray, xs: np.ndarray, log: np.ndarray
 ) -> list[tuple[float, float, float]]:
-    """`peaks` of one map from where it peaks (`_maxima`) and its `_log_padded`."""
-    ys, xs = np.nonzero(maxima)
+    """`peaks` of one map from the cells where it peaks (`_maxima`, `_cells`) and its
+    `_log_padded`."""
     if not len(ys):
         return []
     order = np.argsort(-belief[ys, xs], kind="stable")[: 8 * MAX_PEAKS]
@@ -164,12 +172,12 @@ def decode(beliefs: np.ndarray, fields: np.ndarray, stride: int = STRIDE) -> lis
         beliefs: [types * 9, H, W]; fields: [8 * 2, H, W]; stride: input pixels per cell.
     """
     max_distance = MAX_DISTANCE_PX / stride
-    maxima = _maxima(beliefs, PEAK_THRESHOLD)  # every map at once: a look has dozens
+    peaked = _cells(_maxima(beliefs, PEAK_THRESHOLD))  # every map at once: a look has dozens
     log = _log_padded(beliefs)
     found = []
     for t in range(beliefs.shape[0] // KEYPOINTS):
         centroid = t * KEYPOINTS + CENTROID
-        centroids = _refined(beliefs[centroid], maxima[centroid], log[centroid])
+        centroids = _refined(beliefs[centroid], *peaked[centroid], log[centroid])
         if not centroids:
             continue
         xs, ys = np.array([c[0] for c in centroids]), np.array([c[1] for c in centroids])
@@ -180,7 +188,7 @@ def decode(beliefs: np.ndarray, fields: np.ndarray, stride: int = STRIDE) -> lis
         for k in range(CORNERS):
             base = k * 2
             m = t * KEYPOINTS + k
-            for x, y, _ in _refined(beliefs[m], maxima[m], log[m]):
+            for x, y, _ in _refined(beliefs[m], *peaked[m], log[m]):
                 iy, ix = int(round(y)), int(round(x))
                 target = np.array([x + fields[base, iy, ix], y + fields[base + 1, iy, ix]])
                 d = np.hypot(target[0] - xs, target[1] - ys)

@@ -150,6 +150,17 @@ class KeypointNet(nn.Module):
         self.beliefs = config.beliefs
 
     def forward(self, image: torch.Tensor) -> list[tuple[torch.Tensor, torch.Tensor]]:
+        return [self._split(m) for m in self._maps(image)]
+
+    def last(self, image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """The last output of `forward` alone, what a look reads (the earlier ones are there to
+        be supervised)."""
+        return self._split(self._maps(image)[-1])
+
+    def _split(self, m: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        return torch.sigmoid(m[:, : self.beliefs]), m[:, self.beliefs :]
+
+    def _maps(self, image: torch.Tensor) -> list[torch.Tensor]:
         half = self.stem[0](image)
         quarter = self.stem[1](half)
         features = torch.cat([quarter, self.up(self.down(quarter))], dim=1)
@@ -160,7 +171,7 @@ class KeypointNet(nn.Module):
             maps.append(previous)
         if self.refine is not None:
             maps = [_doubled(m) for m in maps] + [self.refine(previous, half)]
-        return [(torch.sigmoid(m[:, : self.beliefs]), m[:, self.beliefs :]) for m in maps]
+        return maps
 
 
 def build(config: PerceptionNetConfig) -> KeypointNet:

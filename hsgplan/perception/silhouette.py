@@ -132,13 +132,16 @@ def _scores(
     ]
     front = (paint(nearer + list(occluders), camera) != -1)[window]
     named = (named_pixels(colour, image[window]) == types.index(found[i].type_name)) & ~front
+    in_sight, named_count = ~front, int(np.count_nonzero(named))
+    drawn = np.zeros((bottom - top, right - left), np.uint8)
     out = []
     for hull in hulls:
-        drawn = np.zeros((bottom - top, right - left), np.uint8)
+        drawn[:] = 0
         cv2.fillConvexPoly(drawn, hull - (left, top), 1)
-        mask = drawn.astype(bool) & ~front
-        union = int((mask | named).sum())
-        out.append(int((mask & named).sum()) / union if union else 0.0)
+        mask = drawn.view(bool) & in_sight
+        both = int(np.count_nonzero(mask & named))
+        union = int(np.count_nonzero(mask)) + named_count - both
+        out.append(both / union if union else 0.0)
     return out
 
 

@@ -8,6 +8,7 @@ from hsgplan.domain.kitchen import KITCHEN
 from hsgplan.perception.keypoints import PinholeCamera, in_world
 from hsgplan.perception.maps import (
     PEAK_THRESHOLD,
+    _cells,
     _log_padded,
     _maxima,
     _refined,
@@ -68,8 +69,11 @@ def test_a_looks_maps_peak_together_where_each_peaks_alone():
     rng = np.random.default_rng(5)
     beliefs = rng.random((6, 20, 30)).astype(np.float32) ** 4  # sparse, uneven peaks
     together, logs = _maxima(beliefs, PEAK_THRESHOLD), _log_padded(beliefs)
-    for belief, maxima, log in zip(beliefs, together, logs, strict=True):
-        assert _refined(belief, maxima, log) == peaks(belief)
+    for belief, maxima, (ys, xs), log in zip(
+        beliefs, together, _cells(together), logs, strict=True
+    ):
+        assert np.array_equal(np.stack([ys, xs]), np.stack(np.nonzero(maxima)))
+        assert _refined(belief, ys, xs, log) == peaks(belief)
     assert together.any() and not together.all()
 
 

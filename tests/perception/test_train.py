@@ -183,3 +183,14 @@ def test_collections_of_different_view_counts_train_together(tmp_path):
     losses = []
     train_perception(config, tmp_path / "net", lambda e, loss: losses.append(loss))
     assert len(losses) == 1 and losses[0] > 0
+
+
+@pytest.mark.parametrize("stride", [2, 4])
+def test_a_look_reads_the_last_output_alone_as_training_sees_it(stride):
+    torch.manual_seed(0)
+    net = build(PerceptionNetConfig(width=4, stages=2, stride=stride)).eval()
+    image = torch.rand(2, 3, 32, 48)
+    with torch.inference_mode():
+        beliefs, fields = net(image)[-1]
+        last = net.last(image)
+    assert torch.equal(last[0], beliefs) and torch.equal(last[1], fields)
