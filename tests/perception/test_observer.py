@@ -101,6 +101,9 @@ class _SceneMaps(torch.nn.Module):
         self.scene = None
         self.hidden: str | None = None  # an object it does not draw
 
+    def last(self, images):  # what a look reads of a keypoint network
+        return self(images)[-1]
+
     def forward(self, images):
         poses = {o: p for o, p in self.scene.poses().items() if o != self.hidden}
         kinds = np.array([TYPES.index(KITCHEN.type_of(o)) for o in poses])
