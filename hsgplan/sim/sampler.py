@@ -32,6 +32,7 @@ GAP = 0.01  # apart; whether the fingers fit is checked by the pick dry-runs bel
 JITTER = 0.01
 YAW_JITTER = 0.1
 STACK_JITTER = 0.005
+REPAIRS = 3  # times the objects no grasp fits are put elsewhere before a draw is given up
 
 
 def sample_scene(
@@ -53,7 +54,7 @@ def sample_scene(
         state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=world)
         for o in objects:
             scene.park(o)
-        if place_all(scene, state, rng) and _settled_as(scene, state):
+        if place_all(scene, state, rng) and _settled_as(scene, state, rng):
             scene.robot.hold_position()
             return scene, state
     scene.close()
@@ -141,16 +142,50 @@ def touches_arena(scene: Scene, obj: str) -> bool:
     )
 
 
-def _settled_as(scene: Scene, state: SymbolicSceneGraph) -> bool:
+def _settled_as(scene: Scene, state: SymbolicSceneGraph, rng: random.Random) -> bool:
     """Settled into the drawn arrangement, with every object graspable (a dry run), those under
-    another one once it is lifted off: a plan may have to unstack them."""
-    scene.settle()
+    another one once it is lifted off: a plan may have to unstack them. An object on a surface
+    with nothing on it that no grasp fits (its neighbours too close for the open fingers: on a
+    crowded open space, nearly every failed draw at 12 objects) is put on another free spot
+    of its surface, up to `REPAIRS` times, before the whole draw is given up."""
+    for repair in range(REPAIRS + 1):
+        scene.settle()
+        if not _as_drawn(scene, state):
+            return False
+        stuck = [o for o in state.objects if not _graspable(scene, state, o)]
+        if not stuck:
+            return True
+        if repair == REPAIRS or not all(_movable(scene, state, o) for o in stuck):
+            return False
+        for obj in stuck:
+            surface = state.location(obj).args[1]
+            others = [o for o in state.objects if o != obj]
+            pose = free_spot(scene, obj, surface, others, rng)
+            if pose is None:
+                return False
+            scene.set_pose(obj, pose)
+    return False
+
+
+def _as_drawn(scene: Scene, state: SymbolicSceneGraph) -> bool:
     mapping = map_symbols(scene.scene_graph())
     if mapping.anomalies:
         return False
-    if any(mapping.state.location(o) != state.location(o) for o in state.objects):
-        return False
-    return all(_graspable(scene, state, o) for o in state.objects)
+    return all(mapping.state.location(o) == state.location(o) for o in state.objects)
+
+
+def _on_surface(scene: Scene, state: SymbolicSceneGraph, obj: str) -> bool:
+    """Standing on a region or a shelf top (not on another object, nor inside a shelf)."""
+    location = state.location(obj)
+    return (
+        location.predicate is Predicate.ON
+        and scene.world.kind_of(location.args[1]) is not EntityKind.OBJECT
+    )
+
+
+def _movable(scene: Scene, state: SymbolicSceneGraph, obj: str) -> bool:
+    """On a surface with nothing on it: it may be put elsewhere on that surface alone."""
+    return _on_surface(scene, state, obj) and not state.resting_on(obj)
 
 
 def _graspable(scene: Scene, state: SymbolicSceneGraph, obj: str) -> bool:
