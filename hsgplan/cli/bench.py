@@ -356,3 +356,67 @@ def bench_observe(
         ],
         markdown,
     )
+
+
+@app.command("start")
+@refuses_bad_input
+def bench_start(
+    sizes: Annotated[str, typer.Option(help="Problem sizes.")] = "8,10,12",
+    goals: Annotated[int, bounded_option("goals", "Goals per size.")] = 10,
+    seed: SeedOrSplitStart = None,
+    split: SplitOption = None,
+    repairs: Annotated[
+        int | None,
+        typer.Option(
+            help="Times a draw's objects that no grasp fits are put elsewhere before it is "
+            "given up (default: the sampler's; 0: drawn again at once).",
+            min=0,
+            max=10,
+        ),
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON rows.", metavar="")] = False,
+    markdown: MarkdownFlag = False,
+    scene: SceneOption = None,
+) -> None:
+    """Draws and seconds per start scene, and the scenes that could not be drawn, on the goals
+    and episode seeds `eval world` runs with the same sizes, goals, seed and split."""
+    from hsgplan.benchmarks.start_scenes import bench_start as run
+
+    size_list = parse_sizes(sizes)
+    seed = split_seed(seed, split)
+    scene_world(scene)  # a bad scene file: refused before anything is drawn
+    with Progress(console=err, transient=True) as progress:
+        task = progress.add_task("start scenes", total=len(size_list) * goals)
+        rows = run(
+            size_list,
+            goals,
+            seed,
+            split and split.value,
+            None if scene is None else str(scene),
+            lambda: progress.advance(task),
+            repairs,
+        )
+    repairs = rows[0].repairs if rows else repairs
+    if as_json:
+        print(json.dumps([r.to_json() for r in rows], indent=2))
+        return
+    cells = [
+        (
+            str(r.objects),
+            str(r.scenes),
+            str(r.unsampled),
+            f"{r.draws_median:g}",
+            str(r.draws_max),
+            str(r.draws_total),
+            f"{r.seconds_median:.1f}",
+        )
+        for r in rows
+    ]
+    where = f"{split.value} split" if split else "exploration"
+    print_table(
+        f"Start scenes, one core: draws per scene, {repairs} repairs a draw (seed {seed}, "
+        f"{where}{in_scene(scene)})",
+        ("objects", "scenes", "unsampled", "draws median", "draws max", "draws total", "median s"),
+        cells,
+        markdown,
+    )

@@ -48,15 +48,30 @@ def sample_scene(
 
     The same seed gives the same scene: every random number comes from `seed`.
     """
+    scene, state, _ = drawn_scene(objects, seed, p_elsewhere, visuals, world=world)
+    return scene, state
+
+
+def drawn_scene(
+    objects: tuple[str, ...],
+    seed: int,
+    p_elsewhere: float = 0.3,
+    visuals: bool = True,
+    *,
+    world: World,
+    repairs: int = REPAIRS,
+) -> tuple[Scene, SymbolicSceneGraph, int]:
+    """`sample_scene` (with `repairs` of a draw, `_settled_as`), and how many arrangements
+    were drawn for it."""
     rng = random.Random(f"scene-{seed}")
     scene = Scene(objects, seed=seed, visuals=visuals, world=world)
-    for _ in range(ATTEMPTS):
+    for draw in range(1, ATTEMPTS + 1):
         state = random_state(objects, rng, p_elsewhere=p_elsewhere, world=world)
         for o in objects:
             scene.park(o)
-        if place_all(scene, state, rng) and _settled_as(scene, state, rng):
+        if place_all(scene, state, rng) and _settled_as(scene, state, rng, repairs):
             scene.robot.hold_position()
-            return scene, state
+            return scene, state, draw
     scene.close()
     raise UnsampledSceneError(
         f"no collision-free arrangement of {len(objects)} objects found in {ATTEMPTS} attempts "
@@ -142,20 +157,22 @@ def touches_arena(scene: Scene, obj: str) -> bool:
     )
 
 
-def _settled_as(scene: Scene, state: SymbolicSceneGraph, rng: random.Random) -> bool:
+def _settled_as(
+    scene: Scene, state: SymbolicSceneGraph, rng: random.Random, repairs: int = REPAIRS
+) -> bool:
     """Settled into the drawn arrangement, with every object graspable (a dry run), those under
     another one once it is lifted off: a plan may have to unstack them. An object on a surface
     with nothing on it that no grasp fits (its neighbours too close for the open fingers: on a
     crowded open space, nearly every failed draw at 12 objects) is put on another free spot
-    of its surface, up to `REPAIRS` times, before the whole draw is given up."""
-    for repair in range(REPAIRS + 1):
+    of its surface, up to `repairs` times, before the whole draw is given up."""
+    for repair in range(repairs + 1):
         scene.settle()
         if not _as_drawn(scene, state):
             return False
         stuck = [o for o in state.objects if not _graspable(scene, state, o)]
         if not stuck:
             return True
-        if repair == REPAIRS or not all(_movable(scene, state, o) for o in stuck):
+        if repair == repairs or not all(_movable(scene, state, o) for o in stuck):
             return False
         for obj in stuck:
             surface = state.location(obj).args[1]

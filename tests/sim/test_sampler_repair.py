@@ -29,7 +29,6 @@ def test_an_object_no_grasp_fits_is_put_elsewhere_and_the_rest_of_the_draw_kept(
 
         for o, pose in where.items():  # the draw as it was, with no mending allowed
             scene.set_pose(o, pose)
-        monkeypatch.setattr(sampler, "REPAIRS", 0)
-        assert not sampler._settled_as(scene, state, random.Random(0))
+        assert not sampler._settled_as(scene, state, random.Random(0), repairs=0)
     finally:
         scene.close()
