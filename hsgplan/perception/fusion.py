@@ -67,34 +67,13 @@ def ray_gap(a: Seen, b: Seen, table: Rect) -> float:
     """How far apart two instances' centroid rays pass (m); infinite when they meet behind a
     camera or where no object can be (off the `table`, under it, high above it)."""
     (pa, da), (pb, db) = line_of_sight(a), line_of_sight(b)
-    w = pa - pb
-    cross = da @ db
-    denom = 1.0 - cross**2
-    if denom < 1e-9:  # parallel lines of sight
-        return float("inf")
-    ta = (cross * (db @ w) - (da @ w)) / denom
-    tb = ((db @ w) - cross * (da @ w)) / denom
-    qa, qb = pa + ta * da, pb + tb * db
-    meet = (qa + qb) / 2
-    plausible = table.contains(meet[0], meet[1]) and table.z - 0.05 < meet[2] < TOP_Z
-    if ta <= 0 or tb <= 0 or not plausible:
-        return float("inf")
-    return float(np.linalg.norm(qa - qb))
+    return float(_ray_gaps(pa[None], da[None], pb[None], db[None], table, np.inf)[0])
 
 
-def _gaps_within(order: list[Seen], table: Rect, gap: float) -> dict[tuple[int, int], float]:
-    """`ray_gap` of every two instances of one type in two views (indices a < b in `order`)
-    where it is under `gap`: every pair at once, as arrays (a look has hundreds of pairs)."""
-    views = np.array([s.view for s in order])
-    types = np.array([s.type_index for s in order])
-    a, b = np.triu_indices(len(order), 1)
-    keep = (views[a] != views[b]) & (types[a] == types[b])
-    a, b = a[keep], b[keep]
-    if not len(a):
-        return {}
-    origins = np.array([s.ray[0] for s in order])
-    directions = np.array([s.ray[1] for s in order])
-    pa, da, pb, db = origins[a], directions[a], origins[b], directions[b]
+def _ray_gaps(pa, da, pb, db, table: Rect, gap: float) -> np.ndarray:
+    """`ray_gap` of rays [N, 3] (origins `pa`, `pb`, unit directions `da`, `db`) paired row
+    by row, infinite too where it is not under `gap`: every pair at once, as arrays (a look
+    has hundreds of pairs)."""
     w = pa - pb
     cross = (da * db).sum(axis=1)
     denom = 1.0 - cross**2
@@ -104,12 +83,29 @@ def _gaps_within(order: list[Seen], table: Rect, gap: float) -> dict[tuple[int, 
     ta, tb = (cross * bw - dw) / denom, (bw - cross * dw) / denom
     qa, qb = pa + ta[:, None] * da, pb + tb[:, None] * db
     meet, g = (qa + qb) / 2, np.linalg.norm(qa - qb, axis=1)
-    ahead = apart & (ta > 0) & (tb > 0) & (g < gap) & (table.z - 0.05 < meet[:, 2])
-    return {
-        (int(a[k]), int(b[k])): float(g[k])
-        for k in np.flatnonzero(ahead & (meet[:, 2] < TOP_Z))
-        if table.contains(meet[k, 0], meet[k, 1])
-    }
+    ahead = apart & (ta > 0) & (tb > 0) & (g < gap)
+    ahead &= (table.z - 0.05 < meet[:, 2]) & (meet[:, 2] < TOP_Z)
+    out = np.full(len(g), np.inf)
+    for k in np.flatnonzero(ahead):  # over the table: a few pairs are left to ask
+        if table.contains(meet[k, 0], meet[k, 1]):
+            out[k] = g[k]
+    return out
+
+
+def _gaps_within(order: list[Seen], table: Rect, gap: float) -> dict[tuple[int, int], float]:
+    """`ray_gap` of every two instances of one type in two views (indices a < b in `order`)
+    where it is under `gap`."""
+    views = np.array([s.view for s in order])
+    types = np.array([s.type_index for s in order])
+    a, b = np.triu_indices(len(order), 1)
+    keep = (views[a] != views[b]) & (types[a] == types[b])
+    a, b = a[keep], b[keep]
+    if not len(a):
+        return {}
+    origins = np.array([s.ray[0] for s in order])
+    directions = np.array([s.ray[1] for s in order])
+    g = _ray_gaps(origins[a], directions[a], origins[b], directions[b], table, gap)
+    return {(int(a[k]), int(b[k])): float(g[k]) for k in np.flatnonzero(np.isfinite(g))}
 
 
 def grouped(

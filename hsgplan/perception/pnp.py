@@ -89,10 +89,11 @@ def estimate_pose(
     if not fits:
         return None
     errors = _errors(t, views, np.stack(fits))  # each view's fit scored on every view at once
-    best = fits[int(np.argmin(errors))]  # the first of equals, as `min` takes
+    k = int(np.argmin(errors))  # the first of equals, as `min` takes
+    best, rms, used = fits[k], float(errors[k]), sum(int(v.found.sum()) for v in views)
     if rounds:  # a refined fit is never worse: a step is taken only where it lowers the cost
         best = _refine(t, views, best, rounds)
-    rms, used = _error(t, views, best)
+        rms, used = _error(t, views, best)
     return PoseEstimate(Pose.from_matrix(best), rms, used)
 
 
