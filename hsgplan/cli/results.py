@@ -27,7 +27,9 @@ def results(
     plan: Annotated[
         Path, typer.Option(help="The plan: its steps in order.", parser=input_path)
     ] = Path("configs/results/plan.toml"),
-    only: Annotated[str, typer.Option(help="Run only these steps, comma-separated.")] = "",
+    only: Annotated[
+        str, typer.Option(help="Run only these steps (names or tags), comma-separated.")
+    ] = "",
     skip: Annotated[
         str,
         typer.Option(help="Leave out steps of these names or tags, comma-separated (slow, rgb)."),

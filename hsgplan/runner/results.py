@@ -105,7 +105,8 @@ def writers(steps: list[Step], path: str) -> list[Step]:
 
 
 def chosen(steps: list[Step], only: Iterable[str] = (), skip: Iterable[str] = ()) -> list[Step]:
-    """The steps named by `only` (all if none), less those with a tag or name in `skip`."""
+    """The steps named or tagged by `only` (all if none), less those with a tag or name in
+    `skip`."""
     only, skip = set(only), set(skip)
     known = {s.name for s in steps} | {t for s in steps for t in s.tags}
     if unknown := sorted((only | skip) - known):
@@ -113,7 +114,9 @@ def chosen(steps: list[Step], only: Iterable[str] = (), skip: Iterable[str] = ()
     return [
         s
         for s in steps
-        if (not only or s.name in only) and s.name not in skip and not set(s.tags) & skip
+        if (not only or s.name in only or set(s.tags) & only)
+        and s.name not in skip
+        and not set(s.tags) & skip
     ]
 
 

@@ -47,6 +47,7 @@ def test_the_tune_plan_names_configs_that_exist_and_draws_only_from_the_tune_spl
 def test_only_and_skip_choose_steps_and_refuse_unknown_names():
     steps = [Step("a", "x"), Step("b", "y", tags=("slow",)), Step("c", "z")]
     assert [s.name for s in chosen(steps, only=["a", "b"], skip=["slow"])] == ["a"]
+    assert [s.name for s in chosen(steps, only=["slow", "c"])] == ["b", "c"]  # a tag, a name
     with pytest.raises(InvalidInputError, match="no step or tag 'd'"):
         chosen(steps, skip=["d"])
 
