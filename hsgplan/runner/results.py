@@ -112,11 +112,7 @@ def chosen(steps: list[Step], only: Iterable[str] = (), skip: Iterable[str] = ()
     if unknown := sorted((only | skip) - known):
         raise InvalidInputError(f"no step or tag '{unknown[0]}' in the plan")
     return [
-        s
-        for s in steps
-        if (not only or s.name in only or set(s.tags) & only)
-        and s.name not in skip
-        and not set(s.tags) & skip
+        s for s in steps if (not only or {s.name, *s.tags} & only) and not {s.name, *s.tags} & skip
     ]
 
 
