@@ -59,6 +59,10 @@ class MotionTrainConfig:
     save_every: int = setting(5, lo=1, hi=10_000)
     # the first this many samples of the dataset (None: all)
     samples: int | None = setting(None, **BOUNDS["samples"])
+    # with bce, the first this many of its trials (None: every trial up to the last success
+    # kept): a control as large as the successes ce learns from, so that a ladder row can
+    # change the loss alone before a row adds the failed trials
+    trials: int | None = setting(None, **BOUNDS["samples"])
     # The networks are small: measured on 2 busy cores, 2 threads trained ten times slower
     # than 1 (they fight the simulation workers for the cores).
     threads: int = setting(1, **BOUNDS["workers"])
@@ -85,6 +89,8 @@ class MotionTrainConfig:
         if self.head == "per-dim" and self.loss != "ce":
             # its scores are log-probabilities: no logit of a pair's own success to teach
             raise InvalidInputError("head 'per-dim' learns with loss 'ce' only")
+        if self.trials is not None and self.loss != "bce":
+            raise InvalidInputError("trials counts what loss 'bce' learns from: set loss 'bce'")
         self.net_config()  # refuses a bad model name or width
 
     def net_config(self) -> MotionNetConfig:
@@ -110,7 +116,8 @@ class MotionTrainConfig:
 
 
 def _training_rows(config: MotionTrainConfig) -> MotionData:
-    """The first `samples` successes, and with `bce` every trial up to the last of them."""
+    """The first `samples` successes, and with `bce` every trial up to the last of them (the
+    first `trials` of those)."""
     folder = shipped(config.data)
     primitive = MotionPrimitive(config.primitive)
     data = load_dataset(folder / f"{config.primitive}.npz", primitive)
@@ -135,7 +142,15 @@ def _training_rows(config: MotionTrainConfig) -> MotionData:
     trials = load_dataset(folder / f"{config.primitive}_trials.npz", primitive)
     last = (int(data.task[-1]), int(data.attempt[-1]))
     keep = [(int(t), int(a)) <= last for t, a in zip(trials.task, trials.attempt, strict=True)]
-    return trials.take(np.array(keep, dtype=bool))
+    kept = trials.take(np.array(keep, dtype=bool))
+    if config.trials is None:
+        return kept
+    if config.trials > len(kept):
+        raise InvalidInputError(
+            f"trials {config.trials}: the first {len(data)} successes in '{folder}' come with "
+            f"{len(kept)} {config.primitive} trials"
+        )
+    return kept.take(slice(0, config.trials))
 
 
 def _loss(kind: str, model: torch.nn.Module, batch) -> torch.Tensor:
@@ -197,7 +212,7 @@ def train_motion(
         files.append(folder / f"{config.primitive}_trials.npz")
     data = fingerprint(files)
     # settings a folder trained before they existed was trained with: their defaults
-    defaults = {"features": "names", "dropout": 0.0, "weight_decay": 0.0}
+    defaults = {"features": "names", "dropout": 0.0, "weight_decay": 0.0, "trials": None}
     training.claim(out, asdict(config), defaults=defaults, data=data)
     if training.finished(out):
         return  # finished earlier

@@ -43,6 +43,22 @@ def test_held_out_scenes_are_whole_tasks(checkpoints):
     assert not split_tasks(trials, 0.0, 0).any()
 
 
+def test_a_control_of_equal_size_learns_from_the_first_trials_alone(checkpoints):
+    from hsgplan.domain.errors import InvalidInputError
+    from hsgplan.motion.train import _training_rows
+
+    data = str(checkpoints.parent / "data")
+    every = _training_rows(MotionTrainConfig(loss="bce", data=data))
+    successes = _training_rows(MotionTrainConfig(loss="ce", data=data))
+    assert len(every) > len(successes) >= 2  # failed trials among them
+    control = _training_rows(MotionTrainConfig(loss="bce", data=data, trials=len(successes)))
+    assert len(control) == len(successes)
+    assert (control.task == every.task[: len(successes)]).all()
+    assert (control.attempt == every.attempt[: len(successes)]).all()
+    with pytest.raises(InvalidInputError, match=f"trials {len(every) + 1}: .* {len(every)} "):
+        _training_rows(MotionTrainConfig(loss="bce", data=data, trials=len(every) + 1))
+
+
 @pytest.mark.slow
 def test_every_model_is_tried_once_in_the_same_scenes(checkpoints):
     report = evaluate_motion(["place"], 2, 0, checkpoints, workers=1)

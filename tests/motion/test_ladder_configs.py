@@ -1,6 +1,8 @@
-"""The motion ladder's rows change only what they name: the head and the loss."""
+"""The motion ladder's rows change only what they name: the head, the loss, the trials."""
 
 import json
+from dataclasses import asdict
+from itertools import pairwise
 
 import pytest
 
@@ -11,8 +13,16 @@ LADDER = home() / "configs" / "ladder"
 ROWS = {
     "paper-head-ce": {"head": "mlp", "loss": "ce"},
     "paper-per-dim-ce": {"head": "per-dim", "loss": "ce"},
-    "bin-inputs-ce": {"head": "bins", "loss": "ce"},
 }
+RESULTS = home() / "configs" / "results"
+# the results plan's motion ladder, from the paper's recipe to the shipped networks: each row's
+# configuration and what it changes from the row above
+STEPS = (
+    ("paper-{kind}-gnn.json", None),
+    ("ladder-motion/bins-ce/{kind}-gnn.json", {"head"}),
+    ("ladder-motion/bce-equal/{kind}-gnn.json", {"loss", "trials"}),
+    ("{kind}-gnn.json", {"trials"}),
+)
 
 
 @pytest.mark.parametrize("row", sorted(ROWS))
@@ -24,6 +34,19 @@ def test_a_row_differs_from_the_shipped_gnn_in_its_head_and_loss_only(row, kind)
     assert {k for k in shipped if config[k] != shipped[k]} <= {"head", "loss"}
     assert {k: config[k] for k in ROWS[row]} == ROWS[row]
     assert set(config) == set(shipped)
+
+
+@pytest.mark.parametrize("kind", ["place", "push"])
+def test_each_row_of_the_ladder_changes_one_thing_from_the_row_above(kind):
+    rows = []
+    for path, changes in STEPS:
+        config = json.loads((RESULTS / path.format(kind=kind)).read_text())
+        rows.append((asdict(MotionTrainConfig.from_json(config)), changes))
+    for (above, _), (row, changes) in pairwise(rows):
+        assert {k for k in row if row[k] != above[k]} == changes
+    # the control learns from as many examples as the successes of the row above
+    (bins, _), (control, _) = rows[1], rows[2]
+    assert control["trials"] == bins["samples"]
 
 
 @pytest.mark.parametrize("kind", ["place", "push"])

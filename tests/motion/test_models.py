@@ -72,6 +72,14 @@ def test_a_head_per_dimension_learns_from_successes_only():
         MotionTrainConfig(model="gnn", primitive="place", head="per-dim", loss="bce")
 
 
+def test_a_count_of_trials_is_refused_to_a_loss_of_successes():
+    from hsgplan.motion.train import MotionTrainConfig
+
+    MotionTrainConfig(loss="bce", trials=100)
+    with pytest.raises(InvalidInputError, match="trials counts what loss 'bce' learns"):
+        MotionTrainConfig(loss="ce", trials=100)
+
+
 @pytest.mark.parametrize("model,head", MODELS)
 def test_scoring_only_some_bins_gives_their_logits(model, head):
     """`only` (one bin per graph, what the bce loss trains) gives the logits that scoring
