@@ -38,6 +38,17 @@ def _regression_ahead(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     return RegressionPlanner(checkpoint, rules=rules, look_ahead=True)
 
 
+def _regression_parts(name: str, **parts: bool) -> Callable[[Path, RecoveryRules], TaskPlanner]:
+    def make(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
+        from hsgplan.planning.regression.planner import Loop, RegressionPlanner
+
+        planner = RegressionPlanner(checkpoint, rules=rules, loop=Loop(**parts))
+        planner.name = name
+        return planner
+
+    return make
+
+
 def _regression_paper(checkpoint: Path, rules: RecoveryRules) -> TaskPlanner:
     from hsgplan.planning.regression.paper_loop import PaperRegressionPlanner
 
@@ -70,6 +81,14 @@ TASK_PLANNERS: dict[str, Callable[[Path, RecoveryRules], TaskPlanner]] = {
     # aside first (`agents/clearing.py`)
     "regression-ahead-clearing": _regression_ahead,
     "regression-paper": _regression_paper,  # the paper's loop (`paper_loop.py`), no rules
+    # our loop part by part, from the paper's (the task ladder): breadth first alone, then
+    # goal literals that wait, then literals whose preimage holds taken (`planner.Loop`);
+    # `regression` also follows its chain
+    "regression-bfs": _regression_parts(
+        "regression-bfs", waits=False, holds=False, keeps_chain=False
+    ),
+    "regression-bfs-wait": _regression_parts("regression-bfs-wait", holds=False, keeps_chain=False),
+    "regression-bfs-wait-holds": _regression_parts("regression-bfs-wait-holds", keeps_chain=False),
     "forward": _forward,
     "fd": _fast_downward,
 }
@@ -132,6 +151,15 @@ WHOLE_AGENTS: dict[str, str] = {
     "then evaluate only the streams the plan uses",
     "stream-focused-goal": "the same with the goal-directed streams of stream-goal",
 }
+# task planners of the paper's agent or a rung of the ladder to ours: a table's column is named
+# by its motion generator alone (and set beside the paper's)
+PAPER_LIKE = (
+    "regression",
+    "regression-paper",
+    "regression-bfs",
+    "regression-bfs-wait",
+    "regression-bfs-wait-holds",
+)
 # task planners whose agent checks each action in its model before taking it
 CHECKED_PLANNERS = ("regression-ahead-checked", "regression-ahead-clearing")
 # ... and whose agent also moves a neighbour aside when every action offered fails its check

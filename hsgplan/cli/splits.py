@@ -116,7 +116,11 @@ def decisions(
         f"{len(rows)} recorded choices; {opened} made on a reporting seed are still to be "
         "made again on the tune split"
     )
-    print_table(title, record_of.HEADER, record_of.rows(rows), markdown)
+    if markdown:
+        print(f"{title} (each: what, the split it was chosen on and its seeds, by what)\n")
+        print(record_of.markdown(rows) + "\n")
+    else:
+        print_table(title, record_of.HEADER, record_of.rows(rows), markdown)
     bad = [
         f"{d.name} cites test seed(s) {', '.join(map(str, cited))}"
         for d in rows

@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 from rich.progress import Progress
 
-from hsgplan.agents.registry import agent_name, agent_parts
+from hsgplan.agents.registry import PAPER_LIKE, agent_name, agent_parts
 from hsgplan.cli.common import (
     AgentName,
     MotionCheckpoints,
@@ -291,7 +291,7 @@ def evaluate(
         agents = [agent_name(agent.value, planner_name, m) for m in motions]
         # a column is named by its generator (and set beside the paper's) only where the task
         # planner is the paper's; other planners' columns carry their agent's whole name
-        paper_planner = all(agent_parts(a)[0] in ("regression", "regression-paper") for a in agents)
+        paper_planner = all(agent_parts(a)[0] in PAPER_LIKE for a in agents)
         methods = [
             Method(m if paper_planner else a, a) for m, a in zip(motions, agents, strict=True)
         ]

@@ -100,3 +100,11 @@ def _standing(d: Decision) -> str:
 
 
 HEADER = ("choice", "what", "chosen on (seeds); where it stands", "by")
+
+
+def markdown(decisions: list[Decision]) -> str:
+    """The record as a Markdown list, a choice an item: its cells are sentences, which a table
+    squeezes into narrow columns."""
+    return "\n".join(
+        f"- {name}: {what}. {chosen}. By {by}" for name, what, chosen, by in rows(decisions)
+    )

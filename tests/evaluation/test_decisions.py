@@ -84,3 +84,15 @@ def test_a_rows_standing_is_printed_where_its_split_does_not_say_it(tmp_path):
     plain, old = rows(read_decisions(record))
     assert plain[2] == "tune (900)"
     assert old[2] == "reporting (0, 900); kept on tune (seed 900)"
+
+
+def test_the_record_renders_as_a_list_an_item_a_choice(tmp_path):
+    from hsgplan.evaluation.decisions import markdown
+
+    record = tmp_path / "d.toml"
+    record.write_text(
+        _row("plain") + _row("old", "reporting", "[0, 900]", "kept on tune (seed 900)")
+    )
+    lines = markdown(read_decisions(record)).splitlines()
+    assert [line.split(":")[0] for line in lines] == ["- `plain`", "- `old`"]
+    assert "reporting (0, 900); kept on tune (seed 900). By " in lines[1]

@@ -339,3 +339,38 @@ def test_every_shipped_task_configuration_names_data_the_repository_holds(folder
     named += [config.loop_trials] if config.loop_trials else []
     for path in named:
         assert path.startswith("runs/") or shipped(path).is_dir(), path
+
+
+def test_a_reach_limit_draws_a_control_of_that_size_across_the_sources():
+    from hsgplan.planning.regression.train import _drawn
+
+    by_source = {"staged": list(range(10)), "visited": list(range(100, 130))}
+    drawn = _drawn(by_source, 12, seed=0)
+    assert sum(len(v) for v in drawn.values()) == 12 and drawn["visited"]
+    assert all(set(drawn[k]) <= set(by_source[k]) and drawn[k] == sorted(drawn[k]) for k in drawn)
+    assert drawn == _drawn(by_source, 12, seed=0) != _drawn(by_source, 12, seed=1)
+    with pytest.raises(InvalidInputError, match="reach_limit 41: the executed primitives give 40"):
+        _drawn(by_source, 41, 0)
+    with pytest.raises(InvalidInputError, match="set reach 'world'"):
+        TaskTrainConfig.from_json(TINY | {"reach_limit": 10})
+
+
+def test_f_reach_learns_from_the_draw_beside_every_demonstrated_change(monkeypatch):
+    from hsgplan.planning.regression import train
+
+    # the executed primitives as stand-ins: twenty of the staged, thirty of the visited
+    made = {"staged": list(range(20)), "visited": list(range(100, 130))}
+    monkeypatch.setattr(train, "load_world_trials", lambda folder, worlds: folder.name)
+    monkeypatch.setattr(train, "_trial_worlds", lambda *args: [])
+    monkeypatch.setattr(
+        train,
+        "world_reach_examples",
+        lambda trials, demos: made[trials] if trials else ["demo"] * 3,
+    )
+    reach = TINY | {"reach": "world", "world_trials": "staged", "loop_trials": "visited"}
+    every = train._examples("reach", [], [], TaskTrainConfig.from_json(reach), KITCHEN, KITCHEN)
+    config = TaskTrainConfig.from_json(reach | {"reach_limit": 12})
+    drawn = train._examples("reach", [], [], config, KITCHEN, KITCHEN)
+    assert drawn.keys() == every.keys()
+    assert sum(len(drawn[k]) for k in drawn) == 12 + 3
+    assert drawn["demonstrated changes"] == every["demonstrated changes"] == ["demo"] * 3

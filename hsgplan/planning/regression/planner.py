@@ -43,6 +43,27 @@ from hsgplan.scene_graph.symbolic import SymbolicSceneGraph
 MAX_DEPTH = 8
 
 
+@dataclass(frozen=True)
+class Loop:
+    """What the loop does beyond searching breadth first from the goal (the paper draws one
+    path at a time, `paper_loop.py`), each part switchable so that a ladder measures it.
+
+    Attributes:
+        waits: a goal literal whose preimage names another unsatisfied goal literal waits
+            for it (a stack's top for its base) while the free ones are searched.
+        holds: a literal whose whole preimage holds counts as reached, whatever f_reach says.
+        keeps_chain: the chain regressed through is followed at the next decision while each
+            literal's preimage holds, without asking the networks.
+    """
+
+    waits: bool = True
+    holds: bool = True
+    keeps_chain: bool = True
+
+
+OUR_LOOP = Loop()
+
+
 @lru_cache(maxsize=4)
 def _inference_networks(checkpoint: str):
     """f_preimage and f_reach of a checkpoint, compiled for inference; loaded once per process
@@ -115,7 +136,9 @@ class RegressionPlanner:
         rules: RecoveryRules = ALL_RULES,
         look_ahead: bool = False,
         sideways: bool = True,
+        loop: Loop = OUR_LOOP,
     ) -> None:
+        self.loop = loop
         self.look_ahead = look_ahead
         self.sideways = sideways
         self.preimage, self.reach = _inference_networks(str(checkpoint))
@@ -186,7 +209,7 @@ class RegressionPlanner:
         if not (unsatisfied := unsatisfied_literals(state, goal)):
             return TaskDecision.none("the goal holds", start)
         taken = self._taken.setdefault((goal, state), Counter())
-        if (step := self._follow(state, goal, refused)) is not None:
+        if self.loop.keeps_chain and (step := self._follow(state, goal, refused)) is not None:
             taken[step[1]] += 1
             return TaskDecision.taken(step[1], step[0], start, state.world)
         context = frozenset(goal.literals)
@@ -209,7 +232,8 @@ class RegressionPlanner:
         free = [(n, p) for n, p in pairs if not p & set(unsatisfied) - {n.lit}]
         counts = taken if self.rules.least_taken else None
         vetoed: list[Node] = []
-        for frontier in (free, [x for x in pairs if x not in free]):
+        frontiers = (free, [x for x in pairs if x not in free]) if self.loop.waits else (pairs,)
+        for frontier in frontiers:
             found = self._search(state, frontier, set(refused), counts, vetoed)
             if found is not None:
                 return self._take(state, goal, *found, taken, start)
@@ -295,7 +319,8 @@ class RegressionPlanner:
             if found := self._choose(state, hits, avoid, counts):
                 return found
             frontier = self._with_preimages(state, frontier)
-            done = [n for n, pre in frontier if all(state.holds(m) for m in pre)]
+            holding = frontier if self.loop.holds else []
+            done = [n for n, pre in holding if all(state.holds(m) for m in pre)]
             done = self._ahead(state, done, vetoed)
             if found := self._choose(state, done, avoid, counts):
                 return found

@@ -78,6 +78,10 @@ class TaskTrainConfig:
     loop_trials: str | None = None
     # alterations asked alone per state and label (reach = "alterations" or "predicates")
     reach_singles: int = setting(12, lo=1, hi=1000)
+    # for reach = "world", a seeded draw of this many of the executed primitives' examples
+    # (None: all): a control as large as another recipe's f_reach, so that a ladder row can
+    # change where the labels come from before a row adds more of them
+    reach_limit: int | None = setting(None, lo=1, hi=100_000_000)
     # f_reach sees the max-pooled graph context (`gnn.RelationalLayer`): whether the hand is
     # full is news from an object nothing relates. f_preimage and the forward baseline do not:
     # a preimage is local, and with the pool f_preimage let crowded shelf tops elsewhere change
@@ -98,6 +102,8 @@ class TaskTrainConfig:
         check_features(self.features)
         if self.reach not in REACH_SOURCES:
             raise InvalidInputError(f"reach {self.reach!r}: one of {', '.join(REACH_SOURCES)}")
+        if self.reach_limit is not None and self.reach != "world":
+            raise InvalidInputError("reach_limit draws from executed primitives: set reach 'world'")
 
     @staticmethod
     def from_json(d: dict) -> TaskTrainConfig:
@@ -133,6 +139,8 @@ def _examples(
             )
             for name, f in zip(names, _trial_folders(config), strict=False)
         }
+        if config.reach_limit is not None:
+            out = _drawn(out, config.reach_limit, config.seed)
         return out | {"demonstrated changes": world_reach_examples([], demos)}
     make = (
         (lambda t: preimage_examples(t, config.seed, config.vary))
@@ -142,6 +150,22 @@ def _examples(
     out = {"demonstrations": make(trajs[:n])}
     if len(trajs) > n:
         out["copies with added objects"] = make(trajs[n:])
+    return out
+
+
+def _drawn(by_source: dict[str, list[Example]], limit: int, seed: int) -> dict[str, list[Example]]:
+    """`limit` of the examples, drawn uniformly (seeded) across the sources, each source's
+    kept in its order."""
+    total = sum(len(ex) for ex in by_source.values())
+    if limit > total:
+        raise InvalidInputError(
+            f"reach_limit {limit}: the executed primitives give {total} examples"
+        )
+    keep = set(random.Random(seed).sample(range(total), limit))
+    out, start = {}, 0
+    for name, ex in by_source.items():
+        out[name] = [e for i, e in enumerate(ex, start) if i in keep]
+        start += len(ex)
     return out
 
 
