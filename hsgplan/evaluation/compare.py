@@ -15,6 +15,7 @@ from pathlib import Path
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import RECOVERING
+from hsgplan.evaluation.intervals import separate
 from hsgplan.evaluation.report import read_summary
 from hsgplan.evaluation.seeds import marked, seed_words
 from hsgplan.evaluation.table1 import (
@@ -28,6 +29,9 @@ from hsgplan.evaluation.table1 import (
 )
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 
+# the key to `marked_rows`' marks, in a title
+MARKS = "; ▲ (▼): the interval lies wholly above (below) the row above's"
+MARKS_FIRST = "; ▲ (▼): the interval lies wholly above (below) the first row's"
 # what rows must share; the checkpoints are what a ladder's rows change
 LIKE_FOR_LIKE = (
     "protocol",
@@ -92,6 +96,8 @@ def compare(
     rows = []
     for name, by_size in zip(names, by_run, strict=True):
         rows.append((name, *(cell(by_size[str(n)]) if str(n) in by_size else "—" for n in sizes)))
+    intervals = [[by_size.get(str(n), {}).get("success_ci") for n in sizes] for by_size in by_run]
+    rows = marked_rows(rows, intervals, against_first=across_scenes)
     one = len(set(methods)) == 1
     method = methods[0] if one else ""
     if one and (paper := PAPER_TABLE1.get(method)):
@@ -111,9 +117,27 @@ def compare(
         f"Success rate / subgoal completion of {what} "
         f"by {by} ({protocol}{', rules by row' if across_rules else ''}): "
         f"{source}, {repeats}, {seed_words(first['seed'], first.get('split'))}{place}"
+        + ((MARKS_FIRST if across_scenes else MARKS) if any(map(any, intervals)) else "")
     )
     header = ("run", *(f"{n} objects" for n in sizes))
     return TextTable(marked(title, first["seed"], split=first.get("split")), header, tuple(rows))
+
+
+def marked_rows(
+    rows: list[tuple[str, ...]], intervals: list[list], against_first: bool = False
+) -> list[tuple[str, ...]]:
+    """Each row's cells marked ▲ (▼) where its success interval lies wholly above (below) the
+    row above's (the first row's, `against_first`): the only difference called a gain (or a
+    loss)."""
+    out = rows[:1]
+    for k in range(1, len(rows)):
+        cells = list(rows[k])
+        base = intervals[0 if against_first else k - 1]
+        for j, (now, before) in enumerate(zip(intervals[k], base, strict=True)):
+            if separate(now, before):
+                cells[j + 1] += " ▲" if now[0] > before[1] else " ▼"
+        out.append(tuple(cells))
+    return out
 
 
 def _check_episodes(runs: Sequence[Path], by_run: list[dict]) -> None:
@@ -192,10 +216,10 @@ def compare_task_trainings(runs: Sequence[Path], names: Sequence[str], trainings
     protocol, per_size, _ = task_summaries(runs)  # like for like, or refused
     episodes = [[_episode(r["result"]) for r in logged_rows(run)] for run in runs]
     sizes = sorted({e.size for e in episodes[0]})
-    table = []
+    table, intervals = [], []
     for k, name in enumerate(names):
         group = episodes[k * trainings : (k + 1) * trainings]
-        cells = []
+        cells, ci = [], []
         for n in sizes:
             won: dict = {}
             done = []
@@ -206,13 +230,16 @@ def compare_task_trainings(runs: Sequence[Path], names: Sequence[str], trainings
             mean = sum(sum(v) / len(v) for v in won.values()) / len(won)
             low, high = training_goal_interval(won) or (mean, mean)
             cells.append(f"{mean:.2f} ({low:.2f}–{high:.2f}) / {sum(done) / len(done):.2f}")
+            ci.append((low, high))
         table.append((name, *cells))
+        intervals.append(ci)
     title = (
         f"Success rate / subgoal completion in the symbolic loop by configuration ({protocol}): "
         f"{per_size} goals per size, each run once under each of {trainings} trainings (in "
-        "brackets the 95% interval of a bootstrap that draws trainings and goals)"
+        f"brackets the 95% interval of a bootstrap that draws trainings and goals){MARKS}"
     )
-    return TextTable(title, ("configuration", *(f"{n} objects" for n in sizes)), tuple(table))
+    header = ("configuration", *(f"{n} objects" for n in sizes))
+    return TextTable(title, header, tuple(marked_rows(table, intervals)))
 
 
 def task_summaries(runs: Sequence[Path]) -> tuple[str, int, list[dict]]:

@@ -197,6 +197,11 @@ def test_task_runs_of_three_trainings_make_one_row_with_an_interval(tmp_path):
     assert cells[0].startswith("0.25 (") and cells[1].startswith("0.92 (")
     low, high = (float(v) for v in cells[1].split("(")[1].split(")")[0].split("–"))
     assert low < 0.92 <= high <= 1.0  # a training that lost a goal widens the interval
+    their_high = float(cells[0].split("–")[1].split(")")[0])
+    assert their_high >= low and not cells[1].endswith("▲")  # the intervals overlap
+    never = [_task_run(tmp_path / f"n{k}", (False,) * 4, seeds=seeds) for k in range(3)]
+    table = compare_task_trainings([*never, *ours], ["never", "ours"], 3)
+    assert table.rows[1][1].endswith("▲") and "▲ (▼)" in table.title
     assert "each run once under each of 3 trainings" in table.title
     args = ["eval", "compare", *map(str, [*theirs, *ours]), "--trainings", "3"]
     r = CliRunner().invoke(app, [*args, "--names", "theirs,ours", "--markdown"])
@@ -217,3 +222,17 @@ def test_the_method_compared_is_the_one_every_run_holds_else_gnn(tmp_path):
     assert only_method([tmp_path / "nothing"]) == "gnn"  # refused where it is read
     r = CliRunner().invoke(app, ["eval", "compare", str(agent[0]), str(agent[1])])
     assert r.exit_code == 0 and "learned" in r.output, r.output
+
+
+def test_a_row_is_marked_only_where_its_interval_clears_the_row_aboves():
+    from hsgplan.evaluation.compare import marked_rows
+
+    rows = [("a", "0.50", "0.50"), ("b", "0.90", "0.55"), ("c", "0.40", "0.50")]
+    intervals = [[(0.4, 0.6), (0.4, 0.6)], [(0.8, 1.0), (0.45, 0.65)], [(0.3, 0.5), None]]
+    marked = marked_rows(rows, intervals)
+    assert marked[0] == rows[0]  # the first row has none above it
+    assert marked[1] == ("b", "0.90 ▲", "0.55")  # the second cell's intervals overlap
+    assert marked[2] == ("c", "0.40 ▼", "0.50")  # no interval, no mark
+    # across scenes each row is set against the first (the kitchen)
+    against = marked_rows(rows, intervals, against_first=True)
+    assert against[2] == ("c", "0.40", "0.50")  # overlaps the first row's
