@@ -52,6 +52,12 @@ def claim(out: Path, config: dict, defaults: dict | None = None, data: str | Non
     write_atomically(out / TRAIN_CONFIG, json.dumps(config, indent=2) + "\n")
 
 
+def hold(folder: Path) -> None:
+    """Make this process the one writer of one network's folder of a checkpoint that another
+    process claimed (its networks trained side by side)."""
+    hold_folder(folder)
+
+
 def _check_claim(out: Path, config: dict, defaults: dict | None, data: str | None) -> None:
     """`claim`'s refusals, without writing anything."""
     saved = out / TRAIN_CONFIG

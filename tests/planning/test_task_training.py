@@ -374,3 +374,25 @@ def test_f_reach_learns_from_the_draw_beside_every_demonstrated_change(monkeypat
     assert drawn.keys() == every.keys()
     assert sum(len(drawn[k]) for k in drawn) == 12 + 3
     assert drawn["demonstrated changes"] == every["demonstrated changes"] == ["demo"] * 3
+
+
+def test_networks_trained_apart_on_two_workers_are_those_trained_in_one_go(tmp_path):
+    from hsgplan.cli.learn import NETWORK_ORDER
+    from hsgplan.planning.regression.train import NETWORKS
+
+    assert sorted(NETWORK_ORDER) == sorted(NETWORKS)
+    config = tmp_path / "tiny.json"
+    config.write_text(json.dumps(TINY | {"epochs": 1, "copies": 0}))
+    args = ["train", "task", "--config", str(config), "--seeds", "2", "--out"]
+    r = CliRunner().invoke(app, [*args, str(tmp_path / "apart"), "--workers", "2"])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(app, [*args, str(tmp_path / "together")])
+    assert r.exit_code == 0, r.output
+    for seed in (0, 1):
+        for name in NETWORKS:
+            apart, together = (
+                (tmp_path / run / f"seed-{seed}" / name / "model.safetensors").read_bytes()
+                for run in ("apart", "together")
+            )
+            assert apart == together, (seed, name)
+        assert not list((tmp_path / "apart" / f"seed-{seed}").rglob(".lock"))  # all let go

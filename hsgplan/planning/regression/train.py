@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 import random
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -209,13 +209,46 @@ def train_task(
     on_epoch: Callable[[str, int, float], None] | None = None,
     *,
     world: World,
+    networks: Sequence[str] = tuple(NETWORKS),
+    claimed: bool = False,
 ) -> None:
-    """Train (or go on training) the three networks into the checkpoint folder `out` on the
-    demonstrations (and executed primitives) recorded in `world`, or in the scene file they
-    were recorded in (`collect demos --scene`, `collect reach --scene`). The executed
-    primitives may come from other worlds than the demonstrations (a folder of layouts): each
-    state is described in its own. Each network's folder gets `labels.json`, its label counts
-    by source."""
+    """Train (or go on training) the networks (`networks`, by default all three) into the
+    checkpoint folder `out` on the demonstrations (and executed primitives) recorded in
+    `world`, or in the scene file they were recorded in (`collect demos --scene`, `collect
+    reach --scene`). The executed primitives may come from other worlds than the
+    demonstrations (a folder of layouts): each state is described in its own. Each network's
+    folder gets `labels.json`, its label counts by source. With `claimed`, another process
+    claimed `out` (`claim_task`) and this one holds only the networks' folders it trains: the
+    networks of one checkpoint train side by side, each as it would alone."""
+    home, world, demos, data = _prepared(config, world)
+    if not claimed:
+        claim_task(config, out, home)
+    trajs = trajectories(demos, config.copies, config.seed)
+    torch.set_num_threads(config.threads)
+    for name in networks:
+        if training.finished(out / name):
+            continue  # finished earlier
+        if claimed:
+            training.hold(out / name)
+        by_source = _examples(name, demos, trajs, config, world, home)
+        (out / name).mkdir(exist_ok=True)
+        counts = {source: label_counts(ex) for source, ex in by_source.items()}
+        write_atomically(out / name / "labels.json", json.dumps(counts, indent=2) + "\n")
+        examples = [e for ex in by_source.values() for e in ex]
+        _train_one(name, NETWORKS[name], examples, config, out / name, on_epoch, data, world)
+
+
+def claim_task(config: TaskTrainConfig, out: Path, world: World) -> None:
+    """Make `out` the checkpoint folder of a task training with `config`, refused in one line
+    before anything is trained (a bad dataset, another configuration's checkpoint)."""
+    data = _prepared(config, world)[3]
+    # a checkpoint trained before a setting existed was trained with its default
+    training.claim(out, asdict(config), defaults=asdict(TaskTrainConfig()), data=data)
+
+
+def _prepared(config: TaskTrainConfig, world: World) -> tuple[World, World, list, str]:
+    """The world of data that records no scene, the demonstrations' world, the demonstrations
+    and the training data's fingerprint; bad data refused before anything is written."""
     from hsgplan.data.demos import demos_world, load_demos
 
     home, world = world, demos_world(Path(config.demos), world)
@@ -231,20 +264,7 @@ def train_task(
         for folder in _trial_folders(config):  # refused before anything is trained or written
             _trial_worlds(folder, config.features, home)
     sources = [config.demos] + (_trial_folders(config) if config.reach == "world" else [])
-    data = fingerprint(Path(s) for s in sources)
-    # a checkpoint trained before a setting existed was trained with its default
-    training.claim(out, asdict(config), defaults=asdict(TaskTrainConfig()), data=data)
-    trajs = trajectories(demos, config.copies, config.seed)
-    torch.set_num_threads(config.threads)
-    for name, classes in NETWORKS.items():
-        if training.finished(out / name):
-            continue  # finished earlier
-        by_source = _examples(name, demos, trajs, config, world, home)
-        (out / name).mkdir(exist_ok=True)
-        counts = {source: label_counts(ex) for source, ex in by_source.items()}
-        write_atomically(out / name / "labels.json", json.dumps(counts, indent=2) + "\n")
-        examples = [e for ex in by_source.values() for e in ex]
-        _train_one(name, classes, examples, config, out / name, on_epoch, data, world)
+    return home, world, demos, fingerprint(Path(s) for s in sources)
 
 
 def _train_one(
