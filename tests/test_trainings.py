@@ -84,6 +84,33 @@ def test_train_motion_seeds_trains_each_seed_into_its_folder(tmp_path):
     assert again == weights
 
 
+def test_several_configurations_train_in_one_pool_as_each_alone(tmp_path):
+    configs = []
+    for model in ("gnn", "mlp"):
+        configs.append(tmp_path / f"{model}.json")
+        configs[-1].write_text(json.dumps(TINY_MOTION | {"model": model}))
+    out = tmp_path / "both"
+    args = ["train", "motion", "--config", str(configs[0]), "--config", str(configs[1])]
+    r = CliRunner().invoke(app, [*args, "--seeds", "2", "--workers", "2", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert json.loads((out / RECORD).read_text())["trained"] == {
+        "place-gnn": [0, 1],
+        "place-mlp": [0, 1],
+    }
+    alone = tmp_path / "alone"
+    r = CliRunner().invoke(app, [*args[:4], "--seeds", "2", "--out", str(alone)])
+    assert r.exit_code == 0, r.output
+    for s in (0, 1):
+        weights = [f / f"seed-{s}" / "place-gnn" / "model.safetensors" for f in (out, alone)]
+        assert weights[0].read_bytes() == weights[1].read_bytes()
+    # several configurations name their networks themselves, and only with --seeds
+    for extra in (["--seeds", "2", "--name", "x"], []):
+        r = CliRunner().invoke(app, [*args, *extra, "--out", str(tmp_path / "bad")])
+        assert r.exit_code == 2 and "several --config" in r.stderr
+    r = CliRunner().invoke(app, [*args[:4], *args[2:4], "--seeds", "1", "--out", str(out)])
+    assert r.exit_code == 2 and "the same network" in r.stderr
+
+
 def test_an_interval_needs_two_goals():
     assert goal_interval({"a": [1.0, 0.0, 1.0]}) is None
     assert goal_interval({"a": [1.0, 1.0], "b": [1.0]}) == (1.0, 1.0)

@@ -44,6 +44,9 @@ class Model(StrEnum):
     mlp = "mlp"
 
 
+_FOLDER_NAME = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
 @refuses_bad_input
 def train_motion(
     primitive: Annotated[
@@ -53,7 +56,13 @@ def train_motion(
         Model | None, typer.Option(help="gnn or mlp (default: the config's, or gnn).")
     ] = None,
     config: Annotated[
-        Path | None, typer.Option(help="Training configuration (JSON).", parser=input_path)
+        list[Path] | None,
+        typer.Option(
+            help="Training configuration (JSON); with --seeds, repeat it for several networks "
+            "trained together.",
+            parser=input_path,
+            metavar="FILE",
+        ),
     ] = None,
     out_dir: Annotated[
         Path | None,
@@ -79,9 +88,49 @@ def train_motion(
         ),
     ] = None,
 ) -> None:
-    """Train a motion network (config loss: ce on the successes, bce on every trial)."""
-    from hsgplan.motion.train import MotionTrainConfig
+    """Train a motion network (config loss: ce on the successes, bce on every trial); with
+    --seeds and several --config, every network of every seed in one pool of workers."""
     from hsgplan.trainings import record, seed_folder, train_each, training_seeds
+
+    configs = config or [None]
+    if len(configs) > 1 and (seeds is None or name or primitive or model):
+        raise InvalidInputError(
+            "several --config: with --seeds, and without --name, --primitive or --model "
+            "(each network is named PRIMITIVE-MODEL by its configuration)"
+        )
+    cfgs = [_motion_config(c, primitive, model, data) for c in configs]
+    if name is not None and (seeds is None or not _FOLDER_NAME.match(name)):
+        raise InvalidInputError(
+            f"--name '{name}': a folder name (letters, digits, - and _), with --seeds"
+        )
+    named = [name or f"{c.primitive}-{c.model}" for c in cfgs]
+    if len(set(named)) < len(named):
+        raise InvalidInputError(f"two --config train the same network ({', '.join(named)})")
+    first = cfgs[0]
+    folder = out_dir or RUNS / f"train-motion-{first.primitive}-{first.model}"
+    if seeds is None:
+        _train_motion_once(first, folder)
+        out.print(f"trained the {first.model} {first.primitive} network into {shown(folder)}")
+        return
+    trained = []  # (config, seeds, folders) of each network
+    for cfg, network in zip(cfgs, named, strict=True):
+        every = training_seeds(cfg.seed, seeds)
+        trained.append((cfg, every, [seed_folder(folder, s) / network for s in every]))
+    jobs = [
+        (replace(cfg, seed=s), f)
+        for cfg, every, into in trained
+        for s, f in zip(every, into, strict=True)
+    ]
+    train_each(_train_motion_once, jobs, workers)
+    for cfg, every, into in trained:
+        record(folder, every, into[0].name)
+        for f in into:
+            out.print(f"trained the {cfg.model} {cfg.primitive} network into {shown(f)}")
+
+
+def _motion_config(config: Path | None, primitive, model, data: Path | None):
+    """A motion training configuration from its file, the command's overrides applied."""
+    from hsgplan.motion.train import MotionTrainConfig
 
     settings = read_config(config)
     for option, given in (("primitive", primitive), ("model", model)):
@@ -93,28 +142,7 @@ def train_motion(
         if given is not None:
             settings[option] = given.value
     cfg = MotionTrainConfig.from_json(settings)
-    primitive, model = cfg.primitive, cfg.model
-    if data is not None:
-        cfg = replace(cfg, data=str(data))
-    if name is not None and (seeds is None or not _FOLDER_NAME.match(name)):
-        raise InvalidInputError(
-            f"--name '{name}': a folder name (letters, digits, - and _), with --seeds"
-        )
-    folder = out_dir or RUNS / f"train-motion-{primitive}-{model}"
-    if seeds is None:
-        _train_motion_once(cfg, folder)
-        out.print(f"trained the {model} {primitive} network into {shown(folder)}")
-        return
-    every = training_seeds(cfg.seed, seeds)
-    into = [seed_folder(folder, s) / (name or f"{primitive}-{model}") for s in every]
-    jobs = [(replace(cfg, seed=s), f) for s, f in zip(every, into, strict=True)]
-    train_each(_train_motion_once, jobs, workers)
-    record(folder, every, into[0].name)
-    for f in into:
-        out.print(f"trained the {model} {primitive} network into {shown(f)}")
-
-
-_FOLDER_NAME = re.compile(r"^[A-Za-z0-9_-]+$")
+    return cfg if data is None else replace(cfg, data=str(data))
 
 
 def _train_motion_once(cfg, into: Path, show: bool = True) -> None:
