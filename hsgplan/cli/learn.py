@@ -358,6 +358,15 @@ def eval_curve(
         Path | None,
         typer.Option(help="Also draw the curves into this PNG.", parser=out_file),
     ] = None,
+    trainings: Annotated[
+        int,
+        typer.Option(
+            help="Eval task runs: each point is this many consecutive runs of a series, one "
+            "per training of a configuration; its cells give an interval over trainings and "
+            "goals.",
+            min=1,
+        ),
+    ] = 1,
     markdown: MarkdownFlag = False,
 ) -> None:
     """Learning curves: success against how much data a model learned from, read from each
@@ -379,7 +388,7 @@ def eval_curve(
         parsed.append((name.strip(), [Path(r) for r in folders]))
     if len({name for name, _ in parsed}) < len(parsed):
         raise InvalidInputError("two --series share a name")
-    c = curves(parsed, primitive)
+    c = curves(parsed, primitive, trainings)
     table = curve_table(c)
     print_table(table.title, table.header, [list(r) for r in table.rows], markdown)
     if plot is not None:
@@ -388,8 +397,11 @@ def eval_curve(
         drawn: dict[str, dict[int, dict[str, float]]] = {name: {} for name, _ in parsed}
         for p in c.points:
             drawn[p.series][p.amount] = p.success
+        spread: dict[str, dict[int, dict[str, tuple[float, float]]]] = {n: {} for n in drawn}
+        for p in c.points:
+            spread[p.series][p.amount] = p.interval
         paper = {col: rates[0] for col, rates in c.paper.items()}
-        plot_learning_curves(drawn, paper, c.unit, plot)
+        plot_learning_curves(drawn, paper, c.unit, plot, spread)
         err.print(f"wrote {shown(plot)}", highlight=False)  # stdout stays the table alone
 
 

@@ -203,9 +203,6 @@ def compare_task_trainings(runs: Sequence[Path], names: Sequence[str], trainings
     times, each training run on the same episodes): the success rate's mean over trainings
     and goals with its 95% interval (a bootstrap drawing trainings and goals), and subgoal
     completion's mean, per size."""
-    from hsgplan.evaluation.intervals import training_goal_interval
-    from hsgplan.evaluation.task_eval import _episode
-
     if trainings < 1 or len(runs) % trainings:
         raise InvalidInputError(
             f"{len(runs)} runs in rows of {trainings} trainings: give each row all its runs"
@@ -214,25 +211,15 @@ def compare_task_trainings(runs: Sequence[Path], names: Sequence[str], trainings
     if len(names) != len(rows_of):
         raise InvalidInputError(f"{len(rows_of)} rows and {len(names)} names: name each row once")
     protocol, per_size, _ = task_summaries(runs)  # like for like, or refused
-    episodes = [[_episode(r["result"]) for r in logged_rows(run)] for run in runs]
-    sizes = sorted({e.size for e in episodes[0]})
+    sizes = sorted({e.size for e in task_episodes(runs[0])})
     table, intervals = [], []
     for k, name in enumerate(names):
-        group = episodes[k * trainings : (k + 1) * trainings]
-        cells, ci = [], []
-        for n in sizes:
-            won: dict = {}
-            done = []
-            for t, eps in enumerate(group):
-                for e in (e for e in eps if e.size == n):
-                    won.setdefault((t, (e.goal, e.seed)), []).append(float(e.success))
-                    done.append(e.subgoal_completion)
-            mean = sum(sum(v) / len(v) for v in won.values()) / len(won)
-            low, high = training_goal_interval(won) or (mean, mean)
-            cells.append(f"{mean:.2f} ({low:.2f}–{high:.2f}) / {sum(done) / len(done):.2f}")
-            ci.append((low, high))
+        by_size = over_trainings(rows_of[k], sizes)
+        cells = [
+            f"{mean:.2f} ({low:.2f}–{high:.2f}) / {done:.2f}" for mean, (low, high), done in by_size
+        ]
         table.append((name, *cells))
-        intervals.append(ci)
+        intervals.append([ci for _, ci, _ in by_size])
     title = (
         f"Success rate / subgoal completion in the symbolic loop by configuration ({protocol}): "
         f"{per_size} goals per size, each run once under each of {trainings} trainings (in "
@@ -240,6 +227,34 @@ def compare_task_trainings(runs: Sequence[Path], names: Sequence[str], trainings
     )
     header = ("configuration", *(f"{n} objects" for n in sizes))
     return TextTable(title, header, tuple(marked_rows(table, intervals)))
+
+
+def task_episodes(run: Path) -> list:
+    """An eval task run's episodes."""
+    from hsgplan.evaluation.task_eval import _episode
+
+    return [_episode(r["result"]) for r in logged_rows(run)]
+
+
+def over_trainings(runs: Sequence[Path], sizes: Sequence[int]) -> list[tuple]:
+    """Per size, over eval task runs of one configuration's trainings on the same episodes:
+    the success rate's mean over trainings and goals, its 95% interval (a bootstrap drawing
+    trainings and goals) and subgoal completion's mean."""
+    from hsgplan.evaluation.intervals import training_goal_interval
+
+    episodes = [task_episodes(run) for run in runs]
+    out = []
+    for n in sizes:
+        won: dict = {}
+        done = []
+        for t, eps in enumerate(episodes):
+            for e in (e for e in eps if e.size == n):
+                won.setdefault((t, (e.goal, e.seed)), []).append(float(e.success))
+                done.append(e.subgoal_completion)
+        mean = sum(sum(v) / len(v) for v in won.values()) / len(won)
+        ci = training_goal_interval(won) or (mean, mean)
+        out.append((mean, ci, sum(done) / len(done)))
+    return out
 
 
 def task_summaries(runs: Sequence[Path]) -> tuple[str, int, list[dict]]:

@@ -14,14 +14,15 @@ hold the same episodes (task) or the same scenes (motion).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from hsgplan.data.demos import load_demos
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene_file import default_world
-from hsgplan.evaluation.compare import task_summaries
+from hsgplan.evaluation.compare import over_trainings, task_summaries
+from hsgplan.evaluation.intervals import training_goal_interval
 from hsgplan.evaluation.motion_eval import CROWDED, LABELS
 from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable
 from hsgplan.motion.train import SELECTION
@@ -29,6 +30,7 @@ from hsgplan.paths import shipped
 from hsgplan.planning.regression.combine import COMBINED
 from hsgplan.runner.run_folder import CONFIG, logged_rows
 from hsgplan.training import TRAIN_CONFIG
+from hsgplan.trainings import seed_folders
 
 
 @dataclass(frozen=True)
@@ -40,12 +42,16 @@ class CurvePoint:
         amount: how much data it learned from (demonstrations, or training trials).
         success: column (a problem size, or a motion model) -> success rate.
         completion: column -> subgoal completion (task points), else None.
+        interval: column -> the success rate's interval, for a point of several trainings.
     """
 
     series: str
     amount: int
     success: dict[str, float]
     completion: dict[str, float] | None = None
+    # column -> the success rate's 95% interval over trainings and goals (or scenes), where
+    # the point is of several trainings
+    interval: dict[str, tuple[float, float]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -75,7 +81,11 @@ def demonstrations_of(checkpoint: Path) -> int:
 
 
 def trials_of(checkpoints: Path, primitive: str) -> int:
-    """How many training examples (trials) a folder's GNN for `primitive` learned from."""
+    """How many training examples (trials) a folder's GNN for `primitive` learned from (of a
+    trainings folder, their mean over trainings: each holds out its own scenes)."""
+    if trainings := seed_folders(shipped(checkpoints)):
+        counts = [trials_of(folder, primitive) for folder in trainings.values()]
+        return round(sum(counts) / len(counts))
     record = shipped(checkpoints) / f"{primitive}-gnn" / SELECTION
     if not record.is_file():
         raise InvalidInputError(f"'{record}' does not exist: no trained {primitive} GNN there")
@@ -85,37 +95,53 @@ def trials_of(checkpoints: Path, primitive: str) -> int:
     return examples
 
 
-def curves(series: Sequence[tuple[str, Sequence[Path]]], primitive: str = "place") -> Curves:
+def curves(
+    series: Sequence[tuple[str, Sequence[Path]]], primitive: str = "place", trainings: int = 1
+) -> Curves:
     """The points of every series (its name, its runs), by amount within a series. The runs
-    are all `eval task` runs or all `eval motion` runs (of `primitive`). Raises
-    InvalidInputError where they are not like for like, or where two runs of a series learned
-    from as much data."""
+    are all `eval task` runs or all `eval motion` runs (of `primitive`). With `trainings` K,
+    each K consecutive eval task runs of a series are one point: the trainings of one
+    configuration (an eval motion run holds its trainings itself). Raises InvalidInputError
+    where they are not like for like, or where two points of a series learned from as much
+    data."""
     runs = [run for _, rs in series for run in rs]
     if not runs:
         raise InvalidInputError("no run given")
     kinds = {read_json(run / CONFIG, "run configuration").get("kind") for run in runs}
+    if trainings < 1 or any(len(rs) % trainings for _, rs in series):
+        raise InvalidInputError(
+            f"--trainings {trainings}: give each point of a series all its {trainings} runs"
+        )
+    groups = [
+        tuple(rs[k : k + trainings]) for _, rs in series for k in range(0, len(rs), trainings)
+    ]
     if kinds == {"eval-motion"}:
+        if trainings != 1:
+            raise InvalidInputError("an eval motion run holds its trainings: --trainings 1")
         made = _motion(runs, primitive)
     elif kinds == {"eval-task"}:
-        made = _task(runs)
+        made = _task(runs, groups)
     else:
         raise InvalidInputError("a curve's runs are all eval task runs or all eval motion runs")
-    title, unit, columns, by_run, paper = made
+    title, unit, columns, by_point, paper = made
     points = []
     for name, rs in series:
         seen: dict[int, Path] = {}
-        for run in rs:
-            amount, success, completion = by_run[run]
+        for k in range(0, len(rs), trainings):
+            group = tuple(rs[k : k + trainings])
+            amount, success, completion, interval = by_point[group if trainings > 1 else group[0]]
             if amount in seen:
-                raise InvalidInputError(f"'{run}' and '{seen[amount]}' both learned from {amount}")
-            seen[amount] = run
-            points.append(CurvePoint(name, amount, success, completion))
+                raise InvalidInputError(
+                    f"'{group[0]}' and '{seen[amount]}' both learned from {amount}"
+                )
+            seen[amount] = group[0]
+            points.append(CurvePoint(name, amount, success, completion, interval))
     order = [name for name, _ in series]
     points.sort(key=lambda p: (order.index(p.series), p.amount))
     return Curves(title, unit, columns, tuple(points), paper)
 
 
-def _task(runs: Sequence[Path]):
+def _task(runs: Sequence[Path], groups: Sequence[tuple[Path, ...]]):
     protocol, per_size, summaries = task_summaries(runs)
     by_run = {}
     for run, by_size in zip(runs, summaries, strict=True):
@@ -126,8 +152,25 @@ def _task(runs: Sequence[Path]):
             demonstrations_of(Path(checkpoint)),
             {f"{n} objects": v["success_rate"] for n, v in by_size.items()},
             {f"{n} objects": v["subgoal_completion"] for n, v in by_size.items()},
+            {},
         )
     sizes = sorted({int(n) for s in summaries for n in s})
+    for group in (g for g in groups if len(g) > 1):  # a point of several trainings
+        amounts = {by_run[run][0] for run in group}
+        if len(amounts) > 1:
+            raise InvalidInputError(
+                f"the runs from '{group[0]}' on learned from {sorted(amounts)}: one point's "
+                "trainings learn from as much data"
+            )
+        cells = dict(
+            zip((f"{n} objects" for n in sizes), over_trainings(group, sizes), strict=True)
+        )
+        by_run[group] = (
+            amounts.pop(),
+            {col: mean for col, (mean, _, _) in cells.items()},
+            {col: done for col, (_, _, done) in cells.items()},
+            {col: ci for col, (_, ci, _) in cells.items()},
+        )
     columns = tuple(f"{n} objects" for n in sizes)
     paper = {f"{n} objects": rates for n, rates in PAPER_TABLE1["gnn"].items()}
     title = (
@@ -168,12 +211,21 @@ def _motion(runs: Sequence[Path], primitive: str):
                 success[f"{LABELS[model]}, crowded shelf tops"] = sum(crowded) / len(crowded)
         if not isinstance(checkpoints := config.get("checkpoints"), str):
             raise InvalidInputError(f"'{run}' names no motion checkpoints")
-        by_run[run] = (trials_of(Path(checkpoints), primitive), success, None)
+        interval = {}
+        if len({r.get("training") for r in rows}) > 1:  # the trainings of a trainings folder
+            for model in ("gnn", "random"):
+                cells: dict = {}
+                for r in (r for r in rows if r["model"] == model):
+                    key = (r.get("training"), (r.get("scene"), r["task"]))
+                    cells.setdefault(key, []).append(float(r["ok"]))
+                if ci := training_goal_interval(cells):
+                    interval[LABELS[model]] = ci
+        by_run[run] = (trials_of(Path(checkpoints), primitive), success, None, interval)
     title = (
         f"Single-shot {primitive} success on fresh scenes against the GNN's training trials: "
         f"{len(scenes[1])} scenes, seed {scenes[0]}"
     )
-    columns = tuple(dict.fromkeys(col for _, success, _ in by_run.values() for col in success))
+    columns = tuple(dict.fromkeys(col for _, success, *_ in by_run.values() for col in success))
     return title, "training trials", columns, by_run, {}
 
 
@@ -183,9 +235,12 @@ def curve_table(c: Curves) -> TextTable:
     def cell(p: CurvePoint, col: str) -> str:
         if col not in p.success:
             return "—"
-        if p.completion is None:
-            return f"{p.success[col]:.3f}"
-        return f"{p.success[col]:.2f} / {p.completion[col]:.2f}"
+        digits = 3 if p.completion is None else 2
+        rate = f"{p.success[col]:.{digits}f}"
+        if col in p.interval:
+            low, high = p.interval[col]
+            rate += f" ({low:.{digits}f}–{high:.{digits}f})"
+        return rate if p.completion is None else f"{rate} / {p.completion[col]:.2f}"
 
     rows = [(p.series, f"{p.amount:,}", *(cell(p, col) for col in c.columns)) for p in c.points]
     if c.paper:

@@ -34,6 +34,8 @@ def plot_success_by_size(
         ours: method -> size -> (success rate, its interval (low, high) or None).
         paper: method -> size -> the paper's success rate.
         path: where the PNG goes.
+        intervals: series -> amount -> column -> the success rate's 95% interval, drawn as a
+            band where a point has one.
     """
     fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=120)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
@@ -106,7 +108,11 @@ def plot_times_by_size(series: dict[str, dict[str, dict[int, float]]], path: Pat
 
 
 def plot_learning_curves(
-    series: dict[str, dict[int, dict[str, float]]], paper: dict[str, float], unit: str, path: Path
+    series: dict[str, dict[int, dict[str, float]]],
+    paper: dict[str, float],
+    unit: str,
+    path: Path,
+    intervals: dict[str, dict[int, dict[str, tuple[float, float]]]] | None = None,
 ) -> None:
     """Success rate against how much data (log scale), one panel per series and one colour per
     column (a problem size, or a model); the paper's rate of a column as a dashed line.
@@ -128,6 +134,11 @@ def plot_learning_curves(
             colour = colours[k % len(colours)]
             xs = [a for a in amounts if col in points[a]]
             ax.plot(xs, [points[a][col] for a in xs], color=colour, marker="o", label=col)
+            spread = (intervals or {}).get(name, {})
+            banded = [a for a in xs if col in spread.get(a, {})]
+            if banded:
+                low, high = zip(*(spread[a][col] for a in banded), strict=True)
+                ax.fill_between(banded, low, high, color=colour, alpha=0.15, linewidth=0)
             if col in paper:
                 ax.axhline(paper[col], color=colour, linestyle="--", alpha=0.6)
         ax.set_xscale("log", base=2)

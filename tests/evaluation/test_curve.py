@@ -141,3 +141,54 @@ def test_motion_points_read_the_gnns_training_trials_and_refuse_other_scenes(tmp
     task = _run(tmp_path / "t", _checkpoint(tmp_path / "ct", 6), {2: 1})
     with pytest.raises(InvalidInputError, match="all eval task runs or all eval motion"):
         curves([("a", [more]), ("b", [task])])
+
+
+def test_a_point_of_several_trainings_gives_its_mean_and_interval(tmp_path):
+    # two trainings of each of two configurations, on the same episodes
+    six = [_checkpoint(tmp_path / f"c6-{t}", 6) for t in (0, 1)]
+    all18 = [_checkpoint(tmp_path / f"c18-{t}", None) for t in (0, 1)]
+    runs = [
+        _run(tmp_path / "r6-0", six[0], {2: 0}),
+        _run(tmp_path / "r6-1", six[1], {2: 2}),
+        _run(tmp_path / "r18-0", all18[0], {2: 2}),
+        _run(tmp_path / "r18-1", all18[1], {2: 2}),
+    ]
+    c = curves([("recipe", runs)], trainings=2)
+    assert [(p.amount, p.success) for p in c.points] == [
+        (6, {"2 objects": 0.5}),
+        (18, {"2 objects": 1.0}),
+    ]
+    low, high = c.points[0].interval["2 objects"]
+    assert low <= 0.5 <= high and low < high  # the trainings disagree
+    assert c.points[1].interval == {"2 objects": (1.0, 1.0)}
+    assert curve_table(c).rows[0][2].startswith(f"0.50 ({low:.2f}–{high:.2f}) / ")
+    with pytest.raises(InvalidInputError, match="all its 2 runs"):
+        curves([("recipe", runs[:3])], trainings=2)
+    with pytest.raises(InvalidInputError, match="learned from"):  # one point, two amounts
+        curves([("recipe", [runs[0], runs[2]])], trainings=2)
+    args = ["eval", "curve", "--series", f"recipe={','.join(map(str, runs))}", "--trainings"]
+    plot = tmp_path / "curve.png"
+    r = CliRunner().invoke(app, [*args, "2", "--markdown", "--plot", str(plot)])
+    assert r.exit_code == 0 and "| recipe | 18 | 1.00 (1.00–1.00) / 1.00 |" in r.stdout
+    assert plot.stat().st_size > 0  # the intervals drawn as bands
+
+
+def test_a_motion_run_of_several_trainings_reads_their_interval_and_mean_trials(tmp_path):
+    run = _motion_run(tmp_path / "one", 100, {"gnn": 2, "random": 1})
+    rows = json.loads((run / "episodes.jsonl").read_text())["result"]
+    rows = [r | {"training": t, "ok": r["ok"] if t == 0 else True} for t in (0, 1) for r in rows]
+    (run / "episodes.jsonl").write_text(json.dumps({"key": "place/0", "result": rows}) + "\n")
+    # the run's checkpoints a trainings folder: each training held out its own scenes
+    trainings = tmp_path / "trainings"
+    trainings.mkdir()
+    (run.parent / "checkpoints").rename(trainings / "seed-0")
+    (_motion_run(tmp_path / "two", 110, {"gnn": 1}).parent / "checkpoints").rename(
+        trainings / "seed-1"
+    )
+    (trainings / "trainings.json").write_text(json.dumps({"trained": {"place-gnn": [0, 1]}}))
+    config = json.loads((run / "config.json").read_text()) | {"checkpoints": str(trainings)}
+    (run / "config.json").write_text(json.dumps(config))
+    point = curves([("GNN", [run])]).points[0]
+    assert point.amount == 105 and point.success["GNN"] == 0.75
+    low, high = point.interval["GNN"]
+    assert low < 0.75 < high
