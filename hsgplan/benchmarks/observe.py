@@ -1,12 +1,13 @@
 """What one look through f_p costs: `hsgplan bench observe`.
 
-Each scene (`perception.synthetic.render_sample`, the evaluation's kind of scene) is staged and
-rendered from the fixed views first; rendering is timed but kept out of the observation's cost
-(a real robot's cameras deliver the images). The observation is what the agent's observer does
-with them: the keypoint network on every view, PnP, fusion across views, naming by colour and
-resting (`PoseEstimator.detect`), then the tracker's assignment of detections to the objects it
-knows (`perception.observer.tracked`, the known poses being the scene's, as after a first
-look). One core (one torch thread), as an evaluation worker runs; medians and the 90th
+Each scene (`perception.synthetic.render_sample`, the evaluation's kind of scene) is staged;
+as soon as it stands, its fixed cameras render it as a look in the loop does (`Camera.capture`,
+the simulation's cost: a real robot's cameras deliver the images). The observation is what the
+agent's observer does with the images: the keypoint network on every view, PnP, fusion across
+views, naming by colour and resting (`PoseEstimator.detect`), then the tracker's assignment of
+detections to the objects it knows (`perception.observer.tracked`, the known poses being the
+scene's, as after a first look). A look in the simulated loop is the rendering and the
+observation. One core (one torch thread), as an evaluation worker runs; medians and the 90th
 percentile over the scenes, by the number of objects in them.
 """
 
@@ -26,7 +27,7 @@ from hsgplan.domain.world import World
 from hsgplan.perception.estimator import PoseEstimator
 from hsgplan.perception.observer import tracked
 from hsgplan.perception.synthetic import render_sample
-from hsgplan.perception.vocabulary import VIEW_COUNT
+from hsgplan.perception.vocabulary import VIEW_COUNT, Vocabulary
 from hsgplan.scene_graph.geometry import Pose
 
 # objects in a scene, grouped: what a row of the table covers
@@ -39,11 +40,13 @@ class ObserveTiming:
 
     objects: str
     scenes: int
-    render_median: float
+    render_median: float  # the fixed cameras' images, as the loop renders them
     detect_median: float
     track_median: float
     observation_median: float
     observation_p90: float
+    look_median: float  # rendering and observation: a look in the simulated loop
+    look_p90: float
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -63,11 +66,18 @@ def bench_observe(
     estimator = PoseEstimator.load(checkpoint)
     rest = partial(estimator.rest, world) if estimator.settled else None
     times: list[tuple[int, float, float, float]] = []
+    cameras = Vocabulary(world).views[:views]
     for index in range(scenes):
-        start = time.perf_counter()
-        sample = render_sample(seed, index, world, views=views)
-        rendered = time.perf_counter() - start
+        rendering: list[float] = []
+
+        def render(scene, rendering=rendering) -> None:
+            start = time.perf_counter()
+            np.stack([c.capture(scene.bc) for c in cameras])
+            rendering.append(time.perf_counter() - start)
+
+        sample = render_sample(seed, index, world, views=views, staged=render)
         if sample is not None:
+            rendered = rendering[0]
             known = {
                 o: Pose(tuple(map(float, p[:3])), tuple(map(float, p[3:])))
                 for o, p in zip(sample.objects, sample.poses, strict=True)
@@ -86,6 +96,7 @@ def bench_observe(
 
 def _row(name: str, rows: list[tuple[int, float, float, float]]) -> ObserveTiming:
     observation = [d + t for _, _, d, t in rows]
+    look = [r + d + t for _, r, d, t in rows]
     return ObserveTiming(
         name,
         len(rows),
@@ -94,4 +105,6 @@ def _row(name: str, rows: list[tuple[int, float, float, float]]) -> ObserveTimin
         statistics.median(t for _, _, _, t in rows),
         statistics.median(observation),
         float(np.percentile(observation, 90)),
+        statistics.median(look),
+        float(np.percentile(look, 90)),
     )

@@ -14,6 +14,7 @@ tells the types apart.
 from __future__ import annotations
 
 import random
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -110,9 +111,12 @@ def render_sample(
     world: World,
     p_elsewhere: float = P_ELSEWHERE,
     views: int = VIEW_COUNT,
+    staged: Callable[[Scene], None] | None = None,
 ) -> ImageSample | None:
     """The sample `(seed, index)` staged in a scene of `world`, from the first `views` of its
-    fixed views; None when its arrangement could not be staged."""
+    fixed views; None when its arrangement could not be staged. `staged` is shown the scene
+    as soon as it stands (a benchmark times the loop's own rendering there); it draws nothing
+    from the sample's random streams."""
     every = Vocabulary(world).views
     first_views(views, every)
     rng = random.Random(f"images-{seed}-{index}")
@@ -120,6 +124,8 @@ def render_sample(
     with Scene(state.objects, seed=rng.getrandbits(32), world=world) as scene:
         if not stage(scene, state, rng):
             return None
+        if staged is not None:
+            staged(scene)
         _randomise_fixtures(scene, rng)
         for _ in range(rng.randint(0, DISTRACTORS)):
             _add_distractor(scene, rng)
