@@ -19,6 +19,7 @@ import random
 import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
+from functools import cache
 from pathlib import Path
 
 from hsgplan.domain.errors import InvalidInputError
@@ -199,6 +200,13 @@ def find(roots: Iterable[Path]) -> Found:
 
 def drawn_by_test(sizes: Iterable[int] = TEST_SIZES) -> list[Draw]:
     """The test split's episodes in the kitchen as a published run draws them."""
+    return list(_drawn_by_test(tuple(sizes)))
+
+
+@cache
+def _drawn_by_test(sizes: tuple[int, ...]) -> tuple[Draw, ...]:
+    """`drawn_by_test`, drawn once a process: every check asks for the same draws, and drawing
+    the goals of every size takes seconds."""
     seed = TEST.seeds.start
     draws = []
     for n in sizes:
@@ -209,7 +217,7 @@ def drawn_by_test(sizes: Iterable[int] = TEST_SIZES) -> list[Draw]:
                 Draw(text, n, episode_seed(seed, n, i, r), "test split")
                 for r in range(TEST_REPEATS)
             ]
-    return draws
+    return tuple(draws)
 
 
 def goal_space(n: int, draws: int = 3000) -> int:

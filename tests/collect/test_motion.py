@@ -197,7 +197,8 @@ def test_a_place_that_leaves_an_object_unable_to_be_taken_up_is_no_sample():
     # Each task in a scene of its own: a physics client that ran other tasks before can end a
     # replayed trial otherwise than the trial it replays (seen on one CPU, not on another).
     seen = set()
-    for index in range(40):
+    # task 19 holds both (found by the loop below, which stays should it no longer)
+    for index in (19, *range(40)):
         with Scene((), seed=0, world=KITCHEN) as scene:
             task = draw_task(PLACE, 0, index, world=KITCHEN)
             trials = run_task(scene, task) or []
