@@ -73,13 +73,17 @@ class Goal:
         `cherries_2`) swapped in every way, itself first: to a robot that tells objects apart
         by how they look alone, look-alikes are one another, and a goal over them is reached
         when any reading holds."""
+        return [self.renamed(names) for names in self.renamings()]
+
+    def renamings(self) -> list[dict[str, str]]:
+        """The renamings `readings` applies, the identity first."""
         by_type: dict[str, list[str]] = {}
         for o in self.objects:
             by_type.setdefault(self.world.split_instance(o)[0], []).append(o)
         groups = [names for names in by_type.values() if len(names) > 1]
         names = [o for g in groups for o in g]
         return [
-            self.renamed(dict(zip(names, itertools.chain(*orders), strict=True)))
+            dict(zip(names, itertools.chain(*orders), strict=True))
             for orders in itertools.product(*(itertools.permutations(g) for g in groups))
         ]
 

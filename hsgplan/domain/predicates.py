@@ -70,8 +70,13 @@ class Literal:
         return tuple(a for a in self.args if world.kind_of(a) is EntityKind.OBJECT)
 
     def __str__(self) -> str:
-        text = f"{self.predicate.value}({', '.join(self.args)})"
-        return text if self.positive else f"not {text}"
+        return literal_text(self.predicate.value, self.args, self.positive)
+
+
+def literal_text(predicate: str, args: tuple[str, ...], positive: bool = True) -> str:
+    """A literal's text (`On(a, b)`, `not In(a, shelf_a)`), from its parts."""
+    text = f"{predicate}({', '.join(args)})"
+    return text if positive else f"not {text}"
 
 
 def on(o: str, x: str) -> Literal:

@@ -179,3 +179,17 @@ def test_the_check_fails_a_collection_round_test_layouts_and_a_test_run_in_other
     assert len(found.leaks()) == 2
     r = runner.invoke(app, ["splits", "check", str(tmp_path / "runs"), "--sizes", "3"])
     assert r.exit_code == 1 and "ran in test-split layouts" in r.stdout
+
+
+def test_the_canonical_text_is_the_least_reading_of_every_drawn_goal():
+    # the seal rests on each goal's bucket: the text must be what the readings themselves give
+    from hsgplan.domain.kitchen import KITCHEN
+    from hsgplan.evaluation.splits import canonical
+    from hsgplan.symbolic.generator import random_goals
+
+    def by_readings(goal):
+        return min(" & ".join(sorted(str(lit) for lit in r.literals)) for r in goal.readings())
+
+    for n in (2, 5, 8, 12):
+        for goal in random_goals(n, 5, 11, stacking=n > 2, world=KITCHEN):
+            assert canonical(goal) == by_readings(goal)
