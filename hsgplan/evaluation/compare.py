@@ -15,7 +15,7 @@ from pathlib import Path
 from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.recovery import RECOVERING
-from hsgplan.evaluation.intervals import separate
+from hsgplan.evaluation.intervals import separate, training_goal_interval
 from hsgplan.evaluation.report import read_summary
 from hsgplan.evaluation.seeds import marked, seed_words
 from hsgplan.evaluation.table1 import (
@@ -240,8 +240,6 @@ def over_trainings(runs: Sequence[Path], sizes: Sequence[int]) -> list[tuple]:
     """Per size, over eval task runs of one configuration's trainings on the same episodes:
     the success rate's mean over trainings and goals, its 95% interval (a bootstrap drawing
     trainings and goals) and subgoal completion's mean."""
-    from hsgplan.evaluation.intervals import training_goal_interval
-
     episodes = [task_episodes(run) for run in runs]
     out = []
     for n in sizes:

@@ -22,8 +22,7 @@ from hsgplan.domain.checks import read_json
 from hsgplan.domain.errors import InvalidInputError
 from hsgplan.domain.scene_file import default_world
 from hsgplan.evaluation.compare import over_trainings, task_summaries
-from hsgplan.evaluation.intervals import training_goal_interval
-from hsgplan.evaluation.motion_eval import CROWDED, LABELS
+from hsgplan.evaluation.motion_eval import CROWDED, LABELS, rate
 from hsgplan.evaluation.table1 import PAPER_TABLE1, TextTable
 from hsgplan.motion.train import SELECTION
 from hsgplan.paths import shipped
@@ -214,12 +213,9 @@ def _motion(runs: Sequence[Path], primitive: str):
         interval = {}
         if len({r.get("training") for r in rows}) > 1:  # the trainings of a trainings folder
             for model in ("gnn", "random"):
-                cells: dict = {}
-                for r in (r for r in rows if r["model"] == model):
-                    key = (r.get("training"), (r.get("scene"), r["task"]))
-                    cells.setdefault(key, []).append(float(r["ok"]))
-                if ci := training_goal_interval(cells):
-                    interval[LABELS[model]] = ci
+                mine = [r for r in rows if r["model"] == model]
+                if mine and (ci := rate(mine).get("success_ci")):
+                    interval[LABELS[model]] = tuple(ci)
         by_run[run] = (trials_of(Path(checkpoints), primitive), success, None, interval)
     title = (
         f"Single-shot {primitive} success on fresh scenes against the GNN's training trials: "

@@ -122,7 +122,7 @@ def run_eval_chunk(
     return rows
 
 
-def _rate(rows: list[dict]) -> dict:
+def rate(rows: list[dict]) -> dict:
     """The success rate, and its 95% interval over trainings and scenes
     (`evaluation.intervals`)."""
     cells: dict[tuple, list[float]] = defaultdict(list)
@@ -146,7 +146,7 @@ def summarize(rows: list[dict]) -> dict:
         by_level = defaultdict(list)
         for r in mine:
             by_level[str(r["crowding"])].append(r)
-        entry = _rate(mine) | {"by_crowding": {k: _rate(v) for k, v in sorted(by_level.items())}}
+        entry = rate(mine) | {"by_crowding": {k: rate(v) for k, v in sorted(by_level.items())}}
         by_training = defaultdict(list)
         for r in mine:
             by_training[r.get("training")].append(r["ok"])
@@ -156,7 +156,7 @@ def summarize(rows: list[dict]) -> dict:
             }
         crowded = [r for r in mine if r["shelf_top"] and r["crowding"] >= CROWDED]
         if crowded:
-            entry["crowded_shelf_tops"] = _rate(crowded)
+            entry["crowded_shelf_tops"] = rate(crowded)
         out[name] = entry
     return out
 
